@@ -1,0 +1,324 @@
+// plate: the command-line program. See `plate --help`.
+// Exit codes: 0 success; 2 bad input (usage, scene file); 3 a simulation left the model's
+// assumptions (contact lost, sticking, step collapse) -- its output up to that time is kept;
+// 1 any other failure.
+#include "plate/field.hpp"
+#include "plate/output.hpp"
+#include "plate/scene_io.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace plate;
+
+namespace {
+
+const char* kUsage =
+    "plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch)\n"
+    "\n"
+    "usage: plate COMMAND SCENE [options]      plate COMMAND --help for its options\n"
+    "\n"
+    "commands:\n"
+    "  twist         asymptotic twist (36) at one configuration, as JSON\n"
+    "  field         asymptotic twist field on a grid over (s_x, s_y, theta), JSON or CSV\n"
+    "  fixed-points  zeros of the field, refined and classified (stable, unstable, saddle; lines)\n"
+    "  simulate      U-dynamics, full-dynamics or field-integral-curve trajectory, CSV\n"
+    "\n"
+    "SCENE is a JSON scene file (see scenes/). Units are SI. Exit codes: 0 ok, 2 bad input,\n"
+    "3 a simulation left the model's assumptions (contact lost, sticking), 1 other failure.\n";
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Minimal option parser: --name values...; positional arguments in order.
+struct Args {
+    std::vector<std::string> pos;
+    std::map<std::string, std::vector<std::string>> opt;
+    bool help = false;
+
+    Args(int argc, char** argv, const std::map<std::string, int>& arity) {
+        for (int i = 0; i < argc; ++i) {
+            std::string a = argv[i];
+            if (a == "--help" || a == "-h") { help = true; continue; }
+            if (a.rfind("--", 0) == 0) {
+                auto it = arity.find(a);
+                if (it == arity.end()) throw UsageError("unknown option " + a);
+                if (opt.count(a)) throw UsageError("option " + a + " given twice");
+                std::vector<std::string> vals;
+                for (int k = 0; k < it->second; ++k) {
+                    if (i + 1 >= argc) throw UsageError("option " + a + " expects " + std::to_string(it->second) + " value(s)");
+                    vals.push_back(argv[++i]);
+                }
+                opt[a] = vals;
+            } else {
+                pos.push_back(a);
+            }
+        }
+    }
+    bool has(const std::string& k) const { return opt.count(k) > 0; }
+    double num(const std::string& k, int i, double def) const {
+        if (!has(k)) return def;
+        return parse_num(k, opt.at(k)[i]);
+    }
+    static double parse_num(const std::string& k, const std::string& s) {
+        char* end = nullptr;
+        const double x = std::strtod(s.c_str(), &end);
+        if (s.empty() || *end != '\0' || !std::isfinite(x))
+            throw UsageError("option " + k + ": expected a finite number, got '" + s + "'");
+        return x;
+    }
+    long integer(const std::string& k, long def, long lo, long hi) const {
+        if (!has(k)) return def;
+        const std::string& s = opt.at(k)[0];
+        char* end = nullptr;
+        const long x = std::strtol(s.c_str(), &end, 10);
+        if (s.empty() || *end != '\0' || x < lo || x > hi)
+            throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " +
+                             std::to_string(hi) + ", got '" + s + "'");
+        return x;
+    }
+    std::string str(const std::string& k, const std::string& def) const { return has(k) ? opt.at(k)[0] : def; }
+};
+
+Scene scene_arg(const Args& a) {
+    if (a.pos.size() != 1) throw UsageError("expected exactly one SCENE file");
+    return load_scene(a.pos[0]);
+}
+
+// Reads --NAME with 3 numbers (rigid) or 2 (point part; a third is rejected).
+Vec3 config_arg(const Args& a, const std::string& k, const Scene& sc, bool required, const Vec3& def = Vec3::Zero()) {
+    if (!a.has(k)) {
+        if (required) throw UsageError("missing " + k + (sc.part.point ? " SX SY" : " SX SY THETA"));
+        return def;
+    }
+    const auto& v = a.opt.at(k);
+    Vec3 q = Vec3::Zero();
+    const std::size_t need = sc.part.point ? 2 : 3;
+    std::vector<std::string> vals = v;
+    if (vals.size() != need) throw UsageError(k + ": expected " + std::to_string(need) + " numbers");
+    for (std::size_t i = 0; i < need; ++i) q[i] = Args::parse_num(k, vals[i]);
+    return q;
+}
+
+// Options taking 2 or 3 values depending on the part are parsed from the raw argv.
+std::map<std::string, int> with_config(std::map<std::string, int> m, const std::vector<std::string>& keys, int n) {
+    for (const auto& k : keys) m[k] = n;
+    return m;
+}
+
+// For a point part, --at/--from take two values: peek at the scene before parsing.
+int config_arity(int argc, char** argv) {
+    for (int i = 0; i < argc; ++i) {
+        std::string s = argv[i];
+        if (s.rfind("--", 0) == 0 || s == "-h") continue;
+        try {
+            return load_scene(s).part.point ? 2 : 3;
+        } catch (const InputError&) {
+            throw;
+        }
+    }
+    return 3;
+}
+
+struct Progress {
+    std::string what;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last = start;
+    bool shown = false;
+    void operator()(int done, int total) {
+        const auto now = std::chrono::steady_clock::now();
+        const double el = std::chrono::duration<double>(now - start).count();
+        if ((el > 1.5 && std::chrono::duration<double>(now - last).count() > 1.0) || (shown && done == total)) {
+            std::cerr << what << ": " << done << "/" << total << " (" << std::fixed << std::setprecision(1) << el
+                      << " s)" << std::endl;
+            last = now;
+            shown = true;
+        }
+    }
+};
+
+LimitCycleOptions cycle_opts(const Args& a) {
+    LimitCycleOptions o;
+    o.tol = a.num("--tol", 0, o.tol);
+    o.integration.rtol = a.num("--rtol", 0, o.integration.rtol);
+    o.max_periods = static_cast<int>(a.integer("--max-periods", o.max_periods, 2, 100000));
+    if (!(o.tol > 0) || !(o.integration.rtol > 0 && o.integration.rtol < 1e-2))
+        throw UsageError("--tol must be > 0 and --rtol in (0, 1e-2)");
+    return o;
+}
+
+const std::map<std::string, int> kCycleOpts = {{"--tol", 1}, {"--rtol", 1}, {"--max-periods", 1}};
+const std::map<std::string, int> kGridOpts = {{"--grid", 1}, {"--nx", 1}, {"--ny", 1}, {"--ntheta", 1}, {"--x", 2},
+                                              {"--y", 2}, {"--theta0", 1}, {"--threads", 1}};
+
+std::map<std::string, int> merge(std::map<std::string, int> a, const std::map<std::string, int>& b) {
+    a.insert(b.begin(), b.end());
+    return a;
+}
+
+GridSpec grid_opts(const Args& a) {
+    GridSpec g;
+    const int n = static_cast<int>(a.integer("--grid", 7, 1, 201));
+    g.nx = static_cast<int>(a.integer("--nx", n, 1, 201));
+    g.ny = static_cast<int>(a.integer("--ny", n, 1, 201));
+    g.nth = static_cast<int>(a.integer("--ntheta", n, 1, 720));
+    g.x0 = a.num("--x", 0, g.x0);
+    g.x1 = a.num("--x", 1, g.x1);
+    g.y0 = a.num("--y", 0, g.y0);
+    g.y1 = a.num("--y", 1, g.y1);
+    g.th0 = a.num("--theta0", 0, g.th0);
+    if (!(g.x1 >= g.x0) || !(g.y1 >= g.y0)) throw UsageError("--x and --y take MIN MAX with MIN <= MAX");
+    return g;
+}
+
+int cmd_twist(int argc, char** argv) {
+    const int d = config_arity(argc, argv);
+    Args a(argc, argv, merge(with_config({}, {"--at", "--from"}, d), kCycleOpts));
+    if (a.help) {
+        std::cout << "usage: plate twist SCENE --at SX SY THETA [--from VX VY OMEGA] [--tol X] [--rtol X]\n"
+                     "                   [--max-periods N]\n"
+                     "Asymptotic twist (36) of the reduced U-dynamics limit cycle at (SX, SY, THETA), starting\n"
+                     "from the part twist --from (default: at rest relative to the plate). Point parts: --at SX SY.\n"
+                     "--tol: accepted distance to the cycle relative to the slip-speed scale (default 1e-7);\n"
+                     "--rtol: integrator tolerance (default 1e-8); --max-periods (default 400).\n";
+        return 0;
+    }
+    const Scene sc = scene_arg(a);
+    const Vec3 q = config_arg(a, "--at", sc, true);
+    const Vec3 qd = config_arg(a, "--from", sc, false);
+    const LimitCycleSummary lc = limit_cycle(sc, q, cycle_opts(a), qd);
+    std::cout << to_json(sc, q, lc).dump(2) << std::endl;
+    return 0;
+}
+
+int cmd_field(int argc, char** argv) {
+    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--format", 1}, {"--out", 1}}));
+    if (a.help) {
+        std::cout << "usage: plate field SCENE [--grid N] [--nx N] [--ny N] [--ntheta N] [--x MIN MAX]\n"
+                     "                   [--y MIN MAX] [--theta0 T] [--format json|csv] [--out FILE]\n"
+                     "                   [--threads N] [--tol X] [--rtol X] [--max-periods N]\n"
+                     "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.1,0.1]^2 x [0, 2pi)),\n"
+                     "theta covering a full turn. Point parts: asymptotic velocity field on (s_x, s_y).\n"
+                     "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n";
+        return 0;
+    }
+    const Scene sc = scene_arg(a);
+    const GridSpec g = grid_opts(a);
+    const std::string format = a.str("--format", "json");
+    if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
+    FieldOptions fo;
+    fo.cycle = cycle_opts(a);
+    fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+    Progress prog{"field"};
+    fo.progress = std::ref(prog);
+    const Field f = compute_field(sc, g, fo);
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) {
+        if (format == "csv") write_field_csv(out, f);
+        else out << to_json(sc, f).dump(1) << "\n";
+    });
+    return 0;
+}
+
+int cmd_fixed_points(int argc, char** argv) {
+    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--out", 1}}));
+    if (a.help) {
+        std::cout << "usage: plate fixed-points SCENE [grid options as for field] [--out FILE]\n"
+                     "Computes the field, finds cells where every component changes sign, refines the zeros\n"
+                     "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
+                     "and reports curves of zeros as lines. JSON to stdout or --out FILE.\n";
+        return 0;
+    }
+    const Scene sc = scene_arg(a);
+    FieldOptions fo;
+    fo.cycle = cycle_opts(a);
+    fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+    Progress prog{"field"};
+    fo.progress = std::ref(prog);
+    const Field f = compute_field(sc, grid_opts(a), fo);
+    FixedPointOptions fpo;
+    fpo.cycle = fo.cycle;
+    const FixedPoints fp = find_fixed_points(sc, f, fpo);
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; });
+    return 0;
+}
+
+int cmd_simulate(int argc, char** argv) {
+    const int d = config_arity(argc, argv);
+    Args a(argc, argv, merge(with_config({{"--dynamics", 1}, {"--time", 1}, {"--sample", 1}, {"--out", 1},
+                                          {"--rtol", 1}},
+                                         {"--from", "--twist"}, d),
+                             {{"--tol", 1}, {"--max-periods", 1}}));
+    if (a.help) {
+        std::cout << "usage: plate simulate SCENE --dynamics full|u|field --from SX SY THETA --time T\n"
+                     "                      [--twist VX VY OMEGA] [--sample DT] [--out FILE] [--rtol X]\n"
+                     "Trajectory from configuration --from with part twist --twist relative to the plate\n"
+                     "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
+                     "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps).\n"
+                     "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
+                     "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05). Exit code 3 when\n"
+                     "contact is lost or a contact sticks: the CSV then ends at that time.\n";
+        return 0;
+    }
+    const Scene sc = scene_arg(a);
+    const std::string dyn = a.str("--dynamics", "");
+    if (dyn != "full" && dyn != "u" && dyn != "field") throw UsageError("--dynamics: expected full, u or field");
+    const Vec3 q0 = config_arg(a, "--from", sc, true);
+    const Vec3 qd0 = config_arg(a, "--twist", sc, false);
+    if (!a.has("--time")) throw UsageError("missing --time T");
+    const double T = a.num("--time", 0, 0);
+    const double dt = a.num("--sample", 0, sc.plate.T / 4);
+    if (!(T > 0) || !(dt > 0)) throw UsageError("--time and --sample must be > 0");
+    IntegrationOptions io;
+    io.rtol = a.num("--rtol", 0, io.rtol);
+    Trajectory tr;
+    Progress prog{"simulate"};
+    if (dyn == "field") {
+        if (!qd0.isZero()) throw UsageError("--twist has no meaning for --dynamics field");
+        LimitCycleOptions lo;
+        lo.tol = a.num("--tol", 0, lo.tol);
+        tr = field_curve(sc, q0, T, dt, lo);
+    } else {
+        tr = simulate(sc, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, dt, io);
+    }
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc.part.point); });
+    if (tr.stop.reason != StopReason::None) {
+        std::cerr << "plate simulate: " << a.pos[0] << ": stopped: " << tr.stop.describe() << std::endl;
+        return 3;
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+        std::cout << kUsage;
+        return argc < 2 ? 2 : 0;
+    }
+    const std::string cmd = argv[1];
+    try {
+        if (cmd == "twist") return cmd_twist(argc - 2, argv + 2);
+        if (cmd == "field") return cmd_field(argc - 2, argv + 2);
+        if (cmd == "fixed-points") return cmd_fixed_points(argc - 2, argv + 2);
+        if (cmd == "simulate") return cmd_simulate(argc - 2, argv + 2);
+        std::cerr << "plate: unknown command '" << cmd << "'\n" << kUsage;
+        return 2;
+    } catch (const InputError& e) {
+        std::cerr << "plate " << cmd << ": " << e.what() << std::endl;
+        return 2;
+    } catch (const UsageError& e) {
+        std::cerr << "plate " << cmd << ": " << e.what() << " (see plate " << cmd << " --help)" << std::endl;
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "plate " << cmd << ": error: " << e.what() << std::endl;
+        return 1;
+    }
+}

@@ -1,0 +1,116 @@
+// Asymptotic twist fields on SE(2) (rigid parts) and asymptotic velocity fields on R^2
+// (point parts), Section IV-B; their fixed points and stability (Section IV-D); and integral
+// curves of the field, to compare with U- and full-dynamics trajectories (Section IV-C).
+#pragma once
+
+#include "plate/limit_cycle.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace plate {
+
+// A regular grid over (s_x, s_y, theta). theta spans a full turn [th0, th0 + 2 pi) without
+// repeating its end point. Point parts use nth = 1 (theta is meaningless).
+struct GridSpec {
+    int nx = 7, ny = 7, nth = 7;
+    double x0 = -0.1, x1 = 0.1;
+    double y0 = -0.1, y1 = 0.1;
+    double th0 = 0;
+    double dx() const { return nx > 1 ? (x1 - x0) / (nx - 1) : 0; }
+    double dy() const { return ny > 1 ? (y1 - y0) / (ny - 1) : 0; }
+    double dth() const { return 2 * kPi / nth; }
+    Vec3 at(int i, int j, int k) const { return Vec3(x0 + i * dx(), y0 + j * dy(), th0 + k * dth()); }
+    int index(int i, int j, int k) const { return (i * ny + j) * nth + k; }
+    int size() const { return nx * ny * nth; }
+};
+
+struct FieldPoint {
+    Vec3 q = Vec3::Zero();
+    Vec3 twist = Vec3::Zero();     // xi_a(q) (36); NaN where undefined
+    bool converged = false;
+    int periods = 0;
+    double residual = 0;
+    double min_normal_force = 0;
+    StopReason stop = StopReason::None;
+    long rhs_evals = 0;
+};
+
+struct Field {
+    GridSpec grid;
+    bool point_part = false;
+    std::vector<FieldPoint> points;   // GridSpec::index order
+    double seconds = 0;               // wall time
+    long rhs_evals = 0;
+    int threads = 0;
+};
+
+struct FieldOptions {
+    LimitCycleOptions cycle;
+    int threads = 0;           // 0: all cores
+    bool warm_start = true;    // start each theta from the previous theta's cycle
+    std::function<void(int done, int total)> progress;   // called from worker threads, serialised
+};
+
+Field compute_field(const Scene& scene, GridSpec grid, const FieldOptions& opt = {});
+
+// One evaluation of the field with a warm start (updated in place). Throws FieldUndefined
+// where the asymptotic twist is undefined (contact lost, sticking, not converged).
+struct FieldUndefined : std::runtime_error {
+    FieldUndefined(const std::string& what, StopReason why) : std::runtime_error(what), reason(why) {}
+    StopReason reason;
+};
+Vec3 field_at(const Scene& scene, const Vec3& q, const LimitCycleOptions& opt, Vec3* warm = nullptr);
+
+// --- fixed points ------------------------------------------------------------------------
+enum class Stability { Stable, Unstable, Saddle };
+const char* stability_name(Stability s);
+
+struct FixedPoint {
+    Vec3 q = Vec3::Zero();                 // theta in (-pi, pi]
+    Eigen::Vector3cd eigenvalues;          // of the field's Jacobian (point part: 2 used)
+    Stability stability = Stability::Saddle;
+    double residual = 0;                   // |xi_a(q)| [m/s, angular times rho]
+};
+
+// A curve of fixed points (Fig. 1): sampled points, its direction, and the stability given by
+// the Jacobian's eigenvalues transverse to the line.
+struct FixedLine {
+    std::vector<Vec3> points;
+    Vec3 direction = Vec3::Zero();
+    Stability stability = Stability::Saddle;
+    Eigen::Vector3cd eigenvalues;          // at the first point; the one nearest 0 is along the line
+    double length = 0;                     // in (s_x, s_y, rho theta) [m]
+};
+
+struct FixedPointOptions {
+    LimitCycleOptions cycle;
+    double ftol = 1e-6;      // |xi_a| accepted as zero, relative to v_ref
+    int max_newton = 25;
+    double null_ratio = 0.02;  // singular value ratio that makes a line candidate
+};
+
+struct FixedPoints {
+    std::vector<FixedPoint> points;
+    std::vector<FixedLine> lines;
+    int candidates = 0;      // grid cells where every component changes sign
+    long evaluations = 0;    // field evaluations spent refining
+};
+
+// Zeros of the field: candidate cells of `field` (every component changes sign), refined by
+// Gauss-Newton with a finite-difference Jacobian, classified by its eigenvalues; a zero whose
+// Jacobian is singular is followed along its null direction and reported as a line when it
+// continues across the grid.
+FixedPoints find_fixed_points(const Scene& scene, const Field& field, const FixedPointOptions& opt = {});
+
+// --- integral curves -----------------------------------------------------------------------
+// q' = xi_a(q) from q0 (classical RK4, step h), sampled every sample_dt. Stops where the field
+// is undefined (the stop says why).
+Trajectory field_curve(const Scene& scene, const Vec3& q0, double duration, double sample_dt,
+                       const LimitCycleOptions& opt = {}, double h = 0.05);
+
+// Wraps theta to (-pi, pi].
+double wrap_angle(double th);
+
+}  // namespace plate

@@ -1,0 +1,46 @@
+// Limit cycles of the reduced U-dynamics and asymptotic twists (Section IV-A/B).
+//
+// From an initial twist at a frozen configuration q0, integrate (35) period by period until
+// the state at the start of a period repeats (Observation 1, Theorem 1), then return the
+// period average (36). Convergence is judged by the error estimate of a contracting
+// fixed-point iteration: with residual r_k = |x_k - x_{k-1}| and contraction c = r_k/r_{k-1},
+// the distance to the cycle is about r_k c / (1 - c); the cycle is accepted when that is below
+// tol (both in units of the slip-speed scale Scene::v_ref(), angular rates times rho).
+#pragma once
+
+#include "plate/simulate.hpp"
+
+#include <string>
+#include <vector>
+
+namespace plate {
+
+struct LimitCycleOptions {
+    IntegrationOptions integration{1e-8};
+    double tol = 1e-7;          // accepted distance to the cycle, relative to v_ref
+    int max_periods = 400;      // then "not converged"
+    bool record = false;        // keep every accepted step (for plots and tests)
+};
+
+struct LimitCycleSummary {
+    bool converged = false;
+    int periods = 0;            // periods integrated
+    double residual = 0;        // last r_k, relative to v_ref
+    double error_estimate = 0;  // r_k c/(1-c), relative to v_ref
+    double contraction = 0;     // c, per period
+    Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // xi_a (36)
+    Vec3 qd_start = Vec3::Zero();  // state at the start of the last period (a warm start)
+    double min_normal_force = 0;   // smallest N_i over the last period [N]
+    StopEvent stop;
+    Stats stats;
+    std::vector<Sample> path;      // with record: every accepted step from t = 0
+
+    bool contact_lost() const { return stop.reason == StopReason::ContactLost; }
+    bool sticking() const { return stop.reason == StopReason::Sticking; }
+    std::string report() const;   // a few lines saying what happened
+};
+
+LimitCycleSummary limit_cycle(const Scene& scene, const Vec3& q0, const LimitCycleOptions& opt = {},
+                              const Vec3& qd0 = Vec3::Zero());
+
+}  // namespace plate

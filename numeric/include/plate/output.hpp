@@ -1,0 +1,25 @@
+// Writing results: JSON for summaries, CSV for tables. Files are written atomically
+// (to a temporary beside the target, renamed on success), so a failure leaves no partial file.
+#pragma once
+
+#include "plate/field.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <ostream>
+#include <string>
+
+namespace plate {
+
+nlohmann::json to_json(const Scene& scene, const Vec3& q, const LimitCycleSummary& lc);
+nlohmann::json to_json(const Scene& scene, const Field& field);
+nlohmann::json to_json(const Scene& scene, const FixedPoints& fp);
+void write_field_csv(std::ostream& out, const Field& field);
+void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part);
+
+// Calls write(stream) on a temporary file and renames it to `path`; on any exception the
+// temporary is removed and the exception rethrown. path "-" writes to stdout.
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+}  // namespace plate

@@ -1,0 +1,169 @@
+#include "plate/dynamics.hpp"
+
+#include <cmath>
+
+namespace plate {
+namespace {
+
+inline Mat3 rot_z(double th) {
+    const double c = std::cos(th), s = std::sin(th);
+    Mat3 R;
+    R << c, -s, 0, s, c, 0, 0, 0, 1;
+    return R;   // R2 (2): S -> P
+}
+
+}  // namespace
+
+const char* dynamics_name(Dynamics d) {
+    switch (d) {
+        case Dynamics::Full: return "full";
+        case Dynamics::U: return "u";
+        case Dynamics::ReducedU: return "reduced-u";
+    }
+    return "?";
+}
+
+PlateState plate_state(const PlateMotion& plate, double t, Dynamics level, const Mat3& R1) {
+    PlateState ps;
+    plate.acceleration(t, ps.pdd, ps.wd);
+    if (level == Dynamics::Full) {
+        Vec3 pd;
+        plate.velocity(t, pd, ps.w1);
+        ps.R1 = R1;
+    }
+    return ps;
+}
+
+void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v) {
+    if (part.point) {
+        v[0] = qd.head<2>();
+        v[1].setZero();
+        v[2].setZero();
+        return;
+    }
+    const double c = std::cos(q[2]), s = std::sin(q[2]);
+    for (int i = 0; i < 3; ++i) {
+        const double rx = c * part.c[i].x() - s * part.c[i].y();   // R2 c_i
+        const double ry = s * part.c[i].x() + c * part.c[i].y();
+        v[i] = Vec2(qd[0] - qd[2] * ry, qd[1] + qd[2] * rx);       // s' + w2^ R2 c_i
+    }
+}
+
+Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {
+    const Part& P = sc.part;
+    const Vec3 s(q[0], q[1], P.s_z());
+    const Vec3 ez = Vec3::UnitZ();
+    Vec6 b;
+    if (level != Dynamics::Full) {
+        // (33), (34)
+        b.head<3>() = P.m * (ps.pdd + ps.wd.cross(s) + sc.g * ez);
+        b.tail<3>() = P.point ? Vec3::Zero() : Vec3(P.J * (rot_z(q[2]).transpose() * ps.wd));
+        return b;
+    }
+    // (19): f_dagger = m R1^T (p'' + w1^ w1^ R1 s + w1'^ R1 s + 2 w1^ R1 s' + g e_z)
+    const Mat3& R1 = ps.R1;
+    const Vec3 sd(qd[0], qd[1], 0);
+    const Vec3 Rs = R1 * s, Rsd = R1 * sd;
+    b.head<3>() = P.m * (R1.transpose() * (ps.pdd + ps.w1.cross(ps.w1.cross(Rs)) + ps.wd.cross(Rs) +
+                                           2 * ps.w1.cross(Rsd) + sc.g * ez));
+    if (P.point) {
+        b.tail<3>().setZero();
+        return b;
+    }
+    // (30) with (28) corrected: d/dt(R2^T R1^T w1) = -R2^T w2^ R1^T w1 + R2^T R1^T w1'.
+    const Mat3 R2t = rot_z(q[2]).transpose();
+    const Vec3 w2(0, 0, qd[2]);
+    const Vec3 R1tw1 = R1.transpose() * ps.w1;
+    const Vec3 w3 = w2 + R2t * R1tw1;   // (27)
+    b.tail<3>() = P.J * (-(R2t * w2.cross(R1tw1)) + R2t * (R1.transpose() * ps.wd)) + w3.cross(P.J * w3);
+    return b;
+}
+
+void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                   Workspace& ws) {
+    const Part& P = sc.part;
+    ++ws.evals;
+    slip_velocities(P, q, qd, ws.slip);
+    ws.b = rhs_b(sc, level, q, qd, ps);
+
+    if (P.point) {
+        // One contact at s: -m s'' + d N = f, d = e_z - mu v/|v| (17). Row z gives N.
+        const double N = ws.b[2];
+        const double v = ws.slip[0].norm();
+        const Vec2 dir = v > 0 ? Vec2(ws.slip[0] / v) : Vec2::Zero();
+        const Vec2 sdd = (-P.mu[0] * N * dir - ws.b.head<2>()) / P.m;
+        ws.qdd = Vec3(sdd.x(), sdd.y(), 0);
+        ws.n = Vec3(N, 0, 0);
+        return;
+    }
+
+    // A of (31): [-M' D; -J' H], M' = m(e_x e_x^T + e_y e_y^T), J' = J e_z e_z^T.
+    const double c = std::cos(q[2]), s = std::sin(q[2]);
+    Mat6& A = ws.A;
+    A.setZero();
+    A(0, 0) = -P.m;
+    A(1, 1) = -P.m;
+    A.block<3, 1>(3, 2) = -P.J.col(2);
+    for (int i = 0; i < 3; ++i) {
+        const double v = ws.slip[i].norm();
+        const Vec2 u = v > 0 ? Vec2(ws.slip[i] / v) : Vec2::Zero();
+        const Vec3 d(-P.mu[i] * u.x(), -P.mu[i] * u.y(), 1.0);              // (17)
+        const Vec3 dS(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());  // R2^T d_i
+        A.block<3, 1>(0, 3 + i) = d;
+        A.block<3, 1>(3, 3 + i) = P.c[i].cross(dS);                          // h_i (23)
+    }
+    ws.lu.compute(A);
+    ws.z = ws.lu.solve(ws.b);
+    ws.qdd = ws.z.head<3>();
+    ws.n = ws.z.tail<3>();
+}
+
+StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd,
+                     const PlateState& ps) {
+    const Part& P = sc.part;
+    StickTest r;
+    const Vec6 b = rhs_b(sc, level, q, qd, ps);
+    if (P.point) {
+        // s'' = 0: the friction force must supply f_xy, and N = f_z.
+        r.friction_needed = b.head<2>().norm();
+        r.friction_available = P.mu[0] * b[2];
+        r.sticks = b[2] > 0 && r.friction_needed <= r.friction_available;
+        return r;
+    }
+    // Unknowns [q''(3), N(3), F(2)]; contact k exerts N_k e_z + [F; 0].
+    std::array<Vec2, 3> v;
+    slip_velocities(P, q, qd, v);
+    const double c = std::cos(q[2]), s = std::sin(q[2]);
+    const Mat3 R2t = rot_z(q[2]).transpose();
+    Eigen::Matrix<double, 8, 8> M = Eigen::Matrix<double, 8, 8>::Zero();
+    Eigen::Matrix<double, 8, 1> rhs = Eigen::Matrix<double, 8, 1>::Zero();
+    M(0, 0) = -P.m;
+    M(1, 1) = -P.m;
+    M.block<3, 1>(3, 2) = -P.J.col(2);
+    for (int i = 0; i < 3; ++i) {
+        Vec3 d = Vec3::UnitZ();
+        if (i != k) {
+            const double vn = v[i].norm();
+            if (vn > 0) d.head<2>() -= P.mu[i] * v[i] / vn;
+        }
+        M.block<3, 1>(0, 3 + i) = d;
+        M.block<3, 1>(3, 3 + i) = P.c[i].cross(R2t * d);
+    }
+    for (int j = 0; j < 2; ++j) {
+        const Vec3 e = j == 0 ? Vec3::UnitX() : Vec3::UnitY();
+        M.block<3, 1>(0, 6 + j) = e;
+        M.block<3, 1>(3, 6 + j) = P.c[k].cross(R2t * e);
+    }
+    rhs.head<6>() = b;
+    // c_k does not accelerate relative to the plate: s'' + theta'' e_z x r - theta'^2 r = 0.
+    const double rx = c * P.c[k].x() - s * P.c[k].y(), ry = s * P.c[k].x() + c * P.c[k].y();
+    M(6, 0) = 1; M(6, 2) = -ry; rhs[6] = qd[2] * qd[2] * rx;
+    M(7, 1) = 1; M(7, 2) = rx;  rhs[7] = qd[2] * qd[2] * ry;
+    const Eigen::Matrix<double, 8, 1> z = M.partialPivLu().solve(rhs);
+    r.friction_needed = z.segment<2>(6).norm();
+    r.friction_available = P.mu[k] * z[3 + k];
+    r.sticks = z.segment<3>(3).minCoeff() >= 0 && r.friction_needed <= r.friction_available;
+    return r;
+}
+
+}  // namespace plate

@@ -1,0 +1,222 @@
+// Internal: the adaptive stepping loop shared by trajectories and limit cycles.
+// Dormand-Prince 5(4) (Boost.Odeint controlled FSAL stepper) on a scaled state, so that one
+// scalar tolerance is relative for every component. After each accepted step the normal
+// forces and contact slips are checked (simulate.hpp lists the stops).
+#pragma once
+
+#include "plate/simulate.hpp"
+
+#include <boost/numeric/odeint.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace plate::detail {
+
+namespace odeint = boost::numeric::odeint;
+
+// Model concept: State, kDim, rhs(t, y, dy) (physical units, fills ws), q(y), qd(y),
+// plate(t, y) -> PlateState, scale() -> State of characteristic magnitudes.
+template <class Model>
+class Engine {
+public:
+    using State = typename Model::State;
+
+    Engine(Model& model, const Scene& scene, const IntegrationOptions& opt)
+        : model_(model), scene_(scene), opt_(opt),
+          ctrl_(odeint::make_controlled<odeint::runge_kutta_dopri5<State>>(opt.rtol, opt.rtol)) {
+        scale_ = model_.scale();
+        eps_slip_ = opt_.slip_eps * scene_.v_ref();
+        h_min_ = opt_.h_min * scene_.plate.T;
+    }
+
+    // Starts at (t0, y0) in physical units. Returns false with stop set if contact is lost at t0.
+    bool start(double t0, const State& y0) {
+        t_ = t0;
+        for (std::size_t i = 0; i < y_.size(); ++i) ys_[i] = y0[i] / scale_[i];
+        sys(ys_, fs_, t_);
+        n_ = model_.ws.n;
+        slip_ = model_.ws.slip;
+        dt_ = std::min(1e-3, 1e-2 * std::cbrt(opt_.rtol)) * scene_.plate.T;
+        stats.min_normal_force = min_n();
+        stop = StopEvent{};
+        if (stats.min_normal_force < 0) {
+            stop = StopEvent{StopReason::ContactLost, argmin_n(), t_};
+            return false;
+        }
+        return true;
+    }
+
+    double t() const { return t_; }
+    State y() const {
+        State y;
+        for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys_[i] * scale_[i];
+        return y;
+    }
+    const Vec3& n() const { return n_; }
+    // Overwrites components of the state (e.g. to reset an integral), keeping the time.
+    template <class F> void modify(F&& f) {
+        State y = this->y();
+        f(y);
+        for (std::size_t i = 0; i < y.size(); ++i) ys_[i] = y[i] / scale_[i];
+        sys(ys_, fs_, t_);
+    }
+
+    // Advances to t_end exactly. on_step(t, y, n) is called after each accepted step.
+    // Returns false if a stop occurred (see `stop`).
+    template <class OnStep>
+    bool advance(double t_end, OnStep&& on_step) {
+        while (t_ < t_end) {
+            if (stats.steps >= opt_.max_steps) {
+                stop = StopEvent{StopReason::StepLimit, -1, t_};
+                return false;
+            }
+            const bool clamp = t_ + dt_ >= t_end;
+            double dt = clamp ? t_end - t_ : dt_;
+            double t1 = t_;
+            const auto res = ctrl_.try_step(sysref(), ys_, fs_, t1, ys1_, fs1_, dt);
+            if (res == odeint::fail) {
+                ++stats.rejected;
+                dt_ = dt;
+                if (dt_ < h_min_) {
+                    stop = StopEvent{StopReason::StepCollapse, -1, t_};
+                    return false;
+                }
+                continue;
+            }
+            if (clamp) t1 = t_end;   // land on t_end exactly despite rounding
+            ++stats.steps;
+            dt_ = clamp ? std::max(dt_, dt) : dt;
+            // Diagnostics at the new point: the FSAL stage evaluated it last.
+            if (!(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
+                sys(ys1_, fs1_, t1);
+            if (!check(t1)) return false;
+            t_ = t1;
+            ys_ = ys1_;
+            fs_ = fs1_;
+            n_ = model_.ws.n;
+            slip_ = model_.ws.slip;
+            on_step(t_, y(), n_);
+        }
+        return true;
+    }
+
+    StopEvent stop;
+    Stats stats;
+
+private:
+    struct Sys {
+        Engine* e;
+        void operator()(const State& ys, State& dys, double t) const { e->sys(ys, dys, t); }
+    };
+    Sys sysref() { return Sys{this}; }
+
+    void sys(const State& ys, State& dys, double t) {
+        State y, dy;
+        for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys[i] * scale_[i];
+        model_.rhs(t, y, dy);
+        for (std::size_t i = 0; i < y.size(); ++i) dys[i] = dy[i] / scale_[i];
+        ++stats.rhs_evals;
+        last_t_ = t;
+        last_y_ = ys;
+    }
+
+    double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
+    int argmin_n() const {
+        int k = 0;
+        model_.ws.n.head(scene_.part.contacts()).minCoeff(&k);
+        return k;
+    }
+
+    // Event checks over the accepted step [t_, t1]; ws holds the evaluation at t1.
+    bool check(double t1) {
+        const int nc = scene_.part.contacts();
+        const Vec3 n1 = model_.ws.n;
+        // Contact loss: first contact whose N crosses zero (linear interpolation in the step).
+        double t_loss = std::numeric_limits<double>::infinity();
+        int k_loss = -1;
+        for (int i = 0; i < nc; ++i) {
+            stats.min_normal_force = std::min(stats.min_normal_force, n1[i]);
+            if (n1[i] < 0) {
+                const double tl = t_ + (t1 - t_) * n_[i] / (n_[i] - n1[i]);
+                if (tl < t_loss) { t_loss = tl; k_loss = i; }
+            }
+        }
+        // Zero slip: closest approach of the slip velocity to zero within the step.
+        const auto slip1 = model_.ws.slip;
+        double t_zero = std::numeric_limits<double>::infinity();
+        double lam_zero = 0;
+        int zeros = 0, k_zero = -1;
+        for (int i = 0; i < nc; ++i) {
+            const Vec2 v0 = slip_[i], dv = slip1[i] - slip_[i];
+            const double dd = dv.squaredNorm();
+            const double lam = dd > 0 ? std::clamp(-v0.dot(dv) / dd, 0.0, 1.0) : 1.0;
+            if (lam > 0 && (v0 + lam * dv).norm() < eps_slip_) {
+                ++zeros;
+                const double tz = t_ + lam * (t1 - t_);
+                if (tz < t_zero) { t_zero = tz; lam_zero = lam; k_zero = i; }
+            }
+        }
+        if (k_loss >= 0 && t_loss <= t_zero) {
+            stop = StopEvent{StopReason::ContactLost, k_loss, t_loss};
+            return false;
+        }
+        if (k_zero >= 0) {
+            State y0 = y(), y1;
+            for (std::size_t i = 0; i < y1.size(); ++i) y1[i] = y0[i] + lam_zero * (ys1_[i] * scale_[i] - y0[i]);
+            const Vec3 q = model_.q(y1), qd = model_.qd(y1);
+            const PlateState ps = model_.plate(t_zero, y1);
+            bool sticks;
+            if (zeros >= 2 && !scene_.part.point) {
+                // Several contacts at zero slip together (the part moves with the plate):
+                // necessary condition for sticking: |f_xy| <= max mu * f_z.
+                const Vec6 b = rhs_b(scene_, model_.level, q, qd, ps);
+                sticks = b[2] > 0 && b.head<2>().norm() <= scene_.part.mu.maxCoeff() * b[2];
+            } else {
+                sticks = stick_test(scene_, model_.level, k_zero, q, qd, ps).sticks;
+            }
+            if (sticks) {
+                stop = StopEvent{StopReason::Sticking, k_zero, t_zero};
+                return false;
+            }
+            ++stats.slip_reversals;
+            // ws was overwritten by nothing here (stick_test uses its own storage).
+        }
+        return true;
+    }
+
+    Model& model_;
+    const Scene& scene_;
+    IntegrationOptions opt_;
+    typename odeint::result_of::make_controlled<odeint::runge_kutta_dopri5<State>>::type ctrl_;
+    State scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, y_{}, last_y_{};
+    double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
+    double eps_slip_ = 0, h_min_ = 0;
+    Vec3 n_ = Vec3::Zero();
+    std::array<Vec2, 3> slip_{};
+};
+
+// Exponential coordinates of the plate orientation: R1 = exp(phi^). With the spatial angular
+// velocity omega1 (R1' = omega1^ R1, eq. 7), phi' = dexp_{phi}^{-1} omega1, which keeps R1 on
+// SO(3) exactly (R1 is never integrated as nine numbers). |phi| stays far below pi here.
+inline Mat3 hat(const Vec3& w) {
+    Mat3 W;
+    W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+    return W;
+}
+inline Mat3 exp_so3(const Vec3& phi) {
+    return Eigen::AngleAxisd(phi.norm(), phi.norm() > 0 ? Vec3(phi.normalized()) : Vec3::UnitZ())
+        .toRotationMatrix();
+}
+inline Vec3 dexp_inv(const Vec3& phi, const Vec3& w) {
+    const double a = phi.norm();
+    // 1/a^2 - (1 + cos a) / (2 a sin a), series 1/12 + a^2/720 + a^4/30240 near 0.
+    const double k = a < 1e-3 ? 1.0 / 12 + a * a / 720 + a * a * a * a / 30240
+                               : 1 / (a * a) - (1 + std::cos(a)) / (2 * a * std::sin(a));
+    return w - 0.5 * phi.cross(w) + k * phi.cross(phi.cross(w));
+}
+
+}  // namespace plate::detail

@@ -1,0 +1,126 @@
+#include "plate/field.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+namespace plate {
+
+double wrap_angle(double th) {
+    th = std::remainder(th, 2 * kPi);   // [-pi, pi]
+    return th <= -kPi ? th + 2 * kPi : th;
+}
+
+Vec3 field_at(const Scene& sc, const Vec3& q, const LimitCycleOptions& opt, Vec3* warm) {
+    const Vec3 qd0 = warm ? *warm : Vec3::Zero();
+    LimitCycleSummary lc = limit_cycle(sc, q, opt, qd0);
+    if (!lc.converged && warm && !warm->isZero()) lc = limit_cycle(sc, q, opt);   // retry from rest
+    if (!lc.converged) {
+        const bool stopped = lc.stop.reason != StopReason::None;
+        throw FieldUndefined("asymptotic twist undefined at (" + std::to_string(q[0]) + ", " +
+                                 std::to_string(q[1]) + ", " + std::to_string(q[2]) +
+                                 "): " + (stopped ? lc.stop.describe() : "limit cycle not converged"),
+                             stopped ? lc.stop.reason : StopReason::NotConverged);
+    }
+    if (warm) *warm = lc.qd_start;
+    return lc.twist;
+}
+
+Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
+    if (sc.part.point) { grid.nth = 1; grid.th0 = 0; }
+    if (grid.nx < 1 || grid.ny < 1 || grid.nth < 1) throw std::invalid_argument("grid sizes must be >= 1");
+    Field f;
+    f.grid = grid;
+    f.point_part = sc.part.point;
+    f.points.resize(grid.size());
+    const auto t_start = std::chrono::steady_clock::now();
+    const int rows = grid.nx * grid.ny;
+    int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency());
+    threads = std::max(1, std::min(threads, rows));
+    f.threads = threads;
+    std::atomic<int> next{0}, done{0};
+    std::mutex progress_mutex;
+
+    auto worker = [&]() {
+        for (int row; (row = next.fetch_add(1)) < rows;) {
+            const int i = row / grid.ny, j = row % grid.ny;
+            Vec3 warm = Vec3::Zero();
+            for (int k = 0; k < grid.nth; ++k) {
+                FieldPoint& p = f.points[grid.index(i, j, k)];
+                p.q = grid.at(i, j, k);
+                LimitCycleSummary lc = limit_cycle(sc, p.q, opt.cycle, opt.warm_start ? warm : Vec3::Zero());
+                if (!lc.converged && !warm.isZero()) {
+                    const long spent = lc.stats.rhs_evals;
+                    lc = limit_cycle(sc, p.q, opt.cycle);
+                    lc.stats.rhs_evals += spent;
+                }
+                p.twist = lc.twist;
+                p.converged = lc.converged;
+                p.periods = lc.periods;
+                p.residual = lc.residual;
+                p.min_normal_force = lc.min_normal_force;
+                p.stop = lc.stop.reason;
+                p.rhs_evals = lc.stats.rhs_evals;
+                warm = lc.converged ? lc.qd_start : Vec3::Zero();
+                const int d = ++done;
+                if (opt.progress) {
+                    std::lock_guard<std::mutex> lock(progress_mutex);
+                    opt.progress(d, grid.size());
+                }
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    for (const auto& p : f.points) f.rhs_evals += p.rhs_evals;
+    f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    return f;
+}
+
+Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double sample_dt,
+                       const LimitCycleOptions& opt, double h) {
+    if (!(duration > 0 && sample_dt > 0 && h > 0)) throw std::invalid_argument("field_curve: times must be > 0");
+    Trajectory tr;
+    Vec3 q = q0, warm = Vec3::Zero();
+    double t = 0;
+    auto F = [&](const Vec3& x) {
+        Vec3 v = field_at(sc, x, opt, &warm);
+        if (sc.part.point) v[2] = 0;
+        ++tr.stats.steps;
+        return v;
+    };
+    try {
+        Vec3 k1 = F(q);
+        tr.samples.push_back(Sample{0, q, k1, Vec3::Constant(std::numeric_limits<double>::quiet_NaN())});
+        const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
+        for (long s = 1; s <= count; ++s) {
+            const double ts = std::min(s * sample_dt, duration);
+            while (t < ts - 1e-12 * ts) {
+                const double dt = std::min(h, ts - t);
+                const Vec3 k2 = F(q + 0.5 * dt * k1), k3 = F(q + 0.5 * dt * k2), k4 = F(q + dt * k3);
+                q += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+                t += dt;
+                k1 = F(q);
+            }
+            tr.samples.push_back(Sample{ts, q, k1, Vec3::Constant(std::numeric_limits<double>::quiet_NaN())});
+        }
+    } catch (const FieldUndefined& e) {
+        tr.stop = StopEvent{e.reason, -1, t};
+    }
+    return tr;
+}
+
+const char* stability_name(Stability s) {
+    switch (s) {
+        case Stability::Stable: return "stable";
+        case Stability::Unstable: return "unstable";
+        case Stability::Saddle: return "saddle";
+    }
+    return "?";
+}
+
+}  // namespace plate

@@ -1,0 +1,223 @@
+#include "plate/field.hpp"
+
+#include <cmath>
+
+namespace plate {
+namespace {
+
+using VecX = Eigen::VectorXd;
+using MatX = Eigen::MatrixXd;
+
+// The field in scaled coordinates z = (s_x, s_y, rho theta) with values (v_x, v_y, rho omega):
+// both in metres and metres per second, so that distances and singular values compare.
+struct ScaledField {
+    const Scene& sc;
+    const LimitCycleOptions& opt;
+    int dim;
+    double rho;
+    long evals = 0;
+    Vec3 warm = Vec3::Zero();
+
+    Vec3 q_of(const VecX& z) const { return dim == 3 ? Vec3(z[0], z[1], z[2] / rho) : Vec3(z[0], z[1], 0); }
+    VecX z_of(const Vec3& q) const {
+        VecX z(dim);
+        z[0] = q[0];
+        z[1] = q[1];
+        if (dim == 3) z[2] = rho * q[2];
+        return z;
+    }
+    VecX F(const VecX& z) {
+        ++evals;
+        const Vec3 v = field_at(sc, q_of(z), opt, &warm);
+        VecX f(dim);
+        f[0] = v[0];
+        f[1] = v[1];
+        if (dim == 3) f[2] = rho * v[2];
+        return f;
+    }
+    MatX J(const VecX& z, double h) {
+        MatX Jm(dim, dim);
+        for (int c = 0; c < dim; ++c) {
+            VecX zp = z, zm = z;
+            zp[c] += h;
+            zm[c] -= h;
+            Jm.col(c) = (F(zp) - F(zm)) / (2 * h);
+        }
+        return Jm;
+    }
+};
+
+Stability classify(const Eigen::VectorXcd& ev, int skip) {
+    bool neg = true, pos = true;
+    for (int i = 0; i < ev.size(); ++i) {
+        if (i == skip) continue;
+        neg = neg && ev[i].real() < 0;
+        pos = pos && ev[i].real() > 0;
+    }
+    return neg ? Stability::Stable : pos ? Stability::Unstable : Stability::Saddle;
+}
+
+// Gauss-Newton with SVD, the directions with singular values below `cut` * sigma_max left
+// alone (so that on a line of zeros it corrects only across the line). Backtracking on |F|.
+bool newton(ScaledField& f, VecX& z, double ftol, int max_it, double max_step, double h, double cut,
+            const VecX* keep_dir = nullptr) {
+    VecX F = f.F(z);
+    for (int it = 0; it < max_it; ++it) {
+        if (F.lpNorm<Eigen::Infinity>() < ftol) return true;
+        const MatX Jm = f.J(z, h);
+        Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        const VecX s = svd.singularValues();
+        VecX dz = VecX::Zero(z.size());
+        for (int i = 0; i < s.size(); ++i) {
+            if (s[i] <= cut * s[0]) continue;
+            dz -= svd.matrixV().col(i) * (svd.matrixU().col(i).dot(F) / s[i]);
+        }
+        if (keep_dir) dz -= keep_dir->dot(dz) * *keep_dir;   // stay on the hyperplane
+        if (dz.norm() > max_step) dz *= max_step / dz.norm();
+        bool improved = false;
+        for (int ls = 0; ls < 6; ++ls) {
+            VecX zt = z + dz;
+            VecX Ft = f.F(zt);
+            if (Ft.norm() < F.norm()) {
+                z = zt;
+                F = Ft;
+                improved = true;
+                break;
+            }
+            dz *= 0.5;
+        }
+        if (!improved) return F.lpNorm<Eigen::Infinity>() < ftol;
+    }
+    return F.lpNorm<Eigen::Infinity>() < ftol;
+}
+
+}  // namespace
+
+FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPointOptions& opt) {
+    FixedPoints out;
+    const GridSpec& g = field.grid;
+    const int dim = sc.part.point ? 2 : 3;
+    ScaledField f{sc, opt.cycle, dim, sc.part.rho()};
+    const double ftol = opt.ftol * sc.v_ref();
+    double cell = std::min(g.dx() > 0 ? g.dx() : 1.0, g.dy() > 0 ? g.dy() : 1.0);
+    if (dim == 3) cell = std::min(cell, f.rho * g.dth());
+    const double h = 5e-3 * cell;
+
+    auto inside = [&](const VecX& z) {
+        const double mx = 0.25 * g.dx(), my = 0.25 * g.dy();
+        return z[0] >= g.x0 - mx && z[0] <= g.x1 + mx && z[1] >= g.y0 - my && z[1] <= g.y1 + my;
+    };
+    // Scaled distance with theta periodic.
+    auto dist = [&](const VecX& a, const VecX& b) {
+        VecX d = a - b;
+        if (dim == 3) d[2] = f.rho * wrap_angle((a[2] - b[2]) / f.rho);
+        return d.norm();
+    };
+    auto known = [&](const VecX& z, double radius) {
+        for (const auto& p : out.points)
+            if (dist(z, f.z_of(p.q)) < radius) return true;
+        for (const auto& l : out.lines)
+            for (const auto& q : l.points)
+                if (dist(z, f.z_of(q)) < radius) return true;
+        return false;
+    };
+
+    const int nk = dim == 3 ? g.nth : 1;
+    for (int i = 0; i + 1 < g.nx; ++i)
+        for (int j = 0; j + 1 < g.ny; ++j)
+            for (int k = 0; k < nk; ++k) {
+                if (dim == 3 && g.nth < 2) break;
+                // Corners of the cell; theta wraps.
+                Eigen::Vector3d lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+                bool ok = true;
+                for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
+                    const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
+                    const FieldPoint& p = field.points[g.index(ii, jj, kk)];
+                    if (!p.converged) { ok = false; break; }
+                    const Vec3 v(p.twist[0], p.twist[1], f.rho * p.twist[2]);
+                    lo = lo.cwiseMin(v);
+                    hi = hi.cwiseMax(v);
+                }
+                if (!ok) continue;
+                bool cand = true;
+                for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
+                if (!cand) continue;
+                ++out.candidates;
+                Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
+                VecX z = f.z_of(qc);
+                if (known(z, 1.5 * std::sqrt(double(dim)) * cell)) continue;
+                f.warm.setZero();
+                try {
+                    if (!newton(f, z, ftol, opt.max_newton, cell, h, 1e-9)) continue;
+                } catch (const FieldUndefined&) {
+                    continue;
+                }
+                if (!inside(z) || known(z, 0.5 * cell)) continue;
+
+                // Classify.
+                MatX Jm;
+                try { Jm = f.J(z, h); } catch (const FieldUndefined&) { continue; }
+                Eigen::EigenSolver<MatX> es(Jm);
+                const Eigen::VectorXcd ev = es.eigenvalues();
+                Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
+                ev3.head(dim) = ev;
+                Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullV);
+                const VecX s = svd.singularValues();
+                const Vec3 q = f.q_of(z);
+
+                bool is_line = false;
+                if (s[dim - 1] < opt.null_ratio * s[0]) {
+                    // Follow the null direction both ways.
+                    FixedLine line;
+                    VecX v = svd.matrixV().col(dim - 1);
+                    std::vector<Vec3> fwd, bwd;
+                    for (int sgn : {1, -1}) {
+                        VecX zc = z, dir = sgn * v;
+                        double travelled = 0;
+                        for (int step = 0; step < 400; ++step) {
+                            VecX zn = zc + 0.5 * cell * dir;
+                            try {
+                                if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir)) break;
+                            } catch (const FieldUndefined&) {
+                                break;
+                            }
+                            if (!inside(zn)) break;
+                            travelled += dist(zn, zc);
+                            dir = (zn - zc).normalized();
+                            zc = zn;
+                            (sgn > 0 ? fwd : bwd).push_back(f.q_of(zc));
+                            if (dim == 3 && travelled > 2 * kPi * f.rho + (g.x1 - g.x0) + (g.y1 - g.y0)) break;
+                        }
+                    }
+                    if (fwd.size() + bwd.size() >= 2) {
+                        is_line = true;
+                        for (auto it = bwd.rbegin(); it != bwd.rend(); ++it) line.points.push_back(*it);
+                        line.points.push_back(q);
+                        for (const auto& p : fwd) line.points.push_back(p);
+                        for (auto& p : line.points) p[2] = wrap_angle(p[2]);
+                        line.direction = f.q_of(v);
+                        if (dim == 3) line.direction[2] = v[2] / f.rho;
+                        line.eigenvalues = ev3;
+                        int skip = 0;
+                        ev.cwiseAbs().minCoeff(&skip);
+                        line.stability = classify(ev, skip);
+                        for (std::size_t m = 1; m < line.points.size(); ++m)
+                            line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
+                        out.lines.push_back(line);
+                    }
+                }
+                if (!is_line) {
+                    FixedPoint fp;
+                    fp.q = q;
+                    fp.q[2] = dim == 3 ? wrap_angle(q[2]) : 0;
+                    fp.eigenvalues = ev3;
+                    fp.stability = classify(ev, -1);
+                    fp.residual = f.F(z).norm();
+                    out.points.push_back(fp);
+                }
+            }
+    out.evaluations = f.evals;
+    return out;
+}
+
+}  // namespace plate

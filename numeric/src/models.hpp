@@ -1,0 +1,87 @@
+// Internal: the three state layouts integrated by the engine.
+//   ReducedU (35): y = [q'(3), Q(3)], Q = integral of q' (for the average (36)); q frozen.
+//   U (32):        y = [q(3), q'(3)]
+//   Full (31):     y = [q(3), q'(3), phi(3)], R1 = exp(phi^)
+#pragma once
+
+#include "engine.hpp"
+
+namespace plate::detail {
+
+// Scales of the state components: slip speed v_ref, angular rates v_ref / rho, lengths rho.
+struct Scales {
+    double v, w, L;
+    explicit Scales(const Scene& sc)
+        : v(sc.v_ref()), w(sc.v_ref() / sc.part.rho()), L(sc.part.point ? sc.v_ref() * sc.plate.T : sc.part.rho()) {}
+};
+
+struct ReducedModel {
+    using State = std::array<double, 6>;
+    const Scene& sc;
+    Vec3 q0;
+    Dynamics level = Dynamics::ReducedU;
+    Workspace ws;
+    ReducedModel(const Scene& s, const Vec3& q) : sc(s), q0(q) {}
+
+    void rhs(double t, const State& y, State& dy) {
+        const Vec3 qd(y[0], y[1], y[2]);
+        accelerations(sc, level, q0, qd, plate(t, y), ws);
+        for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
+    }
+    Vec3 q(const State&) const { return q0; }
+    Vec3 qd(const State& y) const { return Vec3(y[0], y[1], y[2]); }
+    PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
+    State scale() const {
+        const Scales s(sc);
+        const double T = sc.plate.T;
+        return {s.v, s.v, s.w, s.v * T, s.v * T, s.w * T};
+    }
+};
+
+struct UModel {
+    using State = std::array<double, 6>;
+    const Scene& sc;
+    Dynamics level = Dynamics::U;
+    Workspace ws;
+    explicit UModel(const Scene& s) : sc(s) {}
+
+    void rhs(double t, const State& y, State& dy) {
+        accelerations(sc, level, q(y), qd(y), plate(t, y), ws);
+        for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; }
+    }
+    Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
+    Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
+    PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
+    State scale() const {
+        const Scales s(sc);
+        return {s.L, s.L, 1.0, s.v, s.v, s.w};
+    }
+};
+
+struct FullModel {
+    using State = std::array<double, 9>;
+    const Scene& sc;
+    Dynamics level = Dynamics::Full;
+    Workspace ws;
+    explicit FullModel(const Scene& s) : sc(s) {}
+
+    void rhs(double t, const State& y, State& dy) {
+        const PlateState ps = plate(t, y);
+        accelerations(sc, level, q(y), qd(y), ps, ws);
+        const Vec3 phid = dexp_inv(Vec3(y[6], y[7], y[8]), ps.w1);
+        for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; dy[6 + i] = phid[i]; }
+    }
+    Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
+    Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
+    PlateState plate(double t, const State& y) const {
+        return plate_state(sc.plate, t, level, exp_so3(Vec3(y[6], y[7], y[8])));
+    }
+    State scale() const {
+        const Scales s(sc);
+        const double w = sc.plate.omega();
+        const double a = std::max(sc.plate.angular_amplitude() / (w * w), 1e-6);
+        return {s.L, s.L, 1.0, s.v, s.v, s.w, a, a, a};
+    }
+};
+
+}  // namespace plate::detail

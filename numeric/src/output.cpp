@@ -1,0 +1,150 @@
+#include "plate/output.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <stdexcept>
+
+namespace plate {
+namespace {
+
+using nlohmann::json;
+
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json vec(const Vec3& v, int n) {
+    json a = json::array();
+    for (int i = 0; i < n; ++i) a.push_back(num(v[i]));
+    return a;
+}
+
+json eig(const Eigen::Vector3cd& e, int n) {
+    json a = json::array();
+    for (int i = 0; i < n; ++i) a.push_back({num(e[i].real()), num(e[i].imag())});
+    return a;
+}
+
+}  // namespace
+
+json to_json(const Scene& sc, const Vec3& q, const LimitCycleSummary& lc) {
+    const int d = sc.part.point ? 2 : 3;
+    json j;
+    j["scene"] = sc.name;
+    j["at"] = vec(q, d);
+    j["twist"] = vec(lc.twist, d);
+    j["min_normal_force"] = num(lc.min_normal_force);
+    j["converged"] = lc.converged;
+    j["periods"] = lc.periods;
+    j["residual"] = num(lc.residual);
+    j["error_estimate"] = num(lc.error_estimate);
+    j["contraction_per_period"] = num(lc.contraction);
+    j["contact_lost"] = lc.contact_lost();
+    j["sticking"] = lc.sticking();
+    j["stop"] = stop_name(lc.stop.reason);
+    if (lc.stop.reason != StopReason::None) {
+        j["stop_message"] = lc.stop.describe();
+        j["stop_time"] = num(lc.stop.t);
+        if (lc.stop.contact >= 0) j["stop_contact"] = lc.stop.contact + 1;
+    }
+    j["cycle_start_twist"] = vec(lc.qd_start, d);
+    j["slip_reversals"] = lc.stats.slip_reversals;
+    j["rhs_evaluations"] = lc.stats.rhs_evals;
+    j["units"] = sc.part.point ? "m/s" : "m/s, m/s, rad/s";
+    return j;
+}
+
+json to_json(const Scene& sc, const Field& f) {
+    const int d = f.point_part ? 2 : 3;
+    json j;
+    j["scene"] = sc.name;
+    j["kind"] = f.point_part ? "asymptotic velocity field" : "asymptotic twist field";
+    j["grid"] = {{"nx", f.grid.nx}, {"ny", f.grid.ny}, {"ntheta", f.point_part ? 1 : f.grid.nth},
+                 {"x", {f.grid.x0, f.grid.x1}}, {"y", {f.grid.y0, f.grid.y1}},
+                 {"theta0", f.grid.th0}};
+    j["seconds"] = f.seconds;
+    j["threads"] = f.threads;
+    j["rhs_evaluations"] = f.rhs_evals;
+    json pts = json::array();
+    for (const auto& p : f.points) {
+        pts.push_back({{"at", vec(p.q, d)}, {"twist", vec(p.twist, d)}, {"converged", p.converged},
+                       {"periods", p.periods}, {"residual", num(p.residual)},
+                       {"min_normal_force", num(p.min_normal_force)}, {"stop", stop_name(p.stop)}});
+    }
+    j["points"] = pts;
+    return j;
+}
+
+json to_json(const Scene& sc, const FixedPoints& fp) {
+    const int d = sc.part.point ? 2 : 3;
+    json j;
+    j["scene"] = sc.name;
+    json pts = json::array();
+    for (const auto& p : fp.points)
+        pts.push_back({{"at", vec(p.q, d)}, {"stability", stability_name(p.stability)},
+                       {"eigenvalues", eig(p.eigenvalues, d)}, {"residual", num(p.residual)}});
+    json lines = json::array();
+    for (const auto& l : fp.lines) {
+        json ps = json::array();
+        for (const auto& q : l.points) ps.push_back(vec(q, d));
+        lines.push_back({{"stability", stability_name(l.stability)}, {"direction", vec(l.direction, d)},
+                         {"from", vec(l.points.front(), d)}, {"to", vec(l.points.back(), d)},
+                         {"length", num(l.length)}, {"eigenvalues", eig(l.eigenvalues, d)}, {"points", ps}});
+    }
+    j["points"] = pts;
+    j["lines"] = lines;
+    j["candidate_cells"] = fp.candidates;
+    j["field_evaluations"] = fp.evaluations;
+    return j;
+}
+
+void write_field_csv(std::ostream& out, const Field& f) {
+    out << std::setprecision(12);
+    if (f.point_part) out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop\n";
+    else out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop\n";
+    auto v = [](double x) { return std::isfinite(x) ? std::to_string(x) : std::string("nan"); };
+    for (const auto& p : f.points) {
+        out << p.q[0] << ',' << p.q[1] << ',';
+        if (!f.point_part) out << p.q[2] << ',';
+        out << v(p.twist[0]) << ',' << v(p.twist[1]) << ',';
+        if (!f.point_part) out << v(p.twist[2]) << ',';
+        out << (p.converged ? 1 : 0) << ',' << p.periods << ',' << p.residual << ',' << p.min_normal_force << ','
+            << stop_name(p.stop) << '\n';
+    }
+}
+
+void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part) {
+    out << std::setprecision(12);
+    if (point_part) out << "t,s_x,s_y,s_x_dot,s_y_dot,N1\n";
+    else out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3\n";
+    for (const auto& s : tr.samples) {
+        out << s.t << ',' << s.q[0] << ',' << s.q[1] << ',';
+        if (!point_part) out << s.q[2] << ',';
+        out << s.qd[0] << ',' << s.qd[1] << ',';
+        if (!point_part) out << s.qd[2] << ',' << s.n[0] << ',' << s.n[1] << ',' << s.n[2] << '\n';
+        else out << s.n[0] << '\n';
+    }
+}
+
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
+    if (path == "-") {
+        write(std::cout);
+        std::cout.flush();
+        return;
+    }
+    const std::string tmp = path + ".tmp";
+    try {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) throw std::runtime_error(path + ": cannot open for writing");
+        write(out);
+        out.close();
+        if (!out) throw std::runtime_error(path + ": write failed");
+        if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename into place");
+    } catch (...) {
+        std::remove(tmp.c_str());
+        throw;
+    }
+}
+
+}  // namespace plate

@@ -1,0 +1,215 @@
+#include "plate/scene_io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace plate {
+namespace {
+
+using nlohmann::json;
+
+struct Reader {
+    std::string source;
+
+    [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+        throw InputError(source + ": " + field + ": " + what);
+    }
+
+    void only_keys(const json& obj, const std::string& field, const std::set<std::string>& allowed,
+                   const std::set<std::string>& required) const {
+        if (!obj.is_object()) fail(field.empty() ? "(top level)" : field, "expected an object");
+        for (auto it = obj.begin(); it != obj.end(); ++it)
+            if (!allowed.count(it.key()))
+                fail(join(field, it.key()), "unknown field (allowed: " + list(allowed) + ")");
+        for (const auto& k : required)
+            if (!obj.contains(k)) fail(join(field, k), "missing required field");
+    }
+
+    static std::string join(const std::string& a, const std::string& b) {
+        return a.empty() ? b : a + "." + b;
+    }
+    static std::string list(const std::set<std::string>& s) {
+        std::string out;
+        for (const auto& k : s) out += (out.empty() ? "" : ", ") + k;
+        return out;
+    }
+
+    double number(const json& v, const std::string& field) const {
+        if (!v.is_number()) fail(field, "expected a number, got " + std::string(v.type_name()));
+        const double x = v.get<double>();
+        if (!std::isfinite(x)) fail(field, "expected a finite number");
+        return x;
+    }
+
+    double positive(const json& v, const std::string& field) const {
+        const double x = number(v, field);
+        if (!(x > 0)) fail(field, "expected a positive number, got " + fmt(x));
+        return x;
+    }
+
+    Vec3 vec3(const json& v, const std::string& field) const {
+        if (!v.is_array() || v.size() != 3)
+            fail(field, "expected an array of 3 numbers" +
+                            (v.is_array() ? ", got " + std::to_string(v.size()) + " entries"
+                                          : std::string()));
+        Vec3 out;
+        for (int i = 0; i < 3; ++i) out[i] = number(v[i], field + "[" + std::to_string(i) + "]");
+        return out;
+    }
+
+    static std::string fmt(double x) {
+        std::ostringstream s;
+        s.precision(6);
+        s << x;
+        return s.str();
+    }
+};
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& source) {
+    Reader r{source};
+    json doc;
+    try {
+        doc = json::parse(text);
+    } catch (const json::parse_error& e) {
+        // Report a line and column rather than a byte offset.
+        std::size_t line = 1, col = 1;
+        for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+            if (text[i] == '\n') { ++line; col = 1; } else { ++col; }
+        }
+        throw InputError(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                         ": malformed JSON: " + e.what());
+    }
+
+    Scene s;
+    s.source = source;
+    r.only_keys(doc, "", {"name", "gravity", "part", "plate"}, {"name", "gravity", "part", "plate"});
+    if (!doc["name"].is_string() || doc["name"].get<std::string>().empty())
+        r.fail("name", "expected a non-empty string");
+    s.name = doc["name"].get<std::string>();
+    s.g = r.positive(doc["gravity"], "gravity");
+
+    // part
+    const json& p = doc["part"];
+    if (!p.is_object()) r.fail("part", "expected an object");
+    const bool point = !p.contains("inertia") && !p.contains("contacts");
+    if (point) {
+        r.only_keys(p, "part", {"mass", "friction"}, {"mass", "friction"});
+    } else {
+        r.only_keys(p, "part", {"mass", "inertia", "contacts", "friction"},
+                    {"mass", "inertia", "contacts", "friction"});
+    }
+    Part& part = s.part;
+    part.point = point;
+    part.m = r.positive(p["mass"], "part.mass");
+    const json& f = p["friction"];
+    if (f.is_number()) {
+        part.mu.setConstant(r.number(f, "part.friction"));
+    } else if (f.is_array() && f.size() == 3 && !point) {
+        part.mu = r.vec3(f, "part.friction");
+    } else if (f.is_array() && f.size() == 1 && point) {
+        part.mu.setConstant(r.number(f[0], "part.friction[0]"));
+    } else {
+        r.fail("part.friction", point ? "expected one number for a point part"
+                                      : "expected one number or an array of 3 numbers");
+    }
+    for (int i = 0; i < part.contacts(); ++i)
+        if (part.mu[i] < 0)
+            r.fail("part.friction", "expected friction coefficients >= 0, got " + Reader::fmt(part.mu[i]));
+    if (!point) {
+        const json& I = p["inertia"];
+        if (!I.is_array() || I.size() != 3) r.fail("part.inertia", "expected a 3x3 array of numbers");
+        for (int i = 0; i < 3; ++i)
+            part.J.row(i) = r.vec3(I[i], "part.inertia[" + std::to_string(i) + "]").transpose();
+        const json& C = p["contacts"];
+        if (!C.is_array() || C.size() != 3)
+            r.fail("part.contacts", "expected exactly 3 contact points, each [x, y, z]");
+        for (int i = 0; i < 3; ++i) part.c[i] = r.vec3(C[i], "part.contacts[" + std::to_string(i) + "]");
+    }
+
+    // plate
+    const json& q = doc["plate"];
+    r.only_keys(q, "plate", {"period", "harmonics"}, {"period", "harmonics"});
+    s.plate.T = r.positive(q["period"], "plate.period");
+    const json& H = q["harmonics"];
+    if (!H.is_array()) r.fail("plate.harmonics", "expected an array of harmonics");
+    static const std::pair<const char*, Axis> axes[] = {{"x", Axis::x},   {"y", Axis::y},   {"z", Axis::z},
+                                                        {"rx", Axis::rx}, {"ry", Axis::ry}, {"rz", Axis::rz}};
+    for (std::size_t k = 0; k < H.size(); ++k) {
+        const std::string fk = "plate.harmonics[" + std::to_string(k) + "]";
+        r.only_keys(H[k], fk, {"axis", "n", "amp", "phase"}, {"axis", "n", "amp", "phase"});
+        Harmonic h;
+        const json& a = H[k]["axis"];
+        bool found = false;
+        if (a.is_string())
+            for (const auto& [name, axis] : axes)
+                if (a.get<std::string>() == name) { h.axis = axis; found = true; }
+        if (!found) r.fail(fk + ".axis", "expected one of \"x\", \"y\", \"z\", \"rx\", \"ry\", \"rz\"");
+        const json& n = H[k]["n"];
+        if (!n.is_number_integer() || n.get<long>() < 1 || n.get<long>() > 1000)
+            r.fail(fk + ".n", "expected a whole number from 1 to 1000 (harmonic of the base frequency)");
+        h.n = n.get<int>();
+        h.amp = r.number(H[k]["amp"], fk + ".amp");
+        h.phase = r.number(H[k]["phase"], fk + ".phase");
+        s.plate.harmonics.push_back(h);
+    }
+    validate_scene(s);
+    return s;
+}
+
+void validate_scene(const Scene& s) {
+    Reader r{s.source.empty() ? std::string("(scene)") : s.source};
+    const Part& p = s.part;
+    if (!(std::isfinite(s.g) && s.g > 0)) r.fail("gravity", "expected a positive finite number");
+    if (!(std::isfinite(p.m) && p.m > 0)) r.fail("part.mass", "expected a positive finite number");
+    for (int i = 0; i < p.contacts(); ++i)
+        if (!(std::isfinite(p.mu[i]) && p.mu[i] >= 0))
+            r.fail("part.friction", "expected finite friction coefficients >= 0");
+    if (!p.point) {
+        if (!p.J.allFinite()) r.fail("part.inertia", "expected finite numbers");
+        const double scale = p.J.cwiseAbs().maxCoeff();
+        if ((p.J - p.J.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
+            r.fail("part.inertia", "expected a symmetric matrix");
+        Eigen::LLT<Mat3> llt(p.J);
+        if (scale <= 0 || llt.info() != Eigen::Success ||
+            Eigen::SelfAdjointEigenSolver<Mat3>(p.J).eigenvalues().minCoeff() <= 1e-12 * scale)
+            r.fail("part.inertia", "expected a symmetric positive definite matrix");
+        double size = 0;
+        for (int i = 0; i < 3; ++i) {
+            if (!p.c[i].allFinite()) r.fail("part.contacts[" + std::to_string(i) + "]", "expected finite numbers");
+            for (int j = 0; j < i; ++j) size = std::max(size, (p.c[i] - p.c[j]).norm());
+        }
+        if (size <= 0) r.fail("part.contacts", "expected three distinct contact points");
+        for (int i = 1; i < 3; ++i)
+            if (std::abs(p.c[i].z() - p.c[0].z()) > 1e-9 * size)
+                r.fail("part.contacts", "expected coplanar contacts with one z (the plate is flat): contact " +
+                                            std::to_string(i) + " has z different from contact 0");
+        if (p.c[0].z() > 1e-12 * size)
+            r.fail("part.contacts", "expected z <= 0: the centre of mass cannot lie below the plate surface");
+        const Vec3 e1 = p.c[1] - p.c[0], e2 = p.c[2] - p.c[0];
+        const double area2 = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+        if (area2 <= 1e-6 * size * size)
+            r.fail("part.contacts", "expected non-collinear contacts (assumption 2): the triangle has no area");
+    }
+    if (!(std::isfinite(s.plate.T) && s.plate.T > 0)) r.fail("plate.period", "expected a positive finite number");
+    for (std::size_t k = 0; k < s.plate.harmonics.size(); ++k) {
+        const auto& h = s.plate.harmonics[k];
+        if (!std::isfinite(h.amp) || !std::isfinite(h.phase) || h.n < 1)
+            r.fail("plate.harmonics[" + std::to_string(k) + "]", "expected finite amp and phase, n >= 1");
+    }
+}
+
+Scene load_scene(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path + ": cannot open scene file");
+    std::stringstream buf;
+    buf << in.rdbuf();
+    return parse_scene(buf.str(), path);
+}
+
+}  // namespace plate
