@@ -205,7 +205,7 @@ int cmd_field(int argc, char** argv) {
         std::cout << "usage: plate field SCENE [--grid N] [--nx N] [--ny N] [--ntheta N] [--x MIN MAX]\n"
                      "                   [--y MIN MAX] [--theta0 T] [--format json|csv] [--out FILE]\n"
                      "                   [--threads N] [--tol X] [--rtol X] [--max-periods N]\n"
-                     "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.1,0.1]^2 x [0, 2pi)),\n"
+                     "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.05,0.05]^2 m x [0, 2pi)),\n"
                      "theta covering a full turn. Point parts: asymptotic velocity field on (s_x, s_y).\n"
                      "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n";
         return 0;

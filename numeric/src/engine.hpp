@@ -30,6 +30,7 @@ public:
           ctrl_(odeint::make_controlled<odeint::runge_kutta_dopri5<State>>(opt.rtol, opt.rtol)) {
         scale_ = model_.scale();
         eps_slip_ = opt_.slip_eps * scene_.v_ref();
+        eps_arm_ = 1e-3 * scene_.v_ref();
         h_min_ = opt_.h_min * scene_.plate.T;
     }
 
@@ -40,6 +41,7 @@ public:
         sys(ys_, fs_, t_);
         n_ = model_.ws.n;
         slip_ = model_.ws.slip;
+        for (int i = 0; i < 3; ++i) armed_[i] = slip_[i].norm() > eps_arm_;
         dt_ = std::min(1e-3, 1e-2 * std::cbrt(opt_.rtol)) * scene_.plate.T;
         stats.min_normal_force = min_n();
         stop = StopEvent{};
@@ -154,7 +156,10 @@ private:
             const Vec2 v0 = slip_[i], dv = slip1[i] - slip_[i];
             const double dd = dv.squaredNorm();
             const double lam = dd > 0 ? std::clamp(-v0.dot(dv) / dd, 0.0, 1.0) : 1.0;
-            if (lam > 0 && (v0 + lam * dv).norm() < eps_slip_) {
+            // A contact is armed once its slip has exceeded eps_arm_ since the start or the last
+            // event: a start at rest (all slips zero) or a reversal just passed is not a new event.
+            if (slip1[i].norm() > eps_arm_) armed_[i] = true;
+            if (armed_[i] && lam > 0 && (v0 + lam * dv).norm() < eps_slip_) {
                 ++zeros;
                 const double tz = t_ + lam * (t1 - t_);
                 if (tz < t_zero) { t_zero = tz; lam_zero = lam; k_zero = i; }
@@ -183,7 +188,7 @@ private:
                 return false;
             }
             ++stats.slip_reversals;
-            // ws was overwritten by nothing here (stick_test uses its own storage).
+            armed_[k_zero] = false;
         }
         return true;
     }
@@ -194,7 +199,8 @@ private:
     typename odeint::result_of::make_controlled<odeint::runge_kutta_dopri5<State>>::type ctrl_;
     State scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, y_{}, last_y_{};
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
-    double eps_slip_ = 0, h_min_ = 0;
+    double eps_slip_ = 0, eps_arm_ = 0, h_min_ = 0;
+    std::array<bool, 3> armed_{};
     Vec3 n_ = Vec3::Zero();
     std::array<Vec2, 3> slip_{};
 };

@@ -122,6 +122,20 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
         return false;
     };
 
+    // Is a known zero within the cell centred at qc, widened by half a cell each way?
+    auto in_cell = [&](const Vec3& qc) {
+        auto near = [&](const Vec3& q) {
+            return std::abs(q[0] - qc[0]) <= g.dx() && std::abs(q[1] - qc[1]) <= g.dy() &&
+                   (dim == 2 || std::abs(wrap_angle(q[2] - qc[2])) <= g.dth());
+        };
+        for (const auto& p : out.points)
+            if (near(p.q)) return true;
+        for (const auto& l : out.lines)
+            for (const auto& q : l.points)
+                if (near(q)) return true;
+        return false;
+    };
+
     const int nk = dim == 3 ? g.nth : 1;
     for (int i = 0; i + 1 < g.nx; ++i)
         for (int j = 0; j + 1 < g.ny; ++j)
@@ -145,7 +159,7 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
                 ++out.candidates;
                 Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
                 VecX z = f.z_of(qc);
-                if (known(z, 1.5 * std::sqrt(double(dim)) * cell)) continue;
+                if (in_cell(qc)) continue;   // a zero already found lies in (or next to) this cell
                 f.warm.setZero();
                 try {
                     if (!newton(f, z, ftol, opt.max_newton, cell, h, 1e-9)) continue;

@@ -20,7 +20,9 @@ std::string LimitCycleSummary::report() const {
     return s.str();
 }
 
-LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+namespace {
+
+LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
     detail::ReducedModel model(sc, q0);
     detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
     const double T = sc.plate.T;
@@ -84,6 +86,29 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     out.stats = e.stats;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return out;
+}
+
+
+}  // namespace
+
+LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+    LimitCycleSummary out = one_start(sc, q0, opt, qd0);
+    const double v = sc.v_ref(), w = v / sc.part.rho();
+    const Vec3 kicks[] = {Vec3(v, 0, 0), Vec3(0, v, 0), Vec3(0, 0, sc.part.point ? 0 : w)};
+    std::vector<StopEvent> stops;
+    Stats total = out.stats;
+    for (int r = 0; r < std::min(opt.restarts, 3) && out.sticking(); ++r) {
+        stops.push_back(out.stop);
+        out = one_start(sc, q0, opt, r == 2 && sc.part.point ? Vec3(-v, -v, 0) : kicks[r]);
+        total.rhs_evals += out.stats.rhs_evals;
+        total.steps += out.stats.steps;
+        total.rejected += out.stats.rejected;
+        total.slip_reversals += out.stats.slip_reversals;
+        out.restarts = r + 1;
+    }
+    out.stats = total;
+    out.transient_stops = stops;
     return out;
 }
 

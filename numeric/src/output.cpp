@@ -50,6 +50,10 @@ json to_json(const Scene& sc, const Vec3& q, const LimitCycleSummary& lc) {
     }
     j["cycle_start_twist"] = vec(lc.qd_start, d);
     j["slip_reversals"] = lc.stats.slip_reversals;
+    j["restarts"] = lc.restarts;
+    json ts = json::array();
+    for (const auto& e : lc.transient_stops) ts.push_back(e.describe());
+    j["transient_stops"] = ts;
     j["rhs_evaluations"] = lc.stats.rhs_evals;
     j["units"] = sc.part.point ? "m/s" : "m/s, m/s, rad/s";
     return j;

@@ -15,8 +15,8 @@ namespace plate {
 // repeating its end point. Point parts use nth = 1 (theta is meaningless).
 struct GridSpec {
     int nx = 7, ny = 7, nth = 7;
-    double x0 = -0.1, x1 = 0.1;
-    double y0 = -0.1, y1 = 0.1;
+    double x0 = -0.05, x1 = 0.05;
+    double y0 = -0.05, y1 = 0.05;
     double th0 = 0;
     double dx() const { return nx > 1 ? (x1 - x0) / (nx - 1) : 0; }
     double dy() const { return ny > 1 ? (y1 - y0) / (ny - 1) : 0; }

@@ -20,6 +20,11 @@ struct LimitCycleOptions {
     double tol = 1e-7;          // accepted distance to the cycle, relative to v_ref
     int max_periods = 400;      // then "not converged"
     bool record = false;        // keep every accepted step (for plots and tests)
+    // Observation 1 makes the cycle independent of the initial twist. When a contact sticks
+    // before the cycle is reached (a transient the sliding model cannot follow), start again
+    // from other twists (slip speed v_ref along x, then y, then a spin) up to this many times.
+    // A cycle that sticks from every start is reported as sticking.
+    int restarts = 3;
 };
 
 struct LimitCycleSummary {
@@ -32,7 +37,9 @@ struct LimitCycleSummary {
     Vec3 qd_start = Vec3::Zero();  // state at the start of the last period (a warm start)
     double min_normal_force = 0;   // smallest N_i over the last period [N]
     StopEvent stop;
-    Stats stats;
+    Stats stats;                   // accumulated over restarts
+    int restarts = 0;              // starts abandoned because a contact stuck in the transient
+    std::vector<StopEvent> transient_stops;   // why each abandoned start stopped
     std::vector<Sample> path;      // with record: every accepted step from t = 0
 
     bool contact_lost() const { return stop.reason == StopReason::ContactLost; }
