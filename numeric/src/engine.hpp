@@ -158,7 +158,15 @@ private:
             const double lam = dd > 0 ? std::clamp(-v0.dot(dv) / dd, 0.0, 1.0) : 1.0;
             // A contact is armed once its slip has exceeded eps_arm_ since the start or the last
             // event: a start at rest (all slips zero) or a reversal just passed is not a new event.
-            if (slip1[i].norm() > eps_arm_) armed_[i] = true;
+            if (slip1[i].norm() > eps_arm_) {
+                armed_[i] = true;
+                band_steps_[i] = 0;
+            } else if (++band_steps_[i] > kChatterSteps) {
+                // The slip has stayed near zero for many steps: the integrator chatters about
+                // v_i = 0, i.e. the Filippov solution slides on v_i = 0 -- the contact sticks.
+                stop = StopEvent{StopReason::Sticking, i, t1};
+                return false;
+            }
             if (armed_[i] && lam > 0 && (v0 + lam * dv).norm() < eps_slip_) {
                 ++zeros;
                 const double tz = t_ + lam * (t1 - t_);
@@ -201,6 +209,10 @@ private:
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
     double eps_slip_ = 0, eps_arm_ = 0, h_min_ = 0;
     std::array<bool, 3> armed_{};
+    std::array<long, 3> band_steps_{};
+    // Accepted steps with a slip below eps_arm_ that count as a stuck contact. A transversal
+    // reversal crosses that band in a few steps (dopri5 resolves the kink in ~10-30).
+    static constexpr long kChatterSteps = 400;
     Vec3 n_ = Vec3::Zero();
     std::array<Vec2, 3> slip_{};
 };

@@ -59,12 +59,13 @@ Stability classify(const Eigen::VectorXcd& ev, int skip) {
 
 // Gauss-Newton with SVD, the directions with singular values below `cut` * sigma_max left
 // alone (so that on a line of zeros it corrects only across the line). Backtracking on |F|.
+// With `chord`, that Jacobian is used throughout (chord method, for following a line).
 bool newton(ScaledField& f, VecX& z, double ftol, int max_it, double max_step, double h, double cut,
-            const VecX* keep_dir = nullptr) {
+            const VecX* keep_dir = nullptr, const MatX* chord = nullptr) {
     VecX F = f.F(z);
     for (int it = 0; it < max_it; ++it) {
         if (F.lpNorm<Eigen::Infinity>() < ftol) return true;
-        const MatX Jm = f.J(z, h);
+        const MatX Jm = chord ? *chord : f.J(z, h);
         Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullU | Eigen::ComputeFullV);
         const VecX s = svd.singularValues();
         VecX dz = VecX::Zero(z.size());
@@ -90,6 +91,11 @@ bool newton(ScaledField& f, VecX& z, double ftol, int max_it, double max_step, d
     }
     return F.lpNorm<Eigen::Infinity>() < ftol;
 }
+
+// Singular values below kCut * sigma_max are finite-difference noise: the field is accurate to
+// about 1e-7 v_ref and the difference step is 5e-3 cells, so Jacobian entries carry errors of
+// order 1e-4 relative.
+constexpr double kCut = 1e-3;
 
 }  // namespace
 
@@ -162,7 +168,7 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
                 if (in_cell(qc)) continue;   // a zero already found lies in (or next to) this cell
                 f.warm.setZero();
                 try {
-                    if (!newton(f, z, ftol, opt.max_newton, cell, h, 1e-9)) continue;
+                    if (!newton(f, z, ftol, opt.max_newton, cell, h, kCut)) continue;
                 } catch (const FieldUndefined&) {
                     continue;
                 }
@@ -191,7 +197,7 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
                         for (int step = 0; step < 400; ++step) {
                             VecX zn = zc + 0.5 * cell * dir;
                             try {
-                                if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir)) break;
+                                if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir, &Jm)) break;
                             } catch (const FieldUndefined&) {
                                 break;
                             }
