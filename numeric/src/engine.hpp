@@ -95,12 +95,14 @@ public:
             // Diagnostics at the new point: the FSAL stage evaluated it last.
             if (!(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
                 sys(ys1_, fs1_, t1);
+            n1_ = model_.ws.n;
+            slip1_ = model_.ws.slip;
             if (!check(t1)) return false;
             t_ = t1;
             ys_ = ys1_;
             fs_ = fs1_;
-            n_ = model_.ws.n;
-            slip_ = model_.ws.slip;
+            n_ = n1_;
+            slip_ = slip1_;
             on_step(t_, y(), n_);
         }
         return true;
@@ -133,10 +135,34 @@ private:
         return k;
     }
 
-    // Event checks over the accepted step [t_, t1]; ws holds the evaluation at t1.
+    // The state one Dormand-Prince step of size tau from the last accepted point; ws is left
+    // evaluated there. The step is accurate up to the first event in it: the right-hand side is
+    // smooth before it.
+    State probe(double tau) {
+        State out, dout;
+        ctrl_.stepper().do_step(sysref(), ys_, fs_, t_, out, dout, tau);
+        for (std::size_t i = 0; i < out.size(); ++i) out[i] *= scale_[i];
+        return out;
+    }
+    // First root of g (read from ws after a probe) in (t_, t1], with g > 0 at t_ and g <= 0 at
+    // t1, by bisection to 1e-14 T. Returns the time; y_at receives the state there.
+    template <class G>
+    double refine(double t1, G&& g, State& y_at) {
+        double a = 0, b = t1 - t_;
+        y_at = probe(b);
+        for (int it = 0; it < 80 && b - a > 1e-14 * scene_.plate.T; ++it) {
+            const double m = 0.5 * (a + b);
+            const State ym = probe(m);
+            if (g() > 0) a = m;
+            else { b = m; y_at = ym; }
+        }
+        return t_ + b;
+    }
+
+    // Event checks over the accepted step [t_, t1]; n1_ and slip1_ hold the evaluation at t1.
     bool check(double t1) {
         const int nc = scene_.part.contacts();
-        const Vec3 n1 = model_.ws.n;
+        const Vec3 n1 = n1_;
         // Contact loss: first contact whose N crosses zero (linear interpolation in the step).
         double t_loss = std::numeric_limits<double>::infinity();
         int k_loss = -1;
@@ -148,7 +174,7 @@ private:
             }
         }
         // Zero slip: closest approach of the slip velocity to zero within the step.
-        const auto slip1 = model_.ws.slip;
+        const auto slip1 = slip1_;
         double t_zero = std::numeric_limits<double>::infinity();
         double lam_zero = 0;
         int zeros = 0, k_zero = -1;
@@ -173,15 +199,33 @@ private:
                 if (tz < t_zero) { t_zero = tz; lam_zero = lam; k_zero = i; }
             }
         }
+        State y_ev;
         if (k_loss >= 0 && t_loss <= t_zero) {
+            if (n_[k_loss] > 0) t_loss = refine(t1, [&] { return model_.ws.n[k_loss]; }, y_ev);
             stop = StopEvent{StopReason::ContactLost, k_loss, t_loss};
             return false;
         }
         if (k_zero >= 0) {
-            State y0 = y(), y1;
-            for (std::size_t i = 0; i < y1.size(); ++i) y1[i] = y0[i] + lam_zero * (ys1_[i] * scale_[i] - y0[i]);
-            const Vec3 q = model_.q(y1), qd = model_.qd(y1);
-            const PlateState ps = model_.plate(t_zero, y1);
+            // Locate the zero of the slip component along its direction at t_ (exact up to the
+            // step's local error), unless the slip was already negligible there.
+            const Vec2 v0 = slip_[k_zero];
+            if (v0.norm() > eps_slip_) {
+                const Vec2 dir = v0.normalized();
+                const double g0 = v0.dot(dir), g1 = slip1[k_zero].dot(dir);
+                if (g1 <= 0) {
+                    t_zero = refine(t1, [&] { return model_.ws.slip[k_zero].dot(dir); }, y_ev);
+                } else {
+                    // Not yet through zero, but below eps_slip: the zero lies just ahead, where
+                    // the slip extrapolates (linearly over the step) to zero.
+                    t_zero = g0 > g1 ? t1 + g1 * (t1 - t_) / (g0 - g1) : t1;
+                    for (std::size_t i = 0; i < y_ev.size(); ++i) y_ev[i] = ys1_[i] * scale_[i];
+                }
+            } else {
+                const State y0 = y();
+                for (std::size_t i = 0; i < y_ev.size(); ++i) y_ev[i] = y0[i] + lam_zero * (ys1_[i] * scale_[i] - y0[i]);
+            }
+            const Vec3 q = model_.q(y_ev), qd = model_.qd(y_ev);
+            const PlateState ps = model_.plate(t_zero, y_ev);
             bool sticks;
             if (zeros >= 2 && !scene_.part.point) {
                 // Several contacts at zero slip together (the part moves with the plate):
@@ -213,8 +257,8 @@ private:
     // Accepted steps with a slip below eps_arm_ that count as a stuck contact. A transversal
     // reversal crosses that band in a few steps (dopri5 resolves the kink in ~10-30).
     static constexpr long kChatterSteps = 400;
-    Vec3 n_ = Vec3::Zero();
-    std::array<Vec2, 3> slip_{};
+    Vec3 n_ = Vec3::Zero(), n1_ = Vec3::Zero();
+    std::array<Vec2, 3> slip_{}, slip1_{};
 };
 
 // Exponential coordinates of the plate orientation: R1 = exp(phi^). With the spatial angular

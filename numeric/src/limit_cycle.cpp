@@ -17,6 +17,7 @@ std::string LimitCycleSummary::report() const {
     s << "rhs evaluations " << stats.rhs_evals << ", steps " << stats.steps << " (+" << stats.rejected
       << " rejected), slip reversals " << stats.slip_reversals << "\n";
     if (stop.reason != StopReason::None) s << "stopped: " << stop.describe() << "\n";
+    if (!note.empty()) s << note << "\n";
     return s.str();
 }
 
@@ -93,6 +94,14 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
 }  // namespace
 
 LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+    if (sc.part.mu.head(sc.part.contacts()).maxCoeff() <= 0) {
+        // Without friction q'' = -(p'' + omega1' x s)_xy is periodic with zero mean: every initial
+        // twist is periodic and none attracts the others, so the asymptotic twist is undefined.
+        LimitCycleSummary out;
+        out.stop = StopEvent{StopReason::NotConverged, -1, 0};
+        out.note = "frictionless part: every initial twist repeats, so there is no unique limit cycle";
+        return out;
+    }
     LimitCycleSummary out = one_start(sc, q0, opt, qd0);
     const double v = sc.v_ref(), w = v / sc.part.rho();
     const Vec3 kicks[] = {Vec3(v, 0, 0), Vec3(0, v, 0), Vec3(0, 0, sc.part.point ? 0 : w)};

@@ -51,6 +51,7 @@ json to_json(const Scene& sc, const Vec3& q, const LimitCycleSummary& lc) {
     j["cycle_start_twist"] = vec(lc.qd_start, d);
     j["slip_reversals"] = lc.stats.slip_reversals;
     j["restarts"] = lc.restarts;
+    if (!lc.note.empty()) j["note"] = lc.note;
     json ts = json::array();
     for (const auto& e : lc.transient_stops) ts.push_back(e.describe());
     j["transient_stops"] = ts;

@@ -76,6 +76,8 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     json doc;
     try {
         doc = json::parse(text);
+    } catch (const json::out_of_range& e) {   // a number too large for a double
+        throw InputError(source + ": malformed JSON: " + e.what());
     } catch (const json::parse_error& e) {
         // Report a line and column rather than a byte offset.
         std::size_t line = 1, col = 1;
@@ -202,6 +204,32 @@ void validate_scene(const Scene& s) {
         if (!std::isfinite(h.amp) || !std::isfinite(h.phase) || h.n < 1)
             r.fail("plate.harmonics[" + std::to_string(k) + "]", "expected finite amp and phase, n >= 1");
     }
+}
+
+nlohmann::json scene_to_json(const Scene& s) {
+    json j;
+    j["name"] = s.name;
+    j["gravity"] = s.g;
+    json part;
+    part["mass"] = s.part.m;
+    if (s.part.point) {
+        part["friction"] = s.part.mu[0];
+    } else {
+        json I = json::array(), C = json::array();
+        for (int i = 0; i < 3; ++i) {
+            I.push_back({s.part.J(i, 0), s.part.J(i, 1), s.part.J(i, 2)});
+            C.push_back({s.part.c[i].x(), s.part.c[i].y(), s.part.c[i].z()});
+        }
+        part["inertia"] = I;
+        part["contacts"] = C;
+        part["friction"] = {s.part.mu[0], s.part.mu[1], s.part.mu[2]};
+    }
+    j["part"] = part;
+    json H = json::array();
+    for (const auto& h : s.plate.harmonics)
+        H.push_back({{"axis", axis_name(h.axis)}, {"n", h.n}, {"amp", h.amp}, {"phase", h.phase}});
+    j["plate"] = {{"period", s.plate.T}, {"harmonics", H}};
+    return j;
 }
 
 Scene load_scene(const std::string& path) {

@@ -41,6 +41,7 @@ struct LimitCycleSummary {
     int restarts = 0;              // starts abandoned because a contact stuck in the transient
     std::vector<StopEvent> transient_stops;   // why each abandoned start stopped
     std::vector<Sample> path;      // with record: every accepted step from t = 0
+    std::string note;              // why no cycle was sought, if so
 
     bool contact_lost() const { return stop.reason == StopReason::ContactLost; }
     bool sticking() const { return stop.reason == StopReason::Sticking; }

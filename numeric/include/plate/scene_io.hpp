@@ -9,6 +9,8 @@
 
 #include "plate/model.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <stdexcept>
 #include <string>
 
@@ -23,5 +25,7 @@ Scene load_scene(const std::string& path);               // throws InputError
 Scene parse_scene(const std::string& text, const std::string& source);  // throws InputError
 // Checks the physical admissibility of a scene built in code (same checks as the reader).
 void validate_scene(const Scene& scene);                 // throws InputError
+// The scene in the file form above (parse_scene(scene_to_json(s).dump()) gives s back).
+nlohmann::json scene_to_json(const Scene& scene);
 
 }  // namespace plate

@@ -1,0 +1,246 @@
+// The equations of motion (31)-(34), checked against independent physics: the statics of (38),
+// Coulomb's deceleration, and Newton-Euler written directly in the world frame with the
+// accelerations obtained by finite differences of the kinematics.
+#include "plate/dynamics.hpp"
+#include "plate/random_scene.hpp"
+
+#include "engine.hpp"   // dexp_inv, exp_so3, hat
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace plate;
+
+namespace {
+
+Scene resting(Scene s) {
+    s.plate.harmonics.clear();
+    return s;
+}
+
+// (38) solved by Cramer's rule, written out from the appendix (rows: torque x, torque y, force z).
+Vec3 normal_forces_38(const Part& P, const Vec3& rhs) {
+    Mat3 M;
+    for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
+    const double det = M.determinant();
+    Vec3 n;
+    for (int i = 0; i < 3; ++i) {
+        Mat3 Mi = M;
+        Mi.col(i) = rhs;
+        n[i] = Mi.determinant() / det;
+    }
+    return n;
+}
+
+double rel(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
+
+}  // namespace
+
+TEST_CASE("plate at rest, thin part: normal forces solve (38) and sum to m g, whatever the twist", "[dynamics]") {
+    for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+        RandomSceneOptions ro;
+        ro.thin = true;
+        const Scene sc = resting(random_scene(seed, ro));
+        REQUIRE(sc.part.thin());
+        Rng r(seed + 1000);
+        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const Vec3 n38 = normal_forces_38(sc.part, Vec3(0, 0, sc.part.m * sc.g));
+        Workspace ws;
+        for (int k = 0; k < 5; ++k) {
+            const Vec3 qd(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30));
+            accelerations(sc, Dynamics::U, q, qd, PlateState{}, ws);
+            for (int i = 0; i < 3; ++i) CHECK(rel(ws.n[i], n38[i]) < 1e-11);
+            CHECK(rel(ws.n.sum(), sc.part.m * sc.g) < 1e-13);
+        }
+    }
+}
+
+TEST_CASE("thin part on a moving plate: (38) with the U-dynamics right-hand side", "[dynamics]") {
+    for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+        RandomSceneOptions ro;
+        ro.thin = true;
+        const Scene sc = random_scene(seed, ro);
+        Rng r(seed + 7);
+        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const double t = r.uniform(0, sc.plate.T);
+        const PlateState ps = plate_state(sc.plate, t, Dynamics::U);
+        const Mat3 R2 = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix();
+        const Vec3 JRw = sc.part.J * R2.transpose() * ps.wd;
+        const Vec3 s(q[0], q[1], 0);
+        const Vec3 rhs(JRw.x(), JRw.y(), sc.part.m * (ps.pdd + ps.wd.cross(s) + sc.g * Vec3::UnitZ()).z());
+        const Vec3 n38 = normal_forces_38(sc.part, rhs);
+        Workspace ws;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 qd(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30));
+            accelerations(sc, Dynamics::ReducedU, q, qd, ps, ws);
+            for (int i = 0; i < 3; ++i) CHECK(std::abs(ws.n[i] - n38[i]) < 1e-11 * sc.part.m * sc.g);
+        }
+    }
+}
+
+TEST_CASE("a part sliding in pure translation on a resting plate decelerates at mu g", "[dynamics]") {
+    for (bool thin : {true, false}) {
+        for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+            RandomSceneOptions ro;
+            ro.thin = thin;
+            Scene sc = resting(random_scene(seed, ro));
+            sc.part.mu.setConstant(0.3);
+            Rng r(seed);
+            const double a = r.uniform(-kPi, kPi), v = r.uniform(0.01, 1);
+            Workspace ws;
+            accelerations(sc, Dynamics::U, Vec3(0.01, -0.02, 0.3), Vec3(v * std::cos(a), v * std::sin(a), 0),
+                          PlateState{}, ws);
+            // Sum of friction = -mu (sum N) v/|v| and sum N = m g (force balance along z).
+            CHECK(std::abs(ws.qdd[0] + 0.3 * sc.g * std::cos(a)) < 1e-12 * sc.g);
+            CHECK(std::abs(ws.qdd[1] + 0.3 * sc.g * std::sin(a)) < 1e-12 * sc.g);
+            // A thin part's contact forces have no yaw moment (sum N_i r_i = 0 by (38)).
+            if (thin) CHECK(std::abs(ws.qdd[2]) < 1e-9 * sc.g / sc.part.rho());
+        }
+    }
+}
+
+TEST_CASE("thick part: the normal forces depend on the sliding direction (Appendix A coupling)", "[dynamics]") {
+    const Scene sc = resting(random_scene(5));
+    REQUIRE(!sc.part.thin());
+    Workspace ws;
+    accelerations(sc, Dynamics::U, Vec3::Zero(), Vec3(0.3, 0, 0), PlateState{}, ws);
+    const Vec3 n1 = ws.n;
+    accelerations(sc, Dynamics::U, Vec3::Zero(), Vec3(-0.3, 0, 0), PlateState{}, ws);
+    // Friction acting h below the centre of mass tips the part: a moment mu m g h.
+    const double moment = 0.3 * sc.part.m * sc.g * sc.part.s_z();
+    CHECK((n1 - ws.n).norm() > 0.1 * moment / 0.05);
+}
+
+// Newton-Euler in the world frame W: m a_s = R1 sum F_i - m g e_z and dL/dt = sum r_i x R1 F_i,
+// with a_s and dL/dt by central differences of the kinematics p(t) + R1(t) s(t) and
+// L = R J R^T Omega, R = R1 R2. Nothing here uses (19), (24)-(30).
+struct WorldResidual {
+    double force, torque;   // relative to m g and to m g |c|
+};
+
+WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                             const Vec3& qdd, const Vec3& n) {
+    const Part& P = sc.part;
+    const double h = 1e-5;
+    auto R1 = [&](double t) { return Mat3(detail::exp_so3(ps.w1 * t + 0.5 * ps.wd * t * t) * ps.R1); };
+    auto theta = [&](double t) { return q[2] + qd[2] * t + 0.5 * qdd[2] * t * t; };
+    auto R = [&](double t) { return Mat3(R1(t) * Eigen::AngleAxisd(theta(t), Vec3::UnitZ()).toRotationMatrix()); };
+    auto s = [&](double t) {
+        return Vec3(q[0] + qd[0] * t + 0.5 * qdd[0] * t * t, q[1] + qd[1] * t + 0.5 * qdd[1] * t * t, P.s_z());
+    };
+    auto x = [&](double t) { return Vec3(0.5 * ps.pdd * t * t + R1(t) * s(t)); };   // p(0) = 0, p'(0) = 0
+    auto Omega = [&](double t) { return Vec3(ps.w1 + ps.wd * t + R1(t) * Vec3(0, 0, qd[2] + qdd[2] * t)); };
+    auto L = [&](double t) { return Vec3(R(t) * P.J * R(t).transpose() * Omega(t)); };
+    const Vec3 a = (x(h) - 2 * x(0) + x(-h)) / (h * h);
+    const Vec3 Ld = (L(h) - L(-h)) / (2 * h);
+    std::array<Vec2, 3> v;
+    slip_velocities(P, q, qd, v);
+    Vec3 F = Vec3::Zero(), tau = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) {
+        const Vec2 u = v[i].normalized();
+        const Vec3 Fi = ps.R1 * Vec3(-P.mu[i] * n[i] * u.x(), -P.mu[i] * n[i] * u.y(), n[i]);
+        F += Fi;
+        tau += (R(0) * P.c[i]).cross(Fi);
+    }
+    const double mg = P.m * sc.g;
+    return {(P.m * a - (F - mg * Vec3::UnitZ())).norm() / mg, (Ld - tau).norm() / (mg * P.c[0].norm())};
+}
+
+TEST_CASE("full dynamics (31) satisfy Newton-Euler in the world frame", "[dynamics][full]") {
+    // Central differences with h = 1e-5 s. Force: truncation h^2/12 |x''''| with |x''''| < 200 m/s^4
+    // (|omega1| < 9 rad/s, |omega1'| < 130 rad/s^2, |s| < 0.05 m) is 2e-10 m g; rounding
+    // 2 eps |x| / h^2 is 1e-8 m g. Torque: truncation h^2/6 |L'''| with |L'''| ~ J theta'^4 < 10 is
+    // 1e-8 m g |c|; rounding eps |L| / h is negligible. Bound: 1e-7.
+    for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+        const Scene sc = random_scene(seed);
+        Rng r(seed * 31);
+        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const Vec3 qd(r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-30, 30));
+        PlateState ps;
+        ps.R1 = detail::exp_so3(Vec3(r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)));
+        ps.w1 = Vec3(r.uniform(-5, 5), r.uniform(-5, 5), r.uniform(-5, 5));
+        ps.pdd = Vec3(r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(-3, 3));
+        ps.wd = Vec3(r.uniform(-50, 50), r.uniform(-50, 50), r.uniform(-100, 100));
+        Workspace ws;
+        accelerations(sc, Dynamics::Full, q, qd, ps, ws);
+        const WorldResidual res = world_residual(sc, q, qd, ps, ws.qdd, ws.n);
+        CHECK(res.force < 1e-7);
+        CHECK(res.torque < 1e-7);
+    }
+}
+
+TEST_CASE("the printed (28), with R1 where R1^T belongs, violates Euler's equation", "[dynamics][full][paper]") {
+    // (28) as printed: -R2^T w2^ R1 w1. With R1 = I the two forms agree, so tilt the plate.
+    const Scene sc = random_scene(11);
+    const Vec3 q(0.01, 0.02, 0.7), qd(0.1, -0.2, 25);
+    PlateState ps;
+    ps.R1 = detail::exp_so3(Vec3(0.3, -0.2, 0.9));
+    ps.w1 = Vec3(3, -2, 4);
+    Workspace ws;
+    accelerations(sc, Dynamics::Full, q, qd, ps, ws);
+    const Vec6 b = rhs_b(sc, Dynamics::Full, q, qd, ps);
+    const Mat3 R2t = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix().transpose();
+    const Vec3 w2(0, 0, qd[2]);
+    Vec6 b_printed = b;
+    b_printed.tail<3>() += sc.part.J * (R2t * w2.cross(ps.R1.transpose() * ps.w1)) -
+                           sc.part.J * (R2t * w2.cross(ps.R1 * ps.w1));
+    const Vec6 z = ws.A.partialPivLu().solve(b_printed);
+    const WorldResidual derived = world_residual(sc, q, qd, ps, ws.qdd, ws.n);
+    const WorldResidual printed = world_residual(sc, q, qd, ps, z.head<3>(), z.tail<3>());
+    CHECK(derived.torque < 1e-7);
+    CHECK(printed.torque > 1e-3);
+}
+
+TEST_CASE("U-dynamics are the full dynamics with R1 = I and products of x and u dropped", "[dynamics]") {
+    const Scene sc = random_scene(3);
+    const Vec3 q(0.01, -0.01, 0.2), qd(0.05, 0.02, 3);
+    PlateState ps = plate_state(sc.plate, 0.013, Dynamics::U);
+    Workspace wu, wf;
+    accelerations(sc, Dynamics::U, q, qd, ps, wu);
+    accelerations(sc, Dynamics::Full, q, qd, ps, wf);   // omega1 = 0, R1 = I: only w2^ J w2 differs
+    const Vec3 w2(0, 0, qd[2]);
+    Vec6 b = wu.b;
+    b.tail<3>() += w2.cross(sc.part.J * w2);
+    CHECK((wf.b - b).norm() < 1e-14 * wf.b.norm());
+}
+
+TEST_CASE("exponential coordinates: phi' = dexp^-1(phi) omega1 follows R1' = omega1^ R1", "[dynamics][so3]") {
+    Rng r(99);
+    for (int k = 0; k < 50; ++k) {
+        const Vec3 phi(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
+        const Vec3 w(r.uniform(-3, 3), r.uniform(-3, 3), r.uniform(-3, 3));
+        const double h = 1e-6;
+        const Vec3 phid = detail::dexp_inv(phi * (k == 0 ? 1e-5 : 1.0), w);
+        const Vec3 p0 = phi * (k == 0 ? 1e-5 : 1.0);
+        const Mat3 Rd = (detail::exp_so3(p0 + h * phid) - detail::exp_so3(p0 - h * phid)) / (2 * h);
+        const Mat3 W = Rd * detail::exp_so3(p0).transpose();
+        CHECK((W - detail::hat(w)).norm() < 1e-8 * w.norm());
+    }
+}
+
+TEST_CASE("stick test: a point part at zero slip sticks exactly when |p''| <= mu g", "[dynamics][stick]") {
+    Scene sc;
+    sc.part.point = true;
+    sc.part.m = 0.1;
+    sc.part.mu.setConstant(0.3);
+    sc.plate.T = 0.05;
+    PlateState ps;
+    ps.pdd = Vec3(0.29 * sc.g, 0, 0);
+    CHECK(stick_test(sc, Dynamics::U, 0, Vec3::Zero(), Vec3::Zero(), ps).sticks);
+    ps.pdd = Vec3(0.31 * sc.g, 0, 0);
+    CHECK_FALSE(stick_test(sc, Dynamics::U, 0, Vec3::Zero(), Vec3::Zero(), ps).sticks);
+}
+
+TEST_CASE("stick test: a rigid part held at one contact on a resting plate sticks", "[dynamics][stick]") {
+    const Scene sc = resting(random_scene(4, RandomSceneOptions{true}));
+    // Contact 0 at zero slip, others sliding slowly about it: friction needed is finite and the
+    // static load is positive; with a large spin the centripetal demand exceeds mu N.
+    CHECK(stick_test(sc, Dynamics::U, 0, Vec3::Zero(), Vec3::Zero(), PlateState{}).sticks);
+    const Part& P = sc.part;
+    const double w = 200;   // rad/s about contact 0
+    const Vec3 qd(w * P.c[0].y(), -w * P.c[0].x(), w);   // s' = -w e_z x c_0
+    const StickTest st = stick_test(sc, Dynamics::U, 0, Vec3::Zero(), qd, PlateState{});
+    CHECK_FALSE(st.sticks);
+    CHECK(st.friction_needed > st.friction_available);
+}

@@ -1,0 +1,181 @@
+// Limit cycles and asymptotic twists (Section IV-A/B): closed-form cycles, Observation 1 on
+// the paper's scenes, and the stops (sticking, contact loss, no convergence).
+#include "plate/limit_cycle.hpp"
+#include "plate/random_scene.hpp"
+#include "plate/scene_io.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace plate;
+
+namespace {
+
+Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+
+// Plate position (A cos wt, A sin wt, 0): p'' = -A w^2 (cos wt, sin wt) = A w^2 (sin(wt - pi/2), sin(wt + pi)).
+PlateMotion circle(double Aw2, double T) {
+    PlateMotion u;
+    u.T = T;
+    u.harmonics = {Harmonic{Axis::x, 1, Aw2, -kPi / 2}, Harmonic{Axis::y, 1, Aw2, kPi}};
+    return u;
+}
+
+}  // namespace
+
+TEST_CASE("circular plate translation: the cycle is a circle of speed mu g / w lagging arccos(mu g / A w^2)",
+          "[limit_cycle][closed_form]") {
+    // Steady state (derivation in the test's comment): with relative velocity V e^{i(wt+psi)},
+    // e^{i psi}(mu g + i V w) = A w^2, so the part's absolute velocity is
+    // e^{i wt} A w i mu g / (mu g + i V w): speed mu g / w, lag arccos(mu g / (A w^2)).
+    const double T = 0.05, w = 2 * kPi / T, Aw2 = 20, mu = 0.3, g = 9.81;
+    Scene point;
+    point.name = "circle-point";
+    point.part.point = true;
+    point.part.m = 0.02;
+    point.part.mu.setConstant(mu);
+    point.plate = circle(Aw2, T);
+    Scene thin = point;
+    thin.name = "circle-thin";
+    thin.part = random_scene(8, RandomSceneOptions{true}).part;   // CoM inside its contact triangle
+    thin.part.mu.setConstant(mu);
+    REQUIRE(thin.part.thin());
+
+    for (const Scene* sc : {&point, &thin}) {
+        INFO(sc->name);
+        LimitCycleOptions opt;
+        opt.integration.rtol = 1e-12;
+        opt.tol = 1e-11;
+        opt.record = true;
+        const Vec3 qd0 = sc->part.point ? Vec3(0.05, -0.02, 0) : Vec3(0.05, -0.02, 3);
+        const LimitCycleSummary lc = limit_cycle(*sc, Vec3(0.01, -0.02, 0.4), opt, qd0);
+        REQUIRE(lc.converged);
+        const double speed = mu * g / w, lag = std::acos(mu * g / Aw2);
+        // The last period of the recorded path.
+        const double t_end = lc.path.back().t;
+        int checked = 0;
+        for (const auto& s : lc.path) {
+            if (s.t < t_end - T) continue;
+            Vec3 pd, w1;
+            sc->plate.velocity(s.t, pd, w1);
+            const Vec2 v = s.qd.head<2>() + pd.head<2>();     // absolute velocity
+            CHECK(std::abs(v.norm() - speed) < 1e-6 * speed);
+            const double dphi = std::remainder(std::atan2(pd.y(), pd.x()) - std::atan2(v.y(), v.x()), 2 * kPi);
+            CHECK(std::abs(dphi - lag) < 1e-6 * lag);
+            CHECK(std::abs(s.qd[2]) < 1e-6 * speed / sc->part.rho());   // no spin
+            ++checked;
+        }
+        CHECK(checked > 20);
+        CHECK(lc.twist.head<2>().norm() < 1e-6 * speed);   // zero mean velocity
+    }
+}
+
+TEST_CASE("Observation 1: very different initial twists reach the same limit cycle on the paper's scenes",
+          "[limit_cycle][paper]") {
+    struct Case {
+        const char* scene;
+        Vec3 q;
+    };
+    const Case cases[] = {{"fig1", Vec3(0.02, 0.01, 0.4)}, {"fig1_point", Vec3(0.02, 0.01, 0)},
+                          {"fig4", Vec3(0.03, -0.02, 1.0)}, {"fig5", Vec3(-0.01, 0.02, 2.5)},
+                          {"fig6", Vec3(0.03, 0.03, 1.2)},  {"fig3_random", Vec3(0.01, -0.01, 0.5)}};
+    for (const auto& c : cases) {
+        INFO(c.scene);
+        const Scene sc = scene(c.scene);
+        LimitCycleOptions opt;
+        opt.integration.rtol = 1e-11;
+        opt.tol = 1e-9;
+        const double v = sc.v_ref();
+        const LimitCycleSummary a = limit_cycle(sc, c.q, opt, Vec3(0.5 * v, -0.3 * v, 0));
+        const LimitCycleSummary b = limit_cycle(sc, c.q, opt, Vec3(-3 * v, 2 * v, sc.part.point ? 0 : 40));
+        REQUIRE(a.converged);
+        REQUIRE(b.converged);
+        // Each average lies within its error estimate (<= tol v_ref) of the cycle's; the two runs'
+        // integration errors differ by at most ~ steps x rtol ~ 1e-8 v_ref. Bound: 1e-7 v_ref.
+        const Vec3 scale(v, v, v / sc.part.rho());
+        CHECK(((a.twist - b.twist).array() / scale.array()).abs().maxCoeff() < 1e-7);
+        CHECK(((a.qd_start - b.qd_start).array() / scale.array()).abs().maxCoeff() < 1e-6);
+        CHECK(a.min_normal_force > 0);
+    }
+}
+
+TEST_CASE("a block sliding on a resting plate sticks at t = v0 / (mu g)", "[limit_cycle][stick]") {
+    Scene sc;
+    sc.name = "block";
+    sc.part.point = true;
+    sc.part.m = 0.1;
+    sc.part.mu.setConstant(0.3);
+    sc.plate.T = 0.05;   // no harmonics: the plate rests
+    const double v0 = 0.1;
+    LimitCycleOptions opt;
+    opt.restarts = 0;   // the first start is the block's motion
+    const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), opt, Vec3(v0, 0, 0));
+    REQUIRE(lc.sticking());
+    CHECK_FALSE(lc.converged);
+    // Located by bisection to 1e-14 T (or linear extrapolation) on a velocity that is exactly
+    // linear in t before the stop, so only rounding remains.
+    CHECK(lc.stop.t == Approx(v0 / (0.3 * sc.g)).epsilon(1e-10));
+}
+
+TEST_CASE("vertical plate acceleration beyond g: contact is lost when p''_z = -g", "[limit_cycle][contact]") {
+    Scene sc;
+    sc.name = "bounce";
+    sc.part.point = true;
+    sc.part.m = 0.1;
+    sc.part.mu.setConstant(0.3);
+    sc.plate.T = 0.05;
+    sc.plate.harmonics = {Harmonic{Axis::x, 1, 20, 0}, Harmonic{Axis::z, 1, 15, 0}};
+    const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), LimitCycleOptions{}, Vec3(0.1, 0, 0));
+    REQUIRE(lc.contact_lost());
+    const double w = sc.plate.omega();
+    CHECK(lc.stop.t == Approx((kPi + std::asin(sc.g / 15)) / w).epsilon(1e-10));   // N = m (g + p''_z)
+    CHECK(lc.stop.contact == 0);
+}
+
+TEST_CASE("a rigid part loses contact when the plate tips it off one foot", "[limit_cycle][contact]") {
+    Scene sc = scene("fig4");
+    sc.plate.harmonics = {Harmonic{Axis::x, 1, 20, 0}, Harmonic{Axis::rx, 1, 800, 0}};
+    const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), LimitCycleOptions{}, Vec3(0.1, 0, 0));
+    CHECK(lc.contact_lost());
+    CHECK(lc.stop.t < sc.plate.T);
+    CHECK(lc.stop.describe().find("lost") != std::string::npos);
+}
+
+TEST_CASE("no convergence ends at the period cap, it never hangs", "[limit_cycle]") {
+    Scene sc = scene("fig4");
+    LimitCycleOptions opt;
+    opt.max_periods = 3;
+    LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), opt);
+    CHECK_FALSE(lc.converged);
+    CHECK(lc.periods == 3);
+    CHECK(lc.stop.reason == StopReason::NotConverged);
+    CHECK(std::isnan(lc.twist[0]));
+    // Frictionless: every initial twist is periodic (q'' depends on t only), so a residual of zero
+    // proves nothing; the cycle is not unique and no twist is returned.
+    sc.part.mu.setZero();
+    lc = limit_cycle(sc, Vec3::Zero(), opt, Vec3(0.1, 0.05, 2));
+    CHECK_FALSE(lc.converged);
+    CHECK(lc.note.find("frictionless") != std::string::npos);
+}
+
+TEST_CASE("limit cycles are T-periodic and the twist is the period average (36)", "[limit_cycle]") {
+    const Scene sc = scene("fig4");
+    LimitCycleOptions opt;
+    opt.record = true;
+    opt.integration.rtol = 1e-11;
+    opt.tol = 1e-10;
+    const LimitCycleSummary lc = limit_cycle(sc, Vec3(0.02, 0.01, 0.5), opt, Vec3(0.1, 0, 0));
+    REQUIRE(lc.converged);
+    // Trapezoidal average of the recorded last period agrees with the integrated average to the
+    // trapezoid's error (h^2/12 |q'''| T with h <= T/50): 1e-3 relative to v_ref.
+    const double T = sc.plate.T, t_end = lc.path.back().t;
+    Vec3 avg = Vec3::Zero();
+    for (std::size_t i = 1; i < lc.path.size(); ++i) {
+        if (lc.path[i - 1].t < t_end - T - 1e-12) continue;
+        avg += 0.5 * (lc.path[i].qd + lc.path[i - 1].qd) * (lc.path[i].t - lc.path[i - 1].t);
+    }
+    avg /= T;
+    CHECK((avg - lc.twist).head<2>().norm() < 1e-3 * sc.v_ref());
+    CHECK((lc.path.back().qd - lc.qd_start).head<2>().norm() < 1e-8 * sc.v_ref());
+}
