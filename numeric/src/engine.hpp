@@ -228,10 +228,8 @@ private:
             const PlateState ps = model_.plate(t_zero, y_ev);
             bool sticks;
             if (zeros >= 2 && !scene_.part.point) {
-                // Several contacts at zero slip together (the part moves with the plate):
-                // necessary condition for sticking: |f_xy| <= max mu * f_z.
-                const Vec6 b = rhs_b(scene_, model_.level, q, qd, ps);
-                sticks = b[2] > 0 && b.head<2>().norm() <= scene_.part.mu.maxCoeff() * b[2];
+                // Several contacts at zero slip together: could the whole part ride with the plate?
+                sticks = stick_test_all(scene_, model_.level, q, qd, ps).sticks;
             } else {
                 sticks = stick_test(scene_, model_.level, k_zero, q, qd, ps).sticks;
             }

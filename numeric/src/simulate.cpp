@@ -42,21 +42,19 @@ std::string StopEvent::describe() const {
 }
 
 double breakaway_time(const Scene& sc, const Vec3& q0, double t0) {
-    const double mu = sc.part.point ? sc.part.mu[0] : sc.part.mu.maxCoeff();
-    auto margin = [&](double t) {   // > 0 while friction holds the part
-        const Vec6 b = rhs_b(sc, Dynamics::U, q0, Vec3::Zero(), plate_state(sc.plate, t, Dynamics::U));
-        return mu * b[2] - b.head<2>().norm();
+    auto holds = [&](double t) {   // friction can carry the part with the plate at time t
+        return stick_test_all(sc, Dynamics::U, q0, Vec3::Zero(), plate_state(sc.plate, t, Dynamics::U)).sticks;
     };
     const double T = sc.plate.T;
-    const int n = 4096;
+    const int n = 1024;
+    if (!holds(t0)) return t0;
     double ta = t0;
-    if (margin(t0) < 0) return t0;
     for (int i = 1; i <= n; ++i) {
         double tb = t0 + T * i / n;
-        if (margin(tb) < 0) {
+        if (!holds(tb)) {
             for (int it = 0; it < 200 && tb - ta > 1e-15 * T; ++it) {
                 const double tm = 0.5 * (ta + tb);
-                if (margin(tm) < 0) tb = tm; else ta = tm;
+                if (holds(tm)) ta = tm; else tb = tm;
             }
             return tb;
         }

@@ -57,9 +57,8 @@ struct Trajectory {
     Stats stats;
 };
 
-// A part at rest relative to the plate rides with it while friction can transmit the plate's
-// acceleration (|f~_xy| <= mu f~_z, eq. 33; for a rigid part the largest mu, a necessary
-// condition). Returns the first time >= t0 at which it breaks away and starts sliding, or NaN
+// A part at rest relative to the plate rides with it while friction can supply the wrench that
+// keeps it there (stick_test_all, from the U-dynamics' b~ (33)-(34)). Returns the first time >= t0 at which it breaks away and starts sliding, or NaN
 // if it stays stuck for a whole period. Trajectories and limit cycles that start at rest
 // begin sliding at this time.
 double breakaway_time(const Scene& scene, const Vec3& q0, double t0);
