@@ -1,1 +1,169 @@
+// The plate program end to end: output shapes, and bad input refused with exit code 2, a
+// message naming the file and field, and no output file.
+#include <nlohmann/json.hpp>
+
 #include <catch2/catch.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+    int code;
+    std::string out, err;
+};
+
+fs::path tmpdir() {
+    static const fs::path d = [] {
+        fs::path p = fs::temp_directory_path() / ("plate_cli_" + std::to_string(::getpid()));
+        fs::create_directories(p);
+        return p;
+    }();
+    return d;
+}
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+Run run(const std::string& args) {
+    const fs::path o = tmpdir() / "stdout", e = tmpdir() / "stderr";
+    const std::string cmd = std::string(PLATE_EXE) + " " + args + " > " + o.string() + " 2> " + e.string();
+    const int st = std::system(cmd.c_str());
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(o), slurp(e)};
+}
+
+const std::string kScenes = PLATE_SOURCE_DIR "/scenes/";
+
+std::string fig4_with(const std::string& from, const std::string& to) {
+    std::string s = slurp(kScenes + "fig4.json");
+    const auto p = s.find(from);
+    REQUIRE(p != std::string::npos);
+    return s.replace(p, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
+    const Run r = run("twist " + kScenes + "fig4.json --at 0.02 0.01 0.5");
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["twist"].size() == 3);
+    CHECK(j["converged"] == true);
+    CHECK(j["contact_lost"] == false);
+    CHECK(j["sticking"] == false);
+    CHECK(j["periods"].get<int>() > 1);
+    CHECK(j["min_normal_force"].get<double>() > 0);
+    const Run p = run("twist " + kScenes + "fig1_point.json --at 0.02 0.01");
+    REQUIRE(p.code == 0);
+    CHECK(nlohmann::json::parse(p.out)["twist"].size() == 2);
+}
+
+TEST_CASE("plate field writes JSON and CSV; simulate writes a CSV with a header", "[cli]") {
+    const fs::path out = tmpdir() / "field.csv";
+    Run r = run("field " + kScenes + "fig4.json --grid 2 --format csv --out " + out.string());
+    REQUIRE(r.code == 0);
+    const std::string csv = slurp(out);
+    CHECK(csv.rfind("s_x,s_y,theta,v_x,v_y,omega,", 0) == 0);
+    CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 8);
+    r = run("field " + kScenes + "fig1_point.json --grid 3");
+    REQUIRE(r.code == 0);
+    CHECK(nlohmann::json::parse(r.out)["points"].size() == 9);
+    const fs::path sim = tmpdir() / "sim.csv";
+    r = run("simulate " + kScenes + "fig4.json --dynamics full --from 0.02 0.01 0.5 --time 0.5 --out " + sim.string());
+    REQUIRE(r.code == 0);
+    const std::string s = slurp(sim);
+    CHECK(s.rfind("t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3\n", 0) == 0);
+    r = run("fixed-points " + kScenes + "fig1_point.json --grid 5");
+    REQUIRE(r.code == 0);
+    CHECK(nlohmann::json::parse(r.out)["lines"].size() == 1);
+}
+
+TEST_CASE("every command has --help", "[cli]") {
+    for (const char* c : {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene "}) {
+        const Run r = run(std::string(c) + "--help");
+        CHECK(r.code == 0);
+        CHECK(r.out.find("usage") != std::string::npos);
+    }
+}
+
+TEST_CASE("bad input: exit code 2, the file and the field named, no output file", "[cli][input]") {
+    struct Case {
+        std::string scene, expect;
+    };
+    const Case cases[] = {
+        {"{\"name\": \"x\",", "malformed JSON"},
+        {fig4_with("\"gravity\": 9.81,", ""), "gravity: missing"},
+        {fig4_with("\"period\": 0.05", "\"period\": 0.05, \"speed\": 3"), "plate.speed: unknown field"},
+        {fig4_with("[0, 0.03, -0.002]", "[0, 0.03]"), "part.contacts[1]: expected an array of 3"},
+        {fig4_with("\"mass\": 0.0216", "\"mass\": -0.0216"), "part.mass: expected a positive"},
+        {fig4_with("[0, 1.23e-6, 0]", "[0, -1.23e-6, 0]"), "part.inertia: expected a symmetric positive definite"},
+        {fig4_with("[0.3, 0.3, 0.3]", "[0.3, 0.3, -0.3]"), "part.friction: expected friction coefficients >= 0"},
+        {fig4_with("[0, 0.03, -0.002]", "[0, -0.03, -0.002]"), "part.contacts: expected non-collinear"},
+        {fig4_with("[0, 0.03, -0.002]", "[0, 0.03, 0.001]"), "part.contacts: expected coplanar"},
+        {fig4_with("\"period\": 0.05", "\"period\": 0"), "plate.period: expected a positive"},
+        {fig4_with("\"amp\": 20,", "\"amp\": NaN,"), "malformed JSON"},
+    };
+    int k = 0;
+    for (const auto& c : cases) {
+        const fs::path scene = tmpdir() / ("bad" + std::to_string(k++) + ".json");
+        std::ofstream(scene) << c.scene;
+        const fs::path out = tmpdir() / "must-not-exist.json";
+        fs::remove(out);
+        for (const std::string& cmd : {"field " + scene.string() + " --grid 2 --out " + out.string(),
+                                      "twist " + scene.string() + " --at 0 0 0"}) {
+            const Run r = run(cmd);
+            INFO(cmd << "\n" << r.err);
+            CHECK(r.code == 2);
+            CHECK(r.err.find(scene.string()) != std::string::npos);
+            CHECK(r.err.find(c.expect) != std::string::npos);
+            CHECK_FALSE(fs::exists(out));
+            CHECK_FALSE(fs::exists(out.string() + ".tmp"));
+        }
+    }
+}
+
+TEST_CASE("bad arguments: exit code 2 with the option named", "[cli][input]") {
+    const std::string f4 = kScenes + "fig4.json";
+    const std::pair<std::string, std::string> cases[] = {
+        {"twist " + f4 + " --at 0 nan 0", "--at: expected a finite number"},
+        {"twist " + f4 + " --at 0 0", "--at"},
+        {"twist " + f4, "missing --at"},
+        {"field " + f4 + " --grid 0", "--grid: expected a whole number"},
+        {"field " + f4 + " --format xml", "--format"},
+        {"field " + f4 + " --colour red", "unknown option --colour"},
+        {"simulate " + f4 + " --dynamics fast --from 0 0 0 --time 1", "--dynamics"},
+        {"simulate " + f4 + " --dynamics u --from 0 0 0 --time -1", "--time"},
+        {"twist /nonexistent.json --at 0 0 0", "/nonexistent.json: cannot open"},
+        {"frobnicate", "unknown command"},
+    };
+    for (const auto& [args, expect] : cases) {
+        const Run r = run(args);
+        INFO(args << "\n" << r.err);
+        CHECK(r.code == 2);
+        CHECK(r.err.find(expect) != std::string::npos);
+    }
+}
+
+TEST_CASE("a simulation that leaves the model stops with exit code 3 and says why", "[cli]") {
+    const fs::path scene = tmpdir() / "bounce.json";
+    std::ofstream(scene) << fig4_with("{\"axis\": \"x\",  \"n\": 1, \"amp\": 20,  \"phase\": 0}",
+                                      "{\"axis\": \"x\",  \"n\": 1, \"amp\": 20,  \"phase\": 0}, "
+                                      "{\"axis\": \"z\",  \"n\": 1, \"amp\": 15,  \"phase\": 0}");
+    const fs::path out = tmpdir() / "bounce.csv";
+    const Run r = run("simulate " + scene.string() + " --dynamics u --from 0 0 0 --time 1 --out " + out.string());
+    CHECK(r.code == 3);
+    CHECK(r.err.find("lost") != std::string::npos);
+    CHECK(fs::exists(out));   // the trajectory up to the loss of contact
+}
