@@ -79,8 +79,98 @@ Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const
     return b;
 }
 
+void Workspace::prepare(const Scene& sc) {
+    const Part& P = sc.part;
+    prepared = &sc;
+    in = gen::KernelInput{};
+    in.m = P.m;
+    in.g = sc.g;
+    in.Jxx = P.J(0, 0);
+    in.Jxy = P.J(0, 1);
+    in.Jxz = P.J(0, 2);
+    in.Jyy = P.J(1, 1);
+    in.Jyz = P.J(1, 2);
+    in.Jzz = P.J(2, 2);
+    in.c1x = P.c[0].x(); in.c1y = P.c[0].y();
+    in.c2x = P.c[1].x(); in.c2y = P.c[1].y();
+    in.c3x = P.c[2].x(); in.c3y = P.c[2].y();
+    in.cz = P.point ? 0.0 : P.c[0].z();
+    in.sz = P.s_z();
+    in.mu1 = P.mu[0]; in.mu2 = P.mu[1]; in.mu3 = P.mu[2];
+    in.R11 = in.R22 = in.R33 = 1;
+    theta = std::numeric_limits<double>::quiet_NaN();
+    thin = P.thin();
+    if (thin) {
+        double M[9];
+        gen::thin_M38(in, M);
+        M38_inv = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).inverse();
+    }
+}
+
 void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                    Workspace& ws) {
+    const Part& P = sc.part;
+    ++ws.evals;
+    if (ws.prepared != &sc) ws.prepare(sc);
+    gen::KernelInput& in = ws.in;
+    if (q[2] != ws.theta) {   // constant in the reduced U-dynamics: computed once
+        ws.theta = q[2];
+        in.ct = std::cos(q[2]);
+        in.st = std::sin(q[2]);
+    }
+    in.sx = q[0];
+    in.sy = q[1];
+    in.sxd = qd[0];
+    in.syd = qd[1];
+    in.thd = P.point ? 0.0 : qd[2];
+    // Sliding velocities s' + w2^ R2 c_i and their unit directions (zero at zero slip).
+    double* u[3][2] = {{&in.u1x, &in.u1y}, {&in.u2x, &in.u2y}, {&in.u3x, &in.u3y}};
+    const double cxs[3] = {in.c1x, in.c2x, in.c3x}, cys[3] = {in.c1y, in.c2y, in.c3y};
+    for (int i = 0; i < P.contacts(); ++i) {
+        const double rx = in.ct * cxs[i] - in.st * cys[i], ry = in.st * cxs[i] + in.ct * cys[i];
+        const Vec2 v = P.point ? Vec2(qd[0], qd[1]) : Vec2(qd[0] - qd[2] * ry, qd[1] + qd[2] * rx);
+        ws.slip[i] = v;
+        const double sp = v.norm();
+        *u[i][0] = sp > 0 ? v.x() / sp : 0.0;
+        *u[i][1] = sp > 0 ? v.y() / sp : 0.0;
+    }
+    in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
+    in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();
+    double b[6];
+    if (level == Dynamics::Full) {
+        in.wx = ps.w1.x(); in.wy = ps.w1.y(); in.wz = ps.w1.z();
+        in.R11 = ps.R1(0, 0); in.R12 = ps.R1(0, 1); in.R13 = ps.R1(0, 2);
+        in.R21 = ps.R1(1, 0); in.R22 = ps.R1(1, 1); in.R23 = ps.R1(1, 2);
+        in.R31 = ps.R1(2, 0); in.R32 = ps.R1(2, 1); in.R33 = ps.R1(2, 2);
+        gen::b_full(in, b);
+    } else {
+        gen::b_U(in, b);
+    }
+    ws.b = Eigen::Map<const Vec6>(b);
+    if (P.point) {
+        double z[3];
+        gen::point_solve(in, b, z);
+        ws.qdd = Vec3(z[0], z[1], 0);
+        ws.n = Vec3(z[2], 0, 0);
+        ws.slip[1].setZero();
+        ws.slip[2].setZero();
+        return;
+    }
+    if (ws.thin) {
+        ws.n = ws.M38_inv * Vec3(b[3], b[4], b[2]);   // (38)
+    } else {
+        double M[9], r[3];
+        gen::thick_reduced(in, b, M, r);
+        ws.n = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(
+            Eigen::Map<const Vec3>(r));
+    }
+    double qdd[3];
+    gen::back_substitution(in, b, ws.n.data(), qdd);
+    ws.qdd = Vec3(qdd[0], qdd[1], qdd[2]);
+}
+
+void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                             Workspace& ws) {
     const Part& P = sc.part;
     ++ws.evals;
     slip_velocities(P, q, qd, ws.slip);

@@ -1,0 +1,13 @@
+# Regenerates into OUT and compares every generated file with the committed copy in SRC.
+file(REMOVE_RECURSE "${OUT}")
+execute_process(COMMAND "${DERIVE}" --out "${OUT}" RESULT_VARIABLE rc OUTPUT_QUIET)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "derive failed (${rc})")
+endif()
+foreach(f numeric/generated/plate_kernels.hpp reports/generated/derivation.tex reports/generated/derivation_findings.md)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files "${SRC}/${f}" "${OUT}/${f}" RESULT_VARIABLE diff)
+  if(NOT diff EQUAL 0)
+    message(FATAL_ERROR "${f} differs from a fresh generation: run `cmake --build build --target kernels` and commit")
+  endif()
+  message(STATUS "${f}: matches a fresh generation")
+endforeach()

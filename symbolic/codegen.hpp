@@ -1,0 +1,50 @@
+// C++ code generation from GiNaC expressions, with common subexpressions shared.
+//
+// Every distinct non-trivial subexpression (by GiNaC's structural equality) becomes one
+// `const double tN = ...;`, so a subexpression used by several outputs is computed once.
+// Powers are written out: integer exponents as products (negative ones as a reciprocal),
+// half-integer exponents through std::sqrt. Any other exponent, or a function other than
+// those, is an error -- the GiNaC 1.8 C printer's silent loss of reciprocals with inexact
+// exponents cannot happen here.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace plate::symbolic {
+
+class Emitter {
+public:
+    // inputs: symbol name -> C++ expression that reads it (e.g. "in.m").
+    explicit Emitter(std::map<std::string, std::string> inputs) : inputs_(std::move(inputs)) {}
+    // Emits what e needs and returns a C++ expression for its value.
+    std::string operator()(const GiNaC::ex& e);
+    // Assigns e to `target` (e.g. "out[3]").
+    void assign(const std::string& target, const GiNaC::ex& e);
+    std::string code() const { return body_.str(); }
+    int temporaries() const { return next_; }
+
+private:
+    std::string temp(const std::string& rhs);
+    std::string emit_power(const GiNaC::ex& base, const GiNaC::numeric& exponent);
+    std::map<std::string, std::string> inputs_;
+    std::map<GiNaC::ex, std::string, GiNaC::ex_is_less> memo_;
+    std::ostringstream body_;
+    int next_ = 0;
+};
+
+std::string double_literal(const GiNaC::numeric& x);
+
+// GiNaC orders the terms of sums and products by hash values seeded with type-info addresses,
+// which move from run to run (ASLR). These give a run-independent order: operands sorted by
+// their canonical text, itself built from sorted operands.
+std::string canonical_text(const GiNaC::ex& e);
+std::vector<GiNaC::ex> sorted_operands(const GiNaC::ex& e);
+// LaTeX with the canonical order (symbols printed by name, u1x -> u_{1x}, ...).
+std::string latex_text(const GiNaC::ex& e);
+
+}  // namespace plate::symbolic

@@ -1,0 +1,480 @@
+#include "derivation.hpp"
+
+#include "codegen.hpp"
+
+#include <functional>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace plate::symbolic {
+
+using namespace GiNaC;
+
+namespace {
+
+std::string idx(const char* a, int i, const char* b = "") { return a + std::to_string(i + 1) + b; }
+
+matrix col(const ex& a, const ex& b, const ex& c) { return matrix{{a}, {b}, {c}}; }
+matrix hat(const matrix& v) { return matrix{{0, -v(2, 0), v(1, 0)}, {v(2, 0), 0, -v(0, 0)}, {-v(1, 0), v(0, 0), 0}}; }
+matrix cross(const matrix& a, const matrix& b) { return hat(a).mul(b); }
+matrix vee(const matrix& X) { return col(X(2, 1), X(0, 2), X(1, 0)); }
+
+matrix map(const matrix& M, const std::function<ex(const ex&)>& f) {
+    matrix out(M.rows(), M.cols());
+    for (unsigned i = 0; i < M.rows(); ++i)
+        for (unsigned j = 0; j < M.cols(); ++j) out(i, j) = f(M(i, j));
+    return out;
+}
+matrix expand_all(const matrix& M) { return map(M, [](const ex& e) { return e.expand(); }); }
+matrix sub(const matrix& a, const matrix& b) { return a.sub(b); }
+bool is_zero(const matrix& M) {
+    for (unsigned i = 0; i < M.rows(); ++i)
+        for (unsigned j = 0; j < M.cols(); ++j)
+            if (!M(i, j).expand().is_zero()) return false;
+    return true;
+}
+ex to_ex(const matrix& M) { return M; }
+
+// The total time derivative: d/dt e = sum over symbols s of (de/ds) s'.
+struct Jet {
+    std::vector<std::pair<realsymbol, ex>> rules;
+    ex D(const ex& e) const {
+        ex r = 0;
+        for (const auto& [s, ds] : rules) {
+            const ex de = e.diff(s);
+            if (!de.is_zero()) r += de * ds;
+        }
+        return r.expand();
+    }
+    matrix D(const matrix& M) const { return map(M, [this](const ex& e) { return D(e); }); }
+};
+
+std::vector<realsymbol> all_symbols(const Symbols& S) {
+    std::vector<realsymbol> v = {S.m,  S.g,   S.Jxx, S.Jxy, S.Jxz, S.Jyy, S.Jyz, S.Jzz, S.cz,  S.thd, S.thdd,
+                                 S.sx, S.sy,  S.sz,  S.sxd, S.syd, S.sxdd, S.sydd, S.vx, S.vy, S.xith, S.rho};
+    for (int i = 0; i < 3; ++i) {
+        for (const auto* a : {&S.cx, &S.cy, &S.mu, &S.N, &S.ux, &S.uy, &S.p, &S.pd, &S.pdd, &S.w, &S.wd, &S.rx, &S.ry})
+            v.push_back((*a)[i]);
+    }
+    return v;
+}
+
+}  // namespace
+
+Symbols::Symbols()
+    : m("m"), g("g"), Jxx("Jxx"), Jxy("Jxy"), Jxz("Jxz"), Jyy("Jyy"), Jyz("Jyz"), Jzz("Jzz"), cz("cz"),
+      ct("ct"), st("st"), thd("thd"), thdd("thdd"), sx("sx"), sy("sy"), sz("sz"), sxd("sxd"), syd("syd"),
+      sxdd("sxdd"), sydd("sydd"), vx("vx"), vy("vy"), xith("xith"), rho("rho") {
+    const char* ax[] = {"x", "y", "z"};
+    for (int i = 0; i < 3; ++i) {
+        cx[i] = realsymbol(idx("c", i, "x"));
+        cy[i] = realsymbol(idx("c", i, "y"));
+        mu[i] = realsymbol(idx("mu", i));
+        N[i] = realsymbol(idx("N", i));
+        ux[i] = realsymbol(idx("u", i, "x"));
+        uy[i] = realsymbol(idx("u", i, "y"));
+        p[i] = realsymbol(std::string("p") + ax[i]);
+        pd[i] = realsymbol(std::string("pd") + ax[i]);
+        pdd[i] = realsymbol(std::string("pdd") + ax[i]);
+        w[i] = realsymbol(std::string("w") + ax[i]);
+        wd[i] = realsymbol(std::string("wd") + ax[i]);
+        rx[i] = realsymbol(idx("r", i, "x"));
+        ry[i] = realsymbol(idx("r", i, "y"));
+        for (int j = 0; j < 3; ++j) R[i][j] = realsymbol("R" + std::to_string(i + 1) + std::to_string(j + 1));
+    }
+}
+
+bool vanishes_on_rotations(const ex& e, const Symbols& S, int trials, unsigned seed) {
+    std::mt19937 rng(seed);
+    auto rat = [&](int lo, int hi) {
+        std::uniform_int_distribution<int> num(lo, hi), den(1, 7);
+        return numeric(num(rng), den(rng));
+    };
+    for (int t = 0; t < trials; ++t) {
+        exmap sub;
+        for (const auto& s : all_symbols(S)) sub[s] = rat(-9, 9);
+        // R1 = (I - K)^-1 (I + K), K = k^: exactly orthogonal with rational entries.
+        const matrix K = hat(col(rat(-3, 3), rat(-3, 3), rat(-3, 3)));
+        const matrix I = ex_to<matrix>(unit_matrix(3));
+        const matrix R = I.sub(K).inverse().mul(I.add(K));
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) sub[S.R[i][j]] = R(i, j);
+        const numeric tt = rat(-5, 5);
+        sub[S.ct] = (1 - tt * tt) / (1 + tt * tt);
+        sub[S.st] = 2 * tt / (1 + tt * tt);
+        const ex v = e.subs(sub).expand();
+        if (is_a<matrix>(v)) {
+            if (!is_zero(ex_to<matrix>(v))) return false;
+        } else if (!v.is_zero()) {
+            return false;
+        }
+    }
+    return true;
+}
+
+Derivation derive() {
+    Derivation d;
+    const Symbols& S = d.S;
+    for (int i = 0; i < 6; ++i) d.bsym[i] = realsymbol("b" + std::to_string(i));
+    auto find = [&](std::string eq, bool agrees, std::string printed, std::string derived, std::string reason) {
+        d.findings.push_back(Finding{std::move(eq), agrees, std::move(printed), std::move(derived), std::move(reason)});
+    };
+
+    // --- Frames (1)-(9) -------------------------------------------------------------------
+    matrix R1(3, 3);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) R1(i, j) = S.R[i][j];
+    const matrix R2{{S.ct, -S.st, 0}, {S.st, S.ct, 0}, {0, 0, 1}};                 // (2)
+    const matrix w1 = col(S.w[0], S.w[1], S.w[2]), wd1 = col(S.wd[0], S.wd[1], S.wd[2]);
+    const matrix w2 = col(0, 0, S.thd);                                                // (5)
+    const matrix ez = col(0, 0, 1);
+    Jet J;
+    for (int i = 0; i < 3; ++i) {
+        J.rules.push_back({S.p[i], S.pd[i]});
+        J.rules.push_back({S.pd[i], S.pdd[i]});
+        J.rules.push_back({S.w[i], S.wd[i]});
+    }
+    const matrix R1dot = hat(w1).mul(R1);                                              // (7)
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) J.rules.push_back({S.R[i][j], R1dot(i, j)});
+    J.rules.push_back({S.sx, S.sxd});
+    J.rules.push_back({S.sxd, S.sxdd});
+    J.rules.push_back({S.sy, S.syd});
+    J.rules.push_back({S.syd, S.sydd});
+    J.rules.push_back({S.ct, -S.st * S.thd});   // theta' = thd
+    J.rules.push_back({S.st, S.ct * S.thd});
+    J.rules.push_back({S.thd, S.thdd});
+    // s_z is constant (assumption 1): no rule.
+    find("(8)", is_zero(sub(J.D(R2), hat(w2).mul(R2))), "R2' = w2^ R2", "d/dt R2(theta) = w2^ R2, w2 = theta' e_z",
+         "derived by differentiating (2) in theta");
+
+    // --- Contacts and forces (12)-(17) ------------------------------------------------------
+    const matrix s = col(S.sx, S.sy, S.sz), sd = col(S.sxd, S.syd, 0);
+    matrix Fsum = col(0, 0, 0);
+    matrix D(3, 3), H(3, 3);
+    for (int i = 0; i < 3; ++i) {
+        const matrix ci = col(S.cx[i], S.cy[i], S.cz);
+        d.slip[i] = expand_all(J.D(s.add(R2.mul(ci))));     // velocity of c_i relative to the plate, in P
+        const matrix printed = sd.add(hat(w2).mul(R2).mul(ci));
+        if (i == 0)
+            find("text after (14)", is_zero(sub(d.slip[i], printed)), "P c_i' = s' + w2^ R2 c_i",
+                 "d/dt (s + R2 c_i) in the plate frame", "the sliding velocity of each contact");
+        const matrix di = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0));  // (17), unit slip u_i
+        Fsum = Fsum.add(di.mul_scalar(S.N[i]));                                    // (13) + (14)
+    }
+
+    // --- Newton (15) in W, premultiplied by R1^T (forces are in P' coordinates) -------------
+    const matrix pv = col(S.p[0], S.p[1], S.p[2]);
+    const matrix Ws = pv.add(R1.mul(s));
+    const matrix Wsdd = J.D(J.D(Ws));
+    // m W_s'' = R1 F - m g e_z  (12)  =>  F - R1^T (m W_s'' + m g e_z) = 0, using R1^T R1 = I.
+    const matrix EN = expand_all(Fsum.sub(R1.transpose().mul(Wsdd.mul_scalar(S.m).add(ez.mul_scalar(S.m * S.g)))));
+
+    // --- Euler (21) in S' --------------------------------------------------------------------
+    const matrix R = R1.mul(R2);
+    const matrix X = R.transpose().mul(J.D(R));
+    const matrix omega3_raw = vee(X.sub(X.transpose()).mul_scalar(numeric(1, 2)));
+    // With Q^T a^ Q = (Q^T a)^ for Q in SO(3): R^T R' = (R2^T R1^T w1)^ + (R2^T w2)^, and
+    // R2^T w2 = w2 (w2 lies along the rotation axis of R2).
+    d.omega3 = expand_all(R2.transpose().mul(R1.transpose()).mul(w1).add(w2));            // (27)
+    const bool omega_ok = vanishes_on_rotations(to_ex(sub(omega3_raw, d.omega3)), S);
+    find("(27)", omega_ok && is_zero(sub(d.omega3, w2.add(R2.transpose().mul(R1.transpose()).mul(w1)))),
+         "w3 = w2 + R2^T R1^T w1", "vee(R^T R'), R = R1 R2, on SO(3)", "agrees (checked exactly on rational rotations)");
+    d.omega3_dot = J.D(d.omega3);
+    {
+        const matrix w2dot = col(0, 0, S.thdd);
+        const matrix printed = w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
+        const matrix corrected = w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
+        const bool printed_ok = vanishes_on_rotations(to_ex(sub(d.omega3_dot, printed)), S);
+        const bool corrected_ok = is_zero(sub(d.omega3_dot, corrected));
+        find("(28)", printed_ok, "w3' = w2' - R2^T w2^ R1 w1 + R2^T R1^T w1'",
+             "w3' = w2' - R2^T w2^ R1^T w1 + R2^T R1^T w1'",
+             std::string("differentiating (27): d/dt(R1^T w1) = -R1^T w1^ w1 + R1^T w1' = R1^T w1', and ") +
+                 "d/dt R2^T = -R2^T w2^, so the middle term carries R1^T, as (30) uses it; the printed R1 " +
+                 "differs from R1^T unless the plate is level" + (corrected_ok ? "" : " [CORRECTED FORM FAILED]"));
+    }
+    matrix Jm{{S.Jxx, S.Jxy, S.Jxz}, {S.Jxy, S.Jyy, S.Jyz}, {S.Jxz, S.Jyz, S.Jzz}};
+    matrix torque = col(0, 0, 0);
+    for (int i = 0; i < 3; ++i) {
+        const matrix ci = col(S.cx[i], S.cy[i], S.cz);
+        const matrix Fi = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0)).mul_scalar(S.N[i]);
+        torque = torque.add(cross(ci, R2.transpose().mul(Fi)));                      // (21) left side
+    }
+    const matrix EE = expand_all(torque.sub(Jm.mul(d.omega3_dot).add(cross(d.omega3, Jm.mul(d.omega3)))));
+
+    // --- A z = b (31) ------------------------------------------------------------------------
+    const auto z = S.unknowns();
+    d.A = matrix(6, 6);
+    d.b_full = matrix(6, 1);
+    exmap zero;
+    for (const auto& u : z) zero[u] = 0;
+    for (int r = 0; r < 6; ++r) {
+        const ex E = r < 3 ? EN(r, 0) : EE(r - 3, 0);
+        for (int k = 0; k < 6; ++k) d.A(r, k) = E.diff(z[k]).expand();
+        d.b_full(r, 0) = (-E.subs(zero)).expand();
+        ex lin = -d.b_full(r, 0);
+        for (int k = 0; k < 6; ++k) lin += d.A(r, k) * z[k];
+        if (!(lin - E).expand().is_zero()) throw std::logic_error("equation " + std::to_string(r) + " is not linear in z");
+    }
+    // The s'' coefficients are -m R1^T R1 e_x, e_y: -m e_x, -m e_y on SO(3) (10: s_z'' = 0).
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 2; ++k) {
+            const ex expect = r == k ? ex(-S.m) : ex(0);
+            if (!vanishes_on_rotations(d.A(r, k) - expect, S))
+                throw std::logic_error("Newton's s'' coefficients are not -m I on SO(3)");
+            d.A(r, k) = expect;
+        }
+    {
+        // (31) as printed: [-M' D; -J' H], h_i = c_i^ R2^T d_i (23).
+        matrix Ap(6, 6);
+        Ap(0, 0) = -S.m;
+        Ap(1, 1) = -S.m;
+        for (int i = 0; i < 3; ++i) {
+            const matrix di = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0));
+            const matrix hi = cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(di));
+            for (int r = 0; r < 3; ++r) {
+                Ap(r, 3 + i) = di(r, 0);
+                Ap(3 + r, 3 + i) = hi(r, 0);
+                Ap(3 + r, 2) = -Jm(r, 2);
+            }
+        }
+        find("(31)", is_zero(sub(d.A, Ap)), "A = [-M' D; -J' H], M' = m(e_x e_x^T + e_y e_y^T), J' = J e_z e_z^T",
+             "coefficients of (s_x'', s_y'', theta'', N1, N2, N3) in Newton's and Euler's equations",
+             "agrees; uses (10): s_z'' = 0 and only theta'' about z");
+        // (19)
+        const matrix Rs = R1.mul(s);
+        const matrix f19 = R1.transpose()
+                               .mul(col(S.pdd[0], S.pdd[1], S.pdd[2])
+                                        .add(hat(w1).mul(hat(w1)).mul(Rs))
+                                        .add(hat(wd1).mul(Rs))
+                                        .add(hat(w1).mul(R1).mul(sd).mul_scalar(2))
+                                        .add(ez.mul_scalar(S.g)))
+                               .mul_scalar(S.m);
+        matrix bN(3, 1), bE(3, 1);
+        for (int r = 0; r < 3; ++r) {
+            bN(r, 0) = d.b_full(r, 0);
+            bE(r, 0) = d.b_full(3 + r, 0);
+        }
+        find("(19)", is_zero(sub(bN, f19)), "f = m R1^T (p'' + w1^ w1^ R1 s + w1'^ R1 s + 2 w1^ R1 s' + g e_z)",
+             "twice d/dt of W s = p + R1 s with R1' = w1^ R1", "agrees");
+        // (30)
+        const matrix A2 = R2.transpose().mul(R1.transpose()).mul(w1);
+        const matrix t30 = Jm.mul(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1).mul_scalar(-1)
+                                      .add(R2.transpose().mul(R1.transpose()).mul(wd1)))
+                               .add(hat(w2).add(hat(A2)).mul(Jm).mul(w2.add(A2)));
+        find("(30)", is_zero(sub(bE, t30)), "tau = J(-R2^T w2^ R1^T w1 + R2^T R1^T w1') + (w2^ + (R2^T R1^T w1)^) J (w2 + R2^T R1^T w1)",
+             "J w3'|theta''=0 + w3^ J w3", "agrees (with R1^T in the first term, unlike (28))");
+    }
+
+    // --- U-dynamics (32)-(34) -----------------------------------------------------------------
+    {
+        exmap level;   // R1 = I, omega1 = 0 (small amplitude, property 2)
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) level[S.R[i][j]] = i == j ? 1 : 0;
+            level[S.w[i]] = 0;
+        }
+        const realsymbol lam("lam");
+        exmap scale{{S.thd, lam * S.thd}, {S.sxd, lam * S.sxd}, {S.syd, lam * S.syd}};
+        d.b_U = matrix(6, 1);
+        for (int r = 0; r < 6; ++r) {
+            // Property 4: drop products of velocities (Coriolis, centripetal and w2^ J w2).
+            const ex e = d.b_full(r, 0).subs(level).subs(scale).expand();
+            d.b_U(r, 0) = (e.coeff(lam, 0) + e.coeff(lam, 1).subs(lam == 1)).expand();
+        }
+        const matrix f33 = col(S.pdd[0], S.pdd[1], S.pdd[2]).add(cross(wd1, s)).add(ez.mul_scalar(S.g)).mul_scalar(S.m);
+        const matrix t34 = Jm.mul(R2.transpose()).mul(wd1);
+        matrix bN(3, 1), bE(3, 1);
+        for (int r = 0; r < 3; ++r) {
+            bN(r, 0) = d.b_U(r, 0);
+            bE(r, 0) = d.b_U(3 + r, 0);
+        }
+        find("(33)", is_zero(sub(bN, f33)), "f~ = m(p'' + w1'^ s0 + g e_z)",
+             "f_dagger with R1 = I, w1 = 0 (s0 is the current s)",
+             "agrees. Note: property 4 as worded (drop products of elements of x and u) would also drop "
+             "w1'^ s (u times x); (33) keeps it, and so does the derivation: what is dropped is R1 - I, "
+             "w1, and products of velocities");
+        find("(34)", is_zero(sub(bE, t34)), "tau~ = J R2^T w1'",
+             "tau_dagger with R1 = I, w1 = 0, no products of velocities",
+             "agrees; the part's own gyroscopic term w2^ J w2 = theta'^2 e_z^ J e_z is dropped too "
+             "(it vanishes when J_xz = J_yz = 0)");
+    }
+
+    // --- Point part -----------------------------------------------------------------------------
+    {
+        const realsymbol &sxdd = S.sxdd, &sydd = S.sydd, &N = S.N[0];
+        const matrix F = ez.sub(col(S.mu[0] * S.ux[0], S.mu[0] * S.uy[0], 0)).mul_scalar(N);
+        const matrix E = F.sub(col(sxdd, sydd, 0).mul_scalar(S.m));   // = b (first three rows)
+        d.A_point = matrix(3, 3);
+        const ex zp[3] = {sxdd, sydd, N};
+        for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) d.A_point(r, k) = E(r, 0).diff(ex_to<symbol>(zp[k])).expand();
+        lst eqs, unk{sxdd, sydd, N};
+        for (int r = 0; r < 3; ++r) eqs.append(E(r, 0) == d.bsym[r]);
+        const ex sol = lsolve(eqs, unk);
+        d.point_solution = matrix(3, 1);
+        for (int k = 0; k < 3; ++k) d.point_solution(k, 0) = sol.op(k).rhs().expand();
+    }
+
+    // --- Thick part: reduce A z = b to 3x3 in n --------------------------------------------------
+    {
+        const matrix& A = d.A;
+        for (int r : {0, 1, 2, 3, 4, 5})
+            for (int k : {0, 1})
+                if (r != k && !A(r, k).is_zero()) throw std::logic_error("unexpected structure of A");
+        if (!A(0, 2).is_zero() || !A(1, 2).is_zero() || !A(2, 2).is_zero()) throw std::logic_error("theta'' in Newton");
+        // Row 6 (index 5) gives theta''; rows 1, 2 give s''; rows 3, 4, 5 then hold only n.
+        const ex a52 = A(5, 2);
+        d.M_reduced = matrix(3, 3);
+        d.r_reduced = matrix(3, 1);
+        const int rows[3] = {2, 3, 4};
+        for (int i = 0; i < 3; ++i) {
+            const int r = rows[i];
+            for (int k = 0; k < 3; ++k) d.M_reduced(i, k) = (A(r, 3 + k) - A(r, 2) / a52 * A(5, 3 + k)).expand();
+            d.r_reduced(i, 0) = (d.bsym[r] - A(r, 2) / a52 * d.bsym[5]).expand();
+        }
+        d.back_substitution = matrix(3, 1);
+        ex nx = d.bsym[0], ny = d.bsym[1], nt = d.bsym[5];
+        for (int k = 0; k < 3; ++k) {
+            nx -= A(0, 3 + k) * S.N[k];
+            ny -= A(1, 3 + k) * S.N[k];
+            nt -= A(5, 3 + k) * S.N[k];
+        }
+        d.back_substitution(0, 0) = (nx / A(0, 0)).expand();
+        d.back_substitution(1, 0) = (ny / A(1, 1)).expand();
+        d.back_substitution(2, 0) = (nt / a52).expand();
+    }
+
+    // --- Thin part (Appendix A) --------------------------------------------------------------------
+    {
+        const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};
+        auto swapped = [](const matrix& A) {
+            matrix B = A;
+            for (int k = 0; k < 6; ++k) std::swap(B(2, k), B(5, k));   // rows 3 and 6
+            return B;
+        };
+        d.A_thin_swapped = swapped(map(d.A, [&](const ex& e) { return e.subs(thin).expand(); }));
+        d.A_thick_swapped = swapped(d.A);
+        d.M38 = matrix(3, 3);
+        d.r38_U = matrix(3, 1);
+        for (int i = 0; i < 3; ++i)
+            for (int k = 0; k < 3; ++k) d.M38(i, k) = d.A_thin_swapped(3 + i, 3 + k);
+        // The right-hand side follows the row swap: rows 4, 5 of b, then row 3.
+        const int rb[3] = {3, 4, 2};
+        for (int i = 0; i < 3; ++i) d.r38_U(i, 0) = d.b_U(rb[i], 0).subs(thin).expand();
+        bool lower_zero = true, upper_nonzero = false;
+        for (int r = 3; r < 6; ++r)
+            for (int k = 0; k < 3; ++k) lower_zero = lower_zero && d.A_thin_swapped(r, k).is_zero();
+        for (int r = 0; r < 3; ++r)
+            for (int k = 3; k < 6; ++k) upper_nonzero = upper_nonzero || !d.A_thin_swapped(r, k).is_zero();
+        find("Appendix A (block diagonal)", lower_zero && !upper_nonzero,
+             "swapping rows 3 and 6 makes A block diagonal",
+             "swapping rows 3 and 6 makes A block upper triangular: [[-m I, -, D_xy], [0, -J_zz, h_z], [0, 0, M38]]",
+             "the lower-left block vanishes, so n decouples (M38 n = r38), but the upper-right block "
+             "holds the friction terms d_i,xy and h_i,z, which are not zero; the claim that matters, "
+             "decoupled and velocity-free normal forces, holds");
+        const matrix Mp{{S.cy[0], S.cy[1], S.cy[2]}, {-S.cx[0], -S.cx[1], -S.cx[2]}, {1, 1, 1}};
+        const matrix Jt{{S.Jxx, S.Jxy, 0}, {S.Jxy, S.Jyy, 0}, {0, 0, S.Jzz}};
+        const matrix JRw = Jt.mul(R2.transpose()).mul(wd1);
+        const matrix s0 = col(S.sx, S.sy, 0);
+        const ex fz = col(S.pdd[0], S.pdd[1], S.pdd[2]).add(cross(wd1, s0)).add(ez.mul_scalar(S.g)).mul_scalar(S.m)(2, 0);
+        const matrix rp = col(JRw(0, 0), JRw(1, 0), fz);
+        const bool matrix_ok = is_zero(sub(d.M38, Mp)), rhs_ok = is_zero(sub(d.r38_U, rp));
+        // The printed right-hand side is not well formed (see the reason), so it cannot agree.
+        find("(38)", false,
+             "[c_y; -c_x; 1 1 1] n = [e_x^T J R R2^T w1'; e_y^T J R2^T w1'; e_z^T m(p'' + w1'^ s0 + g e_z^T)]",
+             "[c_y; -c_x; 1 1 1] n = [e_x^T J R2^T w1'; e_y^T J R2^T w1'; m e_z^T (p'' + w1'^ s0 + g e_z)]",
+             std::string(matrix_ok && rhs_ok ? "the derived system equals the corrected form" : "[DERIVED DIFFERS]") +
+                 ": the printed third row adds g e_z^T (a row) to column vectors, it is g e_z; the first "
+                 "row's 'J R R2^T' is J R2^T");
+        {
+            // (37) as printed: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1 1 1], [0 0 0 c_y], [0 0 0 -c_x],
+            // [0 0 -J_zz h_z]; h_i,z is not spelled out in the paper, so row 6 is compared up to it.
+            const matrix At = map(d.A, [&](const ex& e) { return e.subs(thin).expand(); });
+            matrix P37(6, 6);
+            P37(0, 0) = -S.m;
+            P37(1, 1) = -S.m;
+            P37(5, 2) = -S.Jzz;
+            for (int i = 0; i < 3; ++i) {
+                P37(0, 3 + i) = -S.mu[i] * S.ux[i];
+                P37(1, 3 + i) = -S.mu[i] * S.uy[i];
+                P37(2, 3 + i) = 1;
+                P37(3, 3 + i) = S.cy[i];
+                P37(4, 3 + i) = -S.cx[i];
+                P37(5, 3 + i) = At(5, 3 + i);
+            }
+            find("(37)", is_zero(sub(At, P37)), "thin-part A: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1], [0 0 0 c_y], [0 0 0 -c_x], [0 0 -J_zz h_z]",
+                 "A with c_z = 0, J_xz = J_yz = 0", "agrees: h_i = [c_i,y, -c_i,x, h_i,z]");
+        }
+    }
+
+    // --- Limit surface (Appendix B) ----------------------------------------------------------------
+    {
+        d.wrench = matrix(3, 1);
+        d.power = 0;
+        ex Fx = 0, Fy = 0, tau = 0;
+        for (int i = 0; i < 3; ++i) {
+            const ex om = S.xith / S.rho;                       // xi_theta = rho omega
+            const ex vix = S.vx - om * S.ry[i], viy = S.vy + om * S.rx[i];
+            const ex speed = sqrt(vix * vix + viy * viy);
+            const ex fx = -S.mu[i] * S.N[i] * vix / speed, fy = -S.mu[i] * S.N[i] * viy / speed;
+            Fx += fx;
+            Fy += fy;
+            tau += S.rx[i] * fy - S.ry[i] * fx;
+            d.power += S.mu[i] * S.N[i] * speed;
+        }
+        // Expanded: a canonical form whose structure does not depend on GiNaC's run-dependent
+        // term order (which decides, e.g., where a sign is pulled out of a sum).
+        d.wrench(0, 0) = Fx.expand();
+        d.wrench(1, 0) = Fy.expand();
+        d.wrench(2, 0) = (tau / S.rho).expand();                 // w_theta = tau / rho
+        const ex n0 = (d.wrench(0, 0) + d.power.diff(S.vx)).normal();
+        const ex n1 = (d.wrench(1, 0) + d.power.diff(S.vy)).normal();
+        const ex n2 = (d.wrench(2, 0) + d.power.diff(S.xith)).normal();
+        find("Appendix B (normality)", n0.is_zero() && n1.is_zero() && n2.is_zero(),
+             "the relative twist is normal to the limit surface at the frictional wrench",
+             "w = -grad_xi P(xi), P = sum mu_i N_i |v_i| (the dissipated power), in the footnote's scaled "
+             "coordinates",
+             "agrees: the wrench is minus the gradient of a convex function of the twist, so the twist is "
+             "normal to the level set (the limit surface) in wrench space");
+    }
+    return d;
+}
+
+std::string latex_report(const Derivation& d) {
+    std::ostringstream o;
+    auto mat = [&](const matrix& M) {
+        std::ostringstream s;
+        s << "\\begin{pmatrix}";
+        for (unsigned i = 0; i < M.rows(); ++i) {
+            for (unsigned j = 0; j < M.cols(); ++j) s << (j ? " & " : "") << latex_text(M(i, j));
+            s << (i + 1 < M.rows() ? " \\\\ " : "");
+        }
+        s << "\\end{pmatrix}";
+        return s.str();
+    };
+    o << "% GENERATED by symbolic/derive (plate) from the symbolic derivation. Do not edit.\n";
+    o << "% Symbols: ct = cos(theta), st = sin(theta), thd = theta', u_i = unit slip direction of contact i,\n"
+         "% R_ij = entries of R1, w = omega1, wd = omega1'.\n";
+    o << "\\paragraph{Sliding velocity of contact 1 (P frame).} $" << mat(d.slip[0]) << "$\n\n";
+    o << "\\paragraph{(27) part angular velocity.} $\\omega_3 = " << mat(d.omega3) << "$\n\n";
+    o << "\\paragraph{(28) its derivative.} $\\dot\\omega_3 = " << mat(d.omega3_dot) << "$\n\n";
+    o << "\\paragraph{(31) A, columns $\\ddot s_x, \\ddot s_y, \\ddot\\theta, N_1, N_2, N_3$.} $A = " << mat(d.A) << "$\n\n";
+    o << "\\paragraph{(33)-(34) U-dynamics right-hand side.} $\\tilde b = " << mat(d.b_U) << "$\n\n";
+    o << "\\paragraph{Appendix A: thin part, rows 3 and 6 swapped.} $" << mat(d.A_thin_swapped) << "$\n\n";
+    o << "\\paragraph{(38) normal forces of a thin part.} $" << mat(d.M38) << " n = " << mat(d.r38_U) << "$\n\n";
+    o << "\\paragraph{Point part.} $\\begin{pmatrix}\\ddot s_x\\\\ \\ddot s_y\\\\ N\\end{pmatrix} = " << mat(d.point_solution) << "$\n\n";
+    return o.str();
+}
+
+std::string findings_markdown(const Derivation& d) {
+    std::ostringstream o;
+    o << "<!-- GENERATED by symbolic/derive (plate) from the symbolic derivation. Do not edit. -->\n";
+    o << "| equation | verdict | printed | derived | why |\n|---|---|---|---|---|\n";
+    for (const auto& f : d.findings)
+        o << "| " << f.equation << " | " << (f.agrees ? "agrees" : "**differs**") << " | `" << f.printed << "` | `"
+          << f.derived << "` | " << f.reason << " |\n";
+    return o.str();
+}
+
+}  // namespace plate::symbolic
