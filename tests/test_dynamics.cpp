@@ -178,7 +178,7 @@ TEST_CASE("the printed (28), with R1 where R1^T belongs, violates Euler's equati
     ps.R1 = detail::exp_so3(Vec3(0.3, -0.2, 0.9));
     ps.w1 = Vec3(3, -2, 4);
     Workspace ws;
-    accelerations(sc, Dynamics::Full, q, qd, ps, ws);
+    accelerations_reference(sc, Dynamics::Full, q, qd, ps, ws);   // fills ws.A
     const Vec6 b = rhs_b(sc, Dynamics::Full, q, qd, ps);
     const Mat3 R2t = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix().transpose();
     const Vec3 w2(0, 0, qd[2]);
