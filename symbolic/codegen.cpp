@@ -176,23 +176,11 @@ std::string Emitter::operator()(const ex& e) {
         }
         out = temp(s);
     } else if (is_a<mul>(e)) {
-        std::vector<std::string> num, den;
-        for (const ex& f : sorted_operands(e)) {
-            if (is_a<GiNaC::power>(f) && is_a<numeric>(f.op(1)) && ex_to<numeric>(f.op(1)).is_integer() &&
-                ex_to<numeric>(f.op(1)) < 0)
-                den.push_back((*this)(pow(f.op(0), -f.op(1))));
-            else
-                num.push_back((*this)(f));
-        }
-        std::string s;
-        for (const auto& f : num) s += (s.empty() ? "" : " * ") + f;
-        if (s.empty()) s = "1.0";
-        if (!den.empty()) {
-            std::string d;
-            for (const auto& f : den) d += (d.empty() ? "" : " * ") + f;
-            s = s + " / (" + d + ")";
-        }
-        out = temp(s);
+        // Reciprocals are temporaries of their own (one division each, shared by every term that
+        // needs them), so a product is only multiplications.
+        std::string prod;
+        for (const ex& f : sorted_operands(e)) prod += (prod.empty() ? "" : " * ") + (*this)(f);
+        out = temp(prod);
     } else if (is_a<GiNaC::power>(e)) {
         if (!is_a<numeric>(e.op(1))) throw std::invalid_argument("codegen: symbolic exponent");
         out = emit_power(e.op(0), ex_to<numeric>(e.op(1)));

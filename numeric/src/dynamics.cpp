@@ -117,22 +117,24 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         ws.theta = q[2];
         in.ct = std::cos(q[2]);
         in.st = std::sin(q[2]);
+        for (int i = 0; i < 3; ++i)
+            ws.r[i] = Vec2(in.ct * P.c[i].x() - in.st * P.c[i].y(), in.st * P.c[i].x() + in.ct * P.c[i].y());
     }
     in.sx = q[0];
     in.sy = q[1];
     in.sxd = qd[0];
     in.syd = qd[1];
-    in.thd = P.point ? 0.0 : qd[2];
     // Sliding velocities s' + w2^ R2 c_i and their unit directions (zero at zero slip).
     double* u[3][2] = {{&in.u1x, &in.u1y}, {&in.u2x, &in.u2y}, {&in.u3x, &in.u3y}};
-    const double cxs[3] = {in.c1x, in.c2x, in.c3x}, cys[3] = {in.c1y, in.c2y, in.c3y};
+    const double w = P.point ? 0.0 : qd[2];
+    in.thd = w;
     for (int i = 0; i < P.contacts(); ++i) {
-        const double rx = in.ct * cxs[i] - in.st * cys[i], ry = in.st * cxs[i] + in.ct * cys[i];
-        const Vec2 v = P.point ? Vec2(qd[0], qd[1]) : Vec2(qd[0] - qd[2] * ry, qd[1] + qd[2] * rx);
-        ws.slip[i] = v;
-        const double sp = v.norm();
-        *u[i][0] = sp > 0 ? v.x() / sp : 0.0;
-        *u[i][1] = sp > 0 ? v.y() / sp : 0.0;
+        const double vx = qd[0] - w * ws.r[i].y(), vy = qd[1] + w * ws.r[i].x();
+        ws.slip[i] = Vec2(vx, vy);
+        const double sp2 = vx * vx + vy * vy;
+        const double inv = sp2 > 0 ? 1.0 / std::sqrt(sp2) : 0.0;
+        *u[i][0] = vx * inv;
+        *u[i][1] = vy * inv;
     }
     in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
     in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();

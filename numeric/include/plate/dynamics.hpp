@@ -44,6 +44,7 @@ struct Workspace {
     bool thin = false;
     Mat3 M38_inv = Mat3::Zero();           // thin part: inverse of (38)'s matrix, constant
     double theta = std::numeric_limits<double>::quiet_NaN();   // of the cached cos/sin in `in`
+    std::array<Vec2, 3> r{};               // R2 c_i (horizontal) at that theta
 
     Mat6 A = Mat6::Zero();
     Vec6 b = Vec6::Zero();
