@@ -25,6 +25,8 @@ public:
     std::string operator()(const GiNaC::ex& e);
     // Assigns e to `target` (e.g. "out[3]").
     void assign(const std::string& target, const GiNaC::ex& e);
+    // Computes e once and lets later expressions use it through the symbol named `name`.
+    void bind(const std::string& name, const GiNaC::ex& e) { inputs_[name] = (*this)(e); }
     std::string code() const { return body_.str(); }
     int temporaries() const { return next_; }
 

@@ -345,6 +345,85 @@ Derivation derive() {
         d.back_substitution(2, 0) = (nt / a52).expand();
     }
 
+    // --- Staged forms for code generation ----------------------------------------------------------
+    {
+        const matrix& A = d.A;
+        matrix G(6, 6);
+        for (int r = 0; r < 6; ++r)
+            for (int k = 0; k < 6; ++k) {
+                if (is_a<numeric>(A(r, k)) || is_a<symbol>(A(r, k)) || is_a<symbol>(-A(r, k))) {
+                    G(r, k) = A(r, k);
+                } else {
+                    const realsymbol a("a" + std::to_string(r) + std::to_string(k));
+                    d.A_placeholders.push_back({a, A(r, k)});
+                    G(r, k) = a;
+                }
+            }
+        d.M_staged = matrix(3, 3);
+        d.r_staged = matrix(3, 1);
+        const int rows[3] = {2, 3, 4};
+        const ex inv52 = 1 / G(5, 2);
+        for (int i = 0; i < 3; ++i) {
+            const int r = rows[i];
+            for (int k = 0; k < 3; ++k) d.M_staged(i, k) = G(r, 3 + k) - G(r, 2) * inv52 * G(5, 3 + k);
+            d.r_staged(i, 0) = d.bsym[r] - G(r, 2) * inv52 * d.bsym[5];
+        }
+        d.back_staged = matrix(3, 1);
+        ex nx = d.bsym[0], ny = d.bsym[1], nt = d.bsym[5];
+        for (int k = 0; k < 3; ++k) {
+            nx -= G(0, 3 + k) * S.N[k];
+            ny -= G(1, 3 + k) * S.N[k];
+            nt -= G(5, 3 + k) * S.N[k];
+        }
+        d.back_staged(0, 0) = nx / G(0, 0);
+        d.back_staged(1, 0) = ny / G(1, 1);
+        d.back_staged(2, 0) = nt * inv52;
+        // The staged forms are the derived ones once the placeholders are filled in.
+        exmap fill;
+        for (const auto& [a, e] : d.A_placeholders) fill[a] = e;
+        for (int i = 0; i < 3; ++i) {
+            for (int k = 0; k < 3; ++k)
+                if (!(d.M_staged(i, k).subs(fill) - d.M_reduced(i, k)).expand().is_zero())
+                    throw std::logic_error("staged reduction differs");
+            if (!(d.back_staged(i, 0).subs(fill) - d.back_substitution(i, 0)).expand().is_zero())
+                throw std::logic_error("staged back substitution differs");
+        }
+
+        // Full dynamics in plate-frame vectors.
+        const char* ax[] = {"x", "y", "z"};
+        matrix Om(3, 1), al(3, 1), ap(3, 1), ga(3, 1);
+        const matrix R1tw = R1.transpose().mul(w1), R1twd = R1.transpose().mul(wd1);
+        const matrix R1tp = R1.transpose().mul(col(S.pdd[0], S.pdd[1], S.pdd[2])), R1tez = R1.transpose().mul(ez);
+        for (int i = 0; i < 3; ++i) {
+            const realsymbol o(std::string("Om") + ax[i]), a(std::string("al") + ax[i]),
+                p(std::string("ap") + ax[i]), gm(std::string("ga") + ax[i]);
+            d.plate_frame_placeholders.push_back({o, R1tw(i, 0)});
+            d.plate_frame_placeholders.push_back({a, R1twd(i, 0)});
+            d.plate_frame_placeholders.push_back({p, R1tp(i, 0)});
+            d.plate_frame_placeholders.push_back({gm, R1tez(i, 0)});
+            Om(i, 0) = o;
+            al(i, 0) = a;
+            ap(i, 0) = p;
+            ga(i, 0) = gm;
+        }
+        // R1^T (w^ w^ R1 s) = Om^ Om^ s, R1^T (w'^ R1 s) = al^ s, R1^T (w^ R1 s') = Om^ s'.
+        const matrix f = ap.add(cross(Om, cross(Om, s))).add(cross(al, s)).add(cross(Om, sd).mul_scalar(2))
+                             .add(ga.mul_scalar(S.g)).mul_scalar(S.m);
+        const matrix R2t = R2.transpose();
+        const matrix w3 = w2.add(R2t.mul(Om));
+        const matrix tau = Jm.mul(R2t.mul(cross(w2, Om)).mul_scalar(-1).add(R2t.mul(al))).add(cross(w3, Jm.mul(w3)));
+        d.b_full_staged = matrix(6, 1);
+        exmap fillp;
+        for (const auto& [a, e] : d.plate_frame_placeholders) fillp[a] = e;
+        for (int r = 0; r < 3; ++r) {
+            d.b_full_staged(r, 0) = f(r, 0);
+            d.b_full_staged(3 + r, 0) = tau(r, 0);
+        }
+        for (int r = 0; r < 6; ++r)
+            if (!vanishes_on_rotations(d.b_full_staged(r, 0).subs(fillp) - d.b_full(r, 0), S))
+                throw std::logic_error("plate-frame form of b differs on SO(3), row " + std::to_string(r));
+    }
+
     // --- Thin part (Appendix A) --------------------------------------------------------------------
     {
         const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};

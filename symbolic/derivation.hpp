@@ -65,6 +65,14 @@ struct Derivation {
     // Thick part: Schur reduction of A z = b to a 3x3 system M n = r (rows 1-2 and 6 eliminated).
     matrix M_reduced, r_reduced;        // r in terms of bsym
     matrix back_substitution;           // q'' in terms of n (N symbols) and bsym
+    // The same, staged for code generation: in terms of placeholders a_rk for A's non-constant
+    // entries (A_placeholders lists them with their expressions).
+    matrix M_staged, r_staged, back_staged;
+    std::vector<std::pair<realsymbol, ex>> A_placeholders;
+    // b of the full dynamics rewritten in plate-frame vectors Omega = R1^T w1, alpha = R1^T w1',
+    // a = R1^T p'', gamma = R1^T e_z (identities on SO(3), checked exactly against b_full).
+    matrix b_full_staged;
+    std::vector<std::pair<realsymbol, ex>> plate_frame_placeholders;
     // Thin part (Appendix A): A after swapping rows 3 and 6, and the normal-force system (38).
     matrix A_thin_swapped;
     matrix M38, r38_U;                  // (38): M38 n = r38 (U-dynamics right-hand side)

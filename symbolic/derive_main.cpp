@@ -39,11 +39,27 @@ struct Kernel {
     std::string comment, signature;
     std::map<std::string, std::string> in;
     std::vector<std::pair<std::string, ex>> outputs;
+    std::vector<std::pair<realsymbol, ex>> bindings;   // computed first, in this order
 };
 
+// Everything is emitted expanded: a sum of monomials is a canonical form, whereas GiNaC's
+// automatic evaluation of nested sums and products pulls signs out depending on its
+// run-dependent term order. Bindings are emitted only if an output (or a later binding) uses them.
 std::string emit(const Kernel& k) {
     Emitter em(k.in);
-    for (const auto& [target, e] : k.outputs) em.assign(target, e);
+    std::vector<ex> outs;
+    for (const auto& [target, e] : k.outputs) outs.push_back(e.expand());
+    std::vector<bool> used(k.bindings.size(), false);
+    for (std::size_t i = k.bindings.size(); i-- > 0;) {
+        const realsymbol& s = k.bindings[i].first;
+        bool u = false;
+        for (const ex& e : outs) u = u || e.has(s);
+        for (std::size_t j = i + 1; j < k.bindings.size(); ++j) u = u || (used[j] && k.bindings[j].second.has(s));
+        used[i] = u;
+    }
+    for (std::size_t i = 0; i < k.bindings.size(); ++i)
+        if (used[i]) em.bind(k.bindings[i].first.get_name(), k.bindings[i].second.expand());
+    for (std::size_t i = 0; i < outs.size(); ++i) em.assign(k.outputs[i].first, outs[i]);
     std::ostringstream o;
     o << k.comment << "inline void " << k.signature << " {\n" << em.code() << "}\n\n";
     return o.str();
@@ -93,52 +109,104 @@ int main(int argc, char** argv) {
         {
             Kernel k{"// A of (31)/(32), row-major 6x6: rows Newton x y z, Euler x y z; columns s_x'', s_y'',\n"
                      "// theta'', N1, N2, N3. Slip directions enter as unit vectors u_i.\n",
-                     "thick_A(const KernelInput& in, double* A)", in, {}};
+                     "thick_A(const KernelInput& in, double* A)", in, {}, {}};
             for (int r = 0; r < 6; ++r)
                 for (int c = 0; c < 6; ++c) k.outputs.push_back({"A[" + std::to_string(6 * r + c) + "]", d.A(r, c)});
             kernels.push_back(k);
         }
         {
             Kernel k{"// b~ of (32): [f~ (33); tau~ (34)] (U- and reduced U-dynamics). A point part uses b[0..2], s_z = 0.\n",
-                     "b_U(const KernelInput& in, double* b)", in, {}};
+                     "b_U(const KernelInput& in, double* b)", in, {}, {}};
             for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.b_U(r, 0)});
             kernels.push_back(k);
         }
         {
-            Kernel k{"// b of (31): [f_dagger (19); tau_dagger (30)] (full dynamics; R1 entries R_ij, omega1 = w).\n",
-                     "b_full(const KernelInput& in, double* b)", in, {}};
-            for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.b_full(r, 0)});
+            Kernel k{"// b of (31): [f_dagger (19); tau_dagger (30)] (full dynamics; R1 entries R_ij, omega1 = w),\n"
+                     "// through the plate-frame vectors Om = R1^T w, al = R1^T w', ap = R1^T p'', ga = R1^T e_z.\n",
+                     "b_full(const KernelInput& in, double* b)", in, {}, d.plate_frame_placeholders};
+            for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.b_full_staged(r, 0)});
             kernels.push_back(k);
         }
         {
             Kernel k{"// A z = b reduced to M n = r (3x3, row-major): rows 1, 2 of (31) give s'', row 6 gives theta'',\n"
                      "// eliminated from rows 3, 4, 5. Solve M n = r, then back_substitution.\n",
                      "thick_reduced(const KernelInput& in, const double* b, double* M, double* r)",
-                     with(in, "b", "b", 6), {}};
+                     with(in, "b", "b", 6), {}, d.A_placeholders};
             for (int i = 0; i < 3; ++i) {
-                for (int c = 0; c < 3; ++c) k.outputs.push_back({"M[" + std::to_string(3 * i + c) + "]", d.M_reduced(i, c)});
-                k.outputs.push_back({"r[" + std::to_string(i) + "]", d.r_reduced(i, 0)});
+                for (int c = 0; c < 3; ++c) k.outputs.push_back({"M[" + std::to_string(3 * i + c) + "]", d.M_staged(i, c)});
+                k.outputs.push_back({"r[" + std::to_string(i) + "]", d.r_staged(i, 0)});
             }
             kernels.push_back(k);
         }
         {
             Kernel k{"// q'' = (s_x'', s_y'', theta'') from the normal forces n and b (rows 1, 2, 6 of (31)).\n",
                      "back_substitution(const KernelInput& in, const double* b, const double* n, double* qdd)",
-                     with(with(in, "b", "b", 6), "N", "n", 3), {}};
-            for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_substitution(i, 0)});
+                     with(with(in, "b", "b", 6), "N", "n", 3), {}, {}};
+            // Only the placeholders the back substitution uses (rows 1, 2 and 6 of A).
+            for (const auto& [a, e] : d.A_placeholders) {
+                const std::string nm = a.get_name();
+                if (nm[1] == '0' || nm[1] == '1' || nm[1] == '5') k.bindings.push_back({a, e});
+            }
+            for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
+            kernels.push_back(k);
+        }
+        {
+            // One kernel for a thick part: A's entries, the reduced 3x3 system, its solution by
+            // Cramer's rule (det returned, so the caller can fall back to a pivoted LU when the
+            // system is near singular), and the back substitution.
+            Kernel k{"// Thick part, all of A z = b: n by Cramer's rule on the reduced 3x3 system M n = r, then q''.\n"
+                     "// det = det M (near zero only for near-collinear contacts).\n",
+                     "thick_solve(const KernelInput& in, const double* b, double* n, double* qdd, double* det)",
+                     with(in, "b", "b", 6), {}, d.A_placeholders};
+            matrix Mg(3, 3), rg(3, 1);
+            for (int i = 0; i < 3; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
+                    k.bindings.push_back({mij, d.M_staged(i, c)});
+                    Mg(i, c) = mij;
+                }
+                const realsymbol ri("r" + std::to_string(i));
+                k.bindings.push_back({ri, d.r_staged(i, 0)});
+                rg(i, 0) = ri;
+            }
+            const realsymbol dsym("detM");
+            k.bindings.push_back({dsym, Mg.determinant()});
+            for (int c = 0; c < 3; ++c) {
+                matrix Mc = Mg;
+                for (int i = 0; i < 3; ++i) Mc(i, c) = rg(i, 0);
+                k.bindings.push_back({S.N[c], Mc.determinant() / dsym});
+            }
+            for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
+            for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
+            k.outputs.push_back({"det[0]", dsym});
+            kernels.push_back(k);
+        }
+        {
+            Kernel k{"// Thin part: n = M38^-1 (b[3], b[4], b[2]) (38) with the part's constant inverse Minv (row-major),\n"
+                     "// then q''.\n",
+                     "thin_solve(const KernelInput& in, const double* b, const double* Minv, double* n, double* qdd)",
+                     with(with(in, "b", "b", 6), "Minv", "Minv", 9), {}, d.A_placeholders};
+            const int rb[3] = {3, 4, 2};
+            for (int c = 0; c < 3; ++c) {
+                ex e = 0;
+                for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * d.bsym[rb[j]];
+                k.bindings.push_back({S.N[c], e});
+            }
+            for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
+            for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             kernels.push_back(k);
         }
         {
             Kernel k{"// (38): the thin part's normal-force matrix (rows: torque x, torque y, force z), constant for\n"
                      "// a part; n = M38^-1 (b[3], b[4], b[2]) for any b, independent of the part's velocity.\n",
-                     "thin_M38(const KernelInput& in, double* M)", in, {}};
+                     "thin_M38(const KernelInput& in, double* M)", in, {}, {}};
             for (int i = 0; i < 3; ++i)
                 for (int c = 0; c < 3; ++c) k.outputs.push_back({"M[" + std::to_string(3 * i + c) + "]", d.M38(i, c)});
             kernels.push_back(k);
         }
         {
             Kernel k{"// Point part: (s_x'', s_y'', N) from b[0..2] (one contact at the centre of mass).\n",
-                     "point_solve(const KernelInput& in, const double* b, double* z)", with(in, "b", "b", 3), {}};
+                     "point_solve(const KernelInput& in, const double* b, double* z)", with(in, "b", "b", 3), {}, {}};
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"z[" + std::to_string(i) + "]", d.point_solution(i, 0)});
             kernels.push_back(k);
         }
@@ -146,7 +214,7 @@ int main(int argc, char** argv) {
             std::vector<std::string> wf(std::begin(kWrenchFields), std::end(kWrenchFields));
             Kernel k{"// Appendix B: frictional wrench (F_x, F_y, tau/rho) on a thin part sliding with relative twist\n"
                      "// (v_x, v_y, xith = rho omega); contacts at r_i from the centre of mass (plate frame).\n",
-                     "thin_wrench(const WrenchInput& in, double* w)", inputs(wf, "in."), {}};
+                     "thin_wrench(const WrenchInput& in, double* w)", inputs(wf, "in."), {}, {}};
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"w[" + std::to_string(i) + "]", d.wrench(i, 0)});
             kernels.push_back(k);
         }

@@ -104,7 +104,12 @@ void Workspace::prepare(const Scene& sc) {
         double M[9];
         gen::thin_M38(in, M);
         M38_inv = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).inverse();
+        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M38_inv_rowmajor.data()) = M38_inv;
     }
+    // det of the reduced system ~ (contact spread)^2: below 1e-9 of that, fall back to LU.
+    double size = 0;
+    for (int i = 0; i < 3; ++i) size = std::max(size, P.c[i].head<2>().norm());
+    det_floor = 1e-9 * size * size;
 }
 
 void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
@@ -158,16 +163,23 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         ws.slip[2].setZero();
         return;
     }
+    double n[3], qdd[3];
     if (ws.thin) {
-        ws.n = ws.M38_inv * Vec3(b[3], b[4], b[2]);   // (38)
+        gen::thin_solve(in, b, ws.M38_inv_rowmajor.data(), n, qdd);   // (38)
     } else {
-        double M[9], r[3];
-        gen::thick_reduced(in, b, M, r);
-        ws.n = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(
-            Eigen::Map<const Vec3>(r));
+        double det;
+        gen::thick_solve(in, b, n, qdd, &det);
+        if (!(std::abs(det) > ws.det_floor)) {
+            // Near-collinear contacts: Cramer's rule loses accuracy; use a pivoted LU instead.
+            double M[9], r[3];
+            gen::thick_reduced(in, b, M, r);
+            const Vec3 nn = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(
+                Eigen::Map<const Vec3>(r));
+            for (int i = 0; i < 3; ++i) n[i] = nn[i];
+            gen::back_substitution(in, b, n, qdd);
+        }
     }
-    double qdd[3];
-    gen::back_substitution(in, b, ws.n.data(), qdd);
+    ws.n = Vec3(n[0], n[1], n[2]);
     ws.qdd = Vec3(qdd[0], qdd[1], qdd[2]);
 }
 

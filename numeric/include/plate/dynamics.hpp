@@ -43,6 +43,8 @@ struct Workspace {
     gen::KernelInput in;                   // inputs of the generated kernels
     bool thin = false;
     Mat3 M38_inv = Mat3::Zero();           // thin part: inverse of (38)'s matrix, constant
+    std::array<double, 9> M38_inv_rowmajor{};
+    double det_floor = 0;                  // thick part: below it, Cramer's rule gives way to LU
     double theta = std::numeric_limits<double>::quiet_NaN();   // of the cached cos/sin in `in`
     std::array<Vec2, 3> r{};               // R2 c_i (horizontal) at that theta
 
@@ -58,8 +60,9 @@ struct Workspace {
 
 // Solves for q''_part and n at configuration q = (s_x, s_y, theta) and twist qd: the production
 // path, on the kernels generated from the symbolic derivation (numeric/generated/): a thick part
-// solves the 3x3 system left after eliminating s'' and theta'' (Eigen fixed-size LU), a thin
-// part uses (38)'s constant inverse, a point part the explicit solution.
+// solves the 3x3 system left after eliminating s'' and theta'' by Cramer's rule (a pivoted Eigen
+// fixed-size LU when that system is near singular), a thin part uses (38)'s constant inverse, a
+// point part the explicit solution.
 void accelerations(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
                    const PlateState& plate, Workspace& ws);
 
