@@ -348,14 +348,29 @@ Derivation derive() {
     // --- Staged forms for code generation ----------------------------------------------------------
     {
         const matrix& A = d.A;
+        // The torque rows through the friction directions in the part frame, dS_i = R2^T d_i:
+        // h_i = c_i x dS_i (23) is then of degree 2 instead of a sum of degree-5 monomials.
+        std::array<matrix, 3> hS;
+        for (int i = 0; i < 3; ++i) {
+            const matrix dS = R2.transpose().mul(col(-S.mu[i] * S.ux[i], -S.mu[i] * S.uy[i], 1));
+            const realsymbol dx("dS" + std::to_string(i + 1) + "x"), dy("dS" + std::to_string(i + 1) + "y");
+            d.A_placeholders.push_back({dx, dS(0, 0).expand()});
+            d.A_placeholders.push_back({dy, dS(1, 0).expand()});
+            hS[i] = cross(col(S.cx[i], S.cy[i], S.cz), col(dx, dy, 1));
+            exmap back{{dx, dS(0, 0)}, {dy, dS(1, 0)}};
+            for (int r = 0; r < 3; ++r)
+                if (!(hS[i](r, 0).subs(back) - A(3 + r, 3 + i)).expand().is_zero())
+                    throw std::logic_error("h_i through dS_i differs from A");
+        }
         matrix G(6, 6);
         for (int r = 0; r < 6; ++r)
             for (int k = 0; k < 6; ++k) {
-                if (is_a<numeric>(A(r, k)) || is_a<symbol>(A(r, k)) || is_a<symbol>(-A(r, k))) {
-                    G(r, k) = A(r, k);
+                const ex e = r >= 3 && k >= 3 ? hS[k - 3](r - 3, 0).expand() : A(r, k);
+                if (is_a<numeric>(e) || is_a<symbol>(e) || is_a<symbol>(-e)) {
+                    G(r, k) = e;
                 } else {
                     const realsymbol a("a" + std::to_string(r) + std::to_string(k));
-                    d.A_placeholders.push_back({a, A(r, k)});
+                    d.A_placeholders.push_back({a, e});
                     G(r, k) = a;
                 }
             }
@@ -379,8 +394,8 @@ Derivation derive() {
         d.back_staged(1, 0) = ny / G(1, 1);
         d.back_staged(2, 0) = nt * inv52;
         // The staged forms are the derived ones once the placeholders are filled in.
-        exmap fill;
-        for (const auto& [a, e] : d.A_placeholders) fill[a] = e;
+        exmap fill;   // later placeholders may use earlier ones: fill in order
+        for (const auto& [a, e] : d.A_placeholders) fill[a] = e.subs(fill);
         for (int i = 0; i < 3; ++i) {
             for (int k = 0; k < 3; ++k)
                 if (!(d.M_staged(i, k).subs(fill) - d.M_reduced(i, k)).expand().is_zero())

@@ -61,7 +61,14 @@ std::string emit(const Kernel& k) {
         if (used[i]) em.bind(k.bindings[i].first.get_name(), k.bindings[i].second.expand());
     for (std::size_t i = 0; i < outs.size(); ++i) em.assign(k.outputs[i].first, outs[i]);
     std::ostringstream o;
-    o << k.comment << "inline void " << k.signature << " {\n" << em.code() << "}\n\n";
+    // Outputs never alias inputs: say so, so that stores do not force inputs to be reloaded.
+    std::string sig = k.signature;
+    for (const char* from : {"const KernelInput& in", "const WrenchInput& in"}) {
+        const auto p = sig.find(from);
+        if (p != std::string::npos) sig.replace(p, std::string(from).size(), std::string(from).replace(std::string(from).find("& in"), 4, "& __restrict in"));
+    }
+    for (std::size_t p = 0; (p = sig.find("double* ", p)) != std::string::npos; p += 19) sig.replace(p, 8, "double* __restrict ");
+    o << k.comment << "inline void " << sig << " {\n" << em.code() << "}\n\n";
     return o.str();
 }
 
@@ -142,11 +149,7 @@ int main(int argc, char** argv) {
             Kernel k{"// q'' = (s_x'', s_y'', theta'') from the normal forces n and b (rows 1, 2, 6 of (31)).\n",
                      "back_substitution(const KernelInput& in, const double* b, const double* n, double* qdd)",
                      with(with(in, "b", "b", 6), "N", "n", 3), {}, {}};
-            // Only the placeholders the back substitution uses (rows 1, 2 and 6 of A).
-            for (const auto& [a, e] : d.A_placeholders) {
-                const std::string nm = a.get_name();
-                if (nm[1] == '0' || nm[1] == '1' || nm[1] == '5') k.bindings.push_back({a, e});
-            }
+            k.bindings = d.A_placeholders;   // emit() keeps the ones used
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             kernels.push_back(k);
         }
@@ -182,8 +185,27 @@ int main(int argc, char** argv) {
             kernels.push_back(k);
         }
         {
-            Kernel k{"// Thin part: n = M38^-1 (b[3], b[4], b[2]) (38) with the part's constant inverse Minv (row-major),\n"
-                     "// then q''.\n",
+            // Specialised to the thin part (c_z = 0, J_xz = J_yz = 0, s_z = 0): b~ and the solve.
+            const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};
+            Kernel k{"// Thin part, U-dynamics: b~ (33)-(34), n = M38^-1 (b[3], b[4], b[2]) (38) with the part's constant\n"
+                     "// inverse Minv (row-major), then q''. Specialised to c_z = 0, J_xz = J_yz = 0.\n",
+                     "thin_solve_U(const KernelInput& in, const double* Minv, double* b, double* n, double* qdd)",
+                     with(in, "Minv", "Minv", 9), {}, {}};
+            const int rb[3] = {3, 4, 2};
+            for (int r = 0; r < 6; ++r) k.bindings.push_back({d.bsym[r], d.b_U(r, 0).subs(thin)});
+            for (const auto& [a, e] : d.A_placeholders) k.bindings.push_back({a, e.subs(thin)});
+            for (int c = 0; c < 3; ++c) {
+                ex e = 0;
+                for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * d.bsym[rb[j]];
+                k.bindings.push_back({S.N[c], e});
+            }
+            for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.bsym[r]});
+            for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
+            for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0).subs(thin)});
+            kernels.push_back(k);
+        }
+        {
+            Kernel k{"// Thin part, any b: n = M38^-1 (b[3], b[4], b[2]) (38), then q''.\n",
                      "thin_solve(const KernelInput& in, const double* b, const double* Minv, double* n, double* qdd)",
                      with(with(in, "b", "b", 6), "Minv", "Minv", 9), {}, d.A_placeholders};
             const int rb[3] = {3, 4, 2};

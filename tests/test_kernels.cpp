@@ -148,9 +148,37 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
             bn(i, 0) = d.b_U(i, 0).subs(sub).evalf();
         }
         const matrix z = An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
+        double n2[3], qdd2[3], det;
+        gen::thick_solve(in, bU, n2, qdd2, &det);
         for (int i = 0; i < 3; ++i) {
-            CHECK(close(qdd[i], ex_to<numeric>(z(i, 0).evalf()).to_double(), 1.0));
-            CHECK(close(n[i], ex_to<numeric>(z(3 + i, 0).evalf()).to_double(), in.m * in.g));
+            const double zq = ex_to<numeric>(z(i, 0).evalf()).to_double(), zn = ex_to<numeric>(z(3 + i, 0).evalf()).to_double();
+            CHECK(close(qdd[i], zq, 1.0));
+            CHECK(close(n[i], zn, in.m * in.g));
+            CHECK(close(qdd2[i], zq, 1.0));
+            CHECK(close(n2[i], zn, in.m * in.g));
+        }
+
+        // The thin part's specialised kernel against GiNaC's solve of the thin system.
+        gen::KernelInput tin = in;
+        exmap tsub = sub;
+        tin.cz = tin.sz = tin.Jxz = tin.Jyz = 0;
+        tsub[S.cz] = 0;
+        tsub[S.sz] = 0;
+        tsub[S.Jxz] = 0;
+        tsub[S.Jyz] = 0;
+        double M38[9];
+        gen::thin_M38(tin, M38);
+        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> Minv = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M38).inverse();
+        double bt[6], nt[3], qt[3];
+        gen::thin_solve_U(tin, Minv.data(), bt, nt, qt);
+        for (int i = 0; i < 6; ++i) {
+            for (int k = 0; k < 6; ++k) An(i, k) = d.A(i, k).subs(tsub).evalf();
+            bn(i, 0) = d.b_U(i, 0).subs(tsub).evalf();
+        }
+        const matrix zt = An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
+        for (int i = 0; i < 3; ++i) {
+            CHECK(close(qt[i], ex_to<numeric>(zt(i, 0).evalf()).to_double(), 1.0));
+            CHECK(close(nt[i], ex_to<numeric>(zt(3 + i, 0).evalf()).to_double(), in.m * in.g));
         }
     }
 }

@@ -144,6 +144,14 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
     in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();
     double b[6];
+    if (ws.thin && level != Dynamics::Full) {   // the thin part's specialised kernel does it all
+        double n[3], qdd[3];
+        gen::thin_solve_U(in, ws.M38_inv_rowmajor.data(), b, n, qdd);
+        ws.b = Eigen::Map<const Vec6>(b);
+        ws.n = Vec3(n[0], n[1], n[2]);
+        ws.qdd = Vec3(qdd[0], qdd[1], qdd[2]);
+        return;
+    }
     if (level == Dynamics::Full) {
         in.wx = ps.w1.x(); in.wy = ps.w1.y(); in.wz = ps.w1.z();
         in.R11 = ps.R1(0, 0); in.R12 = ps.R1(0, 1); in.R13 = ps.R1(0, 2);
