@@ -6,6 +6,7 @@
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -24,12 +25,12 @@ std::string machine() {
 }
 
 template <class F>
-double ns_per_eval(const Scene& sc, Dynamics level, F&& f, double& checksum) {
+double ns_once(const Scene& sc, Dynamics level, F&& f, double& checksum) {
     Workspace ws;
     const PlateState ps = plate_state(sc.plate, 0.013, level);
     const Vec3 q(0.01, 0.02, 0.3);
     Vec3 qd(0.1, -0.05, 2);
-    const int n = 2'000'000;
+    const int n = 1'000'000;
     f(sc, level, q, qd, ps, ws);   // warm up, prepare
     const auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < n; ++i) {
@@ -38,6 +39,15 @@ double ns_per_eval(const Scene& sc, Dynamics level, F&& f, double& checksum) {
         checksum += ws.qdd[0];
     }
     return 1e9 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / n;
+}
+
+// The smallest of five timings of 10^6 evaluations: the machine is shared, and the minimum is
+// the least disturbed measurement.
+template <class F>
+double ns_per_eval(const Scene& sc, Dynamics level, F&& f, double& checksum) {
+    double best = 1e300;
+    for (int rep = 0; rep < 5; ++rep) best = std::min(best, ns_once(sc, level, f, checksum));
+    return best;
 }
 
 }  // namespace

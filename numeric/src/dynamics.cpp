@@ -130,16 +130,20 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     in.sxd = qd[0];
     in.syd = qd[1];
     // Sliding velocities s' + w2^ R2 c_i and their unit directions (zero at zero slip).
-    double* u[3][2] = {{&in.u1x, &in.u1y}, {&in.u2x, &in.u2y}, {&in.u3x, &in.u3y}};
     const double w = P.point ? 0.0 : qd[2];
     in.thd = w;
-    for (int i = 0; i < P.contacts(); ++i) {
+    auto slip = [&](int i, double& ux, double& uy) {
         const double vx = qd[0] - w * ws.r[i].y(), vy = qd[1] + w * ws.r[i].x();
         ws.slip[i] = Vec2(vx, vy);
         const double sp2 = vx * vx + vy * vy;
         const double inv = sp2 > 0 ? 1.0 / std::sqrt(sp2) : 0.0;
-        *u[i][0] = vx * inv;
-        *u[i][1] = vy * inv;
+        ux = vx * inv;
+        uy = vy * inv;
+    };
+    slip(0, in.u1x, in.u1y);
+    if (!P.point) {
+        slip(1, in.u2x, in.u2y);
+        slip(2, in.u3x, in.u3y);
     }
     in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
     in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();
