@@ -121,4 +121,16 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     return out;
 }
 
+bool period_map(const Scene& sc, const Vec3& q0, const Vec3& qd0, Vec3& out, const IntegrationOptions& opt,
+                StopEvent* stop) {
+    detail::ReducedModel model(sc, q0);
+    detail::Engine<detail::ReducedModel> e(model, sc, opt);
+    const Vec3 qd = sc.part.point ? Vec3(qd0[0], qd0[1], 0) : qd0;
+    bool ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) &&
+              e.advance(sc.plate.T, [](double, const auto&, const Vec3&) {});
+    if (stop) *stop = e.stop;
+    if (ok) out = model.qd(e.y());
+    return ok;
+}
+
 }  // namespace plate

@@ -51,4 +51,9 @@ struct LimitCycleSummary {
 LimitCycleSummary limit_cycle(const Scene& scene, const Vec3& q0, const LimitCycleOptions& opt = {},
                               const Vec3& qd0 = Vec3::Zero());
 
+// The period map of the reduced U-dynamics at q0: the twist at t = T from qd0 at t = 0.
+// Returns false (and leaves `out` unchanged) if the period leaves the model (stop says why).
+bool period_map(const Scene& scene, const Vec3& q0, const Vec3& qd0, Vec3& out,
+                const IntegrationOptions& opt = {}, StopEvent* stop = nullptr);
+
 }  // namespace plate

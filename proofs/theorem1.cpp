@@ -1,0 +1,245 @@
+#include "theorem1.hpp"
+
+#include "plate/dynamics.hpp"
+
+#include <boost/numeric/odeint.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace plate::proofs {
+
+namespace {
+
+namespace odeint = boost::numeric::odeint;
+using Pair = std::array<double, 6>;
+
+}  // namespace
+
+ContractionCase contraction_case(const Scene& sc, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b, int periods,
+                                 double rtol) {
+    ContractionCase out;
+    const double v = sc.v_ref(), rho = sc.part.rho(), T = sc.plate.T;
+    const Vec3 scale(v, v, v / rho);     // state scaling: errors relative to the slip-speed scale
+    const Vec3 S(1, 1, rho);             // the Appendix's scaled twist: (v_x, v_y, rho omega)
+    Workspace wa, wb;
+    auto sys = [&](const Pair& y, Pair& dy, double t) {
+        const PlateState ps = plate_state(sc.plate, t, Dynamics::ReducedU);
+        const Vec3 a(y[0] * scale[0], y[1] * scale[1], y[2] * scale[2]);
+        const Vec3 b(y[3] * scale[0], y[4] * scale[1], y[5] * scale[2]);
+        accelerations(sc, Dynamics::ReducedU, q0, a, ps, wa);
+        accelerations(sc, Dynamics::ReducedU, q0, b, ps, wb);
+        for (int i = 0; i < 3; ++i) {
+            dy[i] = wa.qdd[i] / scale[i];
+            dy[3 + i] = wb.qdd[i] / scale[i];
+        }
+    };
+    auto V = [&](const Pair& y) {
+        double s = 0;
+        for (int i = 0; i < 3; ++i) {
+            const double d = (y[3 + i] - y[i]) * scale[i] * S[i];
+            s += d * d;
+        }
+        return 0.5 * s;
+    };
+    auto ctrl = odeint::make_controlled<odeint::runge_kutta_dopri5<Pair>>(rtol, rtol);
+    Pair y{xi_a[0] / scale[0], xi_a[1] / scale[1], xi_a[2] / scale[2], xi_b[0] / scale[0], xi_b[1] / scale[1],
+           xi_b[2] / scale[2]};
+    Pair dydt, y1, dydt1;
+    double t = 0, dt = 1e-4 * T;
+    sys(y, dydt, t);
+    out.V0 = V(y);
+    out.V_periods.push_back(out.V0);
+    double worst = 0;
+    const double eps_slip = 1e-6 * v;
+    for (int k = 1; k <= periods; ++k) {
+        const double t_end = k * T;
+        long guard = 0;
+        while (t < t_end) {
+            if (++guard > 2'000'000 || dt < 1e-13 * T) {
+                out.why_invalid = "step size collapsed";
+                return out;
+            }
+            double h = std::min(dt, t_end - t);
+            double tt = t;
+            if (ctrl.try_step(sys, y, dydt, tt, y1, dydt1, h) == odeint::fail) {
+                dt = h;
+                continue;
+            }
+            if (t_end - tt < 1e-14 * T) tt = t_end;
+            dt = std::max(h, 1e-12 * T);
+            // The model's assumptions at the new point (the last evaluation was there).
+            sys(y1, dydt1, tt);
+            if (std::min(wa.n.minCoeff(), wb.n.minCoeff()) < 0) {
+                out.why_invalid = "contact lost";
+                return out;
+            }
+            for (int i = 0; i < 3; ++i)
+                if (wa.slip[i].norm() < eps_slip || wb.slip[i].norm() < eps_slip) {
+                    out.why_invalid = "a contact reached zero slip";
+                    return out;
+                }
+            const double Vn = V(y1), Vo = V(y);
+            double xmax = 0, rel = 0;
+            for (int i = 0; i < 6; ++i) xmax = std::max(xmax, std::abs(y1[i]) * scale[i % 3] * S[i % 3]);
+            for (int i = 0; i < 3; ++i) rel += std::pow((y1[3 + i] - y1[i]) * scale[i] * S[i], 2);
+            const double delta = rtol * (v + xmax);
+            const double bound = std::sqrt(rel) * 2 * std::sqrt(3.0) * delta + 6 * delta * delta;
+            if (Vn > Vo) worst = std::max(worst, (Vn - Vo) / bound);
+            y = y1;
+            dydt = dydt1;
+            t = tt;
+        }
+        out.V_periods.push_back(V(y));
+    }
+    out.valid = true;
+    out.V_end = out.V_periods.back();
+    out.worst_increase = worst;
+    out.monotone = worst <= 1;
+    out.converged = out.V_end <= 1e-10 * out.V0;
+    // Contraction of |xi_rel| per period, up to the period where V reaches 1e-16 V0 (noise).
+    int k = 1;
+    while (k + 1 < static_cast<int>(out.V_periods.size()) && out.V_periods[k] > 1e-16 * out.V0) ++k;
+    out.rate = std::pow(std::sqrt(out.V_periods[k] / out.V0), 1.0 / k);
+    return out;
+}
+
+double floquet_radius(const Scene& sc, const Vec3& q0, const Vec3& x0, double rtol) {
+    IntegrationOptions io;
+    io.rtol = rtol;
+    const double v = sc.v_ref();
+    const Vec3 h(1e-5 * v, 1e-5 * v, 1e-5 * v / sc.part.rho());
+    const int dim = sc.part.point ? 2 : 3;
+    Mat3 J = Mat3::Identity();
+    for (int c = 0; c < dim; ++c) {
+        Vec3 p = x0, m = x0, Pp, Pm;
+        p[c] += h[c];
+        m[c] -= h[c];
+        if (!period_map(sc, q0, p, Pp, io) || !period_map(sc, q0, m, Pm, io)) return std::nan("");
+        J.col(c) = (Pp - Pm) / (2 * h[c]);
+    }
+    // In scaled coordinates (similar to J: same eigenvalues).
+    return Eigen::EigenSolver<Mat3>(J.topLeftCorner(3, 3)).eigenvalues().head(dim).cwiseAbs().maxCoeff();
+}
+
+ContractionSummary check_contraction(const ContractionOptions& opt) {
+    ContractionSummary s;
+    std::vector<double> rates;
+    for (int k = 0; k < opt.cases; ++k) {
+        const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(k);
+        RandomSceneOptions ro;
+        ro.thin = opt.thin;
+        Scene sc = random_scene(seed, ro);
+        if (opt.modify) opt.modify(sc);
+        Rng r(seed * 0x9E3779B97F4A7C15ull + 17);
+        const double v = sc.v_ref(), w = v / sc.part.rho();
+        const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
+        const Vec3 a(r.uniform(-v, v), r.uniform(-v, v), r.uniform(-w, w));
+        const Vec3 b(r.uniform(-v, v), r.uniform(-v, v), r.uniform(-w, w));
+        ContractionCase c = contraction_case(sc, q0, a, b, opt.periods, opt.rtol);
+        c.seed = seed;
+        ++s.cases;
+        if (c.valid) {
+            ++s.valid;
+            s.monotone += c.monotone;
+            s.converged += c.converged;
+            if (c.worst_increase > s.worst_increase) {
+                s.worst_increase = c.worst_increase;
+                s.worst_seed = seed;
+            }
+            rates.push_back(c.rate);
+            s.max_rate = std::max(s.max_rate, c.rate);
+            LimitCycleOptions lo;
+            lo.integration.rtol = opt.rtol;
+            lo.tol = 1e-9;
+            lo.restarts = 0;
+            const LimitCycleSummary lc = limit_cycle(sc, q0, lo, a);
+            if (lc.converged) {
+                c.spectral_radius = floquet_radius(sc, q0, lc.qd_start, opt.rtol);
+                s.max_spectral_radius = std::max(s.max_spectral_radius, c.spectral_radius);
+                s.floquet_below_one += c.spectral_radius < 1;
+            }
+        }
+        s.details.push_back(std::move(c));
+    }
+    if (!rates.empty()) {
+        std::sort(rates.begin(), rates.end());
+        s.median_rate = rates[rates.size() / 2];
+    }
+    return s;
+}
+
+LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int directions, double separation) {
+    LimitSurfaceResult r;
+    r.directions = directions;
+    std::vector<Vec3> xi(directions), w(directions);
+    const double golden = kPi * (3 - std::sqrt(5.0));
+    for (int k = 0; k < directions; ++k) {
+        const double z = 1 - (2 * k + 1.0) / directions, rad = std::sqrt(1 - z * z), a = golden * k;
+        xi[k] = Vec3(rad * std::cos(a), rad * std::sin(a), z);
+        w[k] = wmap(xi[k]);
+    }
+    r.min_separation = 1e300;
+    for (int i = 0; i < directions; ++i)
+        for (int j = 0; j < directions; ++j) {
+            if (i == j) continue;
+            ++r.pairs;
+            r.max_work_violation = std::max(r.max_work_violation, (xi[i].dot(w[i]) - xi[i].dot(w[j])) / scale);
+            if (j > i) {
+                r.monotonicity_violation = std::max(r.monotonicity_violation, (xi[i] - xi[j]).dot(w[i] - w[j]) / scale);
+                if ((xi[i] - xi[j]).norm() > separation)
+                    r.min_separation = std::min(r.min_separation, (w[i] - w[j]).norm() / scale);
+            }
+        }
+    return r;
+}
+
+WrenchMap thin_wrench_map(const Scene& sc, const Vec3& q0, double t, double* friction_scale) {
+    Workspace ws;
+    accelerations(sc, Dynamics::ReducedU, q0, Vec3(0.1, 0.05, 1), plate_state(sc.plate, t, Dynamics::ReducedU), ws);
+    gen::WrenchInput in;
+    in.N1 = ws.n[0];
+    in.N2 = ws.n[1];
+    in.N3 = ws.n[2];
+    in.r1x = ws.r[0].x(); in.r1y = ws.r[0].y();
+    in.r2x = ws.r[1].x(); in.r2y = ws.r[1].y();
+    in.r3x = ws.r[2].x(); in.r3y = ws.r[2].y();
+    in.mu1 = sc.part.mu[0];
+    in.mu2 = sc.part.mu[1];
+    in.mu3 = sc.part.mu[2];
+    in.rho = sc.part.rho();
+    if (friction_scale) *friction_scale = in.mu1 * in.N1 + in.mu2 * in.N2 + in.mu3 * in.N3;
+    return [in](const Vec3& xi) mutable {
+        in.vx = xi[0];
+        in.vy = xi[1];
+        in.xith = xi[2];
+        double w[3];
+        gen::thin_wrench(in, w);
+        return Vec3(w[0], w[1], w[2]);
+    };
+}
+
+Conditioning condition_of_A(const Scene& sc, int samples, std::uint64_t seed) {
+    Conditioning c;
+    c.min_singular = 1e300;
+    Rng r(seed);
+    const double m = sc.part.m, g = sc.g, rho = sc.part.rho();
+    // Dimensionless A: unknowns in units (g, g, g/rho, m g, m g, m g), rows in (m g, m g, m g, m g rho x3).
+    Vec6 Dz, De;
+    Dz << g, g, g / rho, m * g, m * g, m * g;
+    De << m * g, m * g, m * g, m * g * rho, m * g * rho, m * g * rho;
+    Workspace ws;
+    for (int k = 0; k < samples; ++k) {
+        const Vec3 q(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
+        const Vec3 qd(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30));
+        accelerations_reference(sc, Dynamics::U, q, qd, PlateState{}, ws);
+        const Mat6 As = De.cwiseInverse().asDiagonal() * ws.A * Dz.asDiagonal();
+        const Vec6 sv = Eigen::JacobiSVD<Mat6>(As).singularValues();
+        c.max_condition = std::max(c.max_condition, sv[0] / sv[5]);
+        c.min_singular = std::min(c.min_singular, sv[5] / sv[0]);
+    }
+    return c;
+}
+
+}  // namespace plate::proofs

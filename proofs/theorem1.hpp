@@ -1,0 +1,95 @@
+// Numerical checks of Theorem 1 and its Appendix (Vose, Umbanhowar & Lynch): the Lyapunov
+// contraction of the relative twist (C), limit surfaces (B), periodicity (D) and the
+// invertibility of A (Section III-E). Every check runs on the generated kernels through the
+// production dynamics, is seeded and reproducible, and returns counts, worst cases and a verdict.
+#pragma once
+
+#include "plate/limit_cycle.hpp"
+#include "plate/random_scene.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace plate::proofs {
+
+// --- C. Trajectory convergence ------------------------------------------------------------
+// Two copies of a part at one configuration, from different twists, integrated together on one
+// step sequence. V = 1/2 |xi_rel|^2 in the Appendix's scaled coordinates (xi_theta = rho omega).
+// Between accepted steps the computed V may rise only by integration error: each copy's local
+// error is at most delta = rtol (v_ref + |xi|) per component (the controller's acceptance test
+// on the scaled state), so xi_rel errs by at most 2 sqrt(3) delta and V by
+// bound = |xi_rel| 2 sqrt(3) delta + 6 delta^2. `worst_increase` is the largest rise divided by
+// that bound: <= 1 is what Theorem 1 allows.
+struct ContractionOptions {
+    int cases = 100;
+    std::uint64_t seed = 1;
+    bool thin = true;          // thin parts (Theorem 1) or thick ones (beyond it)
+    int periods = 40;          // integration length
+    double rtol = 1e-10;
+    // Plate motions and parts come from random_scene; override for deliberately broken cases.
+    std::function<void(Scene&)> modify;
+};
+
+struct ContractionCase {
+    std::uint64_t seed = 0;
+    bool valid = false;             // stayed in the model (contact, sliding)
+    std::string why_invalid;
+    double V0 = 0, V_end = 0;
+    double worst_increase = 0;      // largest rise of V / its error bound (<= 1 passes)
+    double rate = 0;                // |xi_rel| contraction per period (geometric mean)
+    double spectral_radius = 0;     // of the period map's Jacobian at the cycle (Floquet multipliers)
+    bool monotone = false, converged = false;
+    std::vector<double> V_periods;  // V at each period boundary
+};
+
+struct ContractionSummary {
+    int cases = 0, valid = 0, monotone = 0, converged = 0, floquet_below_one = 0;
+    double worst_increase = 0;      // over all valid cases
+    std::uint64_t worst_seed = 0;
+    double median_rate = 0, max_rate = 0, max_spectral_radius = 0;
+    std::vector<ContractionCase> details;
+    bool passed() const { return valid > 0 && monotone == valid && converged == valid && floquet_below_one == valid; }
+};
+
+ContractionCase contraction_case(const Scene& scene, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b,
+                                 int periods, double rtol);
+ContractionSummary check_contraction(const ContractionOptions& opt);
+
+// Jacobian of the period map at the cycle start (central differences) and its spectral radius.
+double floquet_radius(const Scene& scene, const Vec3& q0, const Vec3& cycle_start, double rtol);
+
+// --- B. Limit surfaces ----------------------------------------------------------------------
+// A thin part's frictional wrench as a function of its relative twist (the generated kernel),
+// sampled on twist directions. Checks, over all pairs (i, j):
+//   maximum work  xi_i . w_j >= xi_i . w_i   (w_i minimises the power over the surface: the
+//                 surface is convex and -xi_i is its outward normal at w_i),
+//   (40)          (xi_i - xi_j) . (w_i - w_j) <= 0,
+//   no vertices   distinct directions give distinct wrenches: the smallest |w_i - w_j| over
+//                 pairs at least `separation` apart stays away from zero.
+using WrenchMap = std::function<Vec3(const Vec3& xi)>;   // scaled twist -> (F_x, F_y, tau / rho)
+
+struct LimitSurfaceResult {
+    int directions = 0;
+    long pairs = 0;
+    double max_work_violation = 0;     // max (xi_i.w_i - xi_i.w_j) / (sum mu N), <= 1e-12 passes
+    double monotonicity_violation = 0; // max (xi_i - xi_j).(w_i - w_j) / (sum mu N)
+    double min_separation = 0;         // min |w_i - w_j| / (sum mu N) over well-separated pairs
+    bool convex_and_normal() const { return max_work_violation <= 1e-12 && monotonicity_violation <= 1e-12; }
+};
+
+LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int directions = 600,
+                                       double separation = 0.2);
+// The thin part of `scene` at configuration q0 and plate time t: its normal forces (38) and the
+// generated wrench kernel.
+WrenchMap thin_wrench_map(const Scene& scene, const Vec3& q0, double t, double* friction_scale = nullptr);
+
+// --- Invertibility of A (Section III-E) -------------------------------------------------------
+struct Conditioning {
+    double max_condition = 0;   // of A over the sampled states
+    double min_singular = 0;    // smallest singular value seen (relative to the largest)
+};
+Conditioning condition_of_A(const Scene& scene, int samples, std::uint64_t seed);
+
+}  // namespace plate::proofs

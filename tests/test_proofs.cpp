@@ -1,0 +1,127 @@
+// Small, seeded versions of the Theorem 1 checks, each with a deliberately broken case that it
+// must catch.
+#include "theorem1.hpp"
+
+#include "plate/scene_io.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace plate;
+using namespace plate::proofs;
+
+TEST_CASE("Theorem 1: the relative twist of thin parts contracts (V never rises beyond its error bound)",
+          "[proofs][contraction]") {
+    ContractionOptions o;
+    o.cases = 12;
+    o.seed = 100;
+    const ContractionSummary s = check_contraction(o);
+    INFO("valid " << s.valid << ", worst rise/bound " << s.worst_increase << " (seed " << s.worst_seed
+                  << "), median rate " << s.median_rate << ", max Floquet " << s.max_spectral_radius);
+    CHECK(s.valid >= 8);
+    CHECK(s.monotone == s.valid);
+    CHECK(s.converged == s.valid);
+    CHECK(s.floquet_below_one == s.valid);
+    CHECK(s.max_rate < 1);
+    CHECK(s.passed());
+}
+
+TEST_CASE("the contraction check catches an expanding map (negative friction)", "[proofs][contraction][broken]") {
+    ContractionOptions o;
+    o.cases = 4;
+    o.seed = 100;
+    o.periods = 6;
+    o.modify = [](Scene& sc) { sc.part.mu = -sc.part.mu; };   // friction that pushes: energy grows
+    const ContractionSummary s = check_contraction(o);
+    REQUIRE(s.valid > 0);
+    CHECK(s.monotone < s.valid);
+    CHECK(s.worst_increase > 1e3);
+    CHECK_FALSE(s.passed());
+}
+
+TEST_CASE("limit surface of a thin part: convex, twist normal to it, (40) holds, no vertices", "[proofs][limit_surface]") {
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+        const Scene sc = random_scene(seed, RandomSceneOptions{true});
+        double scale = 0;
+        const WrenchMap w = thin_wrench_map(sc, Vec3(0.01, -0.01, 0.5), 0.01, &scale);
+        const LimitSurfaceResult r = check_limit_surface(w, scale, 300);
+        INFO("seed " << seed << ": max-work violation " << r.max_work_violation << ", (40) "
+                     << r.monotonicity_violation << ", separation " << r.min_separation);
+        CHECK(r.convex_and_normal());
+        CHECK(r.min_separation > 1e-3);
+    }
+}
+
+TEST_CASE("the limit-surface check catches a non-convex surface (the wrench's sign flipped)",
+          "[proofs][limit_surface][broken]") {
+    const Scene sc = random_scene(2, RandomSceneOptions{true});
+    double scale = 0;
+    const WrenchMap w = thin_wrench_map(sc, Vec3::Zero(), 0.0, &scale);
+    const LimitSurfaceResult r = check_limit_surface([&](const Vec3& xi) { return Vec3(-w(xi)); }, scale, 200);
+    CHECK_FALSE(r.convex_and_normal());
+    CHECK(r.max_work_violation > 0.1);
+}
+
+TEST_CASE("as contacts approach collinear the limit surface gets a vertex and A becomes singular",
+          "[proofs][limit_surface][collinear]") {
+    // Contacts (-L, 0), (L, 0), (0, e) (centre of mass at the centroid). With e = 0 every twist
+    // (0, v_y, rho omega) with |omega| L < v_y moves all contacts along +y: they all get the same
+    // wrench, so one wrench has many normals -- a vertex. Two such twists' wrenches approach each
+    // other like e, while the surface stays convex; and A's condition number grows like 1/e.
+    double last_gap = 1e9, last_cond = 0;
+    const double L = 0.03;
+    for (double e : {2e-2, 2e-3, 2e-4}) {
+        Scene sc = random_scene(3, RandomSceneOptions{true});
+        sc.part.c = {Vec3(-L, -e / 3, 0), Vec3(L, -e / 3, 0), Vec3(0, 2 * e / 3, 0)};
+        sc.part.mu.setConstant(0.3);
+        sc.plate.harmonics.clear();
+        double scale = 0;
+        const WrenchMap w = thin_wrench_map(sc, Vec3::Zero(), 0, &scale);
+        const LimitSurfaceResult r = check_limit_surface(w, scale, 300);
+        const double rho = sc.part.rho();
+        const double gap = (w(Vec3(0, 1, 0)) - w(Vec3(0, 1, rho * 0.5 / L).normalized())).norm() / scale;
+        const Conditioning c = condition_of_A(sc, 20, 5);
+        INFO("e = " << e << ": wrench gap " << gap << ", cond(A) " << c.max_condition);
+        CHECK(r.convex_and_normal());     // still convex ...
+        CHECK(gap < 0.2 * last_gap);       // ... but two distinct twists share ever closer wrenches
+        CHECK(c.max_condition > 5 * last_cond);
+        last_gap = gap;
+        last_cond = c.max_condition;
+    }
+    CHECK(last_gap < 0.01);
+    CHECK(last_cond > 100);
+}
+
+TEST_CASE("collinear contacts make A singular", "[proofs][invertibility][collinear]") {
+    Scene sc = random_scene(3, RandomSceneOptions{true});
+    sc.part.c = {Vec3(-0.03, 0, 0), Vec3(0.03, 0, 0), Vec3(0.01, 0, 0)};
+    const Conditioning c = condition_of_A(sc, 10, 5);
+    CHECK(c.min_singular < 1e-12);
+}
+
+TEST_CASE("A is invertible and well conditioned for the paper's parts", "[proofs][invertibility]") {
+    for (const char* name : {"fig4", "fig5"}) {
+        const Scene sc = load_scene(std::string(PLATE_SOURCE_DIR "/scenes/") + name + ".json");
+        const Conditioning c = condition_of_A(sc, 200, 1);
+        INFO(name << ": cond(A) up to " << c.max_condition);
+        CHECK(c.max_condition < 1e3);
+    }
+}
+
+TEST_CASE("Appendix D: the converged cycle repeats with period T", "[proofs][periodicity]") {
+    const Scene sc = random_scene(21, RandomSceneOptions{true});
+    LimitCycleOptions lo;
+    lo.integration.rtol = 1e-11;
+    lo.tol = 1e-10;
+    const LimitCycleSummary lc = limit_cycle(sc, Vec3(0.01, 0, 0.3), lo, Vec3(0.05, 0, 1));
+    REQUIRE(lc.converged);
+    Vec3 next;
+    IntegrationOptions io;
+    io.rtol = 1e-11;
+    REQUIRE(period_map(sc, Vec3(0.01, 0, 0.3), lc.qd_start, next, io));
+    Vec3 again;
+    REQUIRE(period_map(sc, Vec3(0.01, 0, 0.3), next, again, io));
+    const double v = sc.v_ref();
+    // P(x*) = x*: the start repeats after one and after two periods, to the cycle tolerance.
+    CHECK((next - lc.qd_start).head<2>().norm() < 1e-8 * v);
+    CHECK((again - lc.qd_start).head<2>().norm() < 1e-8 * v);
+}
