@@ -26,8 +26,10 @@ struct ContractionOptions {
     int cases = 100;
     std::uint64_t seed = 1;
     bool thin = true;          // thin parts (Theorem 1) or thick ones (beyond it)
-    int periods = 40;          // integration length
+    int periods = 400;         // at most; each case stops when V has fallen by 1e12 (converged)
     double rtol = 1e-10;
+    int starts = 4;            // Observation 1: further initial twists whose cycles must coincide
+    int threads = 0;           // 0: all cores
     // Plate motions and parts come from random_scene; override for deliberately broken cases.
     std::function<void(Scene&)> modify;
 };
@@ -40,17 +42,23 @@ struct ContractionCase {
     double worst_increase = 0;      // largest rise of V / its error bound (<= 1 passes)
     double rate = 0;                // |xi_rel| contraction per period (geometric mean)
     double spectral_radius = 0;     // of the period map's Jacobian at the cycle (Floquet multipliers)
-    bool monotone = false, converged = false;
+    bool monotone = false, converged = false;   // V never rose beyond error; V fell by 1e12
+    bool unique = false;            // all `starts` initial twists reached the same cycle
+    double cycle_spread = 0;        // largest distance between their cycle starts / v_ref
     std::vector<double> V_periods;  // V at each period boundary
 };
 
 struct ContractionSummary {
-    int cases = 0, valid = 0, monotone = 0, converged = 0, floquet_below_one = 0;
+    int cases = 0, valid = 0, monotone = 0, converged = 0, floquet_below_one = 0, unique = 0;
+    double seconds = 0;
     double worst_increase = 0;      // over all valid cases
     std::uint64_t worst_seed = 0;
     double median_rate = 0, max_rate = 0, max_spectral_radius = 0;
     std::vector<ContractionCase> details;
-    bool passed() const { return valid > 0 && monotone == valid && converged == valid && floquet_below_one == valid; }
+    std::vector<std::uint64_t> counterexamples;   // valid cases failing any of the checks
+    bool passed() const {
+        return valid > 0 && monotone == valid && converged == valid && floquet_below_one == valid && unique == valid;
+    }
 };
 
 ContractionCase contraction_case(const Scene& scene, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b,

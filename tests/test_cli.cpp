@@ -167,3 +167,13 @@ TEST_CASE("a simulation that leaves the model stops with exit code 3 and says wh
     CHECK(r.err.find("lost") != std::string::npos);
     CHECK(fs::exists(out));   // the trajectory up to the loss of contact
 }
+
+TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]") {
+    const Run r = run("proofs --thin 6 --thick 3 --surfaces 3 --seed 100");
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["thin"]["cases"] == 6);
+    CHECK(j["thin"]["passed"] == true);
+    CHECK(j["thick"]["cases"] == 3);
+    CHECK(j["limit_surfaces"]["convex_and_normal"] == 3);
+}

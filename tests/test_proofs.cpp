@@ -21,8 +21,24 @@ TEST_CASE("Theorem 1: the relative twist of thin parts contracts (V never rises 
     CHECK(s.monotone == s.valid);
     CHECK(s.converged == s.valid);
     CHECK(s.floquet_below_one == s.valid);
+    CHECK(s.unique == s.valid);
     CHECK(s.max_rate < 1);
     CHECK(s.passed());
+    CHECK(s.counterexamples.empty());
+}
+
+TEST_CASE("beyond Theorem 1: thick parts, seeded search for counter-examples", "[proofs][contraction][thick]") {
+    ContractionOptions o;
+    o.cases = 8;
+    o.seed = 500;
+    o.thin = false;
+    const ContractionSummary s = check_contraction(o);
+    INFO("thick: valid " << s.valid << ", monotone " << s.monotone << ", unique " << s.unique << ", worst rise/bound "
+                         << s.worst_increase << ", max Floquet " << s.max_spectral_radius);
+    CHECK(s.valid >= 4);
+    // Observation 1 (not a theorem for thick parts): the cycles found are unique and attracting.
+    CHECK(s.unique == s.valid);
+    CHECK(s.floquet_below_one == s.valid);
 }
 
 TEST_CASE("the contraction check catches an expanding map (negative friction)", "[proofs][contraction][broken]") {
