@@ -1,0 +1,22 @@
+// The verification report: `plate report --out DIR` writes DIR/index.html with its figures
+// (SVG, drawn by gnuplot) beside it. Every number in it is computed by that run; the run records
+// its seed, the machine and how long each part took.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace plate::report {
+
+struct ReportOptions {
+    std::string out;                 // folder (created)
+    std::string source_dir;          // project root: scenes/ and reports/generated/
+    std::uint64_t seed = 1;
+    bool quick = false;              // small campaigns and grids (tests); the main job runs the full one
+    int threads = 0;
+};
+
+// Writes the report; throws std::runtime_error (with the file or tool named) on failure.
+void write_report(const ReportOptions& opt);
+
+}  // namespace plate::report
