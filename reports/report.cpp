@@ -2,6 +2,7 @@
 
 #include "plate/field.hpp"
 #include "plate/scene_io.hpp"
+#include "derivation.hpp"
 #include "theorem1.hpp"
 
 #include <chrono>
@@ -37,14 +38,6 @@ std::string esc(const std::string& s) {
         else o += c;
     }
     return o;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    if (!in) throw std::runtime_error(p.string() + ": cannot read");
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 std::string machine() {
@@ -97,45 +90,27 @@ pre{overflow-x:auto;padding:.5em}.math{overflow-x:auto}</style>
 
 std::string verdict(bool ok) { return ok ? "<span class=\"pass\">pass</span>" : "<span class=\"fail\">FAIL</span>"; }
 
-// Markdown table (the derivation's findings) to HTML.
-std::string md_table(const std::string& md) {
-    std::istringstream in(md);
-    std::string line, out = "<table>\n";
-    int row = 0;
-    while (std::getline(in, line)) {
-        if (line.rfind("|", 0) != 0) continue;
-        if (line.find("|---") == 0) continue;
-        std::vector<std::string> cells;
-        std::string cell;
-        for (std::size_t i = 1; i < line.size(); ++i) {
-            if (line[i] == '|') { cells.push_back(cell); cell.clear(); } else cell += line[i];
-        }
-        out += "<tr>";
-        for (auto c : cells) {
-            std::string h = esc(c);
-            for (const char* b : {"**differs**"})
-                if (auto p = h.find(b); p != std::string::npos) h.replace(p, std::string(b).size(), "<span class=\"fail\">differs</span>");
-            out += row == 0 ? "<th>" + h + "</th>" : "<td>" + h + "</td>";
-        }
-        out += "</tr>\n";
-        ++row;
-    }
-    return out + "</table>\n";
-}
-
-void section_derivation(Ctx& c, const fs::path& src) {
-    const fs::path gen = src / "reports/generated";
+void section_derivation(Ctx& c) {
+    const symbolic::Derivation d = symbolic::derive();   // run here: every line below is this run's
     c.html << "<h2>1. Symbolic derivation</h2>\n<p>Derived with GiNaC from frames, contact kinematics, Coulomb "
-              "forces and Newton–Euler (<code>symbolic/derivation.cpp</code>); each printed equation compared:</p>\n";
-    c.html << md_table(slurp(gen / "derivation_findings.md"));
-    c.html << "<h3>Derived equations</h3>\n";
-    std::istringstream in(slurp(gen / "derivation.tex"));
+              "forces and Newton–Euler (<code>symbolic/derivation.cpp</code>), time derivatives by a jet rule; each printed "
+              "equation compared with the derived one:</p>\n<table><tr><th>equation</th><th>verdict</th><th>printed</th>"
+              "<th>derived</th><th>why</th></tr>\n";
+    int differ = 0;
+    for (const auto& f : d.findings) {
+        differ += !f.agrees;
+        c.html << "<tr><td>" << esc(f.equation) << "</td><td>"
+               << (f.agrees ? "<span class=\"pass\">agrees</span>" : "<span class=\"fail\">differs</span>") << "</td><td><code>"
+               << esc(f.printed) << "</code></td><td><code>" << esc(f.derived) << "</code></td><td>" << esc(f.reason) << "</td></tr>\n";
+    }
+    c.html << "</table>\n<p>" << d.findings.size() << " comparisons, " << differ << " differ.</p>\n<h3>Derived equations</h3>\n";
+    std::istringstream in(symbolic::latex_report(d));
     std::string line;
     while (std::getline(in, line)) {
         if (line.rfind("\\paragraph{", 0) != 0) continue;
         const auto close = line.find("}");
         const std::string title = line.substr(11, close - 11);
-        const auto a = line.find('$'), b = line.rfind('$');
+        const auto a = line.find('$', close), b = line.rfind('$');
         c.html << "<h4>" << esc(title) << "</h4><div class=\"math\">$$" << esc(line.substr(a + 1, b - a - 1))
                << "$$</div>\n";
     }
@@ -415,7 +390,7 @@ void write_report(const ReportOptions& opt) {
     const fs::path src = opt.source_dir;
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream body;
-    c.timed("derivation", [&] { section_derivation(c, src); });
+    c.timed("derivation", [&] { section_derivation(c); });
     c.timed("kernel equivalence", [&] { section_kernels(c, opt.seed); });
     section_proofs(c, opt);
     c.timed("Fig. 3", [&] { section_fig3(c, src); });
@@ -428,7 +403,7 @@ void write_report(const ReportOptions& opt) {
     if (fs::exists(kdir / "katex.min.js")) {
         fs::copy(kdir, c.dir / "katex", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
         katex = "<link rel=\"stylesheet\" href=\"katex/katex.min.css\"><script src=\"katex/katex.min.js\"></script>"
-                "<script src=\"katex/contrib/auto-render.min.js\"></script><script>document.addEventListener('DOMContentLoaded',"
+                "<script src=\"katex/contrib/auto-render.js\"></script><script>document.addEventListener('DOMContentLoaded',"
                 "function(){renderMathInElement(document.body,{delimiters:[{left:'$$',right:'$$',display:true}],throwOnError:false});});</script>\n";
     }
     std::ofstream html(c.dir / "index.html");
@@ -438,7 +413,12 @@ void write_report(const ReportOptions& opt) {
          << "; machine: " << esc(machine()) << ", " << std::thread::hardware_concurrency() << " hardware threads; total "
          << fmt(total, 4) << " s.</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
-    html << "</table>\n" << c.html.str() << "</body></html>\n";
+    html << "</table>\n" << c.html.str();
+    // For scripts/check-report.sh: after loading, the body says whether every image rendered.
+    html << "<script>window.addEventListener('load',function(){var b=[].slice.call(document.images).filter("
+            "function(i){return !(i.complete&&i.naturalWidth>0);});document.body.setAttribute('data-images',"
+            "b.length?'missing:'+b.map(function(i){return i.getAttribute('src');}).join(','):'ok:'+document.images.length);});"
+            "</script>\n</body></html>\n";
     if (!html) throw std::runtime_error((c.dir / "index.html").string() + ": write failed");
 }
 

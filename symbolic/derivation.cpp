@@ -553,7 +553,7 @@ std::string latex_report(const Derivation& d) {
     o << "\\paragraph{Sliding velocity of contact 1 (P frame).} $" << mat(d.slip[0]) << "$\n\n";
     o << "\\paragraph{(27) part angular velocity.} $\\omega_3 = " << mat(d.omega3) << "$\n\n";
     o << "\\paragraph{(28) its derivative.} $\\dot\\omega_3 = " << mat(d.omega3_dot) << "$\n\n";
-    o << "\\paragraph{(31) A, columns $\\ddot s_x, \\ddot s_y, \\ddot\\theta, N_1, N_2, N_3$.} $A = " << mat(d.A) << "$\n\n";
+    o << "\\paragraph{(31) A; columns: second derivatives of s_x, s_y, theta, then N1, N2, N3.} $A = " << mat(d.A) << "$\n\n";
     o << "\\paragraph{(33)-(34) U-dynamics right-hand side.} $\\tilde b = " << mat(d.b_U) << "$\n\n";
     o << "\\paragraph{Appendix A: thin part, rows 3 and 6 swapped.} $" << mat(d.A_thin_swapped) << "$\n\n";
     o << "\\paragraph{(38) normal forces of a thin part.} $" << mat(d.M38) << " n = " << mat(d.r38_U) << "$\n\n";

@@ -177,3 +177,22 @@ TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]"
     CHECK(j["thick"]["cases"] == 3);
     CHECK(j["limit_surfaces"]["convex_and_normal"] == 3);
 }
+
+TEST_CASE("plate report writes index.html whose every figure exists", "[cli][report]") {
+    const fs::path dir = tmpdir() / "report";
+    fs::remove_all(dir);
+    const Run r = run("report --quick --out " + dir.string());
+    REQUIRE(r.code == 0);
+    const std::string html = slurp(dir / "index.html");
+    int images = 0;
+    for (std::size_t p = 0; (p = html.find("<img src=\"", p)) != std::string::npos; ++images) {
+        p += 10;
+        const std::string src = html.substr(p, html.find('"', p) - p);
+        INFO(src);
+        CHECK(fs::exists(dir / src));
+        CHECK(fs::file_size(dir / src) > 1000);
+    }
+    CHECK(images >= 15);
+    for (const char* s : {"Symbolic derivation", "(28)", "Theorem 1", "Limit surfaces", "Fig. 3", "Fig. 4", "Seed 1"})
+        CHECK(html.find(s) != std::string::npos);
+}
