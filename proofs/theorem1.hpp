@@ -45,6 +45,7 @@ struct ContractionCase {
     bool monotone = false, converged = false;   // V never rose beyond error; V fell by 1e12
     bool unique = false;            // all `starts` initial twists reached the same cycle
     double cycle_spread = 0;        // largest distance between their cycle starts / v_ref
+    int starts_left_model = 0;      // further starts whose transient stuck or lost contact (replaced)
     std::vector<double> V_periods;  // V at each period boundary
 };
 

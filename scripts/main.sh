@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the main job on every shipped scene:
-# the asymptotic twist (velocity) field and its fixed points, and the numerical checks of
-# Theorem 1 (proofs.json), into out/ (or $1).
+# the asymptotic twist (velocity) field and its fixed points, and the verification report
+# (out/report/index.html), into out/ (or $1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -15,6 +15,7 @@ for scene in scenes/*.json; do
   build/plate field "$scene" --format csv --out "$out/$name.field.csv"
   build/plate fixed-points "$scene" --out "$out/$name.fixed-points.json"
 done
-echo "== Theorem 1 checks (10^4 thin, 10^3 thick parts; a few minutes)" >&2
-build/plate proofs --out "$out/proofs.json"
-echo "results in $out/" >&2
+echo "== verification report (derivation, Theorem 1 on 10^4 thin and 10^3 thick parts, fields; several minutes)" >&2
+build/plate report --out "$out/report"
+if command -v chromium >/dev/null; then scripts/check-report.sh "$out/report"; fi
+echo "results in $out/ (open $out/report/index.html)" >&2
