@@ -236,11 +236,14 @@ LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int 
         w[k] = wmap(xi[k]);
     }
     r.min_separation = 1e300;
+    r.min_strict_margin = 1e300;
     for (int i = 0; i < directions; ++i)
         for (int j = 0; j < directions; ++j) {
             if (i == j) continue;
             ++r.pairs;
             r.max_work_violation = std::max(r.max_work_violation, (xi[i].dot(w[i]) - xi[i].dot(w[j])) / scale);
+            if ((xi[i] - xi[j]).norm() > separation)
+                r.min_strict_margin = std::min(r.min_strict_margin, (xi[i].dot(w[j]) - xi[i].dot(w[i])) / scale);
             if (j > i) {
                 r.monotonicity_violation = std::max(r.monotonicity_violation, (xi[i] - xi[j]).dot(w[i] - w[j]) / scale);
                 if ((xi[i] - xi[j]).norm() > separation)

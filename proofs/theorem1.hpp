@@ -85,7 +85,9 @@ struct LimitSurfaceResult {
     double max_work_violation = 0;     // max (xi_i.w_i - xi_i.w_j) / (sum mu N), <= 1e-12 passes
     double monotonicity_violation = 0; // max (xi_i - xi_j).(w_i - w_j) / (sum mu N)
     double min_separation = 0;         // min |w_i - w_j| / (sum mu N) over well-separated pairs
+    double min_strict_margin = 0;      // min (xi_i.w_j - xi_i.w_i) / (sum mu N) over them: > 0, no flat faces
     bool convex_and_normal() const { return max_work_violation <= 1e-12 && monotonicity_violation <= 1e-12; }
+    bool strictly_convex() const { return min_strict_margin > 0 && min_separation > 0; }
 };
 
 LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int directions = 600,

@@ -204,9 +204,37 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
         c.plot("lyapunov_V", s + "\n", "V(t) = ½|ξ<sub>rel</sub>|² at period boundaries, log scale: thin parts contract "
                                        "geometrically; the worst thick case shown last.");
     }
+    // Appendix D: the cycle repeats with period T.
+    {
+        int n = 0, ok = 0;
+        double worst1 = 0, worst2 = 0;
+        for (std::uint64_t k = 0; k < 20; ++k) {
+            const Scene sc = random_scene(opt.seed + 70'000'000 + k, RandomSceneOptions{k % 2 == 0});
+            LimitCycleOptions lo;
+            lo.integration.rtol = 1e-11;
+            lo.tol = 1e-10;
+            const Vec3 q(0.01, -0.005, 0.7);
+            const LimitCycleSummary lc = limit_cycle(sc, q, lo, Vec3(0.05, 0, 1));
+            if (!lc.converged) continue;
+            IntegrationOptions io;
+            io.rtol = 1e-11;
+            Vec3 p1, p2;
+            if (!period_map(sc, q, lc.qd_start, p1, io) || !period_map(sc, q, p1, p2, io)) continue;
+            const double v = sc.v_ref();
+            const double e1 = (p1 - lc.qd_start).head<2>().norm() / v, e2 = (p2 - lc.qd_start).head<2>().norm() / v;
+            worst1 = std::max(worst1, e1);
+            worst2 = std::max(worst2, e2);
+            ++n;
+            ok += e1 < 1e-8 && e2 < 1e-8;
+        }
+        c.html << "<h3>Periodicity (Appendix D)</h3>\n<table><tr><th>converged cycles (thin and thick)</th><th>worst "
+                  "|P(x*) − x*| / v<sub>ref</sub></th><th>worst |P²(x*) − x*| / v<sub>ref</sub></th><th>tolerance</th>"
+                  "<th>verdict</th></tr><tr><td>" << n << "</td><td>" << fmt(worst1, 3) << "</td><td>" << fmt(worst2, 3)
+               << "</td><td>1e-8</td><td>" << verdict(n > 0 && ok == n) << "</td></tr></table>\n";
+    }
     // Limit surfaces
-    int convex = 0;
-    double worst_work = 0, worst_mono = 0, min_sep = 1e300;
+    int convex = 0, strict = 0;
+    double worst_work = 0, worst_mono = 0, min_sep = 1e300, min_margin = 1e300;
     c.timed("limit surfaces", [&] {
         Rng r(opt.seed + 7);
         for (int k = 0; k < n_surf; ++k) {
@@ -216,6 +244,8 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
                                                    r.uniform(0, sc.plate.T), &scale);
             const auto lr = proofs::check_limit_surface(w, scale, 300);
             convex += lr.convex_and_normal();
+            strict += lr.strictly_convex();
+            min_margin = std::min(min_margin, lr.min_strict_margin);
             worst_work = std::max(worst_work, lr.max_work_violation);
             worst_mono = std::max(worst_mono, lr.monotonicity_violation);
             min_sep = std::min(min_sep, lr.min_separation);
@@ -224,10 +254,12 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
     c.html << "<h2>4. Limit surfaces (Appendix B)</h2>\n<p>Wrenches of random thin parts sampled on 300 twist directions; "
               "all pairs tested. Maximum work: ξ<sub>i</sub>·w<sub>j</sub> ≥ ξ<sub>i</sub>·w<sub>i</sub> (convex surface, twist "
               "normal to it); (40): (ξ<sub>i</sub>−ξ<sub>j</sub>)·(w<sub>i</sub>−w<sub>j</sub>) ≤ 0; no vertices: distinct "
-              "directions give distinct wrenches.</p>\n<table><tr><th>parts</th><th>convex and normal</th><th>worst max-work "
-              "violation</th><th>worst (40) violation</th><th>smallest wrench separation</th><th>verdict</th></tr><tr><td>"
-           << n_surf << "</td><td>" << convex << "</td><td>" << fmt(worst_work, 3) << "</td><td>" << fmt(worst_mono, 3)
-           << "</td><td>" << fmt(min_sep, 3) << "</td><td>" << verdict(convex == n_surf && min_sep > 0) << "</td></tr></table>\n";
+              "directions give distinct wrenches; no flat faces: the max-work inequality is strict between distinct directions.</p>\n"
+              "<table><tr><th>parts</th><th>convex and normal</th><th>strictly convex</th><th>worst max-work "
+              "violation</th><th>worst (40) violation</th><th>smallest strict margin</th><th>smallest wrench separation</th><th>verdict</th></tr><tr><td>"
+           << n_surf << "</td><td>" << convex << "</td><td>" << strict << "</td><td>" << fmt(worst_work, 3) << "</td><td>" << fmt(worst_mono, 3)
+           << "</td><td>" << fmt(min_margin, 3) << "</td><td>" << fmt(min_sep, 3) << "</td><td>"
+           << verdict(convex == n_surf && strict == n_surf) << "</td></tr></table>\n";
     {
         const Scene sc = random_scene(opt.seed + 90'000'000, RandomSceneOptions{true});
         double scale = 0;
@@ -246,15 +278,28 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
                "Limit surface of a random thin part: the wrench −∇P(ξ) for 2500 twist directions.");
     }
     // Collinearity: conditioning of A
-    c.html << "<h3>Invertibility of A and collinear contacts</h3>\n<table><tr><th>contacts (−L,0), (L,0), (0,e), e/L</th>"
-              "<th>cond(A), dimensionless</th></tr>\n";
+    c.html << "<h3>Invertibility of A and collinear contacts</h3>\n<p>As the third contact approaches the line of the "
+              "other two, A's condition number grows like L/e, and two distinct twists (pure y-translation, and one with a "
+              "spin that keeps every contact moving along +y) get ever closer wrenches: the limit surface develops a vertex.</p>\n"
+              "<table><tr><th>contacts (−L,0), (L,0), (0,e), e/L</th><th>cond(A), dimensionless</th><th>wrench gap / Σ μN</th>"
+              "<th>convex and normal</th></tr>\n";
     for (double e : {1.0, 0.1, 0.01, 0.001, 0.0}) {
         Scene sc = random_scene(3, RandomSceneOptions{true});
         const double L = 0.03;
         sc.part.c = {Vec3(-L, -e * L / 3, 0), Vec3(L, -e * L / 3, 0), Vec3(0, 2 * e * L / 3, 0)};
         const auto cond = proofs::condition_of_A(sc, 20, opt.seed);
+        std::string gap = "–", cv = "–";
+        if (e > 0) {
+            Scene s2 = sc;
+            s2.part.mu.setConstant(0.3);
+            s2.plate.harmonics.clear();
+            double scale = 0;
+            const auto w = proofs::thin_wrench_map(s2, Vec3::Zero(), 0, &scale);
+            gap = fmt((w(Vec3(0, 1, 0)) - w(Vec3(0, 1, s2.part.rho() * 0.5 / L).normalized())).norm() / scale, 3);
+            cv = proofs::check_limit_surface(w, scale, 200).convex_and_normal() ? "yes" : "no";
+        }
         c.html << "<tr><td>" << e << "</td><td>" << (e > 0 ? fmt(cond.max_condition, 3) : "singular (σ_min/σ_max = " + fmt(cond.min_singular, 2) + ")")
-               << "</td></tr>\n";
+               << "</td><td>" << gap << "</td><td>" << cv << "</td></tr>\n";
     }
     c.html << "</table>\n";
 }

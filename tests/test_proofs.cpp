@@ -63,6 +63,7 @@ TEST_CASE("limit surface of a thin part: convex, twist normal to it, (40) holds,
         INFO("seed " << seed << ": max-work violation " << r.max_work_violation << ", (40) "
                      << r.monotonicity_violation << ", separation " << r.min_separation);
         CHECK(r.convex_and_normal());
+        CHECK(r.strictly_convex());   // no flat faces, no vertices
         CHECK(r.min_separation > 1e-3);
     }
 }
@@ -140,4 +141,8 @@ TEST_CASE("Appendix D: the converged cycle repeats with period T", "[proofs][per
     // P(x*) = x*: the start repeats after one and after two periods, to the cycle tolerance.
     CHECK((next - lc.qd_start).head<2>().norm() < 1e-8 * v);
     CHECK((again - lc.qd_start).head<2>().norm() < 1e-8 * v);
+    // Broken case: a state that is not on the cycle does not repeat (the check can fail).
+    Vec3 off;
+    REQUIRE(period_map(sc, Vec3(0.01, 0, 0.3), lc.qd_start + Vec3(0.3 * v, 0, 0), off, io));
+    CHECK((off - (lc.qd_start + Vec3(0.3 * v, 0, 0))).head<2>().norm() > 1e-3 * v);
 }
