@@ -3,6 +3,7 @@
 // the accuracy reached (against a tight-tolerance reference field) and the machine.
 // Not a test: nothing here passes or fails.
 #include "plate/field.hpp"
+#include "plate/output.hpp"
 #include "plate/scene_io.hpp"
 
 #include <chrono>
@@ -16,13 +17,6 @@ using namespace plate;
 
 namespace {
 
-std::string machine() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
 
 double max_error(const Scene& sc, const Field& f, const Field& ref) {
     double e = 0;
@@ -40,7 +34,7 @@ double max_error(const Scene& sc, const Field& f, const Field& ref) {
 int main(int argc, char** argv) {
     const std::string path = argc > 1 ? argv[1] : PLATE_SOURCE_DIR "/scenes/fig4.json";
     const Scene sc = load_scene(path);
-    std::printf("machine: %s, %u hardware threads\n", machine().c_str(), std::thread::hardware_concurrency());
+    std::printf("machine: %s\n", machine_description().c_str());
     std::printf("scene: %s, v_ref = %.4g m/s (errors below are relative to v_ref, angular rates times rho)\n",
                 sc.name.c_str(), sc.v_ref());
 

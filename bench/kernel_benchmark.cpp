@@ -3,6 +3,7 @@
 // One evaluation = slip directions from the twist, b of (32), the solve, q''. The plate's
 // u(t) is evaluated once outside the loop (it is the same for every method).
 #include "plate/dynamics.hpp"
+#include "plate/output.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
 
@@ -16,13 +17,6 @@ using namespace plate;
 
 namespace {
 
-std::string machine() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
 
 template <class F>
 double ns_once(const Scene& sc, Dynamics level, F&& f, double& checksum) {
@@ -53,7 +47,7 @@ double ns_per_eval(const Scene& sc, Dynamics level, F&& f, double& checksum) {
 }  // namespace
 
 int main() {
-    std::printf("machine: %s (one core)\n", machine().c_str());
+    std::printf("machine: %s (timed on one core)\n", machine_description().c_str());
     const Scene thick = load_scene(PLATE_SOURCE_DIR "/scenes/fig4.json");
     Scene thin = random_scene(8, RandomSceneOptions{true});
     const Scene point = load_scene(PLATE_SOURCE_DIR "/scenes/fig1_point.json");

@@ -1,6 +1,7 @@
 #include "report.hpp"
 
 #include "plate/field.hpp"
+#include "plate/output.hpp"
 #include "plate/scene_io.hpp"
 #include "derivation.hpp"
 #include "theorem1.hpp"
@@ -40,13 +41,6 @@ std::string esc(const std::string& s) {
     return o;
 }
 
-std::string machine() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
 
 struct Ctx {
     fs::path dir;
@@ -463,7 +457,7 @@ void write_report(const ReportOptions& opt) {
     html << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: verification report</title>\n" << kStyle << katex
          << "</head><body>\n<h1>Sliding manipulation on a 6-DoF plate: verification report</h1>\n";
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
-         << "; machine: " << esc(machine()) << ", " << std::thread::hardware_concurrency() << " hardware threads; total "
+         << "; machine: " << esc(machine_description()) << "; total "
          << fmt(total, 4) << " s.</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
     html << "</table>\n" << c.html.str();

@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <iostream>
 #include <stdexcept>
+#include <thread>
 
 namespace plate {
 namespace {
@@ -130,6 +131,17 @@ void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_pa
         if (!point_part) out << s.qd[2] << ',' << s.n[0] << ',' << s.n[1] << ',' << s.n[2] << '\n';
         else out << s.n[0] << '\n';
     }
+}
+
+std::string machine_description() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line, cpu = "unknown CPU";
+    while (std::getline(in, line))
+        if (line.rfind("model name", 0) == 0) {
+            cpu = line.substr(line.find(':') + 2);
+            break;
+        }
+    return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write) {

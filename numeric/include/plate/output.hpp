@@ -18,6 +18,9 @@ nlohmann::json to_json(const Scene& scene, const FixedPoints& fp);
 void write_field_csv(std::ostream& out, const Field& field);
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part);
 
+// The CPU model and hardware thread count, for benchmarks and reports.
+std::string machine_description();
+
 // Calls write(stream) on a temporary file and renames it to `path`; on any exception the
 // temporary is removed and the exception rethrown. path "-" writes to stdout.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write);
