@@ -70,7 +70,7 @@ TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     CHECK(nlohmann::json::parse(p.out)["twist"].size() == 2);
 }
 
-TEST_CASE("plate field writes JSON and CSV; simulate writes a CSV with a header", "[cli]") {
+TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header", "[cli]") {
     const fs::path out = tmpdir() / "field.csv";
     Run r = run("field " + kScenes + "fig4.json --grid 2 --format csv --out " + out.string());
     REQUIRE(r.code == 0);

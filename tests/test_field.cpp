@@ -104,7 +104,7 @@ TEST_CASE("Fig. 4: stable fixed points near (0,0,0) and (0,0,pi), unstable near 
     CHECK(unstable == 2);
 }
 
-TEST_CASE("Fig. 5: transports along y while attracting theta to 0 or pi; no fixed points", "[field][paper]") {
+TEST_CASE("Fig. 5: transports along y while attracting theta to 0 or pi, no fixed points", "[field][paper]") {
     const Scene sc = scene("fig5");
     GridSpec g;
     g.x0 = -0.03;   // the plate tilts about y: keep |s_x| where the part stays in contact
@@ -126,7 +126,7 @@ TEST_CASE("Fig. 5: transports along y while attracting theta to 0 or pi; no fixe
     CHECK(find_fixed_points(sc, f).points.empty());
 }
 
-TEST_CASE("Fig. 6: the field rotates the part; it sticks only near the plate centre", "[field][paper]") {
+TEST_CASE("Fig. 6: the field rotates the part and sticks only near the plate centre", "[field][paper]") {
     const Scene sc = scene("fig6");
     const Field f = compute_field(sc, GridSpec{});
     int converged = 0, stuck = 0;

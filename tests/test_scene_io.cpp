@@ -57,7 +57,7 @@ TEST_CASE("scene_to_json writes what parse_scene reads back", "[scene]") {
     CHECK(b.plate.harmonics[0].amp == a.plate.harmonics[0].amp);
 }
 
-TEST_CASE("friction may be one number; a point part has mass and friction only", "[scene]") {
+TEST_CASE("friction may be one number, a point part has mass and friction only", "[scene]") {
     const Scene s = parse_scene(replace(kGood, "[0.3, 0.3, 0.3]", "0.25"), "f.json");
     CHECK(s.part.mu == Vec3::Constant(0.25));
     const Scene p = parse_scene(R"({"name": "p", "gravity": 9.81, "part": {"mass": 1, "friction": 0.2},
