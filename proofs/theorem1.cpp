@@ -278,6 +278,27 @@ WrenchMap thin_wrench_map(const Scene& sc, const Vec3& q0, double t, double* fri
     };
 }
 
+LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed) {
+    LimitSurfaceCampaign c;
+    c.parts = parts;
+    c.min_separation = c.min_strict_margin = parts > 0 ? 1e300 : 0;
+    Rng r(seed + 7);
+    for (int k = 0; k < parts; ++k) {
+        const Scene sc = random_scene(seed + 90'000'000 + static_cast<std::uint64_t>(k), RandomSceneOptions{true});
+        double scale = 0;
+        const WrenchMap w = thin_wrench_map(sc, Vec3(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)),
+                                            r.uniform(0, sc.plate.T), &scale);
+        const LimitSurfaceResult lr = check_limit_surface(w, scale, 300);
+        c.convex += lr.convex_and_normal();
+        c.strict += lr.strictly_convex();
+        c.worst_max_work = std::max(c.worst_max_work, lr.max_work_violation);
+        c.worst_monotonicity = std::max(c.worst_monotonicity, lr.monotonicity_violation);
+        c.min_separation = std::min(c.min_separation, lr.min_separation);
+        c.min_strict_margin = std::min(c.min_strict_margin, lr.min_strict_margin);
+    }
+    return c;
+}
+
 Conditioning condition_of_A(const Scene& sc, int samples, std::uint64_t seed) {
     Conditioning c;
     c.min_singular = 1e300;

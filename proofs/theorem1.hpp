@@ -92,6 +92,15 @@ struct LimitSurfaceResult {
 
 LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int directions = 600,
                                        double separation = 0.2);
+// Limit surfaces of `parts` random thin parts (seeded), each at a random configuration and plate
+// time, 300 directions each.
+struct LimitSurfaceCampaign {
+    int parts = 0, convex = 0, strict = 0;
+    double worst_max_work = 0, worst_monotonicity = 0, min_separation = 0, min_strict_margin = 0;
+    bool passed() const { return parts > 0 && convex == parts && strict == parts; }
+};
+LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed);
+
 // The thin part of `scene` at configuration q0 and plate time t: its normal forces (38) and the
 // generated wrench kernel.
 WrenchMap thin_wrench_map(const Scene& scene, const Vec3& q0, double t, double* friction_scale = nullptr);

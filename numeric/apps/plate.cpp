@@ -372,25 +372,13 @@ int cmd_proofs(int argc, char** argv) {
     j["thin"] = campaign(true, static_cast<int>(a.integer("--thin", 10000, 0, 10000000)), seed);
     j["thick"] = campaign(false, static_cast<int>(a.integer("--thick", 1000, 0, 10000000)), seed + 50'000'000);
     // Limit surfaces of random thin parts at random plate times.
-    const int K = static_cast<int>(a.integer("--surfaces", 200, 0, 1000000));
-    double worst_work = 0, worst_mono = 0, min_sep = 1e300;
-    int convex = 0;
-    Rng r(seed + 7);
-    for (int k = 0; k < K; ++k) {
-        const Scene sc = random_scene(seed + 90'000'000 + k, RandomSceneOptions{true});
-        double scale = 0;
-        const proofs::WrenchMap w =
-            proofs::thin_wrench_map(sc, Vec3(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)),
-                                    r.uniform(0, sc.plate.T), &scale);
-        const proofs::LimitSurfaceResult lr = proofs::check_limit_surface(w, scale, 300);
-        worst_work = std::max(worst_work, lr.max_work_violation);
-        worst_mono = std::max(worst_mono, lr.monotonicity_violation);
-        min_sep = std::min(min_sep, lr.min_separation);
-        convex += lr.convex_and_normal();
-    }
-    j["limit_surfaces"] = {{"parts", K}, {"directions", 300}, {"convex_and_normal", convex},
-                           {"worst_max_work_violation", worst_work}, {"worst_monotonicity_violation", worst_mono},
-                           {"min_separation", K ? min_sep : 0.0}};
+    const proofs::LimitSurfaceCampaign ls =
+        proofs::check_limit_surfaces(static_cast<int>(a.integer("--surfaces", 200, 0, 1000000)), seed);
+    j["limit_surfaces"] = {{"parts", ls.parts}, {"directions", 300}, {"convex_and_normal", ls.convex},
+                           {"strictly_convex", ls.strict}, {"worst_max_work_violation", ls.worst_max_work},
+                           {"worst_monotonicity_violation", ls.worst_monotonicity},
+                           {"min_separation", ls.min_separation}, {"min_strict_margin", ls.min_strict_margin},
+                           {"passed", ls.passed()}};
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
     return 0;
 }
