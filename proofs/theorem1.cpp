@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <limits>
+#include <mutex>
 #include <thread>
 #include <cmath>
 
@@ -186,9 +187,17 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
     ContractionSummary s;
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<ContractionCase> cases(opt.cases);
-    std::atomic<int> next{0};
+    std::atomic<int> next{0}, done{0};
+    std::mutex progress_mutex;
     auto worker = [&] {
-        for (int k; (k = next.fetch_add(1)) < opt.cases;) cases[k] = run_case(opt, opt.seed + static_cast<std::uint64_t>(k));
+        for (int k; (k = next.fetch_add(1)) < opt.cases;) {
+            cases[k] = run_case(opt, opt.seed + static_cast<std::uint64_t>(k));
+            const int d = ++done;
+            if (opt.progress) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                opt.progress(d, opt.cases);
+            }
+        }
     };
     int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency());
     threads = std::max(1, std::min(threads, opt.cases));

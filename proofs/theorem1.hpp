@@ -32,6 +32,7 @@ struct ContractionOptions {
     int threads = 0;           // 0: all cores
     // Plate motions and parts come from random_scene; override for deliberately broken cases.
     std::function<void(Scene&)> modify;
+    std::function<void(int done, int total)> progress;   // called from workers, serialised
 };
 
 struct ContractionCase {

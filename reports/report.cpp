@@ -146,6 +146,7 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
         o.seed = s0;
         o.thin = is_thin;
         o.threads = opt.threads;
+        o.progress = ProgressPrinter{is_thin ? "report, thin parts" : "report, thick parts", 10.0};
         return proofs::check_contraction(o);
     };
     c.timed("Theorem 1 contraction, thin parts", [&] { thin = run(true, n_thin, opt.seed); });

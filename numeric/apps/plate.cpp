@@ -135,21 +135,6 @@ int config_arity(int argc, char** argv) {
     return 3;
 }
 
-struct Progress {
-    std::string what;
-    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last = start;
-    bool shown = false;
-    void operator()(int done, int total) {
-        const auto now = std::chrono::steady_clock::now();
-        const double el = std::chrono::duration<double>(now - start).count();
-        if ((el > 1.5 && std::chrono::duration<double>(now - last).count() > 1.0) || (shown && done == total)) {
-            std::cerr << what << ": " << done << "/" << total << " (" << std::fixed << std::setprecision(1) << el
-                      << " s)" << std::endl;
-            last = now;
-            shown = true;
-        }
-    }
-};
 
 LimitCycleOptions cycle_opts(const Args& a) {
     LimitCycleOptions o;
@@ -223,7 +208,7 @@ int cmd_field(int argc, char** argv) {
     FieldOptions fo;
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
-    Progress prog{"field"};
+    ProgressPrinter prog{"field"};
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) {
@@ -246,7 +231,7 @@ int cmd_fixed_points(int argc, char** argv) {
     FieldOptions fo;
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
-    Progress prog{"field"};
+    ProgressPrinter prog{"field"};
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, grid_opts(a), fo);
     FixedPointOptions fpo;
@@ -285,7 +270,7 @@ int cmd_simulate(int argc, char** argv) {
     IntegrationOptions io;
     io.rtol = a.num("--rtol", 0, io.rtol);
     Trajectory tr;
-    Progress prog{"simulate"};
+    ProgressPrinter prog{"simulate"};
     if (dyn == "field") {
         if (!qd0.isZero()) throw UsageError("--twist has no meaning for --dynamics field");
         LimitCycleOptions lo;
@@ -366,7 +351,7 @@ int cmd_proofs(int argc, char** argv) {
         o.seed = s0;
         o.thin = thin;
         o.threads = threads;
-        std::cerr << "proofs: " << n << (thin ? " thin" : " thick") << " parts..." << std::endl;
+        o.progress = ProgressPrinter{thin ? "proofs, thin parts" : "proofs, thick parts", 10.0};
         return contraction_json(proofs::check_contraction(o));
     };
     j["thin"] = campaign(true, static_cast<int>(a.integer("--thin", 10000, 0, 10000000)), seed);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -130,6 +131,18 @@ void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_pa
         out << s.qd[0] << ',' << s.qd[1] << ',';
         if (!point_part) out << s.qd[2] << ',' << s.n[0] << ',' << s.n[1] << ',' << s.n[2] << '\n';
         else out << s.n[0] << '\n';
+    }
+}
+
+void ProgressPrinter::operator()(int done, int total) {
+    const auto now = std::chrono::steady_clock::now();
+    const double el = std::chrono::duration<double>(now - start).count();
+    if ((el > 1.5 && std::chrono::duration<double>(now - last).count() > every) || (shown && done == total)) {
+        std::ostringstream s;
+        s << what << ": " << done << "/" << total << " (" << std::fixed << std::setprecision(1) << el << " s)\n";
+        std::cerr << s.str() << std::flush;
+        last = now;
+        shown = true;
     }
 }
 

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -17,6 +18,16 @@ nlohmann::json to_json(const Scene& scene, const Field& field);
 nlohmann::json to_json(const Scene& scene, const FixedPoints& fp);
 void write_field_csv(std::ostream& out, const Field& field);
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part);
+
+// Progress on stderr for long runs: silent for the first 1.5 s, then a line at most every
+// `every` seconds, and the final count if anything was shown.
+struct ProgressPrinter {
+    std::string what;
+    double every = 1.0;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last = start;
+    bool shown = false;
+    void operator()(int done, int total);
+};
 
 // The CPU model and hardware thread count, for benchmarks and reports.
 std::string machine_description();
