@@ -60,6 +60,32 @@ std::vector<realsymbol> all_symbols(const Symbols& S) {
     return v;
 }
 
+// Eliminates s'' (rows 1, 2) and theta'' (row 6) from A z = b: returns M, r of the 3x3 system
+// M n = r (rows 3, 4, 5) and q'' in terms of n and b.
+struct Reduced {
+    matrix M, r, back;
+};
+Reduced reduce(const matrix& A, const std::array<realsymbol, 6>& b, const std::array<realsymbol, 3>& N) {
+    Reduced out{matrix(3, 3), matrix(3, 1), matrix(3, 1)};
+    const ex inv52 = 1 / A(5, 2);
+    const int rows[3] = {2, 3, 4};
+    for (int i = 0; i < 3; ++i) {
+        const int r = rows[i];
+        for (int k = 0; k < 3; ++k) out.M(i, k) = A(r, 3 + k) - A(r, 2) * inv52 * A(5, 3 + k);
+        out.r(i, 0) = b[r] - A(r, 2) * inv52 * b[5];
+    }
+    ex nx = b[0], ny = b[1], nt = b[5];
+    for (int k = 0; k < 3; ++k) {
+        nx -= A(0, 3 + k) * N[k];
+        ny -= A(1, 3 + k) * N[k];
+        nt -= A(5, 3 + k) * N[k];
+    }
+    out.back(0, 0) = nx / A(0, 0);
+    out.back(1, 0) = ny / A(1, 1);
+    out.back(2, 0) = nt * inv52;
+    return out;
+}
+
 }  // namespace
 
 Symbols::Symbols()
@@ -324,25 +350,10 @@ Derivation derive() {
                 if (r != k && !A(r, k).is_zero()) throw std::logic_error("unexpected structure of A");
         if (!A(0, 2).is_zero() || !A(1, 2).is_zero() || !A(2, 2).is_zero()) throw std::logic_error("theta'' in Newton");
         // Row 6 (index 5) gives theta''; rows 1, 2 give s''; rows 3, 4, 5 then hold only n.
-        const ex a52 = A(5, 2);
-        d.M_reduced = matrix(3, 3);
-        d.r_reduced = matrix(3, 1);
-        const int rows[3] = {2, 3, 4};
-        for (int i = 0; i < 3; ++i) {
-            const int r = rows[i];
-            for (int k = 0; k < 3; ++k) d.M_reduced(i, k) = (A(r, 3 + k) - A(r, 2) / a52 * A(5, 3 + k)).expand();
-            d.r_reduced(i, 0) = (d.bsym[r] - A(r, 2) / a52 * d.bsym[5]).expand();
-        }
-        d.back_substitution = matrix(3, 1);
-        ex nx = d.bsym[0], ny = d.bsym[1], nt = d.bsym[5];
-        for (int k = 0; k < 3; ++k) {
-            nx -= A(0, 3 + k) * S.N[k];
-            ny -= A(1, 3 + k) * S.N[k];
-            nt -= A(5, 3 + k) * S.N[k];
-        }
-        d.back_substitution(0, 0) = (nx / A(0, 0)).expand();
-        d.back_substitution(1, 0) = (ny / A(1, 1)).expand();
-        d.back_substitution(2, 0) = (nt / a52).expand();
+        const Reduced red = reduce(A, d.bsym, S.N);
+        d.M_reduced = expand_all(red.M);
+        d.r_reduced = expand_all(red.r);
+        d.back_substitution = expand_all(red.back);
     }
 
     // --- Staged forms for code generation ----------------------------------------------------------
@@ -374,25 +385,10 @@ Derivation derive() {
                     G(r, k) = a;
                 }
             }
-        d.M_staged = matrix(3, 3);
-        d.r_staged = matrix(3, 1);
-        const int rows[3] = {2, 3, 4};
-        const ex inv52 = 1 / G(5, 2);
-        for (int i = 0; i < 3; ++i) {
-            const int r = rows[i];
-            for (int k = 0; k < 3; ++k) d.M_staged(i, k) = G(r, 3 + k) - G(r, 2) * inv52 * G(5, 3 + k);
-            d.r_staged(i, 0) = d.bsym[r] - G(r, 2) * inv52 * d.bsym[5];
-        }
-        d.back_staged = matrix(3, 1);
-        ex nx = d.bsym[0], ny = d.bsym[1], nt = d.bsym[5];
-        for (int k = 0; k < 3; ++k) {
-            nx -= G(0, 3 + k) * S.N[k];
-            ny -= G(1, 3 + k) * S.N[k];
-            nt -= G(5, 3 + k) * S.N[k];
-        }
-        d.back_staged(0, 0) = nx / G(0, 0);
-        d.back_staged(1, 0) = ny / G(1, 1);
-        d.back_staged(2, 0) = nt * inv52;
+        const Reduced staged = reduce(G, d.bsym, S.N);
+        d.M_staged = staged.M;
+        d.r_staged = staged.r;
+        d.back_staged = staged.back;
         // The staged forms are the derived ones once the placeholders are filled in.
         exmap fill;   // later placeholders may use earlier ones: fill in order
         for (const auto& [a, e] : d.A_placeholders) fill[a] = e.subs(fill);
