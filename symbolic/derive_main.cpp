@@ -219,6 +219,31 @@ int main(int argc, char** argv) {
             kernels.push_back(k);
         }
         {
+            // For implicit methods (Rosenbrock, BDF): A depends on the twist only through the unit slip
+            // directions u_i, and b~ (33)-(34) not at all, so d z/d q' = -A^-1 (dA/du_i n) (du_i/dv_i)
+            // (dv_i/dq'). These two kernels are the derived factors; du_i/dv_i is the friction law's.
+            Kernel k{"// Jacobian factor: D[6 r + 2 i + j] = N_i d A(r, 3 + i) / d u_i[j] (j = x, y): how the\n"
+                     "// friction columns of A z move with the unit slip direction of contact i.\n",
+                     "dA_du(const KernelInput& in, const double* n, double* D)", with(in, "N", "n", 3), {}, {}};
+            for (int r = 0; r < 6; ++r)
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 2; ++j)
+                        k.outputs.push_back({"D[" + std::to_string(6 * r + 2 * i + j) + "]",
+                                             S.N[i] * d.A(r, 3 + i).diff(j == 0 ? S.ux[i] : S.uy[i])});
+            kernels.push_back(k);
+        }
+        {
+            Kernel k{"// Jacobian factor: V[3 (2 i + j) + k] = d v_i[j] / d q'[k], the sliding velocity of contact i\n"
+                     "// (text after (14)) against the twist q' = (s_x', s_y', theta').\n",
+                     "dslip_dqd(const KernelInput& in, double* V)", in, {}, {}};
+            const realsymbol qd[3] = {S.sxd, S.syd, S.thd};
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 2; ++j)
+                    for (int c = 0; c < 3; ++c)
+                        k.outputs.push_back({"V[" + std::to_string(3 * (2 * i + j) + c) + "]", d.slip[i](j, 0).diff(qd[c])});
+            kernels.push_back(k);
+        }
+        {
             Kernel k{"// (38): the thin part's normal-force matrix (rows: torque x, torque y, force z), constant for\n"
                      "// a part; n = M38^-1 (b[3], b[4], b[2]) for any b, independent of the part's velocity.\n",
                      "thin_M38(const KernelInput& in, double* M)", in, {}, {}};

@@ -796,6 +796,118 @@ inline void thin_solve(const KernelInput& __restrict in, const double* __restric
     qdd[2] = t61;
 }
 
+// Jacobian factor: D[6 r + 2 i + j] = N_i d A(r, 3 + i) / d u_i[j] (j = x, y): how the
+// friction columns of A z move with the unit slip direction of contact i.
+inline void dA_du(const KernelInput& __restrict in, const double* __restrict n, double* __restrict D) {
+    const double t0 = (-1.0) * n[0] * in.mu1;
+    D[0] = t0;
+    D[1] = 0.0;
+    const double t1 = (-1.0) * n[1] * in.mu2;
+    D[2] = t1;
+    D[3] = 0.0;
+    const double t2 = (-1.0) * n[2] * in.mu3;
+    D[4] = t2;
+    D[5] = 0.0;
+    D[6] = 0.0;
+    D[7] = t0;
+    D[8] = 0.0;
+    D[9] = t1;
+    D[10] = 0.0;
+    D[11] = t2;
+    D[12] = 0.0;
+    D[13] = 0.0;
+    D[14] = 0.0;
+    D[15] = 0.0;
+    D[16] = 0.0;
+    D[17] = 0.0;
+    const double t3 = (-1.0) * n[0] * in.cz * in.mu1 * in.st;
+    D[18] = t3;
+    const double t4 = n[0] * in.ct * in.cz * in.mu1;
+    D[19] = t4;
+    const double t5 = (-1.0) * n[1] * in.cz * in.mu2 * in.st;
+    D[20] = t5;
+    const double t6 = n[1] * in.ct * in.cz * in.mu2;
+    D[21] = t6;
+    const double t7 = (-1.0) * n[2] * in.cz * in.mu3 * in.st;
+    D[22] = t7;
+    const double t8 = n[2] * in.ct * in.cz * in.mu3;
+    D[23] = t8;
+    const double t9 = (-1.0) * n[0] * in.ct * in.cz * in.mu1;
+    D[24] = t9;
+    D[25] = t3;
+    const double t10 = (-1.0) * n[1] * in.ct * in.cz * in.mu2;
+    D[26] = t10;
+    D[27] = t5;
+    const double t11 = (-1.0) * n[2] * in.ct * in.cz * in.mu3;
+    D[28] = t11;
+    D[29] = t7;
+    const double t12 = n[0] * in.c1x * in.mu1 * in.st;
+    const double t13 = n[0] * in.c1y * in.ct * in.mu1;
+    const double t14 = t12 + t13;
+    D[30] = t14;
+    const double t15 = n[0] * in.c1x * in.ct * in.mu1;
+    const double t16 = n[0] * in.c1y * in.mu1 * in.st;
+    const double t17 = -t15 + t16;
+    D[31] = t17;
+    const double t18 = n[1] * in.c2x * in.mu2 * in.st;
+    const double t19 = n[1] * in.c2y * in.ct * in.mu2;
+    const double t20 = t18 + t19;
+    D[32] = t20;
+    const double t21 = n[1] * in.c2x * in.ct * in.mu2;
+    const double t22 = n[1] * in.c2y * in.mu2 * in.st;
+    const double t23 = -t21 + t22;
+    D[33] = t23;
+    const double t24 = n[2] * in.c3x * in.mu3 * in.st;
+    const double t25 = n[2] * in.c3y * in.ct * in.mu3;
+    const double t26 = t24 + t25;
+    D[34] = t26;
+    const double t27 = n[2] * in.c3x * in.ct * in.mu3;
+    const double t28 = n[2] * in.c3y * in.mu3 * in.st;
+    const double t29 = -t27 + t28;
+    D[35] = t29;
+}
+
+// Jacobian factor: V[3 (2 i + j) + k] = d v_i[j] / d q'[k], the sliding velocity of contact i
+// (text after (14)) against the twist q' = (s_x', s_y', theta').
+inline void dslip_dqd(const KernelInput& __restrict in, double* __restrict V) {
+    V[0] = 1.0;
+    V[1] = 0.0;
+    const double t0 = in.c1x * in.st;
+    const double t1 = in.c1y * in.ct;
+    const double t2 = -t0 - t1;
+    V[2] = t2;
+    V[3] = 0.0;
+    V[4] = 1.0;
+    const double t3 = in.c1y * in.st;
+    const double t4 = in.c1x * in.ct;
+    const double t5 = -t3 + t4;
+    V[5] = t5;
+    V[6] = 1.0;
+    V[7] = 0.0;
+    const double t6 = in.c2x * in.st;
+    const double t7 = in.c2y * in.ct;
+    const double t8 = -t6 - t7;
+    V[8] = t8;
+    V[9] = 0.0;
+    V[10] = 1.0;
+    const double t9 = in.c2y * in.st;
+    const double t10 = in.c2x * in.ct;
+    const double t11 = -t9 + t10;
+    V[11] = t11;
+    V[12] = 1.0;
+    V[13] = 0.0;
+    const double t12 = in.c3x * in.st;
+    const double t13 = in.c3y * in.ct;
+    const double t14 = -t12 - t13;
+    V[14] = t14;
+    V[15] = 0.0;
+    V[16] = 1.0;
+    const double t15 = in.c3y * in.st;
+    const double t16 = in.c3x * in.ct;
+    const double t17 = -t15 + t16;
+    V[17] = t17;
+}
+
 // (38): the thin part's normal-force matrix (rows: torque x, torque y, force z), constant for
 // a part; n = M38^-1 (b[3], b[4], b[2]) for any b, independent of the part's velocity.
 inline void thin_M38(const KernelInput& __restrict in, double* __restrict M) {

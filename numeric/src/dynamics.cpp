@@ -1,6 +1,7 @@
 #include "plate/dynamics.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace plate {
 namespace {
@@ -12,6 +13,28 @@ inline Mat3 rot_z(double th) {
     return R;   // R2 (2): S -> P
 }
 
+// u = factor * v for the regularised friction laws (FrictionLaw).
+inline double regularised_factor(FrictionLaw law, double eps, double speed) {
+    if (law == FrictionLaw::Tanh) return speed > 1e-8 * eps ? std::tanh(speed / eps) / speed : 1.0 / eps;
+    return 1.0 / std::max(speed, eps);
+}
+
+// d u/d v (2x2) of the friction law at sliding velocity v.
+Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v) {
+    const double s = v.norm();
+    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+    if (law == FrictionLaw::Linear && s < eps) return I / eps;
+    if (law == FrictionLaw::Tanh) {
+        if (s < 1e-8 * eps) return I / eps;
+        const Vec2 e = v / s;
+        const double th = std::tanh(s / eps), sech2 = 1 - th * th;
+        return th / s * (I - e * e.transpose()) + sech2 / eps * e * e.transpose();
+    }
+    if (s == 0) return Eigen::Matrix2d::Zero();   // Coulomb at zero slip: undefined; no sliding term
+    const Vec2 e = v / s;
+    return (I - e * e.transpose()) / s;
+}
+
 }  // namespace
 
 const char* dynamics_name(Dynamics d) {
@@ -19,6 +42,15 @@ const char* dynamics_name(Dynamics d) {
         case Dynamics::Full: return "full";
         case Dynamics::U: return "u";
         case Dynamics::ReducedU: return "reduced-u";
+    }
+    return "?";
+}
+
+const char* friction_law_name(FrictionLaw f) {
+    switch (f) {
+        case FrictionLaw::Coulomb: return "coulomb";
+        case FrictionLaw::Tanh: return "tanh";
+        case FrictionLaw::Linear: return "linear";
     }
     return "?";
 }
@@ -136,7 +168,8 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         const double vx = qd[0] - w * ws.r[i].y(), vy = qd[1] + w * ws.r[i].x();
         ws.slip[i] = Vec2(vx, vy);
         const double sp2 = vx * vx + vy * vy;
-        const double inv = sp2 > 0 ? 1.0 / std::sqrt(sp2) : 0.0;
+        double inv = sp2 > 0 ? 1.0 / std::sqrt(sp2) : 0.0;
+        if (ws.law != FrictionLaw::Coulomb) inv = regularised_factor(ws.law, ws.law_eps, std::sqrt(sp2));
         ux = vx * inv;
         uy = vy * inv;
     };
@@ -193,6 +226,31 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     }
     ws.n = Vec3(n[0], n[1], n[2]);
     ws.qdd = Vec3(qdd[0], qdd[1], qdd[2]);
+}
+
+void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                    Workspace& ws, Mat3& Jq) {
+    if (level == Dynamics::Full) throw std::invalid_argument("twist_jacobian: U- and reduced U-dynamics only");
+    accelerations(sc, level, q, qd, ps, ws);
+    const Part& P = sc.part;
+    if (P.point) {
+        // s'' = -(mu N u(v) + b_xy)/m with N = b_z independent of the twist.
+        Jq.setZero();
+        Jq.topLeftCorner<2, 2>() = -P.mu[0] * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
+        return;
+    }
+    double A[36], D[36], V[18];
+    const double n[3] = {ws.n[0], ws.n[1], ws.n[2]};
+    gen::thick_A(ws.in, A);
+    gen::dA_du(ws.in, n, D);
+    gen::dslip_dqd(ws.in, V);
+    Mat6 U = Mat6::Zero();
+    for (int i = 0; i < 3; ++i) U.block<2, 2>(2 * i, 2 * i) = direction_derivative(ws.law, ws.law_eps, ws.slip[i]);
+    const Eigen::Matrix<double, 6, 3> G = Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(D) * U *
+                                          Eigen::Map<const Eigen::Matrix<double, 6, 3, Eigen::RowMajor>>(V);
+    const Eigen::Matrix<double, 6, 3> dz =
+        -Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(A).partialPivLu().solve(G);
+    Jq = dz.topRows<3>();
 }
 
 void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,

@@ -2,8 +2,13 @@
 
 #include "models.hpp"
 
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_multiroots.h>
+
 #include <cmath>
+#include <deque>
 #include <sstream>
+#include <stdexcept>
 
 namespace plate {
 
@@ -21,7 +26,44 @@ std::string LimitCycleSummary::report() const {
     return s.str();
 }
 
+const char* cycle_solver_name(CycleSolver s) {
+    switch (s) {
+        case CycleSolver::PeriodByPeriod: return "period-by-period";
+        case CycleSolver::Anderson: return "anderson";
+        case CycleSolver::Newton: return "newton";
+    }
+    return "?";
+}
+
+CycleSolver parse_cycle_solver(const std::string& name) {
+    for (CycleSolver s : {CycleSolver::PeriodByPeriod, CycleSolver::Anderson, CycleSolver::Newton})
+        if (name == cycle_solver_name(s)) return s;
+    throw std::invalid_argument("unknown cycle solver '" + name + "' (expected period-by-period, anderson or newton)");
+}
+
 namespace {
+
+// Anderson extrapolation (type II) from the history of starts x_j and images f_j = P(x_j), in
+// scaled coordinates: minimise |g_k - dG gamma| over the differences of residuals g = f - x,
+// then x_new = f_k - dF gamma.
+Vec3 anderson_next(const std::deque<Vec3>& X, const std::deque<Vec3>& F) {
+    const int m = static_cast<int>(X.size()) - 1;
+    const Vec3 gk = F.back() - X.back();
+    if (m < 1) return F.back();
+    Eigen::Matrix<double, 3, Eigen::Dynamic> dG(3, m), dF(3, m);
+    for (int j = 0; j < m; ++j) {
+        dG.col(j) = (F[j + 1] - X[j + 1]) - (F[j] - X[j]);
+        dF.col(j) = F[j + 1] - F[j];
+    }
+    Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 3, Eigen::Dynamic>> qr(dG);
+    qr.setThreshold(1e-8);   // drop directions the residual differences do not resolve
+    const Eigen::VectorXd gamma = qr.solve(gk);
+    const Vec3 x = F.back() - dF * gamma;
+    // Safeguard: a secant extrapolation far beyond the residual means the differences were nearly
+    // dependent (e.g. a part still decelerating, where P is a translation): take the plain step.
+    if (!x.allFinite() || (x - F.back()).norm() > 10 * gk.norm()) return F.back();
+    return x;
+}
 
 LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
     detail::ReducedModel model(sc, q0);
@@ -52,6 +94,11 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
         const double t_first = t0 > 0 ? T * std::ceil(t0 / T * (1 + 1e-12)) : 0.0;
         bool ok = t0 > 0 ? e.advance(t_first, record) : true;
         if (ok) prev = model.qd(e.y());
+        const bool anderson = opt.solver == CycleSolver::Anderson;
+        std::deque<Vec3> X, Fx;
+        double lambda = 0, r_prev_plain = std::numeric_limits<double>::infinity();
+        Vec3 start = prev;
+        bool extrapolated = false;   // did the period just integrated start from an extrapolation?
         for (int k = 1; ok && k <= opt.max_periods; ++k) {
             e.modify([](auto& z) { z[3] = z[4] = z[5] = 0; });
             double min_n = e.n().head(sc.part.contacts()).minCoeff();
@@ -69,8 +116,13 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
             const double r = ((qd - prev).array() / scale.array()).abs().maxCoeff();
             out.residual = r;
             if (k >= 2 && r_prev > 0) {
-                out.contraction = std::min(r / r_prev, 0.99);
-                out.error_estimate = r * out.contraction / (1 - out.contraction);
+                // With Anderson the ratio r/r_prev measures the acceleration, not the map: keep the
+                // map's contraction from the first plain periods for the error estimate.
+                // The twist is the average over the period from the start x_k, which lies within
+                // r/(1 - lambda) of the cycle; plain periods report their end, within r c/(1 - c).
+                if (!extrapolated) lambda = std::min(r / r_prev, 0.99);
+                out.contraction = anderson ? lambda : std::min(r / r_prev, 0.99);
+                out.error_estimate = anderson ? r / (1 - lambda) : r * out.contraction / (1 - out.contraction);
                 if (out.error_estimate <= opt.tol) {
                     out.converged = true;
                     break;
@@ -81,6 +133,23 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
             }
             r_prev = r;
             prev = qd;
+            extrapolated = false;
+            if (anderson) {
+                // Plain periods until the map's own contraction is measured, then extrapolate.
+                X.push_back(start.cwiseQuotient(scale));
+                Fx.push_back(qd.cwiseQuotient(scale));
+                if (static_cast<int>(X.size()) > opt.anderson_memory + 1) { X.pop_front(); Fx.pop_front(); }
+                // Extrapolate only where the iteration contracts; forget the transient before.
+                if (r >= r_prev_plain) { X.erase(X.begin(), X.end() - 1); Fx.erase(Fx.begin(), Fx.end() - 1); }
+                r_prev_plain = r;
+                if (k >= 2 && X.size() >= 2) {
+                    const Vec3 next = anderson_next(X, Fx).cwiseProduct(scale);
+                    extrapolated = next != prev;
+                    e.modify([&](auto& z) { z[0] = next[0]; z[1] = next[1]; z[2] = sc.part.point ? 0.0 : next[2]; });
+                    prev = model.qd(e.y());
+                }
+            }
+            start = prev;
         }
     }
     out.stop = e.stop;
@@ -91,6 +160,138 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
 }
 
 
+// One period of (35) from twist x at t = 0: the twist at T and the period average (36).
+struct PeriodResult {
+    bool ok = false;
+    Vec3 end = Vec3::Zero(), average = Vec3::Zero();
+    double min_n = 0;
+    StopEvent stop;
+};
+PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const IntegrationOptions& io, Stats& total) {
+    detail::ReducedModel model(sc, q0);
+    detail::Engine<detail::ReducedModel> e(model, sc, io);
+    PeriodResult r;
+    const Vec3 qd = sc.part.point ? Vec3(x[0], x[1], 0) : x;
+    double min_n = std::numeric_limits<double>::infinity();
+    r.ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) &&
+           e.advance(sc.plate.T, [&](double, const auto&, const Vec3& n) {
+               min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
+           });
+    r.stop = e.stop;
+    total.rhs_evals += e.stats.rhs_evals;
+    total.steps += e.stats.steps;
+    total.rejected += e.stats.rejected;
+    total.slip_reversals += e.stats.slip_reversals;
+    if (r.ok) {
+        const auto y = e.y();
+        r.end = model.qd(y);
+        r.average = Vec3(y[3], y[4], y[5]) / sc.plate.T;
+        r.min_n = min_n;
+    }
+    return r;
+}
+
+// Newton shooting on G(x) = (P(x) - x)/scale = 0 with GSL's gnewton (a Newton step with a
+// backtracking guard) and a finite-difference monodromy.
+struct NewtonData {
+    const Scene* sc;
+    Vec3 q0, scale;
+    IntegrationOptions io;
+    Stats stats;
+    StopEvent stop;
+    bool failed = false;
+    int periods = 0;
+};
+
+int newton_f(const gsl_vector* xs, void* p, gsl_vector* f) {
+    auto* d = static_cast<NewtonData*>(p);
+    const Vec3 x = Vec3(gsl_vector_get(xs, 0), gsl_vector_get(xs, 1), gsl_vector_get(xs, 2)).cwiseProduct(d->scale);
+    const PeriodResult r = one_period(*d->sc, d->q0, x, d->io, d->stats);
+    ++d->periods;
+    if (!r.ok) {
+        d->failed = true;
+        d->stop = r.stop;
+        return GSL_EBADFUNC;
+    }
+    const Vec3 g = (r.end - x).cwiseQuotient(d->scale);
+    for (int i = 0; i < 3; ++i) gsl_vector_set(f, i, g[i]);
+    return GSL_SUCCESS;
+}
+
+int newton_df(const gsl_vector* xs, void* p, gsl_matrix* J) {
+    auto* d = static_cast<NewtonData*>(p);
+    gsl_vector* f0 = gsl_vector_alloc(3);
+    gsl_vector* f1 = gsl_vector_alloc(3);
+    gsl_vector* x1 = gsl_vector_alloc(3);
+    int status = newton_f(xs, p, f0);
+    // Step 1e-5 of the scale: far above the period map's integration error (rtol 1e-8).
+    const double h = 1e-5;
+    for (int j = 0; j < 3 && status == GSL_SUCCESS; ++j) {
+        gsl_vector_memcpy(x1, xs);
+        gsl_vector_set(x1, j, gsl_vector_get(xs, j) + h);
+        status = newton_f(x1, p, f1);
+        for (int i = 0; i < 3 && status == GSL_SUCCESS; ++i)
+            gsl_matrix_set(J, i, j, (gsl_vector_get(f1, i) - gsl_vector_get(f0, i)) / h);
+    }
+    if (d->sc->part.point && status == GSL_SUCCESS) {   // no rotation: keep the matrix regular
+        for (int i = 0; i < 3; ++i) gsl_matrix_set(J, 2, i, i == 2 ? -1.0 : 0.0);
+    }
+    gsl_vector_free(f0);
+    gsl_vector_free(f1);
+    gsl_vector_free(x1);
+    return status;
+}
+
+int newton_fdf(const gsl_vector* x, void* p, gsl_vector* f, gsl_matrix* J) {
+    const int s = newton_f(x, p, f);
+    return s == GSL_SUCCESS ? newton_df(x, p, J) : s;
+}
+
+LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+    gsl_set_error_handler_off();
+    const detail::Scales sc_(sc);
+    NewtonData d{&sc, q0, Vec3(sc_.v, sc_.v, sc_.w), opt.integration, {}, {}, false, 0};
+    gsl_multiroot_function_fdf fdf{newton_f, newton_df, newton_fdf, 3, &d};
+    gsl_vector* x = gsl_vector_alloc(3);
+    const Vec3 x0 = qd0.cwiseQuotient(d.scale);
+    for (int i = 0; i < 3; ++i) gsl_vector_set(x, i, x0[i]);
+    gsl_multiroot_fdfsolver* s = gsl_multiroot_fdfsolver_alloc(gsl_multiroot_fdfsolver_gnewton, 3);
+    LimitCycleSummary out;
+    int status = gsl_multiroot_fdfsolver_set(s, &fdf, x);
+    double step = std::numeric_limits<double>::infinity();
+    for (int it = 0; status == GSL_SUCCESS && d.periods < opt.max_periods; ++it) {
+        status = gsl_multiroot_fdfsolver_iterate(s);
+        if (status != GSL_SUCCESS) break;
+        step = 0;
+        for (int i = 0; i < 3; ++i) step = std::max(step, std::abs(gsl_vector_get(s->dx, i)));
+        // The Newton step estimates the distance to the fixed point (quadratic convergence).
+        if (step <= opt.tol) break;
+    }
+    const Vec3 xs = Vec3(gsl_vector_get(s->x, 0), gsl_vector_get(s->x, 1), gsl_vector_get(s->x, 2)).cwiseProduct(d.scale);
+    gsl_multiroot_fdfsolver_free(s);
+    gsl_vector_free(x);
+    out.periods = d.periods;
+    if (!d.failed && step <= opt.tol) {
+        const PeriodResult r = one_period(sc, q0, xs, opt.integration, d.stats);
+        ++out.periods;
+        if (r.ok) {
+            out.converged = true;
+            out.twist = r.average;
+            out.qd_start = xs;
+            out.residual = ((r.end - xs).array() / d.scale.array()).abs().maxCoeff();
+            out.error_estimate = step;
+            out.min_normal_force = r.min_n;
+        } else {
+            out.stop = r.stop;
+        }
+    } else if (d.failed) {
+        out.stop = d.stop;
+    }
+    out.stats = d.stats;
+    if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, 0};
+    return out;
+}
+
 }  // namespace
 
 LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
@@ -100,6 +301,22 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
         LimitCycleSummary out;
         out.stop = StopEvent{StopReason::NotConverged, -1, 0};
         out.note = "frictionless part: every initial twist repeats, so there is no unique limit cycle";
+        return out;
+    }
+    if (opt.solver != CycleSolver::PeriodByPeriod) {
+        // Accelerated solvers first; where they do not converge (an extrapolated start that left the
+        // model, a Newton iteration that failed) the plain iteration decides, and the cost counts.
+        LimitCycleSummary fast = opt.solver == CycleSolver::Newton ? newton_cycle(sc, q0, opt, qd0)
+                                                                    : one_start(sc, q0, opt, qd0);
+        if (fast.converged || fast.periods >= opt.max_periods) return fast;   // the cap is for all of it
+        LimitCycleOptions plain = opt;
+        plain.solver = CycleSolver::PeriodByPeriod;
+        plain.max_periods = opt.max_periods - fast.periods;
+        LimitCycleSummary out = limit_cycle(sc, q0, plain, qd0);
+        out.stats.rhs_evals += fast.stats.rhs_evals;
+        out.stats.steps += fast.stats.steps;
+        out.stats.rejected += fast.stats.rejected;
+        out.periods += fast.periods;
         return out;
     }
     LimitCycleSummary out = one_start(sc, q0, opt, qd0);

@@ -33,6 +33,15 @@ struct PlateState {
 PlateState plate_state(const PlateMotion& plate, double t, Dynamics level,
                        const Mat3& R1 = Mat3::Identity());
 
+// How the friction force of a sliding contact depends on its sliding velocity v (17):
+//   Coulomb  exact kinetic Coulomb friction, direction v/|v| (discontinuous at v = 0)
+//   Tanh     regularised: (v/|v|) tanh(|v|/eps)
+//   Linear   regularised: v / max(|v|, eps) (a viscous law below eps)
+// The regularised laws change the model near zero slip: they trade the kink for an error of
+// order eps in the average twist (charted in the speed-accuracy report).
+enum class FrictionLaw { Coulomb, Tanh, Linear };
+const char* friction_law_name(FrictionLaw f);
+
 // Workspace ("Data"): scratch and results of the last evaluation. Preallocated; the
 // evaluation itself does not allocate. A workspace serves one Scene at a time: the part's
 // constants are loaded into the kernels' inputs on first use with a scene (call prepare() again
@@ -40,6 +49,8 @@ PlateState plate_state(const PlateMotion& plate, double t, Dynamics level,
 struct Workspace {
     void prepare(const Scene& scene);
     const Scene* prepared = nullptr;
+    FrictionLaw law = FrictionLaw::Coulomb;   // set by the caller; eps in m/s
+    double law_eps = 0;
     gen::KernelInput in;                   // inputs of the generated kernels
     bool thin = false;
     Mat3 M38_inv = Mat3::Zero();           // thin part: inverse of (38)'s matrix, constant
@@ -65,6 +76,13 @@ struct Workspace {
 // point part the explicit solution.
 void accelerations(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
                    const PlateState& plate, Workspace& ws);
+
+// d q''/d q' of the U- and reduced U-dynamics (32)/(35) at (q, q'): from the generated factors
+// dA_du and dslip_dqd and the friction law's d u_i/d v_i (b~ does not depend on q', so
+// d z/d q' = -A^-1 (dA/dq') z). Evaluates the accelerations first (ws holds them after). For the
+// implicit integrators; throws std::invalid_argument for full dynamics.
+void twist_jacobian(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate,
+                    Workspace& ws, Mat3& dqdd_dqd);
 
 // The hand-written reference implementation of the same equations (generic 6x6 Eigen solve),
 // kept to check the generated kernels against.

@@ -15,6 +15,18 @@
 
 namespace plate {
 
+// How the fixed point of the period map P (state at t = 0 -> state at t = T) is found:
+//   PeriodByPeriod  x_{k+1} = P(x_k) until the contraction estimate says the cycle is reached
+//   Anderson        the same periods, but each new start is Anderson's extrapolation from the last
+//                   (up to 3) pairs (x_j, P(x_j)); falls back to period by period if a start leaves
+//                   the model
+//   Newton          Newton shooting on P(x) - x = 0 (GSL multiroot, gnewton), monodromy by finite
+//                   differences of P (3 extra periods per iteration)
+// The speed-accuracy study (plate bench) charts cost against accuracy for each.
+enum class CycleSolver { PeriodByPeriod, Anderson, Newton };
+const char* cycle_solver_name(CycleSolver s);
+CycleSolver parse_cycle_solver(const std::string& name);   // throws std::invalid_argument
+
 struct LimitCycleOptions {
     IntegrationOptions integration{1e-8};
     double tol = 1e-7;          // accepted distance to the cycle, relative to v_ref
@@ -25,6 +37,8 @@ struct LimitCycleOptions {
     // from other twists (slip speed v_ref along x, then y, then a spin) up to this many times.
     // A cycle that sticks from every start is reported as sticking.
     int restarts = 3;
+    CycleSolver solver = CycleSolver::Anderson;
+    int anderson_memory = 3;
 };
 
 struct LimitCycleSummary {
