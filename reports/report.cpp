@@ -1,4 +1,5 @@
 #include "report.hpp"
+#include "report_html.hpp"
 
 #include "plate/field.hpp"
 #include "plate/output.hpp"
@@ -24,65 +25,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string fmt(double x, int p = 4) {
-    std::ostringstream s;
-    s << std::setprecision(p) << x;
-    return s.str();
-}
-
-std::string esc(const std::string& s) {
-    std::string o;
-    for (char c : s) {
-        if (c == '<') o += "&lt;";
-        else if (c == '>') o += "&gt;";
-        else if (c == '&') o += "&amp;";
-        else o += c;
-    }
-    return o;
-}
-
-
-struct Ctx {
-    fs::path dir;
-    std::ostringstream html;
-    std::vector<std::pair<std::string, double>> timings;
-    int figures = 0;
-
-    template <class F>
-    void timed(const std::string& what, F&& f) {
-        const auto t0 = std::chrono::steady_clock::now();
-        std::fprintf(stderr, "report: %s...\n", what.c_str());
-        f();
-        timings.push_back({what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
-    }
-    std::ofstream data(const std::string& name) {
-        std::ofstream o(dir / "data" / name);
-        o << std::setprecision(9);
-        return o;
-    }
-    // Runs a gnuplot script (cwd = dir) that must write `name`.svg; adds the <img>.
-    void plot(const std::string& name, const std::string& script, const std::string& caption) {
-        const fs::path gp = dir / "data" / (name + ".gp");
-        std::ofstream(gp) << "set terminal svg size 640,480 dynamic background rgb 'white' font 'sans,11'\n"
-                          << "set output '" << name << ".svg'\n" << script;
-        const std::string cmd = "cd '" + dir.string() + "' && gnuplot 'data/" + name + ".gp' 2> 'data/" + name + ".log'";
-        if (std::system(cmd.c_str()) != 0 || !fs::exists(dir / (name + ".svg")))
-            throw std::runtime_error("gnuplot failed on " + gp.string() + " (see data/" + name + ".log)");
-        html << "<figure><img src=\"" << name << ".svg\" alt=\"" << esc(caption) << "\"><figcaption>" << caption
-             << "</figcaption></figure>\n";
-        ++figures;
-    }
-};
-
-const char* kStyle = R"(<style>
-body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
-h1,h2,h3{color:#123}table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;font-size:90%}
-th{background:#eef}.pass{color:#080;font-weight:bold}.fail{color:#b00;font-weight:bold}figure{display:inline-block;margin:.5em}
-figure img{max-width:520px;border:1px solid #ddd}figcaption{font-size:85%;max-width:520px}code,pre{background:#f6f6f6}
-pre{overflow-x:auto;padding:.5em}.math{overflow-x:auto}</style>
-)";
-
-std::string verdict(bool ok) { return ok ? "<span class=\"pass\">pass</span>" : "<span class=\"fail\">FAIL</span>"; }
+using namespace html;
 
 void section_derivation(Ctx& c) {
     const symbolic::Derivation d = symbolic::derive();   // run here: every line below is this run's
@@ -446,11 +389,13 @@ void write_report(const ReportOptions& opt) {
          << fmt(total, 4) << " s.</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
     html << "</table>\n" << c.html.str();
-    // For scripts/check-report.sh: after loading, the body says whether every image rendered.
-    html << "<script>window.addEventListener('load',function(){var b=[].slice.call(document.images).filter("
-            "function(i){return !(i.complete&&i.naturalWidth>0);});document.body.setAttribute('data-images',"
-            "b.length?'missing:'+b.map(function(i){return i.getAttribute('src');}).join(','):'ok:'+document.images.length);});"
-            "</script>\n</body></html>\n";
+    // The speed-accuracy study (plate bench) keeps its section between the markers.
+    html << kSpeedBegin;
+    const fs::path speed = c.dir / "data" / "speed_section.html";
+    if (fs::exists(speed)) html << std::ifstream(speed).rdbuf();
+    else html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
+              << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
+    html << kSpeedEnd << "\n" << kImageCheck << "</body></html>\n";
     if (!html) throw std::runtime_error((c.dir / "index.html").string() + ": write failed");
 }
 

@@ -19,4 +19,14 @@ struct ReportOptions {
 // Writes the report; throws std::runtime_error (with the file or tool named) on failure.
 void write_report(const ReportOptions& opt);
 
+// The speed-accuracy study (`plate bench`): writes its charts into DIR and its section into
+// DIR/index.html (between the report's markers; a page of its own if there is no report yet).
+// Quick by default (minutes); `full` sweeps more settings, solvers and regularisation widths.
+struct SpeedOptions {
+    std::string out;
+    std::string source_dir;
+    bool full = false;
+};
+void write_speed_study(const SpeedOptions& opt);
+
 }  // namespace plate::report

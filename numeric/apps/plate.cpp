@@ -3,6 +3,7 @@
 // assumptions (contact lost, sticking, step collapse) -- its output up to that time is kept;
 // 1 any other failure.
 #include "plate/field.hpp"
+#include "plate/hierarchy.hpp"
 #include "plate/output.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
@@ -37,6 +38,7 @@ const char* kUsage =
     "  random-scene  a seeded random part and plate motion (like Fig. 3), as a scene file\n"
     "  proofs        the numerical checks of Theorem 1 (contraction, Floquet, limit surfaces, A), JSON\n"
     "  report        the verification report: DIR/index.html with SVG figures (gnuplot)\n"
+    "  bench         the speed-accuracy study, written into the report in DIR (--full: the long campaign)\n"
     "\n"
     "SCENE is a JSON scene file (see scenes/). Units are SI. Exit codes: 0 ok, 2 bad input,\n"
     "3 a simulation left the model's assumptions (contact lost, sticking), 1 other failure.\n";
@@ -141,12 +143,19 @@ LimitCycleOptions cycle_opts(const Args& a) {
     o.tol = a.num("--tol", 0, o.tol);
     o.integration.rtol = a.num("--rtol", 0, o.integration.rtol);
     o.max_periods = static_cast<int>(a.integer("--max-periods", o.max_periods, 2, 100000));
+    if (a.has("--cycle-solver")) {
+        try {
+            o.solver = parse_cycle_solver(a.str("--cycle-solver", ""));
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(std::string("--cycle-solver: ") + e.what());
+        }
+    }
     if (!(o.tol > 0) || !(o.integration.rtol > 0 && o.integration.rtol < 1e-2))
         throw UsageError("--tol must be > 0 and --rtol in (0, 1e-2)");
     return o;
 }
 
-const std::map<std::string, int> kCycleOpts = {{"--tol", 1}, {"--rtol", 1}, {"--max-periods", 1}};
+const std::map<std::string, int> kCycleOpts = {{"--tol", 1}, {"--rtol", 1}, {"--max-periods", 1}, {"--cycle-solver", 1}};
 const std::map<std::string, int> kGridOpts = {{"--grid", 1}, {"--nx", 1}, {"--ny", 1}, {"--ntheta", 1}, {"--x", 2},
                                               {"--y", 2}, {"--theta0", 1}, {"--threads", 1}};
 
@@ -246,21 +255,25 @@ int cmd_simulate(int argc, char** argv) {
     Args a(argc, argv, merge(with_config({{"--dynamics", 1}, {"--time", 1}, {"--sample", 1}, {"--out", 1},
                                           {"--rtol", 1}},
                                          {"--from", "--twist"}, d),
-                             {{"--tol", 1}, {"--max-periods", 1}}));
+                             {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}}));
     if (a.help) {
-        std::cout << "usage: plate simulate SCENE --dynamics full|u|field --from SX SY THETA --time T\n"
+        std::cout << "usage: plate simulate SCENE --dynamics full|u|field|auto --from SX SY THETA --time T\n"
                      "                      [--twist VX VY OMEGA] [--sample DT] [--out FILE] [--rtol X]\n"
                      "Trajectory from configuration --from with part twist --twist relative to the plate\n"
                      "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
                      "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps).\n"
+                     "auto: the cheapest of point/thin/thick part x field/u/full dynamics whose final configuration\n"
+                     "is within --model-tol E (default 1e-2; of rho and radians) of the scene's part under full\n"
+                     "dynamics, measured on this question; the choice and every rung's error go to stderr.\n"
                      "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
                      "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05). Exit code 3 when\n"
                      "contact is lost or a contact sticks: the CSV then ends at that time.\n";
         return 0;
     }
     const Scene sc = scene_arg(a);
-    const std::string dyn = a.str("--dynamics", "");
-    if (dyn != "full" && dyn != "u" && dyn != "field") throw UsageError("--dynamics: expected full, u or field");
+    std::string dyn = a.str("--dynamics", "");
+    if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "auto")
+        throw UsageError("--dynamics: expected full, u, field or auto");
     const Vec3 q0 = config_arg(a, "--from", sc, true);
     const Vec3 qd0 = config_arg(a, "--twist", sc, false);
     if (!a.has("--time")) throw UsageError("missing --time T");
@@ -271,15 +284,26 @@ int cmd_simulate(int argc, char** argv) {
     io.rtol = a.num("--rtol", 0, io.rtol);
     Trajectory tr;
     ProgressPrinter prog{"simulate"};
+    Scene used = sc;
+    if (dyn == "auto") {
+        if (!qd0.isZero()) throw UsageError("--dynamics auto answers from rest: drop --twist");
+        const double tol = a.num("--model-tol", 0, 1e-2);
+        if (!(tol > 0)) throw UsageError("--model-tol must be > 0");
+        const ModelChoice mc = choose_model(sc, q0, T, tol);
+        std::cerr << mc.explain();
+        used = simplified(sc, mc.picked.part);
+        dyn = mc.picked.dynamics == Dynamics::Full ? "full" : mc.picked.dynamics == Dynamics::U ? "u" : "field";
+    }
+    const Scene& sc_run = used;
     if (dyn == "field") {
         if (!qd0.isZero()) throw UsageError("--twist has no meaning for --dynamics field");
         LimitCycleOptions lo;
         lo.tol = a.num("--tol", 0, lo.tol);
-        tr = field_curve(sc, q0, T, dt, lo);
+        tr = field_curve(sc_run, q0, T, dt, lo);
     } else {
-        tr = simulate(sc, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, dt, io);
+        tr = simulate(sc_run, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, dt, io);
     }
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc.part.point); });
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); });
     if (tr.stop.reason != StopReason::None) {
         std::cerr << "plate simulate: " << a.pos[0] << ": stopped: " << tr.stop.describe() << std::endl;
         return 3;
@@ -391,6 +415,29 @@ int cmd_report(int argc, char** argv) {
     return 0;
 }
 
+int cmd_bench(int argc, char** argv) {
+    Args a(argc, argv, {{"--out", 1}, {"--full", 0}, {"--source", 1}});
+    if (a.help) {
+        std::cout << "usage: plate bench --out DIR [--full] [--source ROOT]\n"
+                     "The speed-accuracy study: work-precision charts (every method and friction treatment on (a) an\n"
+                     "asymptotic twist of fig4, (b) fig4's 20 s full-dynamics trajectory, (c) a near-sticking twist of\n"
+                     "fig6) against reference solutions; the limit-cycle solvers on fig4's field against period-by-\n"
+                     "period RK4; failure maps; the model hierarchy. Writes the charts into DIR and the section into\n"
+                     "DIR/index.html (the report's page if `plate report --out DIR` wrote one). Quick by default\n"
+                     "(minutes); --full sweeps more settings.\n";
+        return 0;
+    }
+    if (!a.pos.empty()) throw UsageError("bench takes no SCENE argument");
+    if (!a.has("--out")) throw UsageError("missing --out DIR");
+    report::SpeedOptions o;
+    o.out = a.str("--out", "");
+    o.source_dir = a.str("--source", PLATE_SOURCE_DIR);
+    o.full = a.has("--full");
+    report::write_speed_study(o);
+    std::cerr << "bench: " << o.out << "/index.html" << std::endl;
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -407,6 +454,7 @@ int main(int argc, char** argv) {
         if (cmd == "random-scene") return cmd_random_scene(argc - 2, argv + 2);
         if (cmd == "proofs") return cmd_proofs(argc - 2, argv + 2);
         if (cmd == "report") return cmd_report(argc - 2, argv + 2);
+        if (cmd == "bench") return cmd_bench(argc - 2, argv + 2);
         std::cerr << "plate: unknown command '" << cmd << "'\n" << kUsage;
         return 2;
     } catch (const InputError& e) {

@@ -224,8 +224,9 @@ int newton_df(const gsl_vector* xs, void* p, gsl_matrix* J) {
     gsl_vector* f1 = gsl_vector_alloc(3);
     gsl_vector* x1 = gsl_vector_alloc(3);
     int status = newton_f(xs, p, f0);
-    // Step 1e-5 of the scale: far above the period map's integration error (rtol 1e-8).
-    const double h = 1e-5;
+    // The difference step must stand far above the period map's own integration error (~rtol):
+    // 1e-5 of the scale at rtol 1e-8, larger for looser tolerances.
+    const double h = std::max(1e-5, 1e3 * d->io.rtol);
     for (int j = 0; j < 3 && status == GSL_SUCCESS; ++j) {
         gsl_vector_memcpy(x1, xs);
         gsl_vector_set(x1, j, gsl_vector_get(xs, j) + h);
@@ -274,7 +275,13 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
     if (!d.failed && step <= opt.tol) {
         const PeriodResult r = one_period(sc, q0, xs, opt.integration, d.stats);
         ++out.periods;
-        if (r.ok) {
+        // A Newton step below tol is not enough when the map is noisy (loose rtol): the residual
+        // |P(x) - x| must be small too (it is (1 - lambda) times the distance at a true fixed point).
+        const double res = ((r.end - xs).array() / d.scale.array()).abs().maxCoeff();
+        if (r.ok && res > 10 * opt.tol) {
+            out.stop = StopEvent{StopReason::NotConverged, -1, 0};
+            out.residual = res;
+        } else if (r.ok) {
             out.converged = true;
             out.twist = r.average;
             out.qd_start = xs;

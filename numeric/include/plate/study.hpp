@@ -1,0 +1,65 @@
+// The speed-accuracy study: the plate's questions answered by every integration method and
+// friction treatment, against reference solutions, so that cost can be charted against error
+// (work-precision), failures located (failure maps), and the limit-cycle solvers compared.
+// `plate bench` runs it and writes the charts into the verification report.
+#pragma once
+
+#include "plate/dynamics.hpp"
+#include "plate/limit_cycle.hpp"
+#include "plate/methods.hpp"
+
+#include <string>
+#include <vector>
+
+namespace plate {
+
+// One way of integrating: the project's engine (Dormand-Prince 5(4) with contact events located
+// by bisection on re-stepped steps, simulate.hpp) or a general method with a friction law.
+struct Solver {
+    bool engine = false;
+    Method method = Method::Dopri5;
+    FrictionLaw law = FrictionLaw::Coulomb;
+    double law_eps = 1e-3;     // regularisation width, relative to Scene::v_ref()
+    std::string label() const; // e.g. "engine: dopri5 + events", "gsl-rk8pd / tanh 1e-3"
+};
+
+// The solvers of the study: every method with exact Coulomb friction, the engine, and
+// regularised laws on dopri5 (quick) or on several methods (full).
+std::vector<Solver> study_solvers(bool full);
+// Accuracy settings swept per solver: tolerances (adaptive) or steps per period (RK4).
+std::vector<double> study_knobs(const Solver& s, bool full);
+
+struct RunResult {
+    bool ok = false;
+    std::string failure;        // why not ok: the method's own failure, a model stop, "wrong answer"
+    double knob = 0;            // tolerance, or steps per period
+    long rhs_evals = 0;
+    long jac_evals = 0;
+    double seconds = 0;
+    std::vector<double> value;  // the answer: a twist (3) or samples of q (3 per sample)
+    double error = 0;           // against the reference (filled by the caller)
+    double error_max = 0;       // trajectories: largest error along the path
+};
+
+// (a), (c): the asymptotic twist (36) at q0, reduced U-dynamics, period by period from rest until
+// the cycle's error estimate is below cycle_tol (relative to v_ref).
+RunResult twist_run(const Scene& scene, const Vec3& q0, const Solver& s, double knob, double cycle_tol,
+                    long max_evals = 20'000'000);
+
+// (b): a full-dynamics trajectory from rest at q0 for `duration` s, q sampled every sample_dt
+// from the breakaway time (all solvers start there, from the same state).
+RunResult trajectory_run(const Scene& scene, const Vec3& q0, double duration, double sample_dt, const Solver& s,
+                         double knob, long max_evals = 50'000'000);
+
+// Errors: twists relative to (v_ref, v_ref, v_ref / rho); configurations relative to (rho, rho, 1 rad).
+double twist_error(const Scene& scene, const std::vector<double>& a, const std::vector<double>& b);
+// Final-sample and largest-over-samples configuration error.
+void path_error(const Scene& scene, const std::vector<double>& a, const std::vector<double>& b, double& final_error,
+                double& max_error);
+
+// The OdeSystem of the reduced U-dynamics at q0 in scaled coordinates, y = [q'/v, Q/(v T)], with
+// the generated Jacobian (twist_jacobian); exposed for tests of the methods.
+OdeSystem reduced_system(const Scene& scene, const Vec3& q0, FrictionLaw law, double law_eps_abs,
+                         std::vector<double>& scale);
+
+}  // namespace plate

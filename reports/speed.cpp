@@ -1,0 +1,517 @@
+// `plate bench`: the speed-accuracy study (work-precision charts, failure maps, limit-cycle
+// solvers, the model hierarchy), written as a section of the verification report.
+#include "report.hpp"
+#include "report_html.hpp"
+
+#include "plate/field.hpp"
+#include "plate/hierarchy.hpp"
+#include "plate/output.hpp"
+#include "plate/scene_io.hpp"
+#include "plate/study.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace plate::report {
+
+using namespace html;
+
+namespace {
+
+constexpr double kTarget = 1e-6;       // the accuracy at which costs are compared
+constexpr double kWrong = 1e-2;        // an answer this far off (relative) is a wrong answer
+
+struct Line {
+    Solver solver;
+    std::vector<RunResult> runs;
+};
+
+std::string slug(std::string s) {
+    for (char& c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    return s;
+}
+
+// Repeats a short run so that its wall time is not timer noise; keeps the fastest.
+template <class F>
+RunResult timed_run(F&& f) {
+    RunResult best = f();
+    for (int i = 0; i < 2 && best.seconds < 0.02; ++i) {
+        RunResult r = f();
+        if (r.seconds < best.seconds) best.seconds = r.seconds;
+    }
+    return best;
+}
+
+// Cheapest run of a line with error <= kTarget: (seconds, evals); +inf if none.
+std::pair<double, double> cost_at_target(const Line& l, bool use_max = false) {
+    double s = std::numeric_limits<double>::infinity(), e = s;
+    for (const auto& r : l.runs) {
+        if (!r.ok || (use_max ? r.error_max : r.error) > kTarget) continue;
+        s = std::min(s, r.seconds);
+        e = std::min(e, static_cast<double>(r.rhs_evals));
+    }
+    return {s, e};
+}
+
+// Two log-log charts (error against seconds and against evaluations), failed runs marked at the
+// chart's top edge; a table of the cost at kTarget and of every failure.
+void work_precision(Ctx& c, const std::string& id, const std::string& title, const std::vector<Line>& lines,
+                    bool path_errors) {
+    c.html << "<h3>" << esc(title) << "</h3>\n";
+    std::vector<std::string> files;
+    double ceiling = 1;
+    for (const auto& l : lines) {
+        const std::string f = id + "_" + slug(l.solver.label()) + ".dat";
+        auto o = c.data(f);
+        for (const auto& r : l.runs)
+            if (r.ok) o << r.seconds << " " << r.rhs_evals << " " << std::max(r.error, 1e-16) << " "
+                        << std::max(r.error_max, 1e-16) << "\n";
+        auto fo = c.data(id + "_" + slug(l.solver.label()) + "_failed.dat");
+        for (const auto& r : l.runs)
+            if (!r.ok) fo << r.seconds << " " << r.rhs_evals << " " << ceiling << " " << ceiling << "\n";
+        files.push_back(f);
+    }
+    auto chart = [&](const std::string& name, int xcol, int ycol, const std::string& xl, const std::string& yl,
+                     const std::string& cap) {
+        std::ostringstream gp;
+        gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel '" << xl << "'\nset ylabel '" << yl
+           << "'\nset key outside right top font ',8'\nset grid\nset yrange [*:" << ceiling * 3 << "]\n"
+           << "set arrow from graph 0, first " << kTarget << " to graph 1, first " << kTarget << " nohead dt 2 lc rgb '#888'\n"
+           << "plot ";
+        for (std::size_t i = 0; i < lines.size(); ++i) {
+            const std::string base = "data/" + id + "_" + slug(lines[i].solver.label());
+            gp << (i ? ", " : "") << "'" << base << ".dat' u " << xcol << ":" << ycol << " w lp lw "
+               << (lines[i].solver.engine ? 3 : 1) << " pt " << (i % 12 + 1) << " title '" << lines[i].solver.label() << "'";
+            gp << ", '" << base << "_failed.dat' u " << xcol << ":" << ycol << " w p pt 2 ps 1.5 lc rgb 'red' notitle";
+        }
+        gp << "\n";
+        c.plot(name, gp.str(), cap, "900,520");
+    };
+    const std::string ey = path_errors ? "final-configuration error" : "twist error (relative to v_ref)";
+    chart(id + "_time", 1, 3, "wall time [s]", ey, esc(title) + ": error against wall time. Red crosses at the top: failed runs.");
+    chart(id + "_evals", 2, 3, "right-hand-side evaluations", ey, esc(title) + ": error against right-hand-side evaluations.");
+    if (path_errors)
+        chart(id + "_max", 2, 4, "right-hand-side evaluations", "largest error along the path",
+              esc(title) + ": largest configuration error over the samples, against evaluations.");
+    // Cost at the target accuracy.
+    double fastest = std::numeric_limits<double>::infinity();
+    std::string fastest_name;
+    double engine_s = fastest;
+    for (const auto& l : lines) {
+        const auto [s, e] = cost_at_target(l);
+        (void)e;
+        if (s < fastest) { fastest = s; fastest_name = l.solver.label(); }
+        if (l.solver.engine) engine_s = s;
+    }
+    c.html << "<table><tr><th>solver</th><th>runs</th><th>failed</th><th>best error</th><th>cost at error &le; "
+           << fmt(kTarget, 2) << " [s]</th><th>[evaluations]</th><th>&times; fastest</th></tr>\n";
+    for (const auto& l : lines) {
+        const auto [s, e] = cost_at_target(l);
+        int failed = 0;
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& r : l.runs) {
+            failed += !r.ok;
+            if (r.ok) best = std::min(best, r.error);
+        }
+        c.html << "<tr><td>" << (l.solver.engine ? "<b>" : "") << esc(l.solver.label()) << (l.solver.engine ? " (default)</b>" : "")
+               << "</td><td>" << l.runs.size() << "</td><td>" << failed << "</td><td>" << fmt(best, 2) << "</td><td>"
+               << (std::isfinite(s) ? fmt(s, 3) : "never") << "</td><td>" << (std::isfinite(e) ? fmt(e, 3) : "-")
+               << "</td><td>" << (std::isfinite(s) ? fmt(s / fastest, 3) : "-") << "</td></tr>\n";
+    }
+    c.html << "</table>\n<p>Fastest at " << fmt(kTarget, 2) << ": " << esc(fastest_name) << " (" << fmt(fastest, 3)
+           << " s). The default (engine) costs " << fmt(engine_s / fastest, 3) << "&times; that: "
+           << verdict(engine_s <= 2 * fastest) << " (target: within 2&times;).</p>\n";
+    c.html << "<details><summary>Failed runs (marked, not dropped)</summary><table><tr><th>solver</th><th>setting</th><th>why</th>"
+              "<th>evaluations</th></tr>\n";
+    for (const auto& l : lines)
+        for (const auto& r : l.runs)
+            if (!r.ok)
+                c.html << "<tr><td>" << esc(l.solver.label()) << "</td><td>" << fmt(r.knob, 3) << "</td><td>" << esc(r.failure)
+                       << "</td><td>" << r.rhs_evals << "</td></tr>\n";
+    c.html << "</table></details>\n";
+}
+
+void mark_wrong(RunResult& r) {
+    if (r.ok && !(r.error <= kWrong)) {
+        r.ok = false;
+        r.failure = "wrong answer (error " + fmt(r.error, 3) + ")";
+    }
+}
+
+// (a)/(c): the asymptotic twist at q0.
+void twist_chart(Ctx& c, const Scene& sc, const Vec3& q0, const std::string& id, const std::string& title, bool full) {
+    const double cyc = 1e-11;
+    Solver eng;
+    eng.engine = true;
+    const RunResult ref = twist_run(sc, q0, eng, 1e-12, 1e-12);
+    const RunResult ref2 = twist_run(sc, q0, eng, 1e-11, 1e-12);
+    Solver hi;
+    hi.method = Method::GslRk8pd;
+    const RunResult ind = twist_run(sc, q0, hi, 1e-12, 1e-12);
+    if (!ref.ok) throw std::runtime_error("bench: no reference twist for " + title + ": " + ref.failure);
+    const double self = twist_error(sc, ref.value, ref2.value);
+    c.html << "<p>Reference: engine at rtol 1e-12, cycle tolerance 1e-12, twist (" << fmt(ref.value[0], 6) << ", "
+           << fmt(ref.value[1], 6) << ", " << fmt(ref.value[2], 6) << "). Self-convergence: against rtol 1e-11 it differs by "
+           << fmt(self, 2) << "; an independent method (gsl-rk8pd, exact Coulomb, tol 1e-12) differs by "
+           << (ind.ok ? fmt(twist_error(sc, ref.value, ind.value), 2) : "(failed: " + esc(ind.failure) + ")")
+           << ". Errors charted below 1e-10 are at the reference's and the cycle tolerance's (1e-11) level.</p>\n";
+    std::vector<Line> lines;
+    for (const Solver& s : study_solvers(full)) {
+        Line l{s, {}};
+        for (double k : study_knobs(s, full)) {
+            const double ct = s.engine || s.method != Method::RK4 ? std::max(cyc, 0.1 * k) : cyc;
+            RunResult r = timed_run([&] { return twist_run(sc, q0, s, k, ct, full ? 20'000'000 : 4'000'000); });
+            if (r.ok) r.error = twist_error(sc, r.value, ref.value);
+            mark_wrong(r);
+            l.runs.push_back(r);
+        }
+        std::fprintf(stderr, "bench: %s %s done\n", id.c_str(), s.label().c_str());
+        lines.push_back(l);
+    }
+    work_precision(c, id, title, lines, false);
+}
+
+// (b): fig4's 20-second full-dynamics trajectory.
+void trajectory_chart(Ctx& c, const Scene& sc, bool full) {
+    const Vec3 q0(0.04, -0.04, 1.0);
+    const double dur = 20, dt = 0.5;
+    Solver eng;
+    eng.engine = true;
+    const RunResult ref = trajectory_run(sc, q0, dur, dt, eng, 1e-12);
+    const RunResult ref2 = trajectory_run(sc, q0, dur, dt, eng, 1e-11);
+    if (!ref.ok) throw std::runtime_error("bench: no reference trajectory: " + ref.failure);
+    double fe, me;
+    path_error(sc, ref.value, ref2.value, fe, me);
+    c.html << "<p>Reference: engine at rtol 1e-12 from rest at (0.04, -0.04, 1.0), samples every " << dt
+           << " s after breakaway; against rtol 1e-11 its final configuration differs by " << fmt(fe, 2)
+           << " and the path by at most " << fmt(me, 2) << " (of rho and radians). Final configuration ("
+           << fmt(ref.value[ref.value.size() - 3], 5) << ", " << fmt(ref.value[ref.value.size() - 2], 5) << ", "
+           << fmt(ref.value.back(), 5) << ").</p>\n";
+    std::vector<Line> lines;
+    std::vector<Solver> solvers = study_solvers(false);
+    if (!full) {   // the implicit methods need a Jacobian by differences here: slow, shown in --full
+        solvers.erase(std::remove_if(solvers.begin(), solvers.end(),
+                                     [](const Solver& s) { return !s.engine && method_info(s.method).needs_jacobian; }),
+                      solvers.end());
+    }
+    for (const Solver& s : solvers) {
+        Line l{s, {}};
+        std::vector<double> knobs = study_knobs(s, false);
+        if (!full && !(s.method == Method::RK4 && !s.engine)) knobs.erase(knobs.end() - 2, knobs.end());
+        if (!full && s.method == Method::RK4 && !s.engine) knobs.resize(std::min<std::size_t>(knobs.size(), 7));
+        for (double k : knobs) {
+            RunResult r = trajectory_run(sc, q0, dur, dt, s, k, full ? 100'000'000 : 20'000'000);
+            if (r.ok) path_error(sc, r.value, ref.value, r.error, r.error_max);
+            mark_wrong(r);
+            l.runs.push_back(r);
+        }
+        std::fprintf(stderr, "bench: trajectory %s done\n", s.label().c_str());
+        lines.push_back(l);
+    }
+    work_precision(c, "wp_traj", "(b) fig4: 20 s of full dynamics from rest", lines, true);
+}
+
+double field_error(const Scene& sc, const Field& f, const Field& ref, int* missing) {
+    double e = 0;
+    *missing = 0;
+    for (std::size_t i = 0; i < f.points.size(); ++i) {
+        if (!ref.points[i].converged) continue;
+        if (!f.points[i].converged) { ++*missing; continue; }
+        const Vec3 d = f.points[i].twist, r = ref.points[i].twist;
+        e = std::max(e, twist_error(sc, {d[0], d[1], d[2]}, {r[0], r[1], r[2]}));
+    }
+    return e;
+}
+
+// Limit-cycle solvers on fig4's 343-configuration field, and the ratio against period-by-period RK4.
+void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
+    FieldOptions ro;
+    ro.cycle.integration.rtol = 1e-12;
+    ro.cycle.tol = 1e-11;
+    const Field ref = compute_field(sc, GridSpec{}, ro);
+    c.html << "<p>Reference field: engine rtol 1e-12, cycle tolerance 1e-11 (" << fmt(ref.seconds, 3)
+           << " s). All runs below on one thread, so that times compare.</p>\n";
+    struct Cfg { CycleSolver s; bool warm; };
+    std::vector<Cfg> cfgs{{CycleSolver::PeriodByPeriod, false}, {CycleSolver::PeriodByPeriod, true},
+                          {CycleSolver::Anderson, false}, {CycleSolver::Anderson, true}, {CycleSolver::Newton, true}};
+    std::vector<double> rtols = full ? std::vector<double>{1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10}
+                                     : std::vector<double>{1e-6, 1e-7, 1e-8, 1e-9};
+    c.html << "<table><tr><th>cycle solver</th><th>warm starts</th><th>rtol</th><th>cycle tol</th><th>max error</th>"
+              "<th>not converged</th><th>periods / configuration</th><th>evaluations</th><th>seconds</th></tr>\n";
+    double best_s = std::numeric_limits<double>::infinity();
+    std::string best_name;
+    std::map<std::string, double> best_by;
+    for (const auto& cfg : cfgs) {
+        const std::string name = std::string(cycle_solver_name(cfg.s)) + (cfg.warm ? " + warm" : "");
+        auto o = c.data("cycle_" + slug(name) + ".dat");
+        for (double rt : rtols) {
+            FieldOptions fo;
+            fo.threads = 1;
+            fo.warm_start = cfg.warm;
+            fo.cycle.solver = cfg.s;
+            fo.cycle.integration.rtol = rt;
+            fo.cycle.tol = 10 * rt;
+            const Field f = compute_field(sc, GridSpec{}, fo);
+            int missing = 0;
+            const double e = field_error(sc, f, ref, &missing);
+            double periods = 0;
+            for (const auto& p : f.points) periods += p.periods;
+            o << f.seconds << " " << f.rhs_evals << " " << std::max(e, 1e-16) << "\n";
+            c.html << "<tr><td>" << esc(cycle_solver_name(cfg.s)) << "</td><td>" << (cfg.warm ? "yes" : "no") << "</td><td>"
+                   << fmt(rt, 2) << "</td><td>" << fmt(10 * rt, 2) << "</td><td>" << fmt(e, 3) << "</td><td>" << missing
+                   << "</td><td>" << fmt(periods / f.points.size(), 3) << "</td><td>" << f.rhs_evals << "</td><td>"
+                   << fmt(f.seconds, 3) << "</td></tr>\n";
+            if (missing == 0 && e <= kTarget) {
+                if (!best_by.count(name) || f.seconds < best_by[name]) best_by[name] = f.seconds;
+                if (f.seconds < best_s) { best_s = f.seconds; best_name = name + ", rtol " + fmt(rt, 2); }
+            }
+        }
+        std::fprintf(stderr, "bench: field by %s done\n", name.c_str());
+    }
+    c.html << "</table>\n";
+    // Period-by-period fixed-step RK4 from rest (no warm start): the smallest step count reaching kTarget.
+    Solver rk;
+    rk.method = Method::RK4;
+    double rk_s = std::numeric_limits<double>::infinity();
+    int rk_n = 0;
+    auto rko = c.data("cycle_rk4.dat");
+    c.html << "<p>Baseline: period-by-period fixed-step RK4 from rest, exact Coulomb, cycle tolerance 1e-7:</p>"
+              "<table><tr><th>steps per period</th><th>max error</th><th>failed</th><th>evaluations</th><th>seconds</th></tr>\n";
+    for (int n : {50, 70, 100, 140, 200}) {
+        double e = 0, secs = 0;
+        long ev = 0;
+        int failed = 0;
+        for (const auto& p : ref.points) {
+            const RunResult r = twist_run(sc, p.q, rk, n, 1e-7);
+            secs += r.seconds;
+            ev += r.rhs_evals;
+            if (!r.ok) { ++failed; continue; }
+            if (p.converged) e = std::max(e, twist_error(sc, r.value, {p.twist[0], p.twist[1], p.twist[2]}));
+        }
+        rko << secs << " " << ev << " " << std::max(e, 1e-16) << "\n";
+        c.html << "<tr><td>" << n << "</td><td>" << fmt(e, 3) << "</td><td>" << failed << "</td><td>" << ev << "</td><td>"
+               << fmt(secs, 3) << "</td></tr>\n";
+        if (failed == 0 && e <= kTarget && secs < rk_s) { rk_s = secs; rk_n = n; }
+        if (failed == 0 && e <= kTarget) break;   // more steps only cost more
+    }
+    c.html << "</table>\n";
+    std::ostringstream gp;
+    gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the field'\n"
+          "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first " << kTarget << " to graph 1, first "
+       << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
+    int i = 0;
+    for (const auto& cfg : cfgs) {
+        const std::string name = std::string(cycle_solver_name(cfg.s)) + (cfg.warm ? " + warm" : "");
+        gp << (i ? ", " : "") << "'data/cycle_" << slug(name) << ".dat' u 1:3 w lp pt " << i + 1 << " title '" << name << "'";
+        ++i;
+    }
+    gp << ", 'data/cycle_rk4.dat' u 1:3 w lp pt 7 lc rgb 'black' title 'RK4 period by period'\n";
+    c.plot("cycle_solvers", gp.str(), "fig4 field (343 configurations): maximum twist error against wall time for each "
+                                      "limit-cycle solver (engine rtol swept, cycle tolerance 10 rtol) and the RK4 baseline.");
+    const double ratio = rk_s / best_s;
+    c.html << "<p>At max error &le; " << fmt(kTarget, 2) << ": best " << esc(best_name) << " " << fmt(best_s, 3)
+           << " s; period-by-period RK4 (" << rk_n << " steps per period) " << fmt(rk_s, 3) << " s: ratio <b>"
+           << fmt(ratio, 3) << "&times;</b> " << verdict(ratio >= 20) << " (target &ge; 20&times;).";
+    double fastest = std::numeric_limits<double>::infinity();
+    for (const auto& [n, s] : best_by) fastest = std::min(fastest, s);
+    const std::string def = "anderson + warm";
+    if (best_by.count(def))
+        c.html << " The default (Anderson with warm starts) is " << fmt(best_by[def] / fastest, 3)
+               << "&times; the fastest solver: " << verdict(best_by[def] <= 2 * fastest) << " (target: within 2&times;).";
+    c.html << "</p>\n";
+}
+
+// Where methods and the model fail: sweeps of one scene parameter at a time.
+void failure_map(Ctx& c, const Scene& base, bool full) {
+    const Vec3 q0(0.02, -0.01, 0.5);
+    enum Kind { Mu, Horizontal, Vertical, Collinear };
+    struct Sweep { Kind kind; std::string name, param; std::vector<double> values; };
+    const double mu0 = base.part.mu[0];
+    std::vector<Sweep> sweeps{
+        {Mu, "friction rising toward sticking", "mu", {0.1, 0.3, 0.6, 1.0, 1.5, 2.0}},
+        {Horizontal, "horizontal plate acceleration falling toward mu g", "a_h / (mu g)", {4, 2, 1.5, 1.2, 1.05, 0.95}},
+        {Vertical, "vertical acceleration toward contact loss", "a_z / g", {0, 0.5, 0.9, 0.99, 1.1, 1.5}},
+        {Collinear, "contacts toward collinear", "x-spread of the contacts (x 1 cm)", {1, 0.3, 0.1, 0.01, 0.001, 0}}};
+    std::vector<Solver> solvers;
+    {
+        Solver s;
+        s.engine = true;
+        solvers.push_back(s);
+        for (Method m : {Method::RK4, Method::Dopri5, Method::GslRk8pd, Method::Rosenbrock4, Method::GslMsbdf}) {
+            Solver t;
+            t.method = m;
+            solvers.push_back(t);
+        }
+        for (FrictionLaw law : {FrictionLaw::Tanh, FrictionLaw::Linear}) {
+            Solver t;
+            t.method = Method::Dopri5;
+            t.law = law;
+            solvers.push_back(t);
+        }
+    }
+    c.html << "<p>fig4's part at q = (0.02, -0.01, 0.5); each cell is one run at tolerance 1e-8 (RK4: 200 steps per "
+              "period) compared with the engine at 1e-11. <span style=\"background:#cfc\">ok</span>: error &le; 1e-5; "
+              "<span style=\"background:#ffc\">detected</span>: the run stopped and said why (sticking, contact lost); "
+              "<span style=\"background:#fcc\">wrong</span>: a twist returned where the model fails, or off by more than "
+              "1e-5; <span style=\"background:#ddd\">method failed</span>: tiny steps, budget, no convergence. Each cell "
+              "gives the error or the reason, and the right-hand-side evaluations.</p>\n";
+    for (const auto& sw : sweeps) {
+        c.html << "<h4>" << esc(sw.name) << "</h4><table><tr><th>" << esc(sw.param) << "</th>";
+        for (const auto& s : solvers) c.html << "<th>" << esc(s.label()) << "</th>";
+        c.html << "</tr>\n";
+        for (double v : sw.values) {
+            Scene sc = base;
+            if (sw.kind == Mu) sc.part.mu = Vec3::Constant(v);
+            else if (sw.kind == Horizontal) {
+                const double scale = v * mu0 * sc.g / sc.plate.horizontal_amplitude();
+                for (auto& h : sc.plate.harmonics)
+                    if (h.axis == Axis::x || h.axis == Axis::y) h.amp *= scale;
+            } else if (sw.kind == Vertical) {
+                sc.plate.harmonics.push_back(Harmonic{Axis::z, 1, v * sc.g, 0.7});
+            } else {
+                for (auto& ct : sc.part.c) ct.x() *= v;
+            }
+            Solver eng;
+            eng.engine = true;
+            const RunResult ref = twist_run(sc, q0, eng, 1e-11, 1e-11);
+            c.html << "<tr><td>" << fmt(v, 3) << "</td>";
+            for (const auto& s : solvers) {
+                const RunResult r = twist_run(sc, q0, s, s.method == Method::RK4 && !s.engine ? 200 : 1e-8, 1e-9,
+                                              full ? 20'000'000 : 3'000'000);
+                std::string cls, text;
+                const bool detected = !r.ok && (r.failure.find("stick") != std::string::npos ||
+                                                r.failure.find("contact") != std::string::npos);
+                if (r.ok && !ref.ok) {
+                    cls = "#fcc";
+                    text = "wrong: returned a twist; the model fails here (" + ref.failure + ")";
+                } else if (r.ok) {
+                    const double e = twist_error(sc, r.value, ref.value);
+                    cls = e <= 1e-5 ? "#cfc" : "#fcc";
+                    text = (e <= 1e-5 ? "ok " : "wrong average ") + fmt(e, 2);
+                } else if (detected) {
+                    cls = "#ffc";
+                    text = "detected: " + r.failure;
+                } else {
+                    cls = "#ddd";
+                    text = r.failure;
+                }
+                c.html << "<td style=\"background:" << cls << "\">" << esc(text) << "<br><small>" << r.rhs_evals
+                       << " evals</small></td>";
+            }
+            c.html << "</tr>\n";
+        }
+        c.html << "</table>\n";
+        std::fprintf(stderr, "bench: failure map '%s' done\n", sw.name.c_str());
+    }
+}
+
+void hierarchy(Ctx& c, const fs::path& src, bool full) {
+    c.html << "<p>The question: where is the part after a few seconds, from rest at q0? Each rung answers it; its "
+              "error is against the scene's own part under full dynamics (final configuration, relative to rho and in "
+              "radians). <code>plate simulate --model auto --tol E</code> picks the cheapest rung within E.</p>\n"
+              "<table><tr><th>scene</th><th>q0</th><th>duration</th><th>rung</th><th>error</th><th>seconds</th><th>picked at "
+              "tol 1e-2</th><th>at 1e-3</th></tr>\n";
+    struct Q { const char* scene; Vec3 q0; double dur; };
+    const std::vector<Q> qs{{"fig4", Vec3(0.04, -0.04, 1.0), full ? 20.0 : 5.0},
+                            {"fig5", Vec3(0.02, -0.01, 0.5), 2.0},
+                            {"fig3_random", Vec3(0.02, -0.01, 0.5), 2.0},
+                            {"fig1", Vec3(0.03, 0.02, 0.3), 2.0},
+                            {"fig1_point", Vec3(0.03, 0.02, 0), 2.0}};
+    for (const auto& q : qs) {
+        const Scene sc = load_scene((src / "scenes" / (std::string(q.scene) + ".json")).string());
+        const ModelChoice m2 = choose_model(sc, q.q0, q.dur, 1e-2);
+        ModelChoice m3 = m2;
+        m3.tol = 1e-3;
+        m3.picked = m2.rungs.back();
+        for (const auto& r : m2.rungs)
+            if (&r != &m2.rungs.back() && r.ok && r.error <= 1e-3 && r.seconds < m2.rungs.back().seconds) { m3.picked = r; break; }
+        bool first = true;
+        for (const auto& r : m2.rungs) {
+            c.html << "<tr><td>" << (first ? q.scene : "") << "</td><td>" << (first ? "(" + fmt(q.q0[0], 3) + ", " + fmt(q.q0[1], 3) + ", " + fmt(q.q0[2], 3) + ")" : "")
+                   << "</td><td>" << (first ? fmt(q.dur, 3) + " s" : "") << "</td><td>" << esc(r.name()) << "</td><td>"
+                   << (r.ok ? fmt(r.error, 3) : esc(r.note)) << "</td><td>" << fmt(r.seconds, 3) << "</td><td>"
+                   << (r.name() == m2.picked.name() ? "&#10003;" : "") << "</td><td>" << (r.name() == m3.picked.name() ? "&#10003;" : "")
+                   << "</td></tr>\n";
+            first = false;
+        }
+        std::fprintf(stderr, "bench: hierarchy %s done\n", q.scene);
+    }
+    c.html << "</table>\n";
+}
+
+}  // namespace
+
+void write_speed_study(const SpeedOptions& opt) {
+    if (opt.out.empty()) throw std::runtime_error("bench: no output folder");
+    Ctx c;
+    c.dir = opt.out;
+    fs::create_directories(c.dir / "data");
+    const fs::path src = opt.source_dir;
+    auto scene = [&](const char* n) { return load_scene((src / "scenes" / (std::string(n) + ".json")).string()); };
+    const Scene fig4 = scene("fig4"), fig6 = scene("fig6");
+    const auto t0 = std::chrono::steady_clock::now();
+    c.html << "<h2>Speed and accuracy</h2>\n<p>Written by <code>plate bench" << (opt.full ? " --full" : "")
+           << "</code> on " << esc(machine_description()) << ". Errors are relative: twists to v_ref (angular rates "
+           << "times rho), configurations to rho and radians. Each chart has one line per solver: the engine (the "
+              "project's default: Dormand-Prince 5(4) with located contact events), every general method with exact "
+              "Coulomb friction, and regularised friction (tanh, linear; width relative to v_ref).</p>\n";
+    c.timed("work-precision (a)", [&] {
+        c.html << "<h3>(a) fig4: asymptotic twist at (0.02, -0.01, 0.5)</h3>\n";
+        twist_chart(c, fig4, Vec3(0.02, -0.01, 0.5), "wp_twist", "(a) fig4: asymptotic twist at (0.02, -0.01, 0.5)", opt.full);
+    });
+    c.timed("work-precision (b)", [&] { trajectory_chart(c, fig4, opt.full); });
+    c.timed("work-precision (c)", [&] {
+        // The configuration nearest the centre (along +x, theta = 0) whose cycle slides: fig6 sticks inside.
+        Solver eng;
+        eng.engine = true;
+        Vec3 q(0, 0, 0);
+        for (double x = 0.02; x <= 0.06; x += 0.0025) {
+            q = Vec3(x, 0, 0);
+            if (twist_run(fig6, q, eng, 1e-10, 1e-10).ok) break;
+        }
+        c.html << "<h3>(c) fig6: near sticking at (" << fmt(q[0], 4) << ", 0, 0)</h3>\n<p>The first configuration outward "
+               << "from the plate centre (steps of 2.5 mm along x) whose limit cycle slides throughout: closer in, a "
+               << "contact sticks.</p>\n";
+        twist_chart(c, fig6, q, "wp_stick", "(c) fig6: near-sticking twist", opt.full);
+    });
+    c.timed("limit-cycle solvers", [&] {
+        c.html << "<h3>Limit-cycle solvers on fig4's field</h3>\n";
+        cycle_solvers(c, fig4, opt.full);
+    });
+    c.timed("failure map", [&] {
+        c.html << "<h3>Failure map</h3>\n";
+        failure_map(c, fig4, opt.full);
+    });
+    c.timed("model hierarchy", [&] {
+        c.html << "<h3>Model no more than a scene needs</h3>\n";
+        hierarchy(c, src, opt.full);
+    });
+    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    c.html << "<p>Study total " << fmt(total, 4) << " s:";
+    for (const auto& [w, s] : c.timings) c.html << " " << esc(w) << " " << fmt(s, 3) << " s;";
+    c.html << "</p>\n";
+
+    // The section, kept for `plate report`, and spliced into an existing report page.
+    const fs::path section = c.dir / "data" / "speed_section.html";
+    const std::string body = c.html.str();
+    write_file_atomic(section.string(), [&](std::ostream& o) { o << body; });
+    const fs::path index = c.dir / "index.html";
+    std::string page;
+    if (fs::exists(index)) {
+        std::ifstream in(index);
+        page.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    const auto b = page.find(kSpeedBegin), e = page.find(kSpeedEnd);
+    if (b != std::string::npos && e != std::string::npos && e > b) {
+        page = page.substr(0, b + std::string(kSpeedBegin).size()) + c.html.str() + page.substr(e);
+    } else {
+        page = std::string("<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: speed and accuracy</title>\n") +
+               kStyle + "</head><body>\n" + kSpeedBegin + c.html.str() + kSpeedEnd + "\n" + kImageCheck + "</body></html>\n";
+    }
+    write_file_atomic(index.string(), [&](std::ostream& o) { o << page; });
+}
+
+}  // namespace plate::report
