@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -28,8 +29,8 @@ const std::vector<MethodInfo>& all_methods() {
         {Method::Rosenbrock4, "odeint-rosenbrock4", 4, true, true},
         {Method::GslRkf45, "gsl-rkf45", 5, true, false},
         {Method::GslRk8pd, "gsl-rk8pd", 8, true, false},
-        {Method::GslMsadams, "gsl-msadams", 12, true, false},
-        {Method::GslMsbdf, "gsl-msbdf", 5, true, true},
+        {Method::GslMsadams, "gsl-msadams", 0, true, false},
+        {Method::GslMsbdf, "gsl-msbdf", 0, true, true},
         {Method::GslBsimp, "gsl-bsimp", 0, true, true},
     };
     return m;
@@ -113,6 +114,21 @@ bool adaptive_loop(TryStep&& try_step, const Counted& c, double t0, double t1, V
     return true;
 }
 
+// n equal steps of the method's own formula (no error control).
+template <class Step>
+bool fixed_loop(Step&& step, double t0, double t1, Vec& y, const MethodOptions& opt, MethodRun& run, const Counted& c) {
+    if (!(opt.h > 0)) throw std::invalid_argument("fixed steps need h > 0");
+    const long n = std::max(1L, static_cast<long>(std::ceil((t1 - t0) / opt.h - 1e-9)));
+    const double h = (t1 - t0) / n;
+    for (long k = 0; k < n; ++k) {
+        if (c.over_budget()) return fail(run, at("evaluation budget exhausted", t0 + k * h));
+        step(y, t0 + k * h, h);
+        ++run.steps;
+        if (!finite(y.data(), static_cast<int>(y.size()))) return fail(run, at("non-finite state", t0 + (k + 1) * h));
+    }
+    return true;
+}
+
 bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const MethodOptions& opt,
                 MethodRun& run) {
     const Counted c{sys, run, opt.max_evals};
@@ -121,6 +137,25 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
         c.f(t, x.data(), dx.data());
     };
     const double tol = opt.tol;
+    if (opt.fixed && m != Method::RK4) {
+        switch (m) {
+            case Method::Dopri5:
+            case Method::Dopri5Dense: {
+                odeint::runge_kutta_dopri5<Vec> st;
+                return fixed_loop([&](Vec& x, double t, double h) { st.do_step(rhs, x, t, h); }, t0, t1, y, opt, run, c);
+            }
+            case Method::CashKarp54: {
+                odeint::runge_kutta_cash_karp54<Vec> st;
+                return fixed_loop([&](Vec& x, double t, double h) { st.do_step(rhs, x, t, h); }, t0, t1, y, opt, run, c);
+            }
+            case Method::Fehlberg78: {
+                odeint::runge_kutta_fehlberg78<Vec> st;
+                return fixed_loop([&](Vec& x, double t, double h) { st.do_step(rhs, x, t, h); }, t0, t1, y, opt, run, c);
+            }
+            default: break;   // Rosenbrock below; variable-order methods have no fixed step
+        }
+        if (m != Method::Rosenbrock4) throw std::invalid_argument(std::string(method_info(m).name) + " has no fixed-step form");
+    }
     switch (m) {
         case Method::RK4: {
             if (!(opt.h > 0)) throw std::invalid_argument("odeint-rk4: a fixed step h > 0 is required");
@@ -190,6 +225,16 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
             odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> st(tol, tol);
             UVec x(n);
             for (int i = 0; i < n; ++i) x[i] = y[i];
+            if (opt.fixed) {
+                odeint::rosenbrock4<double> rb;
+                UVec err(n);
+                return fixed_loop(
+                    [&](Vec& yy, double t, double h) {
+                        rb.do_step(std::make_pair(f, jac), x, t, h, err);
+                        for (int i = 0; i < n; ++i) yy[i] = x[i];
+                    },
+                    t0, t1, y, opt, run, c);
+            }
             const bool ok = adaptive_loop(
                 [&](Vec&, double& t, double& h) {
                     const bool acc = st.try_step(std::make_pair(f, jac), x, t, h) == odeint::success;
@@ -240,6 +285,19 @@ bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const
     GslParams p{&c, &sys, &run};
     gsl_odeiv2_system s{gsl_f, sys.jac ? gsl_jac : nullptr, static_cast<size_t>(sys.n), &p};
     double t = t0, h = opt.h > 0 ? opt.h : (t1 - t0) / 1000;
+    if (opt.fixed) {
+        if (method_info(m).order == 0) throw std::invalid_argument(std::string(method_info(m).name) + " has no fixed-step form");
+        gsl_odeiv2_step* st = gsl_odeiv2_step_alloc(type, sys.n);
+        std::vector<double> err(sys.n);
+        const bool ok = fixed_loop(
+            [&](Vec& x, double tt, double hh) {
+                const int status = gsl_odeiv2_step_apply(st, tt, hh, x.data(), err.data(), nullptr, nullptr, &s);
+                if (status != GSL_SUCCESS) x[0] = std::numeric_limits<double>::quiet_NaN();
+            },
+            t0, t1, y, opt, run, c);
+        gsl_odeiv2_step_free(st);
+        return ok;
+    }
     // The multistep steppers (msadams, msbdf) need their driver object: allocate through it.
     gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&s, type, h, opt.tol, opt.tol);
     if (!d) return fail(run, "GSL could not allocate the driver");

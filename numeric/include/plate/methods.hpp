@@ -32,7 +32,8 @@ enum class Method {
 struct MethodInfo {
     Method method;
     const char* name;     // e.g. "odeint-dopri5"
-    int order;            // convergence order on smooth problems (variable-order: the highest used)
+    int order;            // convergence order of one fixed step on smooth problems; 0: variable order
+                          // (extrapolation, multistep), no fixed-step form
     bool adaptive;
     bool needs_jacobian;
 };
@@ -55,6 +56,8 @@ struct MethodOptions {
     double h_min = 0;           // adaptive: a step below this is a failure (0: 1e-14 (t1 - t0))
     long max_steps = 5'000'000;
     long max_evals = 50'000'000;   // right-hand sides, then a failure (never hangs)
+    bool fixed = false;         // steps of exactly h with the method's own formula, no error control
+                                // (for convergence-order tests; only methods with order > 0)
 };
 
 struct MethodRun {
