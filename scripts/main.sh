@@ -17,5 +17,7 @@ for scene in scenes/*.json; do
 done
 echo "== verification report (derivation, Theorem 1 on 10^4 thin and 10^3 thick parts, fields; several minutes)" >&2
 build/plate report --out "$out/report"
+echo "== speed-accuracy study (methods, limit-cycle solvers, failure maps, model hierarchy; a few minutes)" >&2
+build/plate bench --out "$out/report"
 if command -v chromium >/dev/null; then scripts/check-report.sh "$out/report"; fi
 echo "results in $out/ (open $out/report/index.html)" >&2

@@ -91,7 +91,7 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    for (const char* c : {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene "}) {
+    for (const char* c : {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench "}) {
         const Run r = run(std::string(c) + "--help");
         CHECK(r.code == 0);
         CHECK(r.out.find("usage") != std::string::npos);
@@ -147,6 +147,9 @@ TEST_CASE("bad arguments: exit code 2 with the option named", "[cli][input]") {
         {"simulate " + f4 + " --dynamics u --from 0 0 0 --time -1", "--time"},
         {"twist /nonexistent.json --at 0 0 0", "/nonexistent.json: cannot open"},
         {"frobnicate", "unknown command"},
+        {"twist " + f4 + " --at 0 0 0 --cycle-solver secant", "--cycle-solver: unknown cycle solver 'secant'"},
+        {"bench", "missing --out"},
+        {"simulate " + f4 + " --dynamics auto --from 0 0 0 --time 1 --model-tol -1", "--model-tol"},
     };
     for (const auto& [args, expect] : cases) {
         const Run r = run(args);
@@ -166,6 +169,17 @@ TEST_CASE("a simulation that leaves the model stops with exit code 3 and says wh
     CHECK(r.code == 3);
     CHECK(r.err.find("lost") != std::string::npos);
     CHECK(fs::exists(out));   // the trajectory up to the loss of contact
+}
+
+TEST_CASE("plate simulate --dynamics auto states its choice and every rung's error", "[cli][hierarchy]") {
+    const fs::path out = tmpdir() / "auto.csv";
+    const Run r = run("simulate " + kScenes + "fig4.json --dynamics auto --model-tol 0.05 --from 0.04 -0.04 1.0 --time 0.5 --out " +
+                      out.string());
+    INFO(r.err);
+    CHECK(r.code == 0);
+    CHECK(r.err.find("auto model (tolerance 0.05): picked") != std::string::npos);
+    CHECK(r.err.find("thin / u: error") != std::string::npos);
+    CHECK(fs::exists(out));
 }
 
 TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]") {
