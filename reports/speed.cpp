@@ -83,14 +83,16 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
            << "plot ";
         for (std::size_t i = 0; i < lines.size(); ++i) {
             const std::string base = "data/" + id + "_" + slug(lines[i].solver.label());
+            // gnuplot cycles 8 colours: the dash pattern tells lines of one colour apart.
             gp << (i ? ", " : "") << "'" << base << ".dat' u " << xcol << ":" << ycol << " w lp lw "
-               << (lines[i].solver.engine ? 3 : 1) << " pt " << (i % 12 + 1) << " title '" << lines[i].solver.label() << "'";
+               << (lines[i].solver.engine ? 3 : 1) << " lt " << (i % 8 + 1) << " dt " << (i / 8 + 1) << " pt "
+               << (i % 12 + 1) << " title '" << lines[i].solver.label() << "'";
             gp << ", '" << base << "_failed.dat' u " << xcol << ":" << ycol << " w p pt 2 ps 1.5 lc rgb 'red' notitle";
         }
         gp << "\n";
         c.plot(name, gp.str(), cap, "900,520");
     };
-    const std::string ey = path_errors ? "final-configuration error" : "twist error (relative to v_ref)";
+    const std::string ey = path_errors ? "final-configuration error" : "twist error (relative to v_{ref})";
     chart(id + "_time", 1, 3, "wall time [s]", ey, esc(title) + ": error against wall time. Red crosses at the top: failed runs.");
     chart(id + "_evals", 2, 3, "right-hand-side evaluations", ey, esc(title) + ": error against right-hand-side evaluations.");
     if (path_errors)
