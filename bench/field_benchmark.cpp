@@ -5,6 +5,7 @@
 #include "plate/field.hpp"
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
+#include "plate/study.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -15,21 +16,6 @@
 
 using namespace plate;
 
-namespace {
-
-
-double max_error(const Scene& sc, const Field& f, const Field& ref) {
-    double e = 0;
-    const double v = sc.v_ref(), w = v / sc.part.rho();
-    for (std::size_t i = 0; i < f.points.size(); ++i) {
-        if (!f.points[i].converged || !ref.points[i].converged) continue;
-        const Vec3 d = f.points[i].twist - ref.points[i].twist;
-        e = std::max({e, std::abs(d[0]) / v, std::abs(d[1]) / v, std::abs(d[2]) / w});
-    }
-    return e;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
     const std::string path = argc > 1 ? argv[1] : PLATE_SOURCE_DIR "/scenes/fig4.json";
@@ -74,7 +60,7 @@ int main(int argc, char** argv) {
                     "max error %.2g\n",
                     f.grid.nx, f.grid.ny, f.grid.nth, f.threads, f.seconds, f.rhs_evals,
                     1e9 * f.seconds * f.threads / f.rhs_evals, periods / f.points.size(), converged,
-                    f.points.size(), max_error(sc, f, ref));
+                    f.points.size(), field_max_error(sc, f, ref));
     }
     std::printf("reference field (rtol 1e-12, tol 1e-11): %.3f s, %ld rhs evaluations\n", ref.seconds, ref.rhs_evals);
     return 0;

@@ -46,10 +46,10 @@ RunResult timed_run(F&& f) {
 }
 
 // Cheapest run of a line with error <= kTarget: (seconds, evals); +inf if none.
-std::pair<double, double> cost_at_target(const Line& l, bool use_max = false) {
+std::pair<double, double> cost_at_target(const Line& l) {
     double s = std::numeric_limits<double>::infinity(), e = s;
     for (const auto& r : l.runs) {
-        if (!r.ok || (use_max ? r.error_max : r.error) > kTarget) continue;
+        if (!r.ok || r.error > kTarget) continue;
         s = std::min(s, r.seconds);
         e = std::min(e, static_cast<double>(r.rhs_evals));
     }
@@ -103,8 +103,7 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
     std::string fastest_name;
     double engine_s = fastest;
     for (const auto& l : lines) {
-        const auto [s, e] = cost_at_target(l);
-        (void)e;
+        const double s = cost_at_target(l).first;
         if (s < fastest) { fastest = s; fastest_name = l.solver.label(); }
         if (l.solver.engine) engine_s = s;
     }
@@ -216,18 +215,6 @@ void trajectory_chart(Ctx& c, const Scene& sc, bool full) {
     work_precision(c, "wp_traj", "(b) fig4: 20 s of full dynamics from rest", lines, true);
 }
 
-double field_error(const Scene& sc, const Field& f, const Field& ref, int* missing) {
-    double e = 0;
-    *missing = 0;
-    for (std::size_t i = 0; i < f.points.size(); ++i) {
-        if (!ref.points[i].converged) continue;
-        if (!f.points[i].converged) { ++*missing; continue; }
-        const Vec3 d = f.points[i].twist, r = ref.points[i].twist;
-        e = std::max(e, twist_error(sc, {d[0], d[1], d[2]}, {r[0], r[1], r[2]}));
-    }
-    return e;
-}
-
 // Limit-cycle solvers on fig4's 343-configuration field, and the ratio against period-by-period RK4.
 void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     FieldOptions ro;
@@ -258,7 +245,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
             fo.cycle.tol = 10 * rt;
             const Field f = compute_field(sc, GridSpec{}, fo);
             int missing = 0;
-            const double e = field_error(sc, f, ref, &missing);
+            const double e = field_max_error(sc, f, ref, &missing);
             double periods = 0;
             for (const auto& p : f.points) periods += p.periods;
             o << f.seconds << " " << f.rhs_evals << " " << std::max(e, 1e-16) << "\n";
@@ -424,17 +411,13 @@ void hierarchy(Ctx& c, const fs::path& src, bool full) {
     for (const auto& q : qs) {
         const Scene sc = load_scene((src / "scenes" / (std::string(q.scene) + ".json")).string());
         const ModelChoice m2 = choose_model(sc, q.q0, q.dur, 1e-2);
-        ModelChoice m3 = m2;
-        m3.tol = 1e-3;
-        m3.picked = m2.rungs.back();
-        for (const auto& r : m2.rungs)
-            if (&r != &m2.rungs.back() && r.ok && r.error <= 1e-3 && r.seconds < m2.rungs.back().seconds) { m3.picked = r; break; }
+        const Rung& picked3 = m2.pick(1e-3);
         bool first = true;
         for (const auto& r : m2.rungs) {
             c.html << "<tr><td>" << (first ? q.scene : "") << "</td><td>" << (first ? "(" + fmt(q.q0[0], 3) + ", " + fmt(q.q0[1], 3) + ", " + fmt(q.q0[2], 3) + ")" : "")
                    << "</td><td>" << (first ? fmt(q.dur, 3) + " s" : "") << "</td><td>" << esc(r.name()) << "</td><td>"
                    << (r.ok ? fmt(r.error, 3) : esc(r.note)) << "</td><td>" << fmt(r.seconds, 3) << "</td><td>"
-                   << (r.name() == m2.picked.name() ? "&#10003;" : "") << "</td><td>" << (r.name() == m3.picked.name() ? "&#10003;" : "")
+                   << (&r == &m2.pick(1e-2) ? "&#10003;" : "") << "</td><td>" << (&r == &picked3 ? "&#10003;" : "")
                    << "</td></tr>\n";
             first = false;
         }

@@ -52,6 +52,13 @@ std::string ModelChoice::explain() const {
     return o.str();
 }
 
+const Rung& ModelChoice::pick(double t) const {
+    const Rung& ref = rungs.back();
+    for (const auto& r : rungs)
+        if (&r != &ref && r.ok && r.error <= t && r.seconds < ref.seconds) return r;
+    return ref;
+}
+
 namespace {
 
 // Where the part is after `duration`, by one rung.
@@ -107,14 +114,8 @@ ModelChoice choose_model(const Scene& sc, const Vec3& q0, double duration, doubl
     }
     std::sort(mc.rungs.begin(), mc.rungs.end(), [](const Rung& a, const Rung& b) { return a.seconds < b.seconds; });
     mc.rungs.push_back(ref);
-    mc.picked = ref;
-    for (const auto& r : mc.rungs) {
-        if (&r != &mc.rungs.back() && r.ok && r.error <= tol && r.seconds < ref.seconds) {
-            mc.picked = r;
-            mc.any_simplification = true;
-            break;
-        }
-    }
+    mc.picked = mc.pick(tol);
+    mc.any_simplification = &mc.pick(tol) != &mc.rungs.back();
     return mc;
 }
 

@@ -178,10 +178,7 @@ PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const In
                min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
            });
     r.stop = e.stop;
-    total.rhs_evals += e.stats.rhs_evals;
-    total.steps += e.stats.steps;
-    total.rejected += e.stats.rejected;
-    total.slip_reversals += e.stats.slip_reversals;
+    total += e.stats;
     if (r.ok) {
         const auto y = e.y();
         r.end = model.qd(y);
@@ -320,9 +317,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
         plain.solver = CycleSolver::PeriodByPeriod;
         plain.max_periods = opt.max_periods - fast.periods;
         LimitCycleSummary out = limit_cycle(sc, q0, plain, qd0);
-        out.stats.rhs_evals += fast.stats.rhs_evals;
-        out.stats.steps += fast.stats.steps;
-        out.stats.rejected += fast.stats.rejected;
+        out.stats += fast.stats;
         out.periods += fast.periods;
         return out;
     }
@@ -334,10 +329,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     for (int r = 0; r < std::min(opt.restarts, 3) && out.sticking(); ++r) {
         stops.push_back(out.stop);
         out = one_start(sc, q0, opt, r == 2 && sc.part.point ? Vec3(-v, -v, 0) : kicks[r]);
-        total.rhs_evals += out.stats.rhs_evals;
-        total.steps += out.stats.steps;
-        total.rejected += out.stats.rejected;
-        total.slip_reversals += out.stats.slip_reversals;
+        total += out.stats;
         out.restarts = r + 1;
     }
     out.stats = total;
@@ -347,14 +339,11 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
 
 bool period_map(const Scene& sc, const Vec3& q0, const Vec3& qd0, Vec3& out, const IntegrationOptions& opt,
                 StopEvent* stop) {
-    detail::ReducedModel model(sc, q0);
-    detail::Engine<detail::ReducedModel> e(model, sc, opt);
-    const Vec3 qd = sc.part.point ? Vec3(qd0[0], qd0[1], 0) : qd0;
-    bool ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) &&
-              e.advance(sc.plate.T, [](double, const auto&, const Vec3&) {});
-    if (stop) *stop = e.stop;
-    if (ok) out = model.qd(e.y());
-    return ok;
+    Stats ignored;
+    const PeriodResult r = one_period(sc, q0, qd0, opt, ignored);
+    if (stop) *stop = r.stop;
+    if (r.ok) out = r.end;
+    return r.ok;
 }
 
 }  // namespace plate

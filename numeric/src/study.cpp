@@ -2,6 +2,8 @@
 
 #include "models.hpp"
 
+#include "plate/field.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -285,6 +287,19 @@ double twist_error(const Scene& sc, const std::vector<double>& a, const std::vec
     if (a.size() != 3 || b.size() != 3) return std::numeric_limits<double>::infinity();
     const double v = sc.v_ref(), w = v / sc.part.rho();
     return std::max({std::abs(a[0] - b[0]) / v, std::abs(a[1] - b[1]) / v, std::abs(a[2] - b[2]) / w});
+}
+
+double field_max_error(const Scene& sc, const Field& f, const Field& ref, int* missing) {
+    double e = 0;
+    int miss = 0;
+    for (std::size_t i = 0; i < f.points.size(); ++i) {
+        if (!ref.points[i].converged) continue;
+        if (!f.points[i].converged) { ++miss; continue; }
+        const Vec3 d = f.points[i].twist, r = ref.points[i].twist;
+        e = std::max(e, twist_error(sc, {d[0], d[1], d[2]}, {r[0], r[1], r[2]}));
+    }
+    if (missing) *missing = miss;
+    return e;
 }
 
 void path_error(const Scene& sc, const std::vector<double>& a, const std::vector<double>& b, double& final_error,

@@ -41,6 +41,9 @@ struct ModelChoice {
     bool any_simplification = false;
     std::vector<Rung> rungs;   // all, cheapest first; the last is the reference (error 0)
     std::string explain() const;
+    // The cheapest rung cheaper than the reference whose measured error is <= tol (the reference if
+    // none): the choice choose_model made at its own tolerance, and the one it would make at another.
+    const Rung& pick(double tol) const;
 };
 
 // Rungs are ordered by cost: the dynamics ladder first (reduced U, U, full), the part ladder

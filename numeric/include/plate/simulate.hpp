@@ -42,6 +42,14 @@ struct Stats {
     long rejected = 0;
     long slip_reversals = 0;
     double min_normal_force = 0;   // smallest N_i seen at accepted steps [N]
+    // Adds the counts of another run (restarts, fallbacks); min_normal_force is left as it is.
+    Stats& operator+=(const Stats& o) {
+        rhs_evals += o.rhs_evals;
+        steps += o.steps;
+        rejected += o.rejected;
+        slip_reversals += o.slip_reversals;
+        return *this;
+    }
 };
 
 struct Sample {

@@ -53,6 +53,10 @@ RunResult trajectory_run(const Scene& scene, const Vec3& q0, double duration, do
 
 // Errors: twists relative to (v_ref, v_ref, v_ref / rho); configurations relative to (rho, rho, 1 rad).
 double twist_error(const Scene& scene, const std::vector<double>& a, const std::vector<double>& b);
+// Largest twist error of a field against a reference field on the same grid, over the points where
+// the reference converged; `missing` (if given) counts those where `f` did not.
+struct Field;
+double field_max_error(const Scene& scene, const Field& f, const Field& ref, int* missing = nullptr);
 // Final-sample and largest-over-samples configuration error.
 void path_error(const Scene& scene, const std::vector<double>& a, const std::vector<double>& b, double& final_error,
                 double& max_error);
