@@ -400,7 +400,7 @@ void failure_map(Ctx& c, const Scene& base, bool full) {
 void hierarchy(Ctx& c, const fs::path& src, bool full) {
     c.html << "<p>The question: where is the part after a few seconds, from rest at q0? Each rung answers it; its "
               "error is against the scene's own part under full dynamics (final configuration, relative to rho and in "
-              "radians). <code>plate simulate --model auto --tol E</code> picks the cheapest rung within E.</p>\n"
+              "radians). <code>plate simulate --dynamics auto --model-tol E</code> picks the cheapest rung within E.</p>\n"
               "<table><tr><th>scene</th><th>q0</th><th>duration</th><th>rung</th><th>error</th><th>seconds</th><th>picked at "
               "tol 1e-2</th><th>at 1e-3</th></tr>\n";
     struct Q { const char* scene; Vec3 q0; double dur; };
