@@ -177,10 +177,25 @@ std::string Emitter::operator()(const ex& e) {
         out = temp(s);
     } else if (is_a<mul>(e)) {
         // Reciprocals are temporaries of their own (one division each, shared by every term that
-        // needs them), so a product is only multiplications.
-        std::string prod;
-        for (const ex& f : sorted_operands(e)) prod += (prod.empty() ? "" : " * ") + (*this)(f);
-        out = temp(prod);
+        // needs them), so a product is only multiplications. A product is built left to right (as
+        // C++ evaluates a * b * c) and every partial product is shared: a x u and a x v cost three
+        // multiplications, not four.
+        const std::vector<ex> fs = sorted_operands(e);
+        std::string acc = (*this)(fs[0]);
+        ex part = fs[0];
+        for (std::size_t j = 1; j < fs.size(); ++j) {
+            part = part * fs[j];
+            const std::string f = (*this)(fs[j]);
+            if (j + 1 == fs.size()) break;
+            const auto known = memo_.find(part);
+            if (known != memo_.end()) {
+                acc = known->second;
+            } else {
+                acc = temp(acc + " * " + f);
+                memo_[part] = acc;
+            }
+        }
+        out = temp(acc + " * " + (*this)(fs.back()));
     } else if (is_a<GiNaC::power>(e)) {
         if (!is_a<numeric>(e.op(1))) throw std::invalid_argument("codegen: symbolic exponent");
         out = emit_power(e.op(0), ex_to<numeric>(e.op(1)));
@@ -191,6 +206,64 @@ std::string Emitter::operator()(const ex& e) {
     }
     memo_[e] = out;
     return out;
+}
+
+bool Staging::is_fast(const ex& f) const {
+    const ex base = is_a<GiNaC::power>(f) ? f.op(0) : f;
+    if (!is_a<symbol>(base)) return false;
+    for (const ex& s : fast_)
+        if (base.is_equal(s)) return true;
+    return false;
+}
+
+ex Staging::operator()(const ex& e) {
+    // Collect the coefficient of each monomial in the fast symbols.
+    std::map<std::string, std::pair<ex, ex>> terms;   // canonical text of monomial -> (monomial, coefficient)
+    const ex x = e.expand();
+    auto take = [&](const ex& t) {
+        ex mono = 1, coef = 1;
+        if (is_a<mul>(t)) {
+            for (size_t i = 0; i < t.nops(); ++i) (is_fast(t.op(i)) ? mono : coef) *= t.op(i);
+        } else {
+            (is_fast(t) ? mono : coef) *= t;
+        }
+        auto& slot = terms[canonical_text(mono)];
+        slot.first = mono;
+        slot.second += coef;
+    };
+    if (is_a<add>(x)) {
+        for (size_t i = 0; i < x.nops(); ++i) take(x.op(i));
+    } else if (!x.is_zero()) {
+        take(x);
+    }
+    ex out = 0;
+    for (auto& [text, mc] : terms) {
+        const ex c = mc.second.expand();
+        if (c.is_zero()) continue;
+        if (is_a<numeric>(c)) {
+            out += c * mc.first;
+            continue;
+        }
+        const auto same = by_text_.find(canonical_text(c));
+        if (same != by_text_.end()) {
+            out += same->second * mc.first;
+            continue;
+        }
+        const auto opposite = by_text_.find(canonical_text((-c).expand()));
+        if (opposite != by_text_.end()) {
+            out -= opposite->second * mc.first;
+            continue;
+        }
+        const symbol s(array_ + std::to_string(slots_.size()));
+        slots_.push_back({s, c});
+        by_text_.emplace(canonical_text(c), s);
+        out += s * mc.first;
+    }
+    return out;
+}
+
+void Staging::add_inputs(std::map<std::string, std::string>& inputs) const {
+    for (std::size_t k = 0; k < slots_.size(); ++k) inputs[slots_[k].first.get_name()] = array_ + "[" + std::to_string(k) + "]";
 }
 
 void Emitter::assign(const std::string& target, const ex& e) {

@@ -39,6 +39,27 @@ private:
     int next_ = 0;
 };
 
+// Staged evaluation for a frozen configuration (reduced U-dynamics (35)). An expression that is a
+// polynomial in the `fast` symbols (those that change at every evaluation: unit slip directions,
+// plate acceleration, normal forces) is rewritten as a sum of slot * monomial; each slot is one
+// coefficient, an expression in the slow symbols only (part, configuration), computed once per
+// configuration by a kernel of its own. Equal coefficients (up to sign) share one slot.
+class Staging {
+public:
+    Staging(std::vector<GiNaC::ex> fast, std::string array) : fast_(std::move(fast)), array_(std::move(array)) {}
+    GiNaC::ex operator()(const GiNaC::ex& e);
+    const std::vector<std::pair<GiNaC::symbol, GiNaC::ex>>& slots() const { return slots_; }
+    // slot symbol names -> "array[k]", for an Emitter's inputs
+    void add_inputs(std::map<std::string, std::string>& inputs) const;
+
+private:
+    bool is_fast(const GiNaC::ex& factor) const;
+    std::vector<GiNaC::ex> fast_;
+    std::string array_;
+    std::vector<std::pair<GiNaC::symbol, GiNaC::ex>> slots_;
+    std::map<std::string, GiNaC::ex> by_text_;   // canonical text of a coefficient -> its slot symbol
+};
+
 std::string double_literal(const GiNaC::numeric& x);
 
 // GiNaC orders the terms of sums and products by hash values seeded with type-info addresses,

@@ -39,7 +39,7 @@ struct Kernel {
     std::string comment, signature;
     std::map<std::string, std::string> in;
     std::vector<std::pair<std::string, ex>> outputs;
-    std::vector<std::pair<realsymbol, ex>> bindings;   // computed first, in this order
+    std::vector<std::pair<ex, ex>> bindings;   // symbol, value;   // computed first, in this order
 };
 
 // Everything is emitted expanded: a sum of monomials is a canonical form, whereas GiNaC's
@@ -51,14 +51,14 @@ std::string emit(const Kernel& k) {
     for (const auto& [target, e] : k.outputs) outs.push_back(e.expand());
     std::vector<bool> used(k.bindings.size(), false);
     for (std::size_t i = k.bindings.size(); i-- > 0;) {
-        const realsymbol& s = k.bindings[i].first;
+        const ex& s = k.bindings[i].first;
         bool u = false;
         for (const ex& e : outs) u = u || e.has(s);
         for (std::size_t j = i + 1; j < k.bindings.size(); ++j) u = u || (used[j] && k.bindings[j].second.has(s));
         used[i] = u;
     }
     for (std::size_t i = 0; i < k.bindings.size(); ++i)
-        if (used[i]) em.bind(k.bindings[i].first.get_name(), k.bindings[i].second.expand());
+        if (used[i]) em.bind(ex_to<symbol>(k.bindings[i].first).get_name(), k.bindings[i].second.expand());
     for (std::size_t i = 0; i < outs.size(); ++i) em.assign(k.outputs[i].first, outs[i]);
     std::ostringstream o;
     // Outputs never alias inputs: say so, so that stores do not force inputs to be reloaded.
@@ -70,6 +70,39 @@ std::string emit(const Kernel& k) {
     for (std::size_t p = 0; (p = sig.find("double* ", p)) != std::string::npos; p += 19) sig.replace(p, 8, "double* __restrict ");
     o << k.comment << "inline void " << sig << " {\n" << em.code() << "}\n\n";
     return o.str();
+}
+
+// Binds the solution of the 3x3 system Mg n = r into k by cofactors: n = adj(M) r / det M, with
+// adj(M) = K^T shared by the three unknowns (Cramer's rule written out would repeat each 2x2 minor).
+// Mg's entries are numbers or symbols bound earlier in k. Binds k_ic, detM, idet = 1/detM, N_c;
+// returns detM.
+ex bind_cofactor_solve(Kernel& k, const matrix& Mg, const ex (&rg)[3], const Symbols& S) {
+    matrix K(3, 3);   // cofactors; the cyclic indices carry the sign
+    for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            const ex v = (Mg(i1, c1) * Mg(i2, c2) - Mg(i1, c2) * Mg(i2, c1)).expand();
+            if (is_a<numeric>(v)) {
+                K(i, c) = v;
+            } else {
+                const realsymbol kic("k" + std::to_string(i) + std::to_string(c));
+                k.bindings.push_back({kic, v});
+                K(i, c) = kic;
+            }
+        }
+    const realsymbol dsym("detM"), idet("idet");
+    ex det = 0;
+    for (int c = 0; c < 3; ++c) det += Mg(0, c) * K(0, c);
+    k.bindings.push_back({dsym, det});
+    k.bindings.push_back({idet, pow(dsym, -1)});
+    for (int c = 0; c < 3; ++c) {
+        const realsymbol nn("nn" + std::to_string(c));
+        ex e = 0;
+        for (int i = 0; i < 3; ++i) e += K(i, c) * rg[i];
+        k.bindings.push_back({nn, e});
+        k.bindings.push_back({S.N[c], idet * nn});
+    }
+    return dsym;
 }
 
 void write(const std::filesystem::path& p, const std::string& text) {
@@ -130,7 +163,7 @@ int main(int argc, char** argv) {
         {
             Kernel k{"// b of (31): [f_dagger (19); tau_dagger (30)] (full dynamics; R1 entries R_ij, omega1 = w),\n"
                      "// through the plate-frame vectors Om = R1^T w, al = R1^T w', ap = R1^T p'', ga = R1^T e_z.\n",
-                     "b_full(const KernelInput& in, double* b)", in, {}, d.plate_frame_placeholders};
+                     "b_full(const KernelInput& in, double* b)", in, {}, {d.plate_frame_placeholders.begin(), d.plate_frame_placeholders.end()}};
             for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.b_full_staged(r, 0)});
             kernels.push_back(k);
         }
@@ -138,7 +171,7 @@ int main(int argc, char** argv) {
             Kernel k{"// A z = b reduced to M n = r (3x3, row-major): rows 1, 2 of (31) give s'', row 6 gives theta'',\n"
                      "// eliminated from rows 3, 4, 5. Solve M n = r, then back_substitution.\n",
                      "thick_reduced(const KernelInput& in, const double* b, double* M, double* r)",
-                     with(in, "b", "b", 6), {}, d.A_placeholders};
+                     with(in, "b", "b", 6), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
             for (int i = 0; i < 3; ++i) {
                 for (int c = 0; c < 3; ++c) k.outputs.push_back({"M[" + std::to_string(3 * i + c) + "]", d.M_staged(i, c)});
                 k.outputs.push_back({"r[" + std::to_string(i) + "]", d.r_staged(i, 0)});
@@ -149,36 +182,36 @@ int main(int argc, char** argv) {
             Kernel k{"// q'' = (s_x'', s_y'', theta'') from the normal forces n and b (rows 1, 2, 6 of (31)).\n",
                      "back_substitution(const KernelInput& in, const double* b, const double* n, double* qdd)",
                      with(with(in, "b", "b", 6), "N", "n", 3), {}, {}};
-            k.bindings = d.A_placeholders;   // emit() keeps the ones used
+            k.bindings.assign(d.A_placeholders.begin(), d.A_placeholders.end());   // emit() keeps the ones used
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             kernels.push_back(k);
         }
         {
             // One kernel for a thick part: A's entries, the reduced 3x3 system, its solution by
-            // Cramer's rule (det returned, so the caller can fall back to a pivoted LU when the
+            // cofactors (det returned, so the caller can fall back to a pivoted LU when the
             // system is near singular), and the back substitution.
-            Kernel k{"// Thick part, all of A z = b: n by Cramer's rule on the reduced 3x3 system M n = r, then q''.\n"
+            Kernel k{"// Thick part, all of A z = b: n by cofactors of the reduced 3x3 system M n = r, then q''.\n"
                      "// det = det M (near zero only for near-collinear contacts).\n",
                      "thick_solve(const KernelInput& in, const double* b, double* n, double* qdd, double* det)",
-                     with(in, "b", "b", 6), {}, d.A_placeholders};
-            matrix Mg(3, 3), rg(3, 1);
+                     with(in, "b", "b", 6), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
+            matrix Mg(3, 3);
+            ex rg[3];
             for (int i = 0; i < 3; ++i) {
                 for (int c = 0; c < 3; ++c) {
-                    const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
-                    k.bindings.push_back({mij, d.M_staged(i, c)});
-                    Mg(i, c) = mij;
+                    const ex v = d.M_staged(i, c);
+                    if (is_a<numeric>(v)) {
+                        Mg(i, c) = v;
+                    } else {
+                        const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
+                        k.bindings.push_back({mij, v});
+                        Mg(i, c) = mij;
+                    }
                 }
                 const realsymbol ri("r" + std::to_string(i));
                 k.bindings.push_back({ri, d.r_staged(i, 0)});
-                rg(i, 0) = ri;
+                rg[i] = ri;
             }
-            const realsymbol dsym("detM");
-            k.bindings.push_back({dsym, Mg.determinant()});
-            for (int c = 0; c < 3; ++c) {
-                matrix Mc = Mg;
-                for (int i = 0; i < 3; ++i) Mc(i, c) = rg(i, 0);
-                k.bindings.push_back({S.N[c], Mc.determinant() / dsym});
-            }
+            const ex dsym = bind_cofactor_solve(k, Mg, rg, S);
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             k.outputs.push_back({"det[0]", dsym});
@@ -207,7 +240,7 @@ int main(int argc, char** argv) {
         {
             Kernel k{"// Thin part, any b: n = M38^-1 (b[3], b[4], b[2]) (38), then q''.\n",
                      "thin_solve(const KernelInput& in, const double* b, const double* Minv, double* n, double* qdd)",
-                     with(with(in, "b", "b", 6), "Minv", "Minv", 9), {}, d.A_placeholders};
+                     with(with(in, "b", "b", 6), "Minv", "Minv", 9), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
             const int rb[3] = {3, 4, 2};
             for (int c = 0; c < 3; ++c) {
                 ex e = 0;
@@ -217,6 +250,95 @@ int main(int argc, char** argv) {
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             kernels.push_back(k);
+        }
+        // Reduced U-dynamics (35): the configuration is frozen, so all that depends on it (and on
+        // the part) alone is computed once per configuration by a *_config kernel into the slots C,
+        // and an evaluation does only what changes: the unit slip directions u_i and the plate's
+        // acceleration (p'', w1'), both entering polynomially (Staging).
+        std::vector<std::string> constants;
+        {
+            const std::vector<ex> fast{S.ux[0], S.uy[0], S.ux[1], S.uy[1], S.ux[2], S.uy[2], S.pdd[0], S.pdd[1],
+                                           S.pdd[2], S.wd[0], S.wd[1], S.wd[2], S.N[0], S.N[1], S.N[2]};
+            exmap b_of;
+            for (int r = 0; r < 6; ++r) b_of[d.bsym[r]] = d.b_U(r, 0);
+            auto config_kernel = [&](const std::string& name, const std::string& what, const Staging& st,
+                                     const std::string& extra_sig, std::map<std::string, std::string> cin) {
+                Kernel k{"// " + what + ": the per-configuration slots C of " + name + " (" +
+                             std::to_string(st.slots().size()) + " values).\n",
+                         name + "_config(const KernelInput& in, " + extra_sig + "double* C)", std::move(cin), {}, {}};
+                for (std::size_t i = 0; i < st.slots().size(); ++i)
+                    k.outputs.push_back({"C[" + std::to_string(i) + "]", st.slots()[i].second});
+                constants.push_back("constexpr int " + name + "_slots = " + std::to_string(st.slots().size()) + ";");
+                return k;
+            };
+            {
+                // Thick part: the reduced 3x3 system M n = r of thick_reduced, solved through its
+                // cofactors (n = adj(M) r / det M), then the back substitution.
+                Staging st(fast, "C");
+                Kernel k{"// Thick part, reduced U-dynamics (35), one evaluation from the slots C of\n"
+                         "// reduced_U_thick_config: M n = r by cofactors, det = det M (near zero only for\n"
+                         "// near-collinear contacts: the caller then falls back to thick_reduced and a pivoted LU).\n",
+                         "reduced_U_thick(const KernelInput& in, const double* C, double* n, double* qdd, double* det)", in,
+                         {}, {}};
+                matrix Mg(3, 3);
+                ex rg[3];
+                for (int i = 0; i < 3; ++i) {
+                    for (int c = 0; c < 3; ++c) {
+                        const ex v = st(d.M_reduced(i, c));
+                        if (is_a<numeric>(v)) {
+                            Mg(i, c) = v;
+                        } else {
+                            const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
+                            k.bindings.push_back({mij, v});
+                            Mg(i, c) = mij;
+                        }
+                    }
+                    const realsymbol ri("r" + std::to_string(i));
+                    k.bindings.push_back({ri, st(d.r_reduced(i, 0).subs(b_of))});
+                    rg[i] = ri;
+                }
+                const ex dsym = bind_cofactor_solve(k, Mg, rg, S);
+                for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
+                for (int i = 0; i < 3; ++i)
+                    k.outputs.push_back({"qdd[" + std::to_string(i) + "]", st(d.back_substitution(i, 0).subs(b_of))});
+                k.outputs.push_back({"det[0]", dsym});
+                st.add_inputs(k.in);
+                kernels.push_back(config_kernel("reduced_U_thick", "Thick part, reduced U-dynamics", st, "", in));
+                kernels.push_back(k);
+            }
+            {
+                // Thin part: n = M38^-1 (b[3], b[4], b[2]) (38) is affine in the plate's acceleration
+                // alone; the slots hold its coefficients.
+                const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};
+                Staging st(fast, "C");
+                Kernel k{"// Thin part, reduced U-dynamics (35), one evaluation from the slots C of\n"
+                         "// reduced_U_thin_config: n (38) affine in the plate's acceleration, then q''.\n",
+                         "reduced_U_thin(const KernelInput& in, const double* C, double* n, double* qdd)", in, {}, {}};
+                const int rb[3] = {3, 4, 2};
+                for (int c = 0; c < 3; ++c) {
+                    ex e = 0;
+                    for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * d.b_U(rb[j], 0);
+                    k.bindings.push_back({S.N[c], st(e.subs(thin))});
+                    k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
+                }
+                for (int i = 0; i < 3; ++i)
+                    k.outputs.push_back(
+                        {"qdd[" + std::to_string(i) + "]", st(d.back_substitution(i, 0).subs(b_of).subs(thin))});
+                st.add_inputs(k.in);
+                kernels.push_back(config_kernel("reduced_U_thin", "Thin part, reduced U-dynamics", st,
+                                                "const double* Minv, ", with(in, "Minv", "Minv", 9)));
+                kernels.push_back(k);
+            }
+            {
+                Staging st(fast, "C");
+                Kernel k{"// Point part, reduced U-dynamics (35): (s_x'', s_y'', N) from the slots C of reduced_U_point_config.\n",
+                         "reduced_U_point(const KernelInput& in, const double* C, double* z)", in, {}, {}};
+                for (int i = 0; i < 3; ++i)
+                    k.outputs.push_back({"z[" + std::to_string(i) + "]", st(d.point_solution(i, 0).subs(b_of).subs(S.sz == 0))});
+                st.add_inputs(k.in);
+                kernels.push_back(config_kernel("reduced_U_point", "Point part, reduced U-dynamics", st, "", in));
+                kernels.push_back(k);
+            }
         }
         {
             // For implicit methods (Rosenbrock, BDF): A depends on the twist only through the unit slip
@@ -276,6 +398,8 @@ int main(int argc, char** argv) {
         h << "};\n\nstruct WrenchInput {\n";
         for (const char* f : kWrenchFields) h << "    double " << f << " = 0;\n";
         h << "};\n\n";
+        for (const auto& c : constants) h << c << "\n";
+        h << "\n";
         for (const auto& k : kernels) h << emit(k);
         h << "}  // namespace plate::gen\n";
         (void)S;

@@ -131,6 +131,7 @@ void Workspace::prepare(const Scene& sc) {
     in.mu1 = P.mu[0]; in.mu2 = P.mu[1]; in.mu3 = P.mu[2];
     in.R11 = in.R22 = in.R33 = 1;
     theta = std::numeric_limits<double>::quiet_NaN();
+    C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     thin = P.thin();
     if (thin) {
         double M[9];
@@ -144,13 +145,13 @@ void Workspace::prepare(const Scene& sc) {
     det_floor = 1e-9 * size * size;
 }
 
-void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                   Workspace& ws) {
-    const Part& P = sc.part;
-    ++ws.evals;
-    if (ws.prepared != &sc) ws.prepare(sc);
+namespace {
+
+// Configuration inputs of the kernels: s, and cos/sin theta with R2 c_i (cached: constant in the
+// reduced U-dynamics).
+inline void set_configuration(const Part& P, const Vec3& q, Workspace& ws) {
     gen::KernelInput& in = ws.in;
-    if (q[2] != ws.theta) {   // constant in the reduced U-dynamics: computed once
+    if (q[2] != ws.theta) {
         ws.theta = q[2];
         in.ct = std::cos(q[2]);
         in.st = std::sin(q[2]);
@@ -159,24 +160,94 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     }
     in.sx = q[0];
     in.sy = q[1];
+}
+
+// Sliding velocities v_i = s' + w2^ R2 c_i of the first nc contacts (into ws.slip) and their unit
+// directions u_i = f_i v_i (zero at zero slip; the regularised laws scale instead). The contacts
+// are independent: computed side by side, so their square roots and divisions overlap.
+inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, double* uy) {
+    const double w = nc == 1 ? 0.0 : qd[2];
+    double vx[3], vy[3], f[3];
+    for (int i = 0; i < nc; ++i) {
+        vx[i] = qd[0] - w * ws.r[i].y();
+        vy[i] = qd[1] + w * ws.r[i].x();
+    }
+    if (ws.law == FrictionLaw::Coulomb) {
+        for (int i = 0; i < nc; ++i) {
+            const double sp2 = vx[i] * vx[i] + vy[i] * vy[i];
+            f[i] = sp2 > 0 ? 1.0 / std::sqrt(sp2) : 0.0;
+        }
+    } else {
+        for (int i = 0; i < nc; ++i) f[i] = regularised_factor(ws.law, ws.law_eps, std::hypot(vx[i], vy[i]));
+    }
+    for (int i = 0; i < nc; ++i) {
+        ws.slip[i] = Vec2(vx[i], vy[i]);
+        ux[i] = vx[i] * f[i];
+        uy[i] = vy[i] * f[i];
+    }
+    for (int i = nc; i < 3; ++i) ws.slip[i].setZero();
+}
+
+// Reduced U-dynamics (35) on the staged kernels: the slots of the frozen configuration once, then
+// per evaluation only the slip directions and u(t). Returns false when a thick part's reduced
+// system is near singular (the caller then takes the direct path with its pivoted LU).
+bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
+    if (q[0] != ws.C_q[0] || q[1] != ws.C_q[1] || q[2] != ws.C_q[2]) {
+        set_configuration(P, q, ws);
+        ws.C_q = q;
+        if (P.point) gen::reduced_U_point_config(ws.in, ws.C.data());
+        else if (ws.thin) gen::reduced_U_thin_config(ws.in, ws.M38_inv_rowmajor.data(), ws.C.data());
+        else gen::reduced_U_thick_config(ws.in, ws.C.data());
+    }
+    // A local input: the staged kernels read only the slip directions and u(t), which then stay
+    // in registers.
+    gen::KernelInput k;
+    k.pddx = ps.pdd.x(); k.pddy = ps.pdd.y(); k.pddz = ps.pdd.z();
+    k.wdx = ps.wd.x(); k.wdy = ps.wd.y(); k.wdz = ps.wd.z();
+    double ux[3], uy[3];
+    if (P.point) {
+        slip_directions(1, qd, ws, ux, uy);
+        k.u1x = ux[0]; k.u1y = uy[0];
+        double z[3];
+        gen::reduced_U_point(k, ws.C.data(), z);
+        ws.qdd = Vec3(z[0], z[1], 0);
+        ws.n = Vec3(z[2], 0, 0);
+        return true;
+    }
+    slip_directions(3, qd, ws, ux, uy);
+    k.u1x = ux[0]; k.u1y = uy[0];
+    k.u2x = ux[1]; k.u2y = uy[1];
+    k.u3x = ux[2]; k.u3y = uy[2];
+    if (ws.thin) {
+        gen::reduced_U_thin(k, ws.C.data(), ws.n.data(), ws.qdd.data());
+        return true;
+    }
+    double det;
+    gen::reduced_U_thick(k, ws.C.data(), ws.n.data(), ws.qdd.data(), &det);
+    return std::abs(det) > ws.det_floor;
+}
+
+}  // namespace
+
+void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                   Workspace& ws) {
+    const Part& P = sc.part;
+    ++ws.evals;
+    if (ws.prepared != &sc) ws.prepare(sc);
+    if (level == Dynamics::ReducedU && accelerations_reduced_U(P, q, qd, ps, ws)) return;
+    gen::KernelInput& in = ws.in;
+    set_configuration(P, q, ws);
     in.sxd = qd[0];
     in.syd = qd[1];
-    // Sliding velocities s' + w2^ R2 c_i and their unit directions (zero at zero slip).
-    const double w = P.point ? 0.0 : qd[2];
-    in.thd = w;
-    auto slip = [&](int i, double& ux, double& uy) {
-        const double vx = qd[0] - w * ws.r[i].y(), vy = qd[1] + w * ws.r[i].x();
-        ws.slip[i] = Vec2(vx, vy);
-        const double sp2 = vx * vx + vy * vy;
-        double inv = sp2 > 0 ? 1.0 / std::sqrt(sp2) : 0.0;
-        if (ws.law != FrictionLaw::Coulomb) inv = regularised_factor(ws.law, ws.law_eps, std::sqrt(sp2));
-        ux = vx * inv;
-        uy = vy * inv;
-    };
-    slip(0, in.u1x, in.u1y);
-    if (!P.point) {
-        slip(1, in.u2x, in.u2y);
-        slip(2, in.u3x, in.u3y);
+    in.thd = P.point ? 0.0 : qd[2];
+    {
+        double ux[3], uy[3];
+        slip_directions(P.point ? 1 : 3, qd, ws, ux, uy);
+        in.u1x = ux[0]; in.u1y = uy[0];
+        if (!P.point) {
+            in.u2x = ux[1]; in.u2y = uy[1];
+            in.u3x = ux[2]; in.u3y = uy[2];
+        }
     }
     in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
     in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();
@@ -204,8 +275,6 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         gen::point_solve(in, b, z);
         ws.qdd = Vec3(z[0], z[1], 0);
         ws.n = Vec3(z[2], 0, 0);
-        ws.slip[1].setZero();
-        ws.slip[2].setZero();
         return;
     }
     double n[3], qdd[3];
@@ -215,7 +284,7 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         double det;
         gen::thick_solve(in, b, n, qdd, &det);
         if (!(std::abs(det) > ws.det_floor)) {
-            // Near-collinear contacts: Cramer's rule loses accuracy; use a pivoted LU instead.
+            // Near-collinear contacts: the cofactor solution loses accuracy; use a pivoted LU instead.
             double M[9], r[3];
             gen::thick_reduced(in, b, M, r);
             const Vec3 nn = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(
@@ -231,7 +300,9 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
 void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                     Workspace& ws, Mat3& Jq) {
     if (level == Dynamics::Full) throw std::invalid_argument("twist_jacobian: U- and reduced U-dynamics only");
-    accelerations(sc, level, q, qd, ps, ws);
+    // At one instant the U- and reduced U-dynamics coincide; the U path leaves every input of the
+    // factor kernels (slip directions included) in ws.in.
+    accelerations(sc, Dynamics::U, q, qd, ps, ws);
     const Part& P = sc.part;
     if (P.point) {
         // s'' = -(mu N u(v) + b_xy)/m with N = b_z independent of the twist.
