@@ -52,14 +52,24 @@ TEST_CASE("generated kernels equal the reference implementation on 10^4 random s
             const bool full = k % 2 == 1;
             const RandomState st = random_state(r, full);
             const Dynamics level = full ? Dynamics::Full : (k % 4 == 0 ? Dynamics::U : Dynamics::ReducedU);
-            accelerations(sc, level, st.q, st.qd, st.ps, gen);
-            accelerations_reference(sc, level, st.q, st.qd, st.ps, ref);
-            const double g = sc.g, w = g / sc.part.rho(), mg = sc.part.m * g;
-            const double e = std::max({std::abs(gen.qdd[0] - ref.qdd[0]) / g, std::abs(gen.qdd[1] - ref.qdd[1]) / g,
-                                       std::abs(gen.qdd[2] - ref.qdd[2]) / w, (gen.n - ref.n).cwiseAbs().maxCoeff() / mg});
-            worst = std::max(worst, e);
-            CHECK(e < 1e-12);
-            ++count[kind];
+            // Reduced U-dynamics: a second state at the same configuration runs on the slots
+            // computed for the first (the per-configuration cache).
+            for (int again = 0; again < (level == Dynamics::ReducedU ? 2 : 1); ++again) {
+                RandomState s2 = st;
+                if (again) {
+                    const RandomState o = random_state(r, false);
+                    s2.qd = o.qd;
+                    s2.ps = o.ps;
+                }
+                accelerations(sc, level, s2.q, s2.qd, s2.ps, gen);
+                accelerations_reference(sc, level, s2.q, s2.qd, s2.ps, ref);
+                const double g = sc.g, w = g / sc.part.rho(), mg = sc.part.m * g;
+                const double e = std::max({std::abs(gen.qdd[0] - ref.qdd[0]) / g, std::abs(gen.qdd[1] - ref.qdd[1]) / g,
+                                           std::abs(gen.qdd[2] - ref.qdd[2]) / w, (gen.n - ref.n).cwiseAbs().maxCoeff() / mg});
+                worst = std::max(worst, e);
+                CHECK(e < 1e-12);
+                ++count[kind];
+            }
         }
         CHECK(gen.thin == (kind == 1));
     }
@@ -157,6 +167,32 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
             CHECK(close(qdd2[i], zq, 1.0));
             CHECK(close(n2[i], zn, in.m * in.g));
         }
+        // The reduced U-dynamics' staged kernels: slots for the configuration, then one evaluation.
+        {
+            double C[gen::reduced_U_thick_slots], n3[3], q3[3], det3;
+            gen::reduced_U_thick_config(in, C);
+            gen::reduced_U_thick(in, C, n3, q3, &det3);
+            CHECK(close(det3, det, 1e-12));
+            for (int i = 0; i < 3; ++i) {
+                CHECK(close(q3[i], ex_to<numeric>(z(i, 0).evalf()).to_double(), 1.0));
+                CHECK(close(n3[i], ex_to<numeric>(z(3 + i, 0).evalf()).to_double(), in.m * in.g));
+            }
+        }
+        {
+            // Point part: the derived solution with b~ of a point (s_z = 0).
+            gen::KernelInput pin = in;
+            pin.sz = 0;
+            exmap psub = sub;
+            psub[S.sz] = 0;
+            exmap b_of;
+            for (int r = 0; r < 3; ++r) b_of[d.bsym[r]] = d.b_U(r, 0);
+            double C[gen::reduced_U_point_slots], zp[3];
+            gen::reduced_U_point_config(pin, C);
+            gen::reduced_U_point(pin, C, zp);
+            for (int i = 0; i < 3; ++i)
+                CHECK(close(zp[i], ex_to<numeric>(d.point_solution(i, 0).subs(b_of).subs(psub).evalf()).to_double(),
+                            i < 2 ? 1.0 : in.m * in.g));
+        }
 
         // The thin part's specialised kernel against GiNaC's solve of the thin system.
         gen::KernelInput tin = in;
@@ -176,9 +212,14 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
             bn(i, 0) = d.b_U(i, 0).subs(tsub).evalf();
         }
         const matrix zt = An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
+        double Ct[gen::reduced_U_thin_slots], nts[3], qts[3];
+        gen::reduced_U_thin_config(tin, Minv.data(), Ct);
+        gen::reduced_U_thin(tin, Ct, nts, qts);
         for (int i = 0; i < 3; ++i) {
             CHECK(close(qt[i], ex_to<numeric>(zt(i, 0).evalf()).to_double(), 1.0));
             CHECK(close(nt[i], ex_to<numeric>(zt(3 + i, 0).evalf()).to_double(), in.m * in.g));
+            CHECK(close(qts[i], ex_to<numeric>(zt(i, 0).evalf()).to_double(), 1.0));
+            CHECK(close(nts[i], ex_to<numeric>(zt(3 + i, 0).evalf()).to_double(), in.m * in.g));
         }
     }
 }
