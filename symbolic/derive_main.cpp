@@ -6,6 +6,7 @@
 #include "codegen.hpp"
 #include "derivation.hpp"
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -72,11 +73,27 @@ std::string emit(const Kernel& k) {
     return o.str();
 }
 
-// Binds the solution of the 3x3 system Mg n = r into k by cofactors: n = adj(M) r / det M, with
+// Binds the solution of the 3x3 system M n = r into k by cofactors: n = adj(M) r / det M, with
 // adj(M) = K^T shared by the three unknowns (Cramer's rule written out would repeat each 2x2 minor).
-// Mg's entries are numbers or symbols bound earlier in k. Binds k_ic, detM, idet = 1/detM, N_c;
+// Binds M's non-numeric entries m_ic and r_i, the cofactors k_ic, detM, idet = 1/detM and N_c;
 // returns detM.
-ex bind_cofactor_solve(Kernel& k, const matrix& Mg, const ex (&rg)[3], const Symbols& S) {
+ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, const Symbols& S) {
+    matrix Mg(3, 3);
+    ex rg[3];
+    for (int i = 0; i < 3; ++i) {
+        for (int c = 0; c < 3; ++c) {
+            if (is_a<numeric>(M(i, c))) {
+                Mg(i, c) = M(i, c);
+            } else {
+                const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
+                k.bindings.push_back({mij, M(i, c)});
+                Mg(i, c) = mij;
+            }
+        }
+        const realsymbol ri("r" + std::to_string(i));
+        k.bindings.push_back({ri, r[i]});
+        rg[i] = ri;
+    }
     matrix K(3, 3);   // cofactors; the cyclic indices carry the sign
     for (int i = 0; i < 3; ++i)
         for (int c = 0; c < 3; ++c) {
@@ -194,24 +211,7 @@ int main(int argc, char** argv) {
                      "// det = det M (near zero only for near-collinear contacts).\n",
                      "thick_solve(const KernelInput& in, const double* b, double* n, double* qdd, double* det)",
                      with(in, "b", "b", 6), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
-            matrix Mg(3, 3);
-            ex rg[3];
-            for (int i = 0; i < 3; ++i) {
-                for (int c = 0; c < 3; ++c) {
-                    const ex v = d.M_staged(i, c);
-                    if (is_a<numeric>(v)) {
-                        Mg(i, c) = v;
-                    } else {
-                        const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
-                        k.bindings.push_back({mij, v});
-                        Mg(i, c) = mij;
-                    }
-                }
-                const realsymbol ri("r" + std::to_string(i));
-                k.bindings.push_back({ri, d.r_staged(i, 0)});
-                rg[i] = ri;
-            }
-            const ex dsym = bind_cofactor_solve(k, Mg, rg, S);
+            const ex dsym = bind_cofactor_solve(k, d.M_staged, {d.r_staged(0, 0), d.r_staged(1, 0), d.r_staged(2, 0)}, S);
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             k.outputs.push_back({"det[0]", dsym});
@@ -280,24 +280,13 @@ int main(int argc, char** argv) {
                          "// near-collinear contacts: the caller then falls back to thick_reduced and a pivoted LU).\n",
                          "reduced_U_thick(const KernelInput& in, const double* C, double* n, double* qdd, double* det)", in,
                          {}, {}};
-                matrix Mg(3, 3);
-                ex rg[3];
+                matrix M(3, 3);
+                std::array<ex, 3> r;
                 for (int i = 0; i < 3; ++i) {
-                    for (int c = 0; c < 3; ++c) {
-                        const ex v = st(d.M_reduced(i, c));
-                        if (is_a<numeric>(v)) {
-                            Mg(i, c) = v;
-                        } else {
-                            const realsymbol mij("m" + std::to_string(i) + std::to_string(c));
-                            k.bindings.push_back({mij, v});
-                            Mg(i, c) = mij;
-                        }
-                    }
-                    const realsymbol ri("r" + std::to_string(i));
-                    k.bindings.push_back({ri, st(d.r_reduced(i, 0).subs(b_of))});
-                    rg[i] = ri;
+                    for (int c = 0; c < 3; ++c) M(i, c) = st(d.M_reduced(i, c));
+                    r[i] = st(d.r_reduced(i, 0).subs(b_of));
                 }
-                const ex dsym = bind_cofactor_solve(k, Mg, rg, S);
+                const ex dsym = bind_cofactor_solve(k, M, r, S);
                 for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
                 for (int i = 0; i < 3; ++i)
                     k.outputs.push_back({"qdd[" + std::to_string(i) + "]", st(d.back_substitution(i, 0).subs(b_of))});
