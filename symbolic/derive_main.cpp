@@ -40,7 +40,7 @@ struct Kernel {
     std::string comment, signature;
     std::map<std::string, std::string> in;
     std::vector<std::pair<std::string, ex>> outputs;
-    std::vector<std::pair<ex, ex>> bindings;   // symbol, value;   // computed first, in this order
+    std::vector<std::pair<ex, ex>> bindings;   // (symbol, value), computed first, in this order
 };
 
 // Everything is emitted expanded: a sum of monomials is a canonical form, whereas GiNaC's
@@ -71,6 +71,14 @@ std::string emit(const Kernel& k) {
     for (std::size_t p = 0; (p = sig.find("double* ", p)) != std::string::npos; p += 19) sig.replace(p, 8, "double* __restrict ");
     o << k.comment << "inline void " << sig << " {\n" << em.code() << "}\n\n";
     return o.str();
+}
+
+// (38): N_c = (M38^-1 (b[3], b[4], b[2]))_c, the constant inverse entering as symbols Minv0..8.
+ex thin_normal_force(int c, const matrix& b) {
+    const int rb[3] = {3, 4, 2};
+    ex e = 0;
+    for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * b(rb[j], 0);
+    return e;
 }
 
 // Binds the solution of the 3x3 system M n = r into k by cofactors: n = adj(M) r / det M, with
@@ -224,14 +232,11 @@ int main(int argc, char** argv) {
                      "// inverse Minv (row-major), then q''. Specialised to c_z = 0, J_xz = J_yz = 0.\n",
                      "thin_solve_U(const KernelInput& in, const double* Minv, double* b, double* n, double* qdd)",
                      with(in, "Minv", "Minv", 9), {}, {}};
-            const int rb[3] = {3, 4, 2};
+            matrix bs(6, 1);
+            for (int r = 0; r < 6; ++r) bs(r, 0) = d.bsym[r];
             for (int r = 0; r < 6; ++r) k.bindings.push_back({d.bsym[r], d.b_U(r, 0).subs(thin)});
             for (const auto& [a, e] : d.A_placeholders) k.bindings.push_back({a, e.subs(thin)});
-            for (int c = 0; c < 3; ++c) {
-                ex e = 0;
-                for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * d.bsym[rb[j]];
-                k.bindings.push_back({S.N[c], e});
-            }
+            for (int c = 0; c < 3; ++c) k.bindings.push_back({S.N[c], thin_normal_force(c, bs)});
             for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.bsym[r]});
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0).subs(thin)});
@@ -241,12 +246,9 @@ int main(int argc, char** argv) {
             Kernel k{"// Thin part, any b: n = M38^-1 (b[3], b[4], b[2]) (38), then q''.\n",
                      "thin_solve(const KernelInput& in, const double* b, const double* Minv, double* n, double* qdd)",
                      with(with(in, "b", "b", 6), "Minv", "Minv", 9), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
-            const int rb[3] = {3, 4, 2};
-            for (int c = 0; c < 3; ++c) {
-                ex e = 0;
-                for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * d.bsym[rb[j]];
-                k.bindings.push_back({S.N[c], e});
-            }
+            matrix bs(6, 1);
+            for (int r = 0; r < 6; ++r) bs(r, 0) = d.bsym[r];
+            for (int c = 0; c < 3; ++c) k.bindings.push_back({S.N[c], thin_normal_force(c, bs)});
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
             kernels.push_back(k);
@@ -303,11 +305,8 @@ int main(int argc, char** argv) {
                 Kernel k{"// Thin part, reduced U-dynamics (35), one evaluation from the slots C of\n"
                          "// reduced_U_thin_config: n (38) affine in the plate's acceleration, then q''.\n",
                          "reduced_U_thin(const KernelInput& in, const double* C, double* n, double* qdd)", in, {}, {}};
-                const int rb[3] = {3, 4, 2};
                 for (int c = 0; c < 3; ++c) {
-                    ex e = 0;
-                    for (int j = 0; j < 3; ++j) e += realsymbol("Minv" + std::to_string(3 * c + j)) * d.b_U(rb[j], 0);
-                    k.bindings.push_back({S.N[c], st(e.subs(thin))});
+                    k.bindings.push_back({S.N[c], st(thin_normal_force(c, d.b_U).subs(thin))});
                     k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
                 }
                 for (int i = 0; i < 3; ++i)

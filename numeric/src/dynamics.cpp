@@ -179,20 +179,18 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
     if (ws.law == FrictionLaw::Coulomb) {
         double sp[3];
         for (int i = 0; i < nc; ++i) sp[i] = vx[i] * vx[i] + vy[i] * vy[i];
+        int packed = 0;
+#if defined(__SSE2__)
         if (nc == 3) {
             // The square roots and divisions share one unit and dominate an evaluation: contacts
-            // 1 and 2 in packed instructions.
-#if defined(__SSE2__)
+            // 1 and 2 in packed instructions (a zero speed gives 1/0 = inf, masked to 0).
             const __m128d s01 = _mm_set_pd(sp[1], sp[0]);
             const __m128d pos = _mm_cmpgt_pd(s01, _mm_setzero_pd());
             _mm_storeu_pd(f, _mm_and_pd(pos, _mm_div_pd(_mm_set1_pd(1.0), _mm_sqrt_pd(s01))));
-#else
-            for (int i = 0; i < 2; ++i) f[i] = sp[i] > 0 ? 1.0 / std::sqrt(sp[i]) : 0.0;
-#endif
-            f[2] = sp[2] > 0 ? 1.0 / std::sqrt(sp[2]) : 0.0;
-        } else {
-            f[0] = sp[0] > 0 ? 1.0 / std::sqrt(sp[0]) : 0.0;
+            packed = 2;
         }
+#endif
+        for (int i = packed; i < nc; ++i) f[i] = sp[i] > 0 ? 1.0 / std::sqrt(sp[i]) : 0.0;
     } else {
         for (int i = 0; i < nc; ++i) f[i] = regularised_factor(ws.law, ws.law_eps, std::hypot(vx[i], vy[i]));
     }
