@@ -84,8 +84,10 @@ ex thin_normal_force(int c, const matrix& b) {
 // Binds the solution of the 3x3 system M n = r into k by cofactors: n = adj(M) r / det M, with
 // adj(M) = K^T shared by the three unknowns (Cramer's rule written out would repeat each 2x2 minor).
 // Binds M's non-numeric entries m_ic and r_i, the cofactors k_ic, detM, idet = 1/detM and N_c;
-// returns detM.
-ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, const Symbols& S) {
+// returns detM, and (if asked) M^-1 = idet K^T in the bound symbols, for solves with other
+// right-hand sides.
+ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, const Symbols& S,
+                       matrix* inverse = nullptr) {
     matrix Mg(3, 3);
     ex rg[3];
     for (int i = 0; i < 3; ++i) {
@@ -127,7 +129,45 @@ ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, c
         k.bindings.push_back({nn, e});
         k.bindings.push_back({S.N[c], idet * nn});
     }
+    if (inverse) {
+        *inverse = matrix(3, 3);
+        for (int c = 0; c < 3; ++c)
+            for (int i = 0; i < 3; ++i) (*inverse)(c, i) = idet * K(i, c);
+    }
     return dsym;
+}
+
+// d q''/d u for the reduced U-dynamics kernels: qdd[6 r + j] = d q''_r / d u_j, u = (u1x, u1y, u2x,
+// u2y, u3x, u3y) the unit slip directions, N held by the solve. With the normal forces from
+// M(u) N = r (r does not depend on u), dN/du_j = -M^-1 (dM/du_j) N; then
+// d q''_r/du_j = d back_r/du_j + sum_k d back_r/dN_k dN_k/du_j. For a thin or point part N does not
+// depend on u (minv empty), and only the first term remains.
+void bind_slip_jacobian(Kernel& k, const std::array<ex, 3>& back, const matrix* M, const matrix* minv,
+                        const Symbols& S, int contacts) {
+    for (int j = 0; j < 2 * contacts; ++j) {
+        const ex u = j % 2 == 0 ? S.ux[j / 2] : S.uy[j / 2];
+        std::array<ex, 3> dN{0, 0, 0};
+        if (M && minv) {
+            ex w[3];
+            for (int i = 0; i < 3; ++i) {
+                w[i] = 0;
+                for (int c = 0; c < 3; ++c) w[i] -= (*M)(i, c).diff(ex_to<symbol>(u)) * S.N[c];
+            }
+            for (int c = 0; c < 3; ++c) {
+                const realsymbol dn("dN" + std::to_string(c) + "_" + std::to_string(j));
+                ex e = 0;
+                for (int i = 0; i < 3; ++i) e += (*minv)(c, i) * w[i];
+                k.bindings.push_back({dn, e});
+                dN[c] = dn;
+            }
+        }
+        for (int r = 0; r < (contacts == 1 ? 2 : 3); ++r) {
+            ex e = back[r].diff(ex_to<symbol>(u));
+            for (int c = 0; c < 3; ++c)
+                if (dN[c] != 0) e += back[r].diff(ex_to<symbol>(S.N[c])) * dN[c];
+            k.outputs.push_back({"dqdd[" + std::to_string(2 * contacts * r + j) + "]", e});
+        }
+    }
 }
 
 void write(const std::filesystem::path& p, const std::string& text) {
@@ -289,13 +329,25 @@ int main(int argc, char** argv) {
                     r[i] = st(d.r_reduced(i, 0).subs(b_of));
                 }
                 const ex dsym = bind_cofactor_solve(k, M, r, S);
+                std::array<ex, 3> back;
+                for (int i = 0; i < 3; ++i) back[i] = st(d.back_substitution(i, 0).subs(b_of));
                 for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
-                for (int i = 0; i < 3; ++i)
-                    k.outputs.push_back({"qdd[" + std::to_string(i) + "]", st(d.back_substitution(i, 0).subs(b_of))});
+                for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", back[i]});
                 k.outputs.push_back({"det[0]", dsym});
+                // The same evaluation with d q''/d u (variational equations, implicit methods).
+                Kernel kj{"// Thick part, reduced U-dynamics: reduced_U_thick and dqdd[6 r + j] = d q''_r / d u_j\n"
+                          "// (u = u1x, u1y, u2x, u2y, u3x, u3y; dN/du = -M^-1 (dM/du) N by the same cofactors).\n",
+                          "reduced_U_thick_du(const KernelInput& in, const double* C, double* n, double* qdd, double* det, "
+                          "double* dqdd)", in, {}, {}};
+                matrix minv;
+                bind_cofactor_solve(kj, M, r, S, &minv);
+                kj.outputs = k.outputs;
+                bind_slip_jacobian(kj, back, &M, &minv, S, 3);
                 st.add_inputs(k.in);
+                st.add_inputs(kj.in);
                 kernels.push_back(config_kernel("reduced_U_thick", "Thick part, reduced U-dynamics", st, "", in));
                 kernels.push_back(k);
+                kernels.push_back(kj);
             }
             {
                 // Thin part: n = M38^-1 (b[3], b[4], b[2]) (38) is affine in the plate's acceleration
@@ -309,23 +361,39 @@ int main(int argc, char** argv) {
                     k.bindings.push_back({S.N[c], st(thin_normal_force(c, d.b_U).subs(thin))});
                     k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
                 }
-                for (int i = 0; i < 3; ++i)
-                    k.outputs.push_back(
-                        {"qdd[" + std::to_string(i) + "]", st(d.back_substitution(i, 0).subs(b_of).subs(thin))});
+                std::array<ex, 3> back;
+                for (int i = 0; i < 3; ++i) back[i] = st(d.back_substitution(i, 0).subs(b_of).subs(thin));
+                for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", back[i]});
+                Kernel kj{"// Thin part, reduced U-dynamics: reduced_U_thin and dqdd[6 r + j] = d q''_r / d u_j\n"
+                          "// (u = u1x, u1y, u2x, u2y, u3x, u3y; the normal forces (38) do not depend on u).\n",
+                          "reduced_U_thin_du(const KernelInput& in, const double* C, double* n, double* qdd, double* dqdd)", in,
+                          k.outputs, k.bindings};
+                bind_slip_jacobian(kj, back, nullptr, nullptr, S, 3);
                 st.add_inputs(k.in);
+                st.add_inputs(kj.in);
                 kernels.push_back(config_kernel("reduced_U_thin", "Thin part, reduced U-dynamics", st,
                                                 "const double* Minv, ", with(in, "Minv", "Minv", 9)));
                 kernels.push_back(k);
+                kernels.push_back(kj);
             }
             {
                 Staging st(fast, "C");
                 Kernel k{"// Point part, reduced U-dynamics (35): (s_x'', s_y'', N) from the slots C of reduced_U_point_config.\n",
                          "reduced_U_point(const KernelInput& in, const double* C, double* z)", in, {}, {}};
-                for (int i = 0; i < 3; ++i)
-                    k.outputs.push_back({"z[" + std::to_string(i) + "]", st(d.point_solution(i, 0).subs(b_of).subs(S.sz == 0))});
+                std::array<ex, 3> z;
+                for (int i = 0; i < 3; ++i) {
+                    z[i] = st(d.point_solution(i, 0).subs(b_of).subs(S.sz == 0));
+                    k.outputs.push_back({"z[" + std::to_string(i) + "]", z[i]});
+                }
+                Kernel kj{"// Point part, reduced U-dynamics: reduced_U_point and dqdd[2 r + j] = d s''_r / d u1_j (r, j = x, y;\n"
+                          "// N does not depend on u).\n",
+                          "reduced_U_point_du(const KernelInput& in, const double* C, double* z, double* dqdd)", in, k.outputs, {}};
+                bind_slip_jacobian(kj, z, nullptr, nullptr, S, 1);
                 st.add_inputs(k.in);
+                st.add_inputs(kj.in);
                 kernels.push_back(config_kernel("reduced_U_point", "Point part, reduced U-dynamics", st, "", in));
                 kernels.push_back(k);
+                kernels.push_back(kj);
             }
         }
         {

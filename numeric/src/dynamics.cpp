@@ -204,8 +204,12 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
 
 // Reduced U-dynamics (35) on the staged kernels: the slots of the frozen configuration once, then
 // per evaluation only the slip directions and u(t). Returns false when a thick part's reduced
-// system is near singular (the caller then takes the direct path with its pivoted LU).
-bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
+// system is near singular (the caller then takes the direct path with its pivoted LU). With Jq,
+// also d q''/d q' = sum_i (d q''/d u_i) (d u_i/d v_i) (d v_i/d q'): the first factor from the
+// generated *_du kernels, the second the friction law's, the third [I, (-r_iy, r_ix)] with
+// r_i = R2 c_i (v_i = s' + theta' e_z x r_i).
+bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws,
+                             Mat3* Jq = nullptr) {
     if (q[0] != ws.C_q[0] || q[1] != ws.C_q[1] || q[2] != ws.C_q[2]) {
         set_configuration(P, q, ws);
         ws.C_q = q;
@@ -219,26 +223,46 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
     k.pddx = ps.pdd.x(); k.pddy = ps.pdd.y(); k.pddz = ps.pdd.z();
     k.wdx = ps.wd.x(); k.wdy = ps.wd.y(); k.wdz = ps.wd.z();
     double ux[3], uy[3];
+    double dq[18];   // d q''_r / d u_j, row-major (3 x 6; point part 2 x 2)
     if (P.point) {
         slip_directions(1, qd, ws, ux, uy);
         k.u1x = ux[0]; k.u1y = uy[0];
         double z[3];
-        gen::reduced_U_point(k, ws.C.data(), z);
+        if (Jq) gen::reduced_U_point_du(k, ws.C.data(), z, dq);
+        else gen::reduced_U_point(k, ws.C.data(), z);
         ws.qdd = Vec3(z[0], z[1], 0);
         ws.n = Vec3(z[2], 0, 0);
+        if (Jq) {
+            Jq->setZero();
+            Jq->topLeftCorner<2, 2>() = Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(dq) *
+                                        direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
+        }
         return true;
     }
     slip_directions(3, qd, ws, ux, uy);
     k.u1x = ux[0]; k.u1y = uy[0];
     k.u2x = ux[1]; k.u2y = uy[1];
     k.u3x = ux[2]; k.u3y = uy[2];
+    bool regular = true;
     if (ws.thin) {
-        gen::reduced_U_thin(k, ws.C.data(), ws.n.data(), ws.qdd.data());
-        return true;
+        if (Jq) gen::reduced_U_thin_du(k, ws.C.data(), ws.n.data(), ws.qdd.data(), dq);
+        else gen::reduced_U_thin(k, ws.C.data(), ws.n.data(), ws.qdd.data());
+    } else {
+        double det;
+        if (Jq) gen::reduced_U_thick_du(k, ws.C.data(), ws.n.data(), ws.qdd.data(), &det, dq);
+        else gen::reduced_U_thick(k, ws.C.data(), ws.n.data(), ws.qdd.data(), &det);
+        regular = std::abs(det) > ws.det_floor;
     }
-    double det;
-    gen::reduced_U_thick(k, ws.C.data(), ws.n.data(), ws.qdd.data(), &det);
-    return std::abs(det) > ws.det_floor;
+    if (Jq && regular) {
+        const Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> dqdd_du(dq);
+        Jq->setZero();
+        for (int i = 0; i < 3; ++i) {
+            Eigen::Matrix<double, 2, 3> V;
+            V << 1, 0, -ws.r[i].y(), 0, 1, ws.r[i].x();
+            *Jq += dqdd_du.middleCols<2>(2 * i) * (direction_derivative(ws.law, ws.law_eps, ws.slip[i]) * V);
+        }
+    }
+    return regular;
 }
 
 }  // namespace
@@ -314,6 +338,11 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
 void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                     Workspace& ws, Mat3& Jq) {
     if (level == Dynamics::Full) throw std::invalid_argument("twist_jacobian: U- and reduced U-dynamics only");
+    if (level == Dynamics::ReducedU) {
+        ++ws.evals;
+        if (ws.prepared != &sc) ws.prepare(sc);
+        if (accelerations_reduced_U(sc.part, q, qd, ps, ws, &Jq)) return;
+    }
     // At one instant the U- and reduced U-dynamics coincide; the U path leaves every input of the
     // factor kernels (slip directions included) in ws.in.
     accelerations(sc, Dynamics::U, q, qd, ps, ws);

@@ -22,8 +22,13 @@ namespace plate {
 //                   the model
 //   Newton          Newton shooting on P(x) - x = 0 (GSL multiroot, gnewton), monodromy by finite
 //                   differences of P (3 extra periods per iteration)
+//   Shooting        Newton shooting with the monodromy M = dP/dx from the variational equations,
+//                   integrated along with the first period; then chord steps with that M (plain
+//                   periods) while they contract, a fresh M where they stop. The reported twist is
+//                   the last period's average corrected to first order by its sensitivity to the
+//                   start and the last step. Without a warm start (qd0 = 0) it begins with Anderson.
 // The speed-accuracy study (plate bench) charts cost against accuracy for each.
-enum class CycleSolver { PeriodByPeriod, Anderson, Newton };
+enum class CycleSolver { PeriodByPeriod, Anderson, Newton, Shooting };
 const char* cycle_solver_name(CycleSolver s);
 CycleSolver parse_cycle_solver(const std::string& name);   // throws std::invalid_argument
 
@@ -49,6 +54,12 @@ struct LimitCycleSummary {
     double contraction = 0;     // c, per period
     Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // xi_a (36)
     Vec3 qd_start = Vec3::Zero();  // state at the start of the last period (a warm start)
+    // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers) and the
+    // sensitivity of the average (36) to the start, dxi_a/dx, both in the scaled twist (v_ref,
+    // v_ref, v_ref / rho), at the start where they were last computed.
+    bool has_monodromy = false;
+    Mat3 monodromy = Mat3::Zero();
+    Mat3 average_sensitivity = Mat3::Zero();
     double min_normal_force = 0;   // smallest N_i over the last period [N]
     StopEvent stop;
     Stats stats;                   // accumulated over restarts
@@ -64,6 +75,7 @@ struct LimitCycleSummary {
 
 LimitCycleSummary limit_cycle(const Scene& scene, const Vec3& q0, const LimitCycleOptions& opt = {},
                               const Vec3& qd0 = Vec3::Zero());
+
 
 // The period map of the reduced U-dynamics at q0: the twist at t = T from qd0 at t = 0.
 // Returns false (and leaves `out` unchanged) if the period leaves the model (stop says why).
