@@ -13,20 +13,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <tuple>
-#include <type_traits>
 
 namespace plate::detail {
 
 namespace odeint = boost::numeric::odeint;
-
-// The leading state components the error norm covers: Model::kErrDim if the model declares it
-// (a variational model leaves its sensitivities out: integrated with the same steps and stages,
-// they are the exact derivative of the numerical solution), else the whole state.
-template <class M, class = void>
-struct ErrDim { static constexpr std::size_t value = std::tuple_size<typename M::State>::value; };
-template <class M>
-struct ErrDim<M, std::void_t<decltype(M::kErrDim)>> { static constexpr std::size_t value = M::kErrDim; };
 
 // Model concept: State, kDim, rhs(t, y, dy) (physical units, fills ws), q(y), qd(y),
 // plate(t, y) -> PlateState, scale() -> State of characteristic magnitudes.
@@ -145,7 +135,7 @@ private:
     bool try_step(double& t1, double& dt) {
         stepper_.do_step(sysref(), ys_, fs_, t1, ys1_, fs1_, dt, err_);
         double err = 0;
-        for (std::size_t i = 0; i < ErrDim<Model>::value; ++i)
+        for (std::size_t i = 0; i < err_.size(); ++i)
             err = std::max(err, std::abs(err_[i]) / (opt_.rtol * (1 + std::max(std::abs(ys_[i]), std::abs(ys1_[i])))));
         if (!std::isfinite(err)) {
             dt *= 0.2;

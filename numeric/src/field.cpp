@@ -82,35 +82,39 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
             }
         }
     };
-    // Shooting converges in two periods from a start within ~1e-2 v_ref of the cycle, so the
-    // starts are predicted. Lines along y; a point's start is the parallelogram rule
-    // x(a) + x(b) - x(c) over solved neighbours (the cycle start is nearly additive in the
-    // coordinates: on fig4 it leaves 3e-3 in (y, theta), 8e-3 in (x, y), against 1e-2 for a linear
-    // extrapolation along y and 0.03-0.08 for the nearest neighbour alone). Phase 1 solves the
-    // lines (i, y, theta_0) in order of i, phase 2 the lines (i, y, theta_k), k >= 1, each plane i
-    // a task in order of k: every prediction reads only points solved before it in the same
-    // task, so the field does not depend on the number of threads.
+    // Shooting converges in two periods from a start within ~1e-2 v_ref of its cycle, so the starts
+    // are predicted by the parallelogram rule x(a) + x(b) - x(c) over solved neighbours: the cycle
+    // start is nearly additive in the coordinates (on fig4 it leaves 3e-3 v_ref in (y, theta) and
+    // 8e-3 in (x, y), against 1e-2 for a linear extrapolation along y and 0.03-0.08 for the nearest
+    // neighbour alone). Phase 1, in order: the points (x, y_0, theta), then the lines
+    // (x, y, theta_0); phase 2, a task per plane x_i: its lines (x_i, y, theta_k), k >= 1, in order.
+    // Every prediction reads only points solved before it in the same task, so the field does not
+    // depend on the number of threads.
     auto X = [&](int i, int j, int k) { return start[grid.index(i, j, k)]; };
-    auto predict = [&](int i, int j, int k) -> Vec3 {
-        const int kp = (k + grid.nth - 1) % grid.nth;
-        Vec3 p = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-        if (j > 0 && k > 0) p = X(i, j - 1, k) + X(i, j, kp) - X(i, j - 1, kp);                  // (y, theta)
-        if (!p.allFinite() && j > 0 && k == 0 && i > 0) p = X(i, j - 1, k) + X(i - 1, j, k) - X(i - 1, j - 1, k);  // (x, y)
-        if (!p.allFinite() && j > 1) p = 2 * X(i, j - 1, k) - X(i, j - 2, k);                    // along y
-        if (!p.allFinite() && j > 0) p = X(i, j - 1, k);
-        if (!p.allFinite() && j == 0 && k > 0) p = X(i, 0, kp);
-        if (!p.allFinite() && j == 0 && k == 0 && i > 0) p = X(i - 1, 0, 0);
-        return p.allFinite() ? Vec3(p.cwiseProduct(S)) : Vec3::Zero();
-    };
-    auto y_line = [&](int i, int k) {
-        for (int j = 0; j < grid.ny; ++j) solve(i, j, k, predict(i, j, k));
+    auto warm = [&](int i, int j, int k) -> Vec3 {
+        const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+        const auto first = [&](std::initializer_list<Vec3> cands) {
+            for (const Vec3& c : cands)
+                if (c.allFinite()) return Vec3(c.cwiseProduct(S));
+            return Vec3(Vec3::Zero());
+        };
+        if (j == 0)
+            return first({i > 0 && k > 0 ? Vec3(X(i, 0, k - 1) + X(i - 1, 0, k) - X(i - 1, 0, k - 1)) : nan,   // (x, theta)
+                          k > 0 ? X(i, 0, k - 1) : nan, i > 0 ? X(i - 1, 0, k) : nan});
+        return first({k > 0 ? Vec3(X(i, j - 1, k) + X(i, j, k - 1) - X(i, j - 1, k - 1)) : nan,   // (y, theta)
+                      i > 0 ? Vec3(X(i, j - 1, k) + X(i - 1, j, k) - X(i - 1, j - 1, k)) : nan,   // (x, y)
+                      j > 1 ? Vec3(2 * X(i, j - 1, k) - X(i, j - 2, k)) : nan, X(i, j - 1, k)});
     };
     auto planes = [&]() {
         for (int i; (i = next.fetch_add(1)) < grid.nx;)
-            for (int k = 1; k < grid.nth; ++k) y_line(i, k);
+            for (int k = 1; k < grid.nth; ++k)
+                for (int j = 1; j < grid.ny; ++j) solve(i, j, k, warm(i, j, k));
     };
     if (shooting) {
-        for (int i = 0; i < grid.nx; ++i) y_line(i, 0);
+        for (int i = 0; i < grid.nx; ++i)
+            for (int k = 0; k < grid.nth; ++k) solve(i, 0, k, warm(i, 0, k));
+        for (int i = 0; i < grid.nx; ++i)
+            for (int j = 1; j < grid.ny; ++j) solve(i, j, 0, warm(i, j, 0));
         threads = std::max(1, std::min(threads, grid.nx));
     } else {
         threads = std::max(1, std::min(threads, rows));

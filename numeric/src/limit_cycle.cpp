@@ -299,11 +299,10 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
     return out;
 }
 
-// Newton shooting on G(x) = P(x) - x in the scaled twist, with the monodromy M = dP/dx from the
-// variational equations (VariationalModel): x+ = x + (I - M)^-1 (P(x) - x). With a hint's M the
-// steps are chord steps and no variational equations are integrated until a step fails to halve the
-// one before (then M is refreshed at the current start). The periods run on one engine, so the step
-// size carries over from period to period.
+// Newton shooting on G(x) = P(x) - x in the scaled twist: x+ = x + (I - M)^-1 (P(x) - x), with the
+// monodromy M = dP/dx from the variational equations along the first period, then chord steps with
+// that M (plain periods); a step that contracts by less than half refreshes M at its start. The
+// periods run on one engine, so the step size carries over from period to period.
 //
 // Stopping: the twist is the average over the period from x_k plus (d xi_a/dx) delta_k, i.e. the
 // average at x_{k+1} to first order, so its error is |d xi_a/dx| times the distance of x_{k+1} from
@@ -312,10 +311,12 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
 // first point starts 0.025 v_ref from its cycle: theta alone under-estimated the error 5x there.
 // A step sequence that does not contract gives up (the caller falls back to Anderson).
 LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
-    detail::VariationalModel model(sc, q0);
-    detail::Engine<detail::VariationalModel> e(model, sc, opt.integration);
+    detail::ReducedModel model(sc, q0);
+    detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
+    Workspace jws;   // the Jacobian's own workspace: the engine's holds its last evaluation
     const double T = sc.plate.T;
-    const Vec3 S = model.S;
+    const detail::Scales sc_(sc);
+    const Vec3 S(sc_.v, sc_.v, sc_.w);
     const int nc = sc.part.contacts();
     const bool point = sc.part.point;
     LimitCycleSummary out;
@@ -323,23 +324,36 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     bool refresh = true;
     Mat3 M = Mat3::Zero(), Pa = Mat3::Zero();
     double d_prev = std::numeric_limits<double>::infinity();
-    detail::VariationalModel::State y;
     for (int k = 0; k < opt.max_periods; ++k) {
-        model.variational = refresh;
-        model.reset(y, x);
+        const detail::ReducedModel::State y{x[0], x[1], x[2], 0, 0, 0};
         bool ok = true;
         if (k == 0) ok = e.start(0, y);
         else e.modify([&](auto& z) { z = y; });
+        // The variational equations Phi' = J(t) Phi, Psi' = Phi (J = d q''/d q', generated) on the
+        // engine's accepted steps by the trapezoidal rule, J at each step's end: second order,
+        // about 1e-4 relative on fig4, one Jacobian per step (chord steps need no more).
+        Mat3 Phi = Mat3::Identity(), Psi = Mat3::Zero(), J;
+        double t_prev = e.t();
+        if (refresh) twist_jacobian(sc, Dynamics::ReducedU, q0, x, plate_state(sc.plate, t_prev, Dynamics::ReducedU), jws, J);
         double min_n = e.n().head(nc).minCoeff();
-        ok = ok && e.advance((k + 1) * T, [&](double, const auto&, const Vec3& n) {
+        ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
             min_n = std::min(min_n, n.head(nc).minCoeff());
+            if (!refresh) return;
+            const double h = t - t_prev;
+            Mat3 J1;
+            twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), plate_state(sc.plate, t, Dynamics::ReducedU), jws, J1);
+            const Mat3 Phi1 = (Mat3::Identity() - 0.5 * h * J1).partialPivLu().solve((Mat3::Identity() + 0.5 * h * J) * Phi);
+            Psi += 0.5 * h * (Phi + Phi1);
+            Phi = Phi1;
+            J = J1;
+            t_prev = t;
         });
         out.periods = k + 1;
         if (!ok) break;
         const auto z = e.y();
         if (refresh) {
-            M = S.asDiagonal().inverse() * model.Phi(z) * S.asDiagonal();
-            Pa = S.asDiagonal().inverse() * model.Psi(z) * S.asDiagonal() / T;
+            M = S.asDiagonal().inverse() * Phi * S.asDiagonal();
+            Pa = S.asDiagonal().inverse() * Psi * S.asDiagonal() / T;
         }
         const bool was_fresh = refresh;
         refresh = false;
@@ -352,7 +366,9 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         }
         const Vec3 delta = A.partialPivLu().solve(r);
         const double dn = delta.cwiseAbs().maxCoeff();
-        if (!std::isfinite(dn)) break;
+        // A step beyond a quarter of the slip-speed scale means a Floquet multiplier near 1 (or a
+        // start far from the cycle): Newton is no better than its linearisation there; give up.
+        if (!(dn <= 0.25)) break;
         out.twist = Vec3(z[3], z[4], z[5]) / T + (Pa * delta).cwiseProduct(S);
         out.qd_start = x;
         out.residual = r.cwiseAbs().maxCoeff();
@@ -360,9 +376,8 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         out.has_monodromy = true;
         out.monodromy = M;
         out.average_sensitivity = Pa;
-        if (dn == 0) { out.converged = true; break; }
         if (k >= 1) {
-            const double theta = dn / d_prev;
+            const double theta = d_prev > 0 ? dn / d_prev : 0.0;
             out.contraction = theta;
             // The next step contracts by about theta again on a chord, by less under Newton; but a
             // chord step after a fresh monodromy at the previous start contracts by up to 2 theta
@@ -383,6 +398,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     }
     out.stop = e.stop;
     out.stats = e.stats;
+    out.stats.rhs_evals += jws.evals;   // the Jacobians' evaluations
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
     return out;
@@ -403,8 +419,8 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
         // Accelerated solvers first; where they do not converge (an extrapolated start that left the
         // model, a Newton iteration that failed) the next simpler one decides (shooting: Anderson;
         // Anderson and Newton: period by period), and the cost counts. Shooting without a warm
-        // start is Anderson's.
-        const bool shoot = opt.solver == CycleSolver::Shooting && !qd0.isZero();
+        // start, or recording the path, is Anderson's.
+        const bool shoot = opt.solver == CycleSolver::Shooting && !qd0.isZero() && !opt.record;
         LimitCycleSummary fast = shoot ? shooting_cycle(sc, q0, opt, qd0)
                                  : opt.solver == CycleSolver::Newton ? newton_cycle(sc, q0, opt, qd0)
                                                                      : one_start(sc, q0, opt, qd0);

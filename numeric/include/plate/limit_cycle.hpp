@@ -22,11 +22,13 @@ namespace plate {
 //                   the model
 //   Newton          Newton shooting on P(x) - x = 0 (GSL multiroot, gnewton), monodromy by finite
 //                   differences of P (3 extra periods per iteration)
-//   Shooting        Newton shooting with the monodromy M = dP/dx from the variational equations,
-//                   integrated along with the first period; then chord steps with that M (plain
-//                   periods) while they contract, a fresh M where they stop. The reported twist is
-//                   the last period's average corrected to first order by its sensitivity to the
-//                   start and the last step. Without a warm start (qd0 = 0) it begins with Anderson.
+//   Shooting        Newton shooting with the monodromy M = dP/dx from the variational equations
+//                   (the generated d q''/d q', trapezoidal rule on the engine's steps) along the
+//                   first period; then chord steps with that M (plain periods) while they contract,
+//                   a fresh M where they stop. The reported twist is the last period's average
+//                   corrected to first order by its sensitivity to the start and the last step.
+//                   Needs a warm start near the cycle (fields predict one from solved neighbours);
+//                   without one (qd0 = 0), or with `record`, it is Anderson. Falls back to Anderson.
 // The speed-accuracy study (plate bench) charts cost against accuracy for each.
 enum class CycleSolver { PeriodByPeriod, Anderson, Newton, Shooting };
 const char* cycle_solver_name(CycleSolver s);
@@ -42,7 +44,7 @@ struct LimitCycleOptions {
     // from other twists (slip speed v_ref along x, then y, then a spin) up to this many times.
     // A cycle that sticks from every start is reported as sticking.
     int restarts = 3;
-    CycleSolver solver = CycleSolver::Anderson;
+    CycleSolver solver = CycleSolver::Shooting;   // the fastest on fig4's field (plate bench)
     int anderson_memory = 3;
 };
 
