@@ -96,8 +96,7 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
         const double t_first = t0 > 0 ? T * std::ceil(t0 / T * (1 + 1e-12)) : 0.0;
         bool ok = t0 > 0 ? e.advance(t_first, record) : true;
         if (ok) prev = model.qd(e.y());
-        // (Shooting without a warm start begins as Anderson.)
-        const bool anderson = opt.solver == CycleSolver::Anderson || opt.solver == CycleSolver::Shooting;
+        const bool anderson = opt.solver == CycleSolver::Anderson;
         std::deque<Vec3> X, Fx;
         double lambda = 0, r_prev_plain = std::numeric_limits<double>::infinity();
         Vec3 start = prev;
@@ -376,7 +375,6 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         out.min_normal_force = min_n;
         out.has_monodromy = true;
         out.monodromy = M;
-        out.average_sensitivity = Pa;
         if (k >= 1) {
             const double theta = d_prev > 0 ? dn / d_prev : 0.0;
             out.contraction = theta;
@@ -422,6 +420,11 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
         // Anderson and Newton: period by period), and the cost counts. Shooting without a warm
         // start, or recording the path, is Anderson's.
         const bool shoot = opt.solver == CycleSolver::Shooting && !qd0.isZero() && !opt.record;
+        if (opt.solver == CycleSolver::Shooting && !shoot) {
+            LimitCycleOptions a = opt;
+            a.solver = CycleSolver::Anderson;
+            return limit_cycle(sc, q0, a, qd0);
+        }
         LimitCycleSummary fast = shoot ? shooting_cycle(sc, q0, opt, qd0)
                                  : opt.solver == CycleSolver::Newton ? newton_cycle(sc, q0, opt, qd0)
                                                                      : one_start(sc, q0, opt, qd0);

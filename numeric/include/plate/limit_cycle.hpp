@@ -56,12 +56,10 @@ struct LimitCycleSummary {
     double contraction = 0;     // c, per period
     Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // xi_a (36)
     Vec3 qd_start = Vec3::Zero();  // state at the start of the last period (a warm start)
-    // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers) and the
-    // sensitivity of the average (36) to the start, dxi_a/dx, both in the scaled twist (v_ref,
-    // v_ref, v_ref / rho), at the start where they were last computed.
+    // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers) in the
+    // scaled twist (v_ref, v_ref, v_ref / rho), at the start where it was last computed.
     bool has_monodromy = false;
     Mat3 monodromy = Mat3::Zero();
-    Mat3 average_sensitivity = Mat3::Zero();
     double min_normal_force = 0;   // smallest N_i over the last period [N]
     StopEvent stop;
     Stats stats;                   // accumulated over restarts
@@ -77,7 +75,6 @@ struct LimitCycleSummary {
 
 LimitCycleSummary limit_cycle(const Scene& scene, const Vec3& q0, const LimitCycleOptions& opt = {},
                               const Vec3& qd0 = Vec3::Zero());
-
 
 // The period map of the reduced U-dynamics at q0: the twist at t = T from qd0 at t = 0.
 // Returns false (and leaves `out` unchanged) if the period leaves the model (stop says why).
