@@ -45,6 +45,14 @@ RunResult timed_run(F&& f) {
     return best;
 }
 
+// A field computed, and again up to twice while it takes under 0.2 s, keeping the fastest time
+// (the field is deterministic: only the time differs between the runs).
+Field timed_field(const Scene& sc, const FieldOptions& fo) {
+    Field best = compute_field(sc, GridSpec{}, fo);
+    for (int i = 0; i < 2 && best.seconds < 0.2; ++i) best.seconds = std::min(best.seconds, compute_field(sc, GridSpec{}, fo).seconds);
+    return best;
+}
+
 // Cheapest run of a line with error <= kTarget: (seconds, evals); +inf if none.
 std::pair<double, double> cost_at_target(const Line& l) {
     double s = std::numeric_limits<double>::infinity(), e = s;
@@ -235,6 +243,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
               "<th>not converged</th><th>periods / configuration</th><th>evaluations</th><th>seconds</th></tr>\n";
     double best_s = std::numeric_limits<double>::infinity();
     std::string best_name;
+    FieldOptions best_fo;
     std::map<std::string, double> best_by;
     // Two splits of the accuracy budget between the integrator and the cycle test: cycle
     // tolerance 10 rtol (lines) and equal to rtol (points of the same colour).
@@ -249,7 +258,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
             fo.cycle.solver = cfg.s;
             fo.cycle.integration.rtol = rt;
             fo.cycle.tol = tf * rt;
-            const Field f = compute_field(sc, GridSpec{}, fo);
+            const Field f = timed_field(sc, fo);
             int missing = 0;
             const double e = field_max_error(sc, f, ref, &missing);
             double periods = 0;
@@ -264,6 +273,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
                 if (f.seconds < best_s) {
                     best_s = f.seconds;
                     best_name = name + ", rtol " + fmt(rt, 2) + ", cycle tol " + fmt(tf * rt, 2);
+                    best_fo = fo;
                 }
             }
         }
@@ -271,32 +281,51 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
         std::fprintf(stderr, "bench: field by %s done\n", name.c_str());
     }
     c.html << "</table>\n";
-    // Period-by-period fixed-step RK4 from rest (no warm start): the smallest step count reaching kTarget.
+    // Period-by-period fixed-step RK4 from rest (no warm start): for each cycle tolerance the smallest
+    // step count reaching kTarget; the baseline is the cheapest of those (fewest evaluations: a fixed
+    // step costs the same everywhere, and evaluations do not jitter as times do).
     Solver rk;
     rk.method = Method::RK4;
-    double rk_s = std::numeric_limits<double>::infinity();
-    int rk_n = 0;
-    auto rko = c.data("cycle_rk4.dat");
-    c.html << "<p>Baseline: period-by-period fixed-step RK4 from rest, exact Coulomb, cycle tolerance 1e-7:</p>"
-              "<table><tr><th>steps per period</th><th>max error</th><th>failed</th><th>evaluations</th><th>seconds</th></tr>\n";
-    for (int n : {50, 60, 70, 80, 90, 100, 120, 140, 200}) {
-        double e = 0, secs = 0;
+    struct RkSetting { int n = 0; double ct = 0; long evals = std::numeric_limits<long>::max(); };
+    RkSetting rk_best;
+    auto rk_sweep = [&](int n, double ct, double* max_err, int* failed, long* evals) {
+        double secs = 0, e = 0;
         long ev = 0;
-        int failed = 0;
+        int nf = 0;
         for (const auto& p : ref.points) {
-            const RunResult r = twist_run(sc, p.q, rk, n, 1e-7);
+            const RunResult r = timed_run([&] { return twist_run(sc, p.q, rk, n, ct); });
             secs += r.seconds;
             ev += r.rhs_evals;
-            if (!r.ok) { ++failed; continue; }
+            if (!r.ok) { ++nf; continue; }
             if (p.converged) e = std::max(e, twist_error(sc, r.value, {p.twist[0], p.twist[1], p.twist[2]}));
         }
-        rko << secs << " " << ev << " " << std::max(e, 1e-16) << "\n";
-        c.html << "<tr><td>" << n << "</td><td>" << fmt(e, 3) << "</td><td>" << failed << "</td><td>" << ev << "</td><td>"
-               << fmt(secs, 3) << "</td></tr>\n";
-        if (failed == 0 && e <= kTarget && secs < rk_s) { rk_s = secs; rk_n = n; }
-        if (failed == 0 && e <= kTarget) break;   // more steps only cost more
+        if (max_err) *max_err = e;
+        if (failed) *failed = nf;
+        if (evals) *evals = ev;
+        return secs;
+    };
+    auto rko = c.data("cycle_rk4.dat");
+    c.html << "<p>Baseline: period-by-period fixed-step RK4 from rest, exact Coulomb, at two cycle tolerances:</p>"
+              "<table><tr><th>cycle tol</th><th>steps per period</th><th>max error</th><th>failed</th><th>evaluations</th>"
+              "<th>seconds</th></tr>\n";
+    for (double ct : full ? std::vector<double>{1e-6, 3e-7, 1e-7} : std::vector<double>{3e-7, 1e-7}) {
+        for (int n : {50, 60, 70, 80, 90, 100, 120, 140, 200}) {
+            double e = 0;
+            int failed = 0;
+            long ev = 0;
+            const double secs = rk_sweep(n, ct, &e, &failed, &ev);
+            rko << secs << " " << ev << " " << std::max(e, 1e-16) << "\n";
+            c.html << "<tr><td>" << fmt(ct, 2) << "</td><td>" << n << "</td><td>" << fmt(e, 3) << "</td><td>" << failed
+                   << "</td><td>" << ev << "</td><td>" << fmt(secs, 3) << "</td></tr>\n";
+            if (failed == 0 && e <= kTarget) {
+                if (ev < rk_best.evals) rk_best = RkSetting{n, ct, ev};
+                break;   // more steps only cost more
+            }
+        }
+        rko << "\n";   // a break in the chart's line between cycle tolerances
     }
     c.html << "</table>\n";
+    std::fprintf(stderr, "bench: RK4 baseline done\n");
     std::ostringstream gp;
     gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the field'\n"
           "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first " << kTarget << " to graph 1, first "
@@ -313,10 +342,35 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     c.plot("cycle_solvers", gp.str(), "fig4 field (343 configurations): maximum twist error against wall time for each "
                                       "limit-cycle solver (engine rtol swept; lines: cycle tolerance 10 rtol, points of the "
                                       "same colour: cycle tolerance = rtol) and the RK4 baseline.");
-    const double ratio = rk_s / best_s;
-    c.html << "<p>At max error &le; " << fmt(kTarget, 2) << ": best " << esc(best_name) << " " << fmt(best_s, 3)
-           << " s; period-by-period RK4 (" << rk_n << " steps per period) " << fmt(rk_s, 3) << " s: ratio <b>"
-           << fmt(ratio, 3) << "&times;</b> " << verdict(ratio >= 20) << " (target &ge; 20&times;).";
+    // The ratio, head to head: this machine's speed drifts by up to 30% over seconds (a shared host),
+    // so the best field and the RK4 baseline are timed alternately, F R F R ... F, and each round's
+    // ratio divides R by the mean of the fields on either side of it. Reported: the median of five.
+    if (best_name.empty() || rk_best.n == 0) {
+        c.html << "<p>At max error &le; " << fmt(kTarget, 2) << ": " << (best_name.empty() ? "no cycle solver" : "no RK4 setting")
+               << " reached it: " << verdict(false) << ".</p>\n";
+        return;
+    }
+    constexpr int kRounds = 5;
+    std::vector<double> ratios, fs, rs;
+    fs.push_back(timed_field(sc, best_fo).seconds);
+    for (int r = 0; r < kRounds; ++r) {
+        rs.push_back(rk_sweep(rk_best.n, rk_best.ct, nullptr, nullptr, nullptr));
+        fs.push_back(timed_field(sc, best_fo).seconds);
+        ratios.push_back(rs.back() / (0.5 * (fs[r] + fs[r + 1])));
+    }
+    std::vector<double> sorted = ratios;
+    std::sort(sorted.begin(), sorted.end());
+    const double ratio = sorted[kRounds / 2];
+    c.html << "<p>At max error &le; " << fmt(kTarget, 2) << ": best " << esc(best_name) << "; period-by-period RK4 at "
+           << rk_best.n << " steps per period, cycle tolerance " << fmt(rk_best.ct, 2) << " (" << rk_best.evals
+           << " evaluations). Head to head, alternately, five rounds (seconds, each the fastest of three runs; RK4 "
+              "per configuration): fields ";
+    for (std::size_t i = 0; i < fs.size(); ++i) c.html << (i ? ", " : "") << fmt(fs[i], 3);
+    c.html << "; RK4 ";
+    for (std::size_t i = 0; i < rs.size(); ++i) c.html << (i ? ", " : "") << fmt(rs[i], 3);
+    c.html << "; ratios ";
+    for (std::size_t i = 0; i < ratios.size(); ++i) c.html << (i ? ", " : "") << fmt(ratios[i], 3);
+    c.html << ". Median ratio <b>" << fmt(ratio, 3) << "&times;</b> " << verdict(ratio >= 20) << " (target &ge; 20&times;).";
     double fastest = std::numeric_limits<double>::infinity();
     for (const auto& [n, s] : best_by) fastest = std::min(fastest, s);
     const std::string def = "shooting + warm";

@@ -257,6 +257,16 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
         const Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> dqdd_du(dq);
         Jq->setZero();
         for (int i = 0; i < 3; ++i) {
+            const double s = ws.slip[i].norm();
+            if (ws.law == FrictionLaw::Coulomb) {
+                // d u/d v = e_perp e_perp^T / |v| (e_perp = (-u_y, u_x)): each contact adds the rank-1
+                // (d q''/d u_i e_perp) (V_i^T e_perp)^T / |v_i|, V_i^T e_perp = (-u_y, u_x, r . u).
+                if (s == 0) continue;   // at zero slip the Coulomb term has no derivative
+                const Vec3 a = dqdd_du.col(2 * i + 1) * ux[i] - dqdd_du.col(2 * i) * uy[i];
+                const Vec3 b(-uy[i], ux[i], ws.r[i].x() * ux[i] + ws.r[i].y() * uy[i]);
+                *Jq += a * (b / s).transpose();
+                continue;
+            }
             Eigen::Matrix<double, 2, 3> V;
             V << 1, 0, -ws.r[i].y(), 0, 1, ws.r[i].x();
             *Jq += dqdd_du.middleCols<2>(2 * i) * (direction_derivative(ws.law, ws.law_eps, ws.slip[i]) * V);

@@ -28,6 +28,7 @@ public:
     Engine(Model& model, const Scene& scene, const IntegrationOptions& opt)
         : model_(model), scene_(scene), opt_(opt) {
         scale_ = model_.scale();
+        for (std::size_t i = 0; i < scale_.size(); ++i) inv_scale_[i] = 1 / scale_[i];
         eps_slip_ = opt_.slip_eps * scene_.v_ref();
         eps_arm_ = 1e-3 * scene_.v_ref();
         h_min_ = opt_.h_min * scene_.plate.T;
@@ -120,7 +121,7 @@ private:
         State y, dy;
         for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys[i] * scale_[i];
         model_.rhs(t, y, dy);
-        for (std::size_t i = 0; i < y.size(); ++i) dys[i] = dy[i] / scale_[i];
+        for (std::size_t i = 0; i < y.size(); ++i) dys[i] = dy[i] * inv_scale_[i];
         ++stats.rhs_evals;
         last_t_ = t;
         last_y_ = ys;
@@ -141,14 +142,15 @@ private:
             dt *= 0.2;
             return false;
         }
+        // err^expo / err_old^beta through logarithms: one log and one exp per step, not two pows.
         constexpr double beta = 0.04, expo = 0.2 - 0.75 * beta;
-        const double fac11 = std::pow(std::max(err, 1e-16), expo);
+        const double log_err = std::log(std::max(err, 1e-16));
         if (err > 1) {
-            dt /= std::min(5.0, fac11 / 0.9);
+            dt /= std::min(5.0, std::exp(expo * log_err) / 0.9);
             return false;
         }
-        const double fac = std::clamp(fac11 / std::pow(err_old_, beta) / 0.9, 0.1, 5.0);
-        err_old_ = std::max(err, 1e-4);
+        const double fac = std::clamp(std::exp(expo * log_err - beta * log_err_old_) / 0.9, 0.1, 5.0);
+        log_err_old_ = std::max(log_err, std::log(1e-4));
         t1 += dt;
         dt /= fac;
         return true;
@@ -274,8 +276,8 @@ private:
     IntegrationOptions opt_;
     odeint::runge_kutta_dopri5<State> stepper_;
     State err_{};
-    double err_old_ = 1e-4;
-    State scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, y_{}, last_y_{};
+    double log_err_old_ = std::log(1e-4);
+    State scale_{}, inv_scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, y_{}, last_y_{};
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
     double eps_slip_ = 0, eps_arm_ = 0, h_min_ = 0;
     std::array<bool, 3> armed_{};

@@ -1,5 +1,6 @@
 #include "plate/field.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -82,28 +83,46 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
             }
         }
     };
-    // Shooting converges in two periods from a start within ~1e-2 v_ref of its cycle, so the starts
-    // are predicted by the parallelogram rule x(a) + x(b) - x(c) over solved neighbours: the cycle
-    // start is nearly additive in the coordinates (on fig4 it leaves 3e-3 v_ref in (y, theta) and
-    // 8e-3 in (x, y), against 1e-2 for a linear extrapolation along y and 0.03-0.08 for the nearest
-    // neighbour alone). Phase 1, in order: the points (x, y_0, theta), then the lines
-    // (x, y, theta_0); phase 2, a task per plane x_i: its lines (x_i, y, theta_k), k >= 1, in order.
-    // Every prediction reads only points solved before it in the same task, so the field does not
-    // depend on the number of threads.
+    // Shooting converges in two periods from a start within ~1e-2 v_ref of its cycle, so each start is
+    // predicted from solved neighbours: extrapolated along one grid line by a polynomial through up
+    // to three points, plus the difference between the neighbouring parallel line's value and the
+    // same extrapolation on it (for order 0 the parallelogram rule x(a) + x(b) - x(c)). The cycle start
+    // is nearly additive in the coordinates and smooth along y, so this leaves on fig4 (max over the
+    // grid, against the 1e-11 cycles, in v_ref): along y with theta's line 3.6e-4 (cubic), 6.3e-4
+    // (quadratic), 2.7e-3 (parallelogram); along y with x's line 2.6e-3 (quadratic) and 8.2e-3
+    // (parallelogram); along x with theta's line 2.6e-3 (quadratic); the nearest neighbour alone
+    // 0.03-0.08. Phase 1, in order: the points (x, y_0, theta), then the lines (x, y, theta_0); phase 2,
+    // a task per plane x_i: its lines (x_i, y, theta_k), k >= 1, in order. Every prediction reads only
+    // points solved before it in the same task, so the field does not depend on the number of threads.
     auto X = [&](int i, int j, int k) { return start[grid.index(i, j, k)]; };
+    // Extrapolation to index n from n-1, n-2, n-3 along a line, order 0-2 (backward differences).
+    static constexpr double kExtrap[3][3] = {{1, 0, 0}, {2, -1, 0}, {3, -3, 1}};
     auto warm = [&](int i, int j, int k) -> Vec3 {
-        const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-        const auto first = [&](std::initializer_list<Vec3> cands) {
-            for (const Vec3& c : cands)
-                if (c.allFinite()) return Vec3(c.cwiseProduct(S));
-            return Vec3(Vec3::Zero());
+        // Along y (j > 0) or, on the first line j = 0, along x; the neighbouring parallel line is
+        // theta's (k - 1) if there is one, else x's (i - 1) for lines along y.
+        const bool along_y = j > 0;
+        const int n = along_y ? j : i;
+        auto at = [&](int m, bool nb) {   // the point at index m on the line (nb: on the neighbour line)
+            const int kk = nb && k > 0 ? k - 1 : k;
+            const int ii = nb && k == 0 ? i - 1 : i;
+            return along_y ? X(ii, m, kk) : X(m, 0, kk);
         };
-        if (j == 0)
-            return first({i > 0 && k > 0 ? Vec3(X(i, 0, k - 1) + X(i - 1, 0, k) - X(i - 1, 0, k - 1)) : nan,   // (x, theta)
-                          k > 0 ? X(i, 0, k - 1) : nan, i > 0 ? X(i - 1, 0, k) : nan});
-        return first({k > 0 ? Vec3(X(i, j - 1, k) + X(i, j, k - 1) - X(i, j - 1, k - 1)) : nan,   // (y, theta)
-                      i > 0 ? Vec3(X(i, j - 1, k) + X(i - 1, j, k) - X(i - 1, j - 1, k)) : nan,   // (x, y)
-                      j > 1 ? Vec3(2 * X(i, j - 1, k) - X(i, j - 2, k)) : nan, X(i, j - 1, k)});
+        const bool has_nb = k > 0 || (along_y && i > 0);
+        for (int order = std::min(n, 3) - 1; order >= 0; --order) {
+            for (bool nb : {true, false}) {
+                if (nb && !has_nb) continue;
+                Vec3 x = Vec3::Zero();
+                for (int l = 0; l <= order; ++l) {
+                    x += kExtrap[order][l] * at(n - 1 - l, false);
+                    if (nb) x -= kExtrap[order][l] * at(n - 1 - l, true);
+                }
+                if (nb) x += at(n, true);
+                if (x.allFinite()) return x.cwiseProduct(S);
+            }
+        }
+        // The first point of the first line: its theta neighbour, else none (a cold start).
+        if (n == 0 && k > 0 && X(i, j, k - 1).allFinite()) return X(i, j, k - 1).cwiseProduct(S);
+        return Vec3::Zero();
     };
     auto planes = [&]() {
         for (int i; (i = next.fetch_add(1)) < grid.nx;)

@@ -334,15 +334,15 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         // Jacobian per step: a chord needs no more, and the error estimate allows for it.
         Mat3 Phi = Mat3::Identity(), Psi = Mat3::Zero(), J;
         double t_prev = e.t();
-        if (refresh) twist_jacobian(sc, Dynamics::ReducedU, q0, x, plate_state(sc.plate, t_prev, Dynamics::ReducedU), jws, J);
+        if (refresh) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
         double min_n = e.n().head(nc).minCoeff();
         ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
             min_n = std::min(min_n, n.head(nc).minCoeff());
             if (!refresh) return;
             const double h = t - t_prev;
             Mat3 J1;
-            twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), plate_state(sc.plate, t, Dynamics::ReducedU), jws, J1);
-            const Mat3 Phi1 = (Mat3::Identity() - 0.5 * h * J1).partialPivLu().solve((Mat3::Identity() + 0.5 * h * J) * Phi);
+            twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), model.plate_at(t), jws, J1);
+            const Mat3 Phi1 = (Mat3::Identity() - 0.5 * h * J1).inverse() * ((Mat3::Identity() + 0.5 * h * J) * Phi);
             Psi += 0.5 * h * (Phi + Phi1);
             Phi = Phi1;
             J = J1;

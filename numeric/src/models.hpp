@@ -23,14 +23,21 @@ struct ReducedModel {
     Workspace ws;
     ReducedModel(const Scene& s, const Vec3& q) : sc(s), q0(q) {}
 
+    // u(t) of the last evaluation (shooting's Jacobian on an accepted step reuses it).
+    double t_last = std::numeric_limits<double>::quiet_NaN();
+    PlateState ps_last;
+
     void rhs(double t, const State& y, State& dy) {
         const Vec3 qd(y[0], y[1], y[2]);
-        accelerations(sc, level, q0, qd, plate(t, y), ws);
+        ps_last = plate(t, y);
+        t_last = t;
+        accelerations(sc, level, q0, qd, ps_last, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
     }
     Vec3 q(const State&) const { return q0; }
     Vec3 qd(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
+    PlateState plate_at(double t) const { return t == t_last ? ps_last : plate_state(sc.plate, t, level); }
     State scale() const {
         const Scales s(sc);
         const double T = sc.plate.T;
