@@ -42,7 +42,7 @@ public:
         n_ = model_.ws.n;
         slip_ = model_.ws.slip;
         for (int i = 0; i < 3; ++i) armed_[i] = slip_[i].norm() > eps_arm_;
-        dt_ = std::min(1e-3, 1e-2 * std::cbrt(opt_.rtol)) * scene_.plate.T;
+        dt_ = (opt_.h0 > 0 ? opt_.h0 : std::min(1e-3, 1e-2 * std::cbrt(opt_.rtol))) * scene_.plate.T;
         stats.min_normal_force = min_n();
         stop = StopEvent{};
         if (stats.min_normal_force < 0) {
@@ -53,6 +53,7 @@ public:
     }
 
     double t() const { return t_; }
+    double next_step() const { return dt_; }   // the step the controller proposes next [s]
     State y() const {
         State y;
         for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys_[i] * scale_[i];

@@ -46,16 +46,21 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
     std::vector<Vec3> start(grid.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
 
-    auto solve = [&](int i, int j, int k, const Vec3& warm) {
+    // Solves one point from `warm`; with warm starts, the first step is the one the previous point of
+    // the same task ended with (h0: its step hint, updated here), which saves the step-size ramp-up.
+    auto solve = [&](int i, int j, int k, const Vec3& warm, double& h0) {
         const int idx = grid.index(i, j, k);
         FieldPoint& p = f.points[idx];
         p.q = grid.at(i, j, k);
-        LimitCycleSummary lc = limit_cycle(sc, p.q, opt.cycle, warm);
+        LimitCycleOptions o = opt.cycle;
+        if (opt.warm_start) o.integration.h0 = h0;
+        LimitCycleSummary lc = limit_cycle(sc, p.q, o, warm);
         if (!lc.converged && !warm.isZero()) {
             const long spent = lc.stats.rhs_evals;
             lc = limit_cycle(sc, p.q, opt.cycle);
             lc.stats.rhs_evals += spent;
         }
+        if (lc.converged) h0 = lc.step_hint;
         p.twist = lc.twist;
         p.converged = lc.converged;
         p.periods = lc.periods;
@@ -77,8 +82,9 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         for (int row; (row = next.fetch_add(1)) < rows;) {
             const int i = row / grid.ny, j = row % grid.ny;
             Vec3 warm = Vec3::Zero();
+            double h0 = 0;
             for (int k = 0; k < grid.nth; ++k) {
-                const LimitCycleSummary lc = solve(i, j, k, opt.warm_start ? warm : Vec3::Zero());
+                const LimitCycleSummary lc = solve(i, j, k, opt.warm_start ? warm : Vec3::Zero(), h0);
                 warm = lc.converged ? lc.qd_start : Vec3::Zero();
             }
         }
@@ -125,15 +131,18 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         return Vec3::Zero();
     };
     auto planes = [&]() {
-        for (int i; (i = next.fetch_add(1)) < grid.nx;)
+        for (int i; (i = next.fetch_add(1)) < grid.nx;) {
+            double h0 = 0;
             for (int k = 1; k < grid.nth; ++k)
-                for (int j = 1; j < grid.ny; ++j) solve(i, j, k, warm(i, j, k));
+                for (int j = 1; j < grid.ny; ++j) solve(i, j, k, warm(i, j, k), h0);
+        }
     };
     if (shooting) {
+        double h0 = 0;
         for (int i = 0; i < grid.nx; ++i)
-            for (int k = 0; k < grid.nth; ++k) solve(i, 0, k, warm(i, 0, k));
+            for (int k = 0; k < grid.nth; ++k) solve(i, 0, k, warm(i, 0, k), h0);
         for (int i = 0; i < grid.nx; ++i)
-            for (int j = 1; j < grid.ny; ++j) solve(i, j, 0, warm(i, j, 0));
+            for (int j = 1; j < grid.ny; ++j) solve(i, j, 0, warm(i, j, 0), h0);
         threads = std::max(1, std::min(threads, grid.nx));
     } else {
         threads = std::max(1, std::min(threads, rows));

@@ -61,6 +61,8 @@ struct LimitCycleSummary {
     bool has_monodromy = false;
     Mat3 monodromy = Mat3::Zero();
     double min_normal_force = 0;   // smallest N_i over the last period [N]
+    double step_hint = 0;          // the step proposed at the end, relative to T: a first step
+                                   // (IntegrationOptions::h0) for a neighbouring configuration
     StopEvent stop;
     Stats stats;                   // accumulated over restarts
     int restarts = 0;              // starts abandoned because a contact stuck in the transient

@@ -23,6 +23,8 @@ struct IntegrationOptions {
     double rtol = 1e-9;        // local error tolerance on the scaled state (see engine)
     double slip_eps = 1e-6;    // slip speed counted as zero, relative to Scene::v_ref()
     double h_min = 1e-12;      // smallest step, relative to the period T
+    double h0 = 0;             // first step, relative to T; 0: a small one from rtol (a neighbouring
+                               // run's LimitCycleSummary::step_hint saves the ramp-up)
     long max_steps = 20'000'000;
 };
 
