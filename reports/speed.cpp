@@ -231,8 +231,10 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     ro.cycle.solver = CycleSolver::Anderson;   // not the default shooting it checks
     const Field ref = compute_field(sc, GridSpec{}, ro);
     c.html << "<p>Reference field: Anderson, engine rtol 1e-12, cycle tolerance 1e-11 (" << fmt(ref.seconds, 3)
-           << " s). All runs below on one thread, so that times compare. Shooting's warm starts are predicted "
-              "from solved neighbours (parallelogram rule); the others start from the previous theta's cycle.</p>\n";
+           << " s). All runs below on one thread, so that times compare; each time is the fastest of three runs "
+              "(fields under 0.2 s). Shooting's warm starts are predicted from solved neighbours (extrapolation "
+              "along a grid line plus the neighbouring line's difference); the others start from the previous "
+              "theta's cycle. With warm starts every point's first step is the one its predecessor ended with.</p>\n";
     struct Cfg { CycleSolver s; bool warm; };
     std::vector<Cfg> cfgs{{CycleSolver::PeriodByPeriod, false}, {CycleSolver::PeriodByPeriod, true},
                           {CycleSolver::Anderson, false}, {CycleSolver::Anderson, true}, {CycleSolver::Newton, true},
