@@ -235,7 +235,11 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
               "(fields under 0.2 s). Shooting's warm starts are predicted from solved neighbours (extrapolation "
               "along a grid line plus the neighbouring line's difference); the others start from the previous "
               "theta's cycle. With warm starts every point's first step is the one its predecessor ended with.</p>\n";
-    struct Cfg { CycleSolver s; bool warm; };
+    struct Cfg {
+        CycleSolver s;
+        bool warm;
+        std::string name() const { return std::string(cycle_solver_name(s)) + (warm ? " + warm" : ""); }
+    };
     std::vector<Cfg> cfgs{{CycleSolver::PeriodByPeriod, false}, {CycleSolver::PeriodByPeriod, true},
                           {CycleSolver::Anderson, false}, {CycleSolver::Anderson, true}, {CycleSolver::Newton, true},
                           {CycleSolver::Shooting, true}};
@@ -250,35 +254,35 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     // Two splits of the accuracy budget between the integrator and the cycle test: cycle
     // tolerance 10 rtol (lines) and equal to rtol (points of the same colour).
     for (const auto& cfg : cfgs) {
-        const std::string name = std::string(cycle_solver_name(cfg.s)) + (cfg.warm ? " + warm" : "");
+        const std::string name = cfg.name();
         for (double tf : {10.0, 1.0}) {
-        auto o = c.data("cycle_" + slug(name) + (tf == 1 ? "_tol1" : "") + ".dat");
-        for (double rt : rtols) {
-            FieldOptions fo;
-            fo.threads = 1;
-            fo.warm_start = cfg.warm;
-            fo.cycle.solver = cfg.s;
-            fo.cycle.integration.rtol = rt;
-            fo.cycle.tol = tf * rt;
-            const Field f = timed_field(sc, fo);
-            int missing = 0;
-            const double e = field_max_error(sc, f, ref, &missing);
-            double periods = 0;
-            for (const auto& p : f.points) periods += p.periods;
-            o << f.seconds << " " << f.rhs_evals << " " << std::max(e, 1e-16) << "\n";
-            c.html << "<tr><td>" << esc(cycle_solver_name(cfg.s)) << "</td><td>" << (cfg.warm ? "yes" : "no") << "</td><td>"
-                   << fmt(rt, 2) << "</td><td>" << fmt(tf * rt, 2) << "</td><td>" << fmt(e, 3) << "</td><td>" << missing
-                   << "</td><td>" << fmt(periods / f.points.size(), 3) << "</td><td>" << f.rhs_evals << "</td><td>"
-                   << fmt(f.seconds, 3) << "</td></tr>\n";
-            if (missing == 0 && e <= kTarget) {
-                if (!best_by.count(name) || f.seconds < best_by[name]) best_by[name] = f.seconds;
-                if (f.seconds < best_s) {
-                    best_s = f.seconds;
-                    best_name = name + ", rtol " + fmt(rt, 2) + ", cycle tol " + fmt(tf * rt, 2);
-                    best_fo = fo;
+            auto o = c.data("cycle_" + slug(name) + (tf == 1 ? "_tol1" : "") + ".dat");
+            for (double rt : rtols) {
+                FieldOptions fo;
+                fo.threads = 1;
+                fo.warm_start = cfg.warm;
+                fo.cycle.solver = cfg.s;
+                fo.cycle.integration.rtol = rt;
+                fo.cycle.tol = tf * rt;
+                const Field f = timed_field(sc, fo);
+                int missing = 0;
+                const double e = field_max_error(sc, f, ref, &missing);
+                double periods = 0;
+                for (const auto& p : f.points) periods += p.periods;
+                o << f.seconds << " " << f.rhs_evals << " " << std::max(e, 1e-16) << "\n";
+                c.html << "<tr><td>" << esc(cycle_solver_name(cfg.s)) << "</td><td>" << (cfg.warm ? "yes" : "no") << "</td><td>"
+                       << fmt(rt, 2) << "</td><td>" << fmt(tf * rt, 2) << "</td><td>" << fmt(e, 3) << "</td><td>" << missing
+                       << "</td><td>" << fmt(periods / f.points.size(), 3) << "</td><td>" << f.rhs_evals << "</td><td>"
+                       << fmt(f.seconds, 3) << "</td></tr>\n";
+                if (missing == 0 && e <= kTarget) {
+                    if (!best_by.count(name) || f.seconds < best_by[name]) best_by[name] = f.seconds;
+                    if (f.seconds < best_s) {
+                        best_s = f.seconds;
+                        best_name = name + ", rtol " + fmt(rt, 2) + ", cycle tol " + fmt(tf * rt, 2);
+                        best_fo = fo;
+                    }
                 }
             }
-        }
         }
         std::fprintf(stderr, "bench: field by %s done\n", name.c_str());
     }
@@ -290,21 +294,18 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     rk.method = Method::RK4;
     struct RkSetting { int n = 0; double ct = 0; long evals = std::numeric_limits<long>::max(); };
     RkSetting rk_best;
-    auto rk_sweep = [&](int n, double ct, double* max_err, int* failed, long* evals) {
-        double secs = 0, e = 0;
-        long ev = 0;
-        int nf = 0;
+    struct RkSweep { double seconds = 0, max_error = 0; int failed = 0; long evals = 0; };
+    auto rk_sweep = [&](int n, double ct) {
+        RkSweep out;
         for (const auto& p : ref.points) {
             const RunResult r = timed_run([&] { return twist_run(sc, p.q, rk, n, ct); });
-            secs += r.seconds;
-            ev += r.rhs_evals;
-            if (!r.ok) { ++nf; continue; }
-            if (p.converged) e = std::max(e, twist_error(sc, r.value, {p.twist[0], p.twist[1], p.twist[2]}));
+            out.seconds += r.seconds;
+            out.evals += r.rhs_evals;
+            if (!r.ok) { ++out.failed; continue; }
+            if (p.converged)
+                out.max_error = std::max(out.max_error, twist_error(sc, r.value, {p.twist[0], p.twist[1], p.twist[2]}));
         }
-        if (max_err) *max_err = e;
-        if (failed) *failed = nf;
-        if (evals) *evals = ev;
-        return secs;
+        return out;
     };
     auto rko = c.data("cycle_rk4.dat");
     c.html << "<p>Baseline: period-by-period fixed-step RK4 from rest, exact Coulomb, at two cycle tolerances:</p>"
@@ -312,15 +313,12 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
               "<th>seconds</th></tr>\n";
     for (double ct : full ? std::vector<double>{1e-6, 3e-7, 1e-7} : std::vector<double>{3e-7, 1e-7}) {
         for (int n : {50, 60, 70, 80, 90, 100, 120, 140, 200}) {
-            double e = 0;
-            int failed = 0;
-            long ev = 0;
-            const double secs = rk_sweep(n, ct, &e, &failed, &ev);
-            rko << secs << " " << ev << " " << std::max(e, 1e-16) << "\n";
-            c.html << "<tr><td>" << fmt(ct, 2) << "</td><td>" << n << "</td><td>" << fmt(e, 3) << "</td><td>" << failed
-                   << "</td><td>" << ev << "</td><td>" << fmt(secs, 3) << "</td></tr>\n";
-            if (failed == 0 && e <= kTarget) {
-                if (ev < rk_best.evals) rk_best = RkSetting{n, ct, ev};
+            const RkSweep w = rk_sweep(n, ct);
+            rko << w.seconds << " " << w.evals << " " << std::max(w.max_error, 1e-16) << "\n";
+            c.html << "<tr><td>" << fmt(ct, 2) << "</td><td>" << n << "</td><td>" << fmt(w.max_error, 3) << "</td><td>"
+                   << w.failed << "</td><td>" << w.evals << "</td><td>" << fmt(w.seconds, 3) << "</td></tr>\n";
+            if (w.failed == 0 && w.max_error <= kTarget) {
+                if (w.evals < rk_best.evals) rk_best = RkSetting{n, ct, w.evals};
                 break;   // more steps only cost more
             }
         }
@@ -334,7 +332,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
        << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
     int i = 0;
     for (const auto& cfg : cfgs) {
-        const std::string name = std::string(cycle_solver_name(cfg.s)) + (cfg.warm ? " + warm" : "");
+        const std::string name = cfg.name();
         gp << (i ? ", " : "") << "'data/cycle_" << slug(name) << ".dat' u 1:3 w lp lt " << i + 1 << " pt " << i + 1
            << " title '" << name << "', 'data/cycle_" << slug(name) << "_tol1.dat' u 1:3 w p lt " << i + 1 << " pt " << i + 1
            << " notitle";
@@ -356,7 +354,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     std::vector<double> ratios, fs, rs;
     fs.push_back(timed_field(sc, best_fo).seconds);
     for (int r = 0; r < kRounds; ++r) {
-        rs.push_back(rk_sweep(rk_best.n, rk_best.ct, nullptr, nullptr, nullptr));
+        rs.push_back(rk_sweep(rk_best.n, rk_best.ct).seconds);
         fs.push_back(timed_field(sc, best_fo).seconds);
         ratios.push_back(rs.back() / (0.5 * (fs[r] + fs[r + 1])));
     }
@@ -480,13 +478,14 @@ void hierarchy(Ctx& c, const fs::path& src, bool full) {
     for (const auto& q : qs) {
         const Scene sc = load_scene((src / "scenes" / (std::string(q.scene) + ".json")).string());
         const ModelChoice m2 = choose_model(sc, q.q0, q.dur, 1e-2);
+        const Rung& picked2 = m2.pick(1e-2);
         const Rung& picked3 = m2.pick(1e-3);
         bool first = true;
         for (const auto& r : m2.rungs) {
             c.html << "<tr><td>" << (first ? q.scene : "") << "</td><td>" << (first ? "(" + fmt(q.q0[0], 3) + ", " + fmt(q.q0[1], 3) + ", " + fmt(q.q0[2], 3) + ")" : "")
                    << "</td><td>" << (first ? fmt(q.dur, 3) + " s" : "") << "</td><td>" << esc(r.name()) << "</td><td>"
                    << (r.ok ? fmt(r.error, 3) : esc(r.note)) << "</td><td>" << fmt(r.seconds, 3) << "</td><td>"
-                   << (&r == &m2.pick(1e-2) ? "&#10003;" : "") << "</td><td>" << (&r == &picked3 ? "&#10003;" : "")
+                   << (&r == &picked2 ? "&#10003;" : "") << "</td><td>" << (&r == &picked3 ? "&#10003;" : "")
                    << "</td></tr>\n";
             first = false;
         }

@@ -183,10 +183,9 @@ std::string Emitter::operator()(const ex& e) {
         const std::vector<ex> fs = sorted_operands(e);
         std::string acc = (*this)(fs[0]);
         ex part = fs[0];
-        for (std::size_t j = 1; j < fs.size(); ++j) {
+        for (std::size_t j = 1; j + 1 < fs.size(); ++j) {
             part = part * fs[j];
             const std::string f = (*this)(fs[j]);
-            if (j + 1 == fs.size()) break;
             const auto known = memo_.find(part);
             if (known != memo_.end()) {
                 acc = known->second;

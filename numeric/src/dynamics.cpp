@@ -257,10 +257,10 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
         const Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> dqdd_du(dq);
         Jq->setZero();
         for (int i = 0; i < 3; ++i) {
-            const double s = ws.slip[i].norm();
             if (ws.law == FrictionLaw::Coulomb) {
                 // d u/d v = e_perp e_perp^T / |v| (e_perp = (-u_y, u_x)): each contact adds the rank-1
                 // (d q''/d u_i e_perp) (V_i^T e_perp)^T / |v_i|, V_i^T e_perp = (-u_y, u_x, r . u).
+                const double s = ws.slip[i].norm();
                 if (s == 0) continue;   // at zero slip the Coulomb term has no derivative
                 const Vec3 a = dqdd_du.col(2 * i + 1) * ux[i] - dqdd_du.col(2 * i) * uy[i];
                 const Vec3 b(-uy[i], ux[i], ws.r[i].x() * ux[i] + ws.r[i].y() * uy[i]);

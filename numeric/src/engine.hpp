@@ -131,9 +131,10 @@ private:
     // One Dormand-Prince step of size dt from (t_, ys_) into ys1_, fs1_. The error norm is
     // max_i |err_i| / (rtol (1 + max(|y_i|, |y1_i|))). odeint's default checker divides by
     // rtol (1 + |y_i| + dt |y'_i|) instead: a tolerance that grows with the step, so the error no
-    // longer scales as dt^5 and its controller overshoots (29% of fig4's field steps rejected). The step size follows the PI controller of Hairer & Wanner's DOPRI5
-    // (Solving ODEs I, II.4; beta = 0.04, safety 0.9, factors in [0.2, 10]). On success t1 += dt
-    // and dt becomes the next step; on failure dt becomes the step to retry with.
+    // longer scales as dt^5 and its controller overshoots (29% of fig4's field steps rejected).
+    // The step size follows the PI controller of Hairer & Wanner's DOPRI5 (Solving ODEs I, II.4;
+    // beta = 0.04, safety 0.9, factors in [0.2, 10]). On success t1 += dt and dt becomes the next
+    // step; on failure dt becomes the step to retry with.
     bool try_step(double& t1, double& dt) {
         stepper_.do_step(sysref(), ys_, fs_, t1, ys1_, fs1_, dt, err_);
         double err = 0;

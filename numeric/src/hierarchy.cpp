@@ -114,8 +114,9 @@ ModelChoice choose_model(const Scene& sc, const Vec3& q0, double duration, doubl
     }
     std::sort(mc.rungs.begin(), mc.rungs.end(), [](const Rung& a, const Rung& b) { return a.seconds < b.seconds; });
     mc.rungs.push_back(ref);
-    mc.picked = mc.pick(tol);
-    mc.any_simplification = &mc.pick(tol) != &mc.rungs.back();
+    const Rung& picked = mc.pick(tol);
+    mc.picked = picked;
+    mc.any_simplification = &picked != &mc.rungs.back();
     return mc;
 }
 

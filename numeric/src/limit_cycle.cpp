@@ -398,8 +398,8 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     }
     out.stop = e.stop;
     out.stats = e.stats;
-    out.step_hint = e.next_step() / T;
     out.stats.rhs_evals += jws.evals;   // the Jacobians' evaluations
+    out.step_hint = e.next_step() / T;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
     return out;
