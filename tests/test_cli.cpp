@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -62,7 +63,10 @@ TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     CHECK(j["twist"].size() == 3);
     CHECK(j["converged"] == true);
     CHECK(j["contact_lost"] == false);
-    CHECK(j["sticking"] == false);
+    CHECK(j["stuck_all_period"] == false);
+    CHECK(j["stick_fraction"] == nlohmann::json::array({0.0, 0.0, 0.0}));   // fig4 never sticks
+    CHECK(j["mode_sequence"].size() == 1);
+    CHECK(j["mode_sequence"][0]["mode"] == "slide");
     CHECK(j["periods"].get<int>() > 1);
     CHECK(j["min_normal_force"].get<double>() > 0);
     const Run p = run("twist " + kScenes + "fig1_point.json --at 0.02 0.01");
@@ -84,10 +88,38 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     r = run("simulate " + kScenes + "fig4.json --dynamics full --from 0.02 0.01 0.5 --time 0.5 --out " + sim.string());
     REQUIRE(r.code == 0);
     const std::string s = slurp(sim);
-    CHECK(s.rfind("t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3\n", 0) == 0);
+    CHECK(s.rfind("t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n", 0) == 0);
     r = run("fixed-points " + kScenes + "fig1_point.json --grid 5");
     REQUIRE(r.code == 0);
     CHECK(nlohmann::json::parse(r.out)["lines"].size() == 1);
+}
+
+TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twist reports its stick fractions",
+          "[cli][stick]") {
+    // Issue 14's first check: Fig. 1(a)'s run from rest used to stop at t = 0.00077 s.
+    const fs::path sim = tmpdir() / "fig1.csv";
+    Run r = run("simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 20 --out " + sim.string());
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    std::istringstream in(slurp(sim));
+    std::string line, last;
+    int rows = 0;
+    while (std::getline(in, line)) { last = line; ++rows; }
+    CHECK(rows == 1 + 1601);   // every sample of T/4 up to 20 s
+    // It ends near a stable line of Fig. 1: (0, s_y, 0) or (0, s_y, pi).
+    std::vector<double> v;
+    std::istringstream ls(last);
+    for (std::string c; std::getline(ls, c, ',') && v.size() < 4;) v.push_back(std::stod(c));
+    CHECK(v[0] == Approx(20));
+    CHECK(std::abs(v[1]) < 0.005);
+    CHECK(std::min(std::abs(std::remainder(v[3], 3.14159265358979323846)), 1.0) < 0.05);
+    // A fig6 configuration where contact 1 pivots for part of the cycle.
+    r = run("twist " + kScenes + "fig6.json --at -0.05 0.016666666666666663 4.487989505128276");
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["converged"] == true);
+    CHECK(j["stick_fraction"][0].get<double>() > 0.1);
+    CHECK(j["mode_sequence"].size() > 1);
 }
 
 TEST_CASE("every command has --help", "[cli]") {

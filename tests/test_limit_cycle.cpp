@@ -100,22 +100,31 @@ TEST_CASE("Observation 1: very different initial twists reach the same limit cyc
     }
 }
 
-TEST_CASE("a block sliding on a resting plate sticks at t = v0 / (mu g)", "[limit_cycle][stick]") {
+TEST_CASE("a block sliding on a resting plate sticks at t = v0 / (mu g) and its cycle is stuck, twist exactly 0",
+          "[limit_cycle][stick]") {
     Scene sc;
     sc.name = "block";
     sc.part.point = true;
     sc.part.m = 0.1;
     sc.part.mu.setConstant(0.3);
     sc.plate.T = 0.05;   // no harmonics: the plate rests
-    const double v0 = 0.1;
-    LimitCycleOptions opt;
-    opt.restarts = 0;   // the first start is the block's motion
-    const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), opt, Vec3(v0, 0, 0));
-    REQUIRE(lc.sticking());
-    CHECK_FALSE(lc.converged);
-    // Located by bisection to 1e-14 T (or linear extrapolation) on a velocity that is exactly
-    // linear in t before the stop, so only rounding remains.
-    CHECK(lc.stop.t == Approx(v0 / (0.3 * sc.g)).epsilon(1e-10));
+    const double v0 = 0.1, t_star = v0 / (0.3 * sc.g);   // uniform deceleration mu g
+    // The trajectory: Slide until t*, then Stuck for good (static friction needs nothing).
+    const Trajectory tr = simulate(sc, Dynamics::U, Vec3::Zero(), Vec3(v0, 0, 0), 0.2, 0.01);
+    REQUIRE(tr.stop.reason == StopReason::None);
+    REQUIRE(tr.events.size() == 1u);
+    CHECK(tr.events[0].from.kind == ModeKind::Slide);
+    CHECK(tr.events[0].to.kind == ModeKind::Stuck);
+    // Located on the dense output of a velocity that is exactly linear in t: only rounding remains.
+    CHECK(tr.events[0].t == Approx(t_star).epsilon(1e-10));
+    CHECK(tr.samples.back().q[0] == Approx(v0 * v0 / (2 * 0.3 * sc.g)).epsilon(1e-10));
+    CHECK(tr.samples.back().qd.norm() == 0);
+    // The cycle: the part rides the plate all period long, so the twist is exactly zero.
+    const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), LimitCycleOptions{}, Vec3(v0, 0, 0));
+    REQUIRE(lc.converged);
+    CHECK(lc.stuck_all_period());
+    CHECK(lc.twist.norm() == 0);
+    CHECK(lc.stick_fraction[0] == 1.0);
 }
 
 TEST_CASE("vertical plate acceleration beyond g: contact is lost when p''_z = -g", "[limit_cycle][contact]") {

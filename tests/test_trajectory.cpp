@@ -110,9 +110,20 @@ TEST_CASE("Fig. 4: from rest near the edge, the part goes to the centre along th
                                                << worst_full << " m, " << worst_full_th << " rad");
 }
 
-TEST_CASE("a part that cannot break away is reported stuck, not simulated", "[trajectory][stick]") {
+TEST_CASE("a part that cannot break away rides the plate: stuck all along, not moved", "[trajectory][stick]") {
     Scene sc = scene("fig4");
     for (auto& h : sc.plate.harmonics) h.amp *= 0.05;   // |p''| << mu g
-    const Trajectory t = simulate(sc, Dynamics::U, Vec3::Zero(), Vec3::Zero(), 1.0, 0.1);
-    CHECK(t.stop.reason == StopReason::Sticking);
+    for (Dynamics level : {Dynamics::U, Dynamics::Full}) {
+        const Vec3 q0(0.01, -0.02, 0.3);
+        const Trajectory t = simulate(sc, level, q0, Vec3::Zero(), 1.0, 0.1);
+        REQUIRE(t.stop.reason == StopReason::None);
+        CHECK(t.samples.back().t == Approx(1.0));
+        for (const auto& s : t.samples) {
+            CHECK(s.mode.kind == ModeKind::Stuck);
+            CHECK(s.q == q0);
+            CHECK(s.qd.isZero());
+        }
+        CHECK(t.events.size() == 1u);   // the start: slide -> stuck at t = 0
+        CHECK(t.held_time[0] == Approx(1.0));
+    }
 }

@@ -41,7 +41,7 @@ const char* kUsage =
     "  bench         the speed-accuracy study, written into the report in DIR (--full: the long campaign)\n"
     "\n"
     "SCENE is a JSON scene file (see scenes/). Units are SI. Exit codes: 0 ok, 2 bad input,\n"
-    "3 a simulation left the model's assumptions (contact lost, sticking), 1 other failure.\n";
+    "3 a simulation left the model (a normal force reached zero: the part would fly), 1 other failure.\n";
 
 struct UsageError : std::runtime_error {
     using std::runtime_error::runtime_error;
@@ -266,8 +266,9 @@ int cmd_simulate(int argc, char** argv) {
                      "is within --model-tol E (default 1e-2; of rho and radians) of the scene's part under full\n"
                      "dynamics, measured on this question; the choice and every rung's error go to stderr.\n"
                      "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
-                     "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05). Exit code 3 when\n"
-                     "contact is lost or a contact sticks: the CSV then ends at that time.\n";
+                     "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05), and the contact mode on the\n"
+                     "step that ended there (slide, pivot1-3, stuck: stick-slip is simulated through). Exit code 3\n"
+                     "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n";
         return 0;
     }
     const Scene sc = scene_arg(a);
@@ -306,7 +307,7 @@ int cmd_simulate(int argc, char** argv) {
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); });
     if (tr.stop.reason != StopReason::None) {
         std::cerr << "plate simulate: " << a.pos[0] << ": stopped: " << tr.stop.describe() << std::endl;
-        return 3;
+        return tr.stop.reason == StopReason::ContactLost ? 3 : 1;
     }
     return 0;
 }

@@ -199,6 +199,15 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
         ux[i] = vx[i] * f[i];
         uy[i] = vy[i] * f[i];
     }
+    if (ws.use_hints) {
+        const double hs2 = ws.hint_speed * ws.hint_speed;
+        for (int i = 0; i < nc; ++i) {
+            const double s2 = vx[i] * vx[i] + vy[i] * vy[i];
+            const double along = vx[i] * ws.hint[i].x() + vy[i] * ws.hint[i].y();
+            const bool past_zero = s2 < 0.01 * ws.hint_from[i] * ws.hint_from[i] && (along <= 0 || along * along <= 0.25 * s2);
+            if (s2 <= hs2 || past_zero) { ux[i] = ws.hint[i].x(); uy[i] = ws.hint[i].y(); }
+        }
+    }
     for (int i = nc; i < 3; ++i) ws.slip[i].setZero();
 }
 

@@ -1,9 +1,24 @@
-// Internal: the adaptive stepping loop shared by trajectories and limit cycles.
+// Internal: the adaptive stepping loop shared by trajectories and limit cycles, with stick-slip.
 // Dormand-Prince 5(4) (Boost.Odeint's FSAL stepper) on a scaled state, so that one scalar
-// tolerance is relative for every component, with a PI step-size controller (try_step). After
-// each accepted step the normal forces and contact slips are checked (simulate.hpp lists the stops).
+// tolerance is relative for every component, with a PI step-size controller (try_step).
+//
+// The contact mode (modes.hpp: slide, pivot about a contact, stuck) is part of the state. Each mode
+// has guards that stay positive while it holds: the normal forces; in slide, each contact's slip
+// along its direction at the step's start; in pivot k, mu_k N_k - |f_k| and theta' times the
+// turning sense; in stuck, 1 - gauge. After each accepted step the guards are evaluated at its end;
+// a guard that changed sign is located by the Illinois root finder on the step's dense output
+// (Dormand-Prince's fourth-order interpolant: no re-stepping, one right-hand side per iterate), the
+// step is cut there, and the new mode is chosen (choose_mode) -- the integration goes on from the
+// event in that mode. Only a normal force reaching zero stops the run (the part would fly).
+//
+// Accumulating events (Zeno): a guard is tested only for a sign change from strictly positive (a
+// slip) or from non-negative (a hold), so an event at t* cannot fire again before one step past t*;
+// a burst of more than kBurst events within 1e-9 T ends the run as EventAccumulation with a
+// message, instead of hanging. A slip that merely swings past zero (its component along the step's
+// starting direction changes sign while the slip stays away from zero) is not an event.
 #pragma once
 
+#include "plate/modes.hpp"
 #include "plate/simulate.hpp"
 
 #include <boost/numeric/odeint.hpp>
@@ -13,74 +28,99 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 namespace plate::detail {
 
 namespace odeint = boost::numeric::odeint;
 
-// Model concept: State, kDim, rhs(t, y, dy) (physical units, fills ws), q(y), qd(y),
-// plate(t, y) -> PlateState, scale() -> State of characteristic magnitudes.
+// Model concept: State, level, ws, mode; rhs(t, y, dy) in physical units, in the model's mode (fills
+// ws); q(y), qd(y), set_qd(y, qd); plate(t, y) -> PlateState; scale() -> State of characteristic
+// magnitudes; kStuckFrozen: nothing in the state moves while the part is stuck.
 template <class Model>
 class Engine {
 public:
     using State = typename Model::State;
+    static constexpr int kGuards = 6;   // N_1..N_3, then the mode's own (up to 3)
+    using Guards = std::array<double, kGuards>;
 
     Engine(Model& model, const Scene& scene, const IntegrationOptions& opt)
         : model_(model), scene_(scene), opt_(opt) {
         scale_ = model_.scale();
         for (std::size_t i = 0; i < scale_.size(); ++i) inv_scale_[i] = 1 / scale_[i];
-        eps_slip_ = opt_.slip_eps * scene_.v_ref();
-        eps_arm_ = 1e-3 * scene_.v_ref();
+        v_ref_ = scene_.v_ref();
         h_min_ = opt_.h_min * scene_.plate.T;
+        // Below hint_speed (ten times the integration error of a slip) a sliding contact's friction
+        // keeps its last direction: v/|v| of a slip that small is rounding noise (just after a
+        // break-away its direction is the hint choose_mode set).
+        model_.ws.use_hints = true;
+        model_.ws.hint_speed = std::max(10 * opt_.rtol, 1e-12) * v_ref_;
+        zero_abs_ = std::max(1e3 * opt_.rtol, 1e-9) * v_ref_;
     }
 
-    // Starts at (t0, y0) in physical units. Returns false with stop set if contact is lost at t0.
+    // Starts at (t0, y0) in physical units; the mode follows from the state (a contact with zero slip
+    // is held or breaks away, choose_mode). Returns false with stop set if contact is lost at t0.
     bool start(double t0, const State& y0) {
         t_ = t0;
-        for (std::size_t i = 0; i < y_.size(); ++i) ys_[i] = y0[i] / scale_[i];
-        sys(ys_, fs_, t_);
-        n_ = model_.ws.n;
-        slip_ = model_.ws.slip;
-        for (int i = 0; i < 3; ++i) armed_[i] = slip_[i].norm() > eps_arm_;
-        dt_ = (opt_.h0 > 0 ? opt_.h0 : std::min(1e-3, 1e-2 * std::cbrt(opt_.rtol))) * scene_.plate.T;
-        stats.min_normal_force = min_n();
         stop = StopEvent{};
-        if (stats.min_normal_force < 0) {
-            stop = StopEvent{StopReason::ContactLost, argmin_n(), t_};
-            return false;
-        }
+        dt_ = (opt_.h0 > 0 ? opt_.h0 : std::min(1e-3, 1e-2 * std::cbrt(opt_.rtol))) * scene_.plate.T;
+        State y = y0;
+        if (!classify(y)) return false;
+        stats.min_normal_force = min_n();
         return true;
     }
 
     double t() const { return t_; }
     double next_step() const { return dt_; }   // the step the controller proposes next [s]
+    const Mode& mode() const { return model_.mode; }
     State y() const {
         State y;
         for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys_[i] * scale_[i];
         return y;
     }
     const Vec3& n() const { return n_; }
-    // Overwrites components of the state (e.g. to reset an integral), keeping the time.
+    // Overwrites components of the state (e.g. to reset an integral, or a new start twist), keeping
+    // the time; a changed twist chooses its mode again.
     template <class F> void modify(F&& f) {
         State y = this->y();
+        const Vec3 qd_old = model_.qd(y);
         f(y);
-        for (std::size_t i = 0; i < y.size(); ++i) ys_[i] = y[i] / scale_[i];
-        sys(ys_, fs_, t_);
+        if (model_.qd(y) != qd_old) {
+            if (!classify(y)) return;
+        } else {
+            set(y);
+        }
+    }
+    // Restarts the bookkeeping of held time and mode changes (e.g. at a period's start).
+    void reset_log() {
+        held_time = {0, 0, 0};
+        events.clear();
     }
 
-    // Advances to t_end exactly. on_step(t, y, n) is called after each accepted step.
-    // Returns false if a stop occurred (see `stop`).
+    // Advances to t_end exactly. on_step(t, y, n) is called after each accepted step and at each
+    // event. Returns false if a stop occurred (see `stop`).
     template <class OnStep>
     bool advance(double t_end, OnStep&& on_step) {
+        if (stop.reason != StopReason::None) return false;
+        const double T = scene_.plate.T;
         while (t_ < t_end) {
             if (stats.steps >= opt_.max_steps) {
                 stop = StopEvent{StopReason::StepLimit, -1, t_};
                 return false;
             }
-            const bool clamp = t_ + dt_ >= t_end;
-            double dt = clamp ? t_end - t_ : dt_;
+            // While stuck, the guard (the gauge) is sampled at least 200 times a period.
+            const bool stuck = model_.mode.kind == ModeKind::Stuck;
+            frozen_ = stuck && Model::kStuckFrozen;
+            const double cap = stuck ? T / 200 : std::numeric_limits<double>::infinity();
+            const double want = frozen_ ? cap : std::min(dt_, cap);
+            const bool clamp = t_ + want >= t_end;
+            double dt = clamp ? t_end - t_ : want;
             double t1 = t_;
-            if (!try_step(t1, dt)) {
+            if (frozen_) {
+                t1 = t_ + dt;   // nothing moves: the step is on the guards alone
+                ys1_ = ys_;
+                fs1_ = fs_;
+            } else if (!try_step(t1, dt)) {
                 ++stats.rejected;
                 dt_ = dt;
                 if (dt_ < h_min_) {
@@ -88,21 +128,80 @@ public:
                     return false;
                 }
                 continue;
+            } else {
+                dt_ = clamp ? std::max(dt_, dt) : dt;
             }
             if (clamp) t1 = t_end;   // land on t_end exactly despite rounding
             ++stats.steps;
-            dt_ = clamp ? std::max(dt_, dt) : dt;
             // Diagnostics at the new point: the FSAL stage evaluated it last.
-            if (!(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
+            if (frozen_ || !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
                 sys(ys1_, fs1_, t1);
-            n1_ = model_.ws.n;
-            slip1_ = model_.ws.slip;
-            if (!check(t1)) return false;
-            t_ = t1;
-            ys_ = ys1_;
-            fs_ = fs1_;
-            n_ = n1_;
-            slip_ = slip1_;
+            Guards g1;
+            guards(ys1_, g1);
+            const Vec3 n1 = model_.ws.n;
+            const std::array<Vec2, 3> slip1 = model_.ws.slip;
+            const int nc = scene_.part.contacts();
+            for (int i = 0; i < nc; ++i) stats.min_normal_force = std::min(stats.min_normal_force, n1[i]);
+            // The earliest located event in the step, if any.
+            int ev = -1;
+            double t_ev = std::numeric_limits<double>::infinity();
+            State y_ev{};
+            bool swing = false;
+            for (int i = 0; i < kGuards; ++i) {
+                if (!crossed(i, g0_[i], g1[i])) continue;
+                State yr;
+                const double tr = locate(i, t1, g1[i], yr);
+                if (i >= 3 && model_.mode.kind == ModeKind::Slide && !slip_zero(i - 3, tr, yr)) {
+                    swing = true;   // the slip swung past zero without reaching it
+                    continue;
+                }
+                if (tr < t_ev || (tr == t_ev && i < 3)) { t_ev = tr; ev = i; y_ev = yr; }
+            }
+            if (swing && ev < 0) {
+                // A swing within one step: the step kept the start's friction direction past the
+                // turn (ws.hint_from), so retry it shorter until the turn is resolved.
+                ++stats.rejected;
+                dt_ = 0.5 * (t1 - t_);
+                if (dt_ < h_min_) {
+                    stop = StopEvent{StopReason::StepCollapse, -1, t_};
+                    return false;
+                }
+                sys(ys_, fs_, t_);   // the workspace back at the step's start
+                --stats.steps;
+                continue;
+            }
+            if (ev < 0) {
+                account(t1);
+                t_ = t1;
+                ys_ = ys1_;
+                fs_ = fs1_;
+                n_ = n1;
+                rebase(g1, slip1);
+                // A slip that lingers just above zero (near a grazing stick, where the deceleration
+                // vanishes with the slip, it need not cross zero) makes v/|v| stiff and the steps tiny:
+                // after kLinger steps below zero_abs_ it is taken as zero (the error is below zero_abs_,
+                // i.e. 1e3 rtol v_ref).
+                unsigned linger = 0;
+                if (model_.mode.kind == ModeKind::Slide)
+                    for (int i = 0; i < nc; ++i) {
+                        // (a slip growing away from zero, as after a break-away, does not linger)
+                        const double sn = slip1[i].norm();
+                        low_[i] = sn < zero_abs_ && sn <= slip_prev_[i] ? low_[i] + 1 : 0;
+                        slip_prev_[i] = sn;
+                        if (low_[i] >= kLinger) linger |= 1u << i;
+                    }
+                if (linger) {
+                    for (int i = 0; i < nc; ++i)
+                        if (slip1[i].norm() < zero_abs_) linger |= 1u << i;
+                    if (!try_hold(linger)) return false;
+                }
+                on_step(t_, y(), n_);
+                continue;
+            }
+            account(t_ev);
+            t_ = t_ev;
+            ys_ = y_ev;
+            if (!event(ev)) return false;
             on_step(t_, y(), n_);
         }
         return true;
@@ -110,6 +209,8 @@ public:
 
     StopEvent stop;
     Stats stats;
+    std::array<double, 3> held_time{};   // time each contact had zero slip since reset_log() [s]
+    std::vector<ModeEvent> events;       // mode changes since reset_log()
 
 private:
     struct Sys {
@@ -159,136 +260,289 @@ private:
     }
 
     double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
-    int argmin_n() const {
-        int k = 0;
-        model_.ws.n.head(scene_.part.contacts()).minCoeff(&k);
-        return k;
+
+    // Sets the state (physical units) and evaluates there; the guards' baseline follows.
+    void set(const State& y) {
+        for (std::size_t i = 0; i < y.size(); ++i) ys_[i] = y[i] / scale_[i];
+        std::array<Vec2, 3> v;
+        slip_velocities(scene_.part, model_.q(y), model_.qd(y), v);
+        reference_directions(v);
+        sys(ys_, fs_, t_);
+        n_ = model_.ws.n;
+        guards(ys_, g0_);
     }
 
-    // The state one Dormand-Prince step of size tau from the last accepted point; ws is left
-    // evaluated there. The step is accurate up to the first event in it: the right-hand side is
-    // smooth before it.
-    State probe(double tau) {
-        State out, dout;
-        stepper_.do_step(sysref(), ys_, fs_, t_, out, dout, tau);
-        for (std::size_t i = 0; i < out.size(); ++i) out[i] *= scale_[i];
-        return out;
-    }
-    // First root of g (read from ws after a probe) in (t_, t1], with g > 0 at t_ and g <= 0 at
-    // t1, by bisection to 1e-14 T. Returns the time; y_at receives the state there.
-    template <class G>
-    double refine(double t1, G&& g, State& y_at) {
-        double a = 0, b = t1 - t_;
-        y_at = probe(b);
-        for (int it = 0; it < 80 && b - a > 1e-14 * scene_.plate.T; ++it) {
-            const double m = 0.5 * (a + b);
-            const State ym = probe(m);
-            if (g() > 0) a = m;
-            else { b = m; y_at = ym; }
-        }
-        return t_ + b;
-    }
-
-    // Event checks over the accepted step [t_, t1]; n1_ and slip1_ hold the evaluation at t1.
-    bool check(double t1) {
+    // Chooses the mode of state y at t_ (contacts with zero slip are held or break away) and sets it.
+    bool classify(State& y) {
         const int nc = scene_.part.contacts();
-        const Vec3 n1 = n1_;
-        // Contact loss: first contact whose N crosses zero (linear interpolation in the step).
-        double t_loss = std::numeric_limits<double>::infinity();
-        int k_loss = -1;
-        for (int i = 0; i < nc; ++i) {
-            stats.min_normal_force = std::min(stats.min_normal_force, n1[i]);
-            if (n1[i] < 0) {
-                const double tl = t_ + (t1 - t_) * n_[i] / (n_[i] - n1[i]);
-                if (tl < t_loss) { t_loss = tl; k_loss = i; }
-            }
-        }
-        // Zero slip: closest approach of the slip velocity to zero within the step.
-        const auto slip1 = slip1_;
-        double t_zero = std::numeric_limits<double>::infinity();
-        double lam_zero = 0;
-        int zeros = 0, k_zero = -1;
-        for (int i = 0; i < nc; ++i) {
-            const Vec2 v0 = slip_[i], dv = slip1[i] - slip_[i];
-            const double dd = dv.squaredNorm();
-            const double lam = dd > 0 ? std::clamp(-v0.dot(dv) / dd, 0.0, 1.0) : 1.0;
-            // A contact is armed once its slip has exceeded eps_arm_ since the start or the last
-            // event: a start at rest (all slips zero) or a reversal just passed is not a new event.
-            if (slip1[i].norm() > eps_arm_) {
-                armed_[i] = true;
-                band_steps_[i] = 0;
-            } else if (++band_steps_[i] > kChatterSteps) {
-                // The slip has stayed near zero for many steps: the integrator chatters about
-                // v_i = 0, i.e. the Filippov solution slides on v_i = 0 -- the contact sticks.
-                stop = StopEvent{StopReason::Sticking, i, t1};
+        std::array<Vec2, 3> v;
+        slip_velocities(scene_.part, model_.q(y), model_.qd(y), v);
+        unsigned zero = 0;
+        for (int i = 0; i < nc; ++i)
+            if (v[i].norm() <= 1e-14 * v_ref_) zero |= 1u << i;
+        const Mode from = model_.mode;
+        if (zero == 0) {
+            model_.mode = Mode{};
+        } else {
+            Vec3 qd = model_.qd(y);
+            const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
+            if (c.lost) {
+                stop = StopEvent{StopReason::ContactLost, c.lost_contact, t_};
                 return false;
             }
-            if (armed_[i] && lam > 0 && (v0 + lam * dv).norm() < eps_slip_) {
-                ++zeros;
-                const double tz = t_ + lam * (t1 - t_);
-                if (tz < t_zero) { t_zero = tz; lam_zero = lam; k_zero = i; }
-            }
+            model_.mode = c.mode;
+            model_.set_qd(y, qd);
         }
-        State y_ev;
-        if (k_loss >= 0 && t_loss <= t_zero) {
-            if (n_[k_loss] > 0) t_loss = refine(t1, [&] { return model_.ws.n[k_loss]; }, y_ev);
-            stop = StopEvent{StopReason::ContactLost, k_loss, t_loss};
+        set(y);
+        if (min_n() < 0) {
+            int k = 0;
+            model_.ws.n.head(nc).minCoeff(&k);
+            stop = StopEvent{StopReason::ContactLost, k, t_};
             return false;
         }
-        if (k_zero >= 0) {
-            // Locate the zero of the slip component along its direction at t_ (exact up to the
-            // step's local error), unless the slip was already negligible there.
-            const Vec2 v0 = slip_[k_zero];
-            if (v0.norm() > eps_slip_) {
-                const Vec2 dir = v0.normalized();
-                const double g0 = v0.dot(dir), g1 = slip1[k_zero].dot(dir);
-                if (g1 <= 0) {
-                    t_zero = refine(t1, [&] { return model_.ws.slip[k_zero].dot(dir); }, y_ev);
-                } else {
-                    // Not yet through zero, but below eps_slip: the zero lies just ahead, where
-                    // the slip extrapolates (linearly over the step) to zero.
-                    t_zero = g0 > g1 ? t1 + g1 * (t1 - t_) / (g0 - g1) : t1;
-                    for (std::size_t i = 0; i < y_ev.size(); ++i) y_ev[i] = ys1_[i] * scale_[i];
+        if (model_.mode != from) log_event(from);
+        return true;
+    }
+
+    void log_event(const Mode& from) {
+        events.push_back(ModeEvent{t_, from, model_.mode});
+        ++stats.mode_switches;
+        burst_ = t_ - last_event_t_ <= 1e-9 * scene_.plate.T ? burst_ + 1 : 0;
+        last_event_t_ = t_;
+    }
+
+    // The unit slip directions at the step's start, against which the slide guards are measured.
+    void reference_directions(const std::array<Vec2, 3>& slip) {
+        for (int i = 0; i < 3; ++i) {
+            const double s = slip[i].norm();
+            ref_[i] = s > model_.ws.hint_speed ? Vec2(slip[i] / s) : model_.ws.hint[i];
+            // The friction direction a slip keeps near zero within the next step (dynamics.hpp).
+            if (model_.mode.kind == ModeKind::Slide) {
+                model_.ws.hint[i] = ref_[i];
+                model_.ws.hint_from[i] = s;
+            }
+        }
+    }
+    // The guards' baseline at a new step start: g, with the slide guards measured along the new
+    // reference directions.
+    void rebase(const Guards& g, const std::array<Vec2, 3>& slip) {
+        // The derivative at the new start was evaluated with the last step's directions: where a slip
+        // fell below a tenth of its speed at that step's start, evaluate it again with the new ones.
+        bool again = false;
+        if (model_.mode.kind == ModeKind::Slide)
+            for (int i = 0; i < scene_.part.contacts(); ++i) again |= slip[i].norm() < 0.1 * model_.ws.hint_from[i];
+        reference_directions(slip);
+        if (again) sys(ys_, fs_, t_);
+        g0_ = g;
+        if (model_.mode.kind == ModeKind::Slide)
+            for (int i = 0; i < scene_.part.contacts(); ++i) g0_[3 + i] = slip[i].dot(ref_[i]);
+    }
+
+    // Guards at scaled state ys (evaluated: ws already holds the evaluation there).
+    void guards(const State& ys, Guards& g) {
+        const int nc = scene_.part.contacts();
+        const Workspace& ws = model_.ws;
+        for (int i = 0; i < 3; ++i) g[i] = i < nc ? ws.n[i] : 1.0;
+        g[3] = g[4] = g[5] = 1.0;
+        const Mode& m = model_.mode;
+        switch (m.kind) {
+            case ModeKind::Slide:
+                for (int i = 0; i < nc; ++i) g[3 + i] = ws.slip[i].dot(ref_[i]);
+                break;
+            case ModeKind::Pivot: {
+                State y;
+                for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys[i] * scale_[i];
+                g[3] = scene_.part.mu[m.k] * ws.n[m.k] - ws.f_held[m.k].norm();
+                g[4] = model_.qd(y)[2] * m.sense;
+                break;
+            }
+            case ModeKind::Stuck: {
+                State y;
+                for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys[i] * scale_[i];
+                g[3] = 1 - friction_gauge(scene_.part, model_.q(y)[2], ws.n, ws.F_needed, ws.tau_needed).gamma;
+                break;
+            }
+        }
+    }
+
+    // Has guard i changed sign over the step? Slips must leave a strictly positive value; holds
+    // (normal forces, the static friction margin, the pivot's turning) are violated below zero.
+    bool crossed(int i, double g0, double g1) const {
+        const bool slip = i >= 3 && model_.mode.kind == ModeKind::Slide;
+        return slip ? (g0 > 0 && g1 <= 0) : (g0 >= 0 && g1 < 0);
+    }
+
+    // The state at time t in the last step, scaled (dense output; constant while frozen).
+    void dense(double t, double t1, State& out) {
+        if (frozen_) { out = ys_; return; }
+        stepper_.calc_state(t, out, ys_, fs_, t_, ys1_, fs1_, t1);
+    }
+
+    // First root of guard i in (t_, t1] (Illinois on the dense output) to 1e-13 T; yr receives the
+    // scaled state at the returned time, where the guard is already violated.
+    double locate(int i, double t1, double g1, State& yr) {
+        double a = t_, b = t1, ga = g0_[i], gb = g1;
+        yr = ys1_;
+        int side = 0;
+        State ym, dym;
+        Guards gm;
+        for (int it = 0; it < 200 && b - a > 1e-13 * scene_.plate.T; ++it) {
+            double m = gb != ga ? (a * gb - b * ga) / (gb - ga) : 0.5 * (a + b);
+            if (!(m > a && m < b) || it % 8 == 7) m = 0.5 * (a + b);   // a bisection now and then
+            dense(m, t1, ym);
+            sys(ym, dym, m);
+            guards(ym, gm);
+            if (crossed(i, ga, gm[i])) {
+                b = m; gb = gm[i]; yr = ym;
+                if (side == -1) ga *= 0.5;
+                side = -1;
+            } else {
+                a = m; ga = gm[i];
+                if (side == 1) gb *= 0.5;
+                side = 1;
+            }
+        }
+        return b;
+    }
+
+    // Did contact k's slip really reach zero at the root of its guard (rather than swing past zero)?
+    bool slip_zero(int k, double t, const State& yr) {
+        State dy;
+        sys(yr, dy, t);
+        return model_.ws.slip[k].norm() <= std::max(1e-3 * slip0_norm(k), zero_abs_);
+    }
+    double slip0_norm(int k) const { return std::abs(g0_[3 + k]); }
+
+    void account(double t1) {
+        for (int i = 0; i < 3; ++i)
+            if (model_.mode.holds(i)) held_time[i] += t1 - t_;
+    }
+
+    // Handles event ev at (t_, ys_): stops (contact lost) or chooses the next mode.
+    bool event(int ev) {
+        const int nc = scene_.part.contacts();
+        if (ev < 3) {
+            stop = StopEvent{StopReason::ContactLost, ev, t_};
+            sys(ys_, fs_, t_);
+            n_ = model_.ws.n;
+            return false;
+        }
+        State y = this->y();
+        const Vec3 q = model_.q(y);
+        Vec3 qd = model_.qd(y);
+        const PlateState ps = model_.plate(t_, y);
+        const Mode from = model_.mode;
+        Workspace& ws = model_.ws;
+        unsigned zero = 0;
+        bool hold = true;
+        (void)nc;
+        switch (from.kind) {
+            case ModeKind::Slide: {
+                std::array<Vec2, 3> v;
+                slip_velocities(scene_.part, q, qd, v);
+                zero = 1u << (ev - 3);
+                for (int i = 0; i < nc; ++i)
+                    if (v[i].norm() <= std::max(1e-3 * slip0_norm(i), zero_abs_)) zero |= 1u << i;
+                return slide_zero(zero);
+            }
+            case ModeKind::Pivot:
+                if (ev == 3 && std::abs(qd[2]) > 1e-14 * v_ref_ / scene_.part.rho()) {
+                    // Contact k breaks away, opposite the static friction it carried (the rim's force).
+                    mode_accelerations(scene_, model_.level, q, qd, ps, from, ws);
+                    const Vec2 f = ws.f_held[from.k];
+                    std::array<Vec2, 3> v;
+                    slip_velocities(scene_.part, q, qd, v);
+                    qd.head<2>() -= v[from.k];
+                    ws.hint[from.k] = f.norm() > 0 ? Vec2(-f / f.norm()) : Vec2::Zero();
+                    model_.mode = Mode{};
+                    model_.set_qd(y, qd);
+                    set(y);
+                    log_event(from);
+                    return check_burst();
                 }
-            } else {
-                const State y0 = y();
-                for (std::size_t i = 0; i < y_ev.size(); ++i) y_ev[i] = y0[i] + lam_zero * (ys1_[i] * scale_[i] - y0[i]);
-            }
-            const Vec3 q = model_.q(y_ev), qd = model_.qd(y_ev);
-            const PlateState ps = model_.plate(t_zero, y_ev);
-            bool sticks;
-            if (zeros >= 2 && !scene_.part.point) {
-                // Several contacts at zero slip together: could the whole part ride with the plate?
-                sticks = stick_test_all(scene_, model_.level, q, qd, ps).sticks;
-            } else {
-                sticks = stick_test(scene_, model_.level, k_zero, q, qd, ps).sticks;
-            }
-            if (sticks) {
-                stop = StopEvent{StopReason::Sticking, k_zero, t_zero};
-                return false;
-            }
-            ++stats.slip_reversals;
-            armed_[k_zero] = false;
+                zero = 7;   // theta' reached zero: every slip is zero
+                break;
+            case ModeKind::Stuck:
+                zero = 7;
+                hold = false;   // the gauge crossed 1: break away
+                break;
+        }
+        return switch_mode(zero, hold);
+    }
+
+    // A lingering slip: held (pivot, stuck) if static friction can hold it there; else slide on.
+    bool try_hold(unsigned zero) {
+        low_ = {0, 0, 0};
+        State y = this->y();
+        Vec3 qd = model_.qd(y);
+        const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
+        if (!c.lost && c.mode.kind != ModeKind::Slide) {
+            const Mode from = model_.mode;
+            model_.mode = c.mode;
+            model_.set_qd(y, qd);
+            set(y);
+            log_event(from);
+            return check_burst();
+        }
+        set(y);   // nothing changes: restore the workspace
+        return true;
+    }
+
+    // The slips of the contacts `zero` reached zero while sliding.
+    bool slide_zero(unsigned zero) {
+        low_ = {0, 0, 0};
+        return switch_mode(zero, true);
+    }
+
+    // Chooses the mode at (t_, ys_) with the contacts `zero` at zero slip and goes on in it.
+    bool switch_mode(unsigned zero, bool hold) {
+        State y = this->y();
+        const Vec3 q = model_.q(y);
+        Vec3 qd = model_.qd(y);
+        const Mode from = model_.mode;
+        Workspace& ws = model_.ws;
+        const ModeChoice c = choose_mode(scene_, model_.level, q, qd, model_.plate(t_, y), zero, ws, hold);
+        if (c.lost) {
+            stop = StopEvent{StopReason::ContactLost, c.lost_contact, t_};
+            sys(ys_, fs_, t_);
+            n_ = ws.n;
+            return false;
+        }
+        if (from.kind == ModeKind::Slide && c.mode.kind == ModeKind::Slide) ++stats.slip_reversals;
+        model_.mode = c.mode;
+        model_.set_qd(y, qd);
+        set(y);
+        log_event(from);
+        return check_burst();
+    }
+
+    bool check_burst() {
+        if (burst_ > kBurst) {
+            stop = StopEvent{StopReason::EventAccumulation, -1, t_};
+            return false;
         }
         return true;
     }
 
+    static constexpr int kBurst = 1000;
+    static constexpr int kLinger = 4;
+    std::array<int, 3> low_{};
+    std::array<double, 3> slip_prev_{};
     Model& model_;
     const Scene& scene_;
     IntegrationOptions opt_;
     odeint::runge_kutta_dopri5<State> stepper_;
     State err_{};
     double log_err_old_ = std::log(1e-4);
-    State scale_{}, inv_scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, y_{}, last_y_{};
+    State scale_{}, inv_scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, last_y_{};
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
-    double eps_slip_ = 0, eps_arm_ = 0, h_min_ = 0;
-    std::array<bool, 3> armed_{};
-    std::array<long, 3> band_steps_{};
-    // Accepted steps with a slip below eps_arm_ that count as a stuck contact. A transversal
-    // reversal crosses that band in a few steps (dopri5 resolves the kink in ~10-30).
-    static constexpr long kChatterSteps = 400;
-    Vec3 n_ = Vec3::Zero(), n1_ = Vec3::Zero();
-    std::array<Vec2, 3> slip_{}, slip1_{};
+    double v_ref_ = 0, h_min_ = 0, zero_abs_ = 0;
+    bool frozen_ = false;
+    Guards g0_{};
+    std::array<Vec2, 3> ref_{};
+    Vec3 n_ = Vec3::Zero();
+    int burst_ = 0;
+    double last_event_t_ = -std::numeric_limits<double>::infinity();
 };
 
 // Exponential coordinates of the plate orientation: R1 = exp(phi^). With the spatial angular

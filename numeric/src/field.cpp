@@ -68,6 +68,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         p.min_normal_force = lc.min_normal_force;
         p.stop = lc.stop.reason;
         p.rhs_evals = lc.stats.rhs_evals;
+        p.stick_fraction = lc.stick_fraction;
         if (lc.converged) start[idx] = lc.qd_start.cwiseQuotient(S);
         const int d = ++done;
         if (opt.progress) {
@@ -172,7 +173,7 @@ Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double 
     };
     try {
         Vec3 k1 = F(q);
-        tr.samples.push_back(Sample{0, q, k1, Vec3::Constant(std::numeric_limits<double>::quiet_NaN())});
+        tr.samples.push_back(Sample{0, q, k1, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), Mode{}});
         const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
         for (long s = 1; s <= count; ++s) {
             const double ts = std::min(s * sample_dt, duration);
@@ -183,7 +184,7 @@ Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double 
                 t += dt;
                 k1 = F(q);
             }
-            tr.samples.push_back(Sample{ts, q, k1, Vec3::Constant(std::numeric_limits<double>::quiet_NaN())});
+            tr.samples.push_back(Sample{ts, q, k1, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), Mode{}});
         }
     } catch (const FieldUndefined& e) {
         tr.stop = StopEvent{e.reason, -1, t};

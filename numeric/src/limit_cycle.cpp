@@ -67,6 +67,16 @@ Vec3 anderson_next(const std::deque<Vec3>& X, const std::deque<Vec3>& F) {
     return x;
 }
 
+// The stick bookkeeping of the period that just ended: per-contact stick fractions, the mode at
+// its start and its mode changes (times from the period's start).
+template <class E>
+void record_modes(LimitCycleSummary& out, const E& e, const Mode& start_mode, double t_start, double T) {
+    for (int i = 0; i < 3; ++i) out.stick_fraction[i] = e.held_time[i] / T;
+    out.start_mode = start_mode;
+    out.mode_events = e.events;
+    for (ModeEvent& ev : out.mode_events) ev.t -= t_start;
+}
+
 LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
     detail::ReducedModel model(sc, q0);
     detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
@@ -79,17 +89,12 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
     detail::ReducedModel::State y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0};
     Vec3 prev = qd_init;
     double r_prev = std::numeric_limits<double>::quiet_NaN();
-    // From rest the part rides with the plate until it breaks away (simulate.hpp).
-    const double t0 = qd_init.isZero() ? breakaway_time(sc, q0, 0) : 0.0;
-    if (std::isnan(t0)) {
-        out.stop = StopEvent{StopReason::Sticking, 0, 0};
-        return out;
-    }
-    if (opt.record) out.path.push_back(Sample{t0, q0, qd_init, Vec3::Zero()});
+    // From rest the part rides with the plate while friction holds it (the engine's stuck mode).
+    const double t0 = 0.0;
     if (e.start(t0, y)) {
-        if (opt.record) out.path.back().n = e.n();
+        if (opt.record) out.path.push_back(Sample{t0, q0, model.qd(e.y()), e.n(), e.mode()});
         auto record = [&](double t, const auto& z, const Vec3& n) {
-            if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n});
+            if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n, e.mode()});
         };
         // Periods are the windows [kT, (k+1)T]: after a breakaway at t0 > 0, first reach the
         // next period boundary, so that every cycle state (and warm start) has phase 0.
@@ -103,6 +108,8 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
         bool extrapolated = false;   // did the period just integrated start from an extrapolation?
         for (int k = 1; ok && k <= opt.max_periods; ++k) {
             e.modify([](auto& z) { z[3] = z[4] = z[5] = 0; });
+            e.reset_log();
+            const Mode start_mode = e.mode();
             double min_n = e.n().head(sc.part.contacts()).minCoeff();
             ok = e.advance(t_first + k * T, [&](double t, const auto& z, const Vec3& n) {
                 min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
@@ -114,6 +121,7 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
             y = e.y();
             const Vec3 qd = model.qd(y);
             out.twist = Vec3(y[3], y[4], y[5]) / T;   // (36)
+            record_modes(out, e, start_mode, t_first + (k - 1) * T, T);
             out.qd_start = prev;
             const double r = ((qd - prev).array() / scale.array()).abs().maxCoeff();
             out.residual = r;
@@ -335,6 +343,12 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         // Jacobian per step: a chord needs no more, and the error estimate allows for it.
         Mat3 Phi = Mat3::Identity(), Psi = Mat3::Zero(), J;
         double t_prev = e.t();
+        const long switches = e.stats.mode_switches;
+        // The variational equations below are those of sliding: a period with a change of contact
+        // mode (or that starts held) is left to Anderson's iteration (limit_cycle falls back), whose
+        // periods converge in one step where the part sticks fully (the state after a full stick does
+        // not depend on the start).
+        if (e.mode().kind != ModeKind::Slide) break;
         if (refresh) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
         double min_n = e.n().head(nc).minCoeff();
         ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
@@ -350,7 +364,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
             t_prev = t;
         });
         out.periods = k + 1;
-        if (!ok) break;
+        if (!ok || e.stats.mode_switches != switches) break;
         const auto z = e.y();
         if (refresh) {
             M = S.asDiagonal().inverse() * Phi * S.asDiagonal();
@@ -444,7 +458,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     const Vec3 kicks[] = {Vec3(v, 0, 0), Vec3(0, v, 0), Vec3(0, 0, sc.part.point ? 0 : w)};
     std::vector<StopEvent> stops;
     Stats total = out.stats;
-    for (int r = 0; r < std::min(opt.restarts, 3) && out.sticking(); ++r) {
+    for (int r = 0; r < std::min(opt.restarts, 3) && out.contact_lost(); ++r) {
         stops.push_back(out.stop);
         out = one_start(sc, q0, opt, r == 2 && sc.part.point ? Vec3(-v, -v, 0) : kicks[r]);
         total += out.stats;

@@ -17,10 +17,12 @@ struct Scales {
 
 struct ReducedModel {
     using State = std::array<double, 6>;
+    static constexpr bool kStuckFrozen = true;
     const Scene& sc;
     Vec3 q0;
     Dynamics level = Dynamics::ReducedU;
     Workspace ws;
+    Mode mode;
     ReducedModel(const Scene& s, const Vec3& q) : sc(s), q0(q) {}
 
     // u(t) of the last evaluation (shooting's Jacobian on an accepted step reuses it).
@@ -31,11 +33,12 @@ struct ReducedModel {
         const Vec3 qd(y[0], y[1], y[2]);
         ps_last = plate(t, y);
         t_last = t;
-        accelerations(sc, level, q0, qd, ps_last, ws);
+        mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
     }
     Vec3 q(const State&) const { return q0; }
     Vec3 qd(const State& y) const { return Vec3(y[0], y[1], y[2]); }
+    void set_qd(State& y, const Vec3& v) const { y[0] = v[0]; y[1] = v[1]; y[2] = v[2]; }
     PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
     PlateState plate_at(double t) const { return t == t_last ? ps_last : plate_state(sc.plate, t, level); }
     State scale() const {
@@ -47,17 +50,20 @@ struct ReducedModel {
 
 struct UModel {
     using State = std::array<double, 6>;
+    static constexpr bool kStuckFrozen = true;
     const Scene& sc;
     Dynamics level = Dynamics::U;
     Workspace ws;
+    Mode mode;
     explicit UModel(const Scene& s) : sc(s) {}
 
     void rhs(double t, const State& y, State& dy) {
-        accelerations(sc, level, q(y), qd(y), plate(t, y), ws);
+        mode_accelerations(sc, level, q(y), qd(y), plate(t, y), mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; }
     }
     Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
+    void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }
     PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
     State scale() const {
         const Scales s(sc);
@@ -67,19 +73,22 @@ struct UModel {
 
 struct FullModel {
     using State = std::array<double, 9>;
+    static constexpr bool kStuckFrozen = false;   // the plate's orientation phi moves
     const Scene& sc;
     Dynamics level = Dynamics::Full;
     Workspace ws;
+    Mode mode;
     explicit FullModel(const Scene& s) : sc(s) {}
 
     void rhs(double t, const State& y, State& dy) {
         const PlateState ps = plate(t, y);
-        accelerations(sc, level, q(y), qd(y), ps, ws);
+        mode_accelerations(sc, level, q(y), qd(y), ps, mode, ws);
         const Vec3 phid = dexp_inv(Vec3(y[6], y[7], y[8]), ps.w1);
         for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; dy[6 + i] = phid[i]; }
     }
     Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
+    void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }
     PlateState plate(double t, const State& y) const {
         return plate_state(sc.plate, t, level, exp_so3(Vec3(y[6], y[7], y[8])));
     }

@@ -22,6 +22,12 @@ json vec(const Vec3& v, int n) {
     return a;
 }
 
+json stick_fractions(const std::array<double, 3>& f, int n) {
+    json a = json::array();
+    for (int i = 0; i < n; ++i) a.push_back(num(f[i]));
+    return a;
+}
+
 json eig(const Eigen::Vector3cd& e, int n) {
     json a = json::array();
     for (int i = 0; i < n; ++i) a.push_back({num(e[i].real()), num(e[i].imag())});
@@ -43,7 +49,17 @@ json to_json(const Scene& sc, const Vec3& q, const LimitCycleSummary& lc) {
     j["error_estimate"] = num(lc.error_estimate);
     j["contraction_per_period"] = num(lc.contraction);
     j["contact_lost"] = lc.contact_lost();
-    j["sticking"] = lc.sticking();
+    // Stick-slip over the cycle's last period (modes.hpp).
+    j["stick_fraction"] = stick_fractions(lc.stick_fraction, sc.part.contacts());
+    json modes = json::array();
+    if (lc.converged) {
+        modes.push_back({{"t", 0.0}, {"mode", mode_name(lc.start_mode)}});
+        for (const ModeEvent& e : lc.mode_events) modes.push_back({{"t", num(e.t)}, {"mode", mode_name(e.to)}});
+    }
+    j["mode_sequence"] = modes;
+    j["stuck_all_period"] = lc.stuck_all_period();
+    if (lc.stuck_all_period())
+        j["stuck_note"] = "the part rides the plate all period long (static friction holds it): the asymptotic twist is exactly zero";
     j["stop"] = stop_name(lc.stop.reason);
     if (lc.stop.reason != StopReason::None) {
         j["stop_message"] = lc.stop.describe();
@@ -77,7 +93,8 @@ json to_json(const Scene& sc, const Field& f) {
     for (const auto& p : f.points) {
         pts.push_back({{"at", vec(p.q, d)}, {"twist", vec(p.twist, d)}, {"converged", p.converged},
                        {"periods", p.periods}, {"residual", num(p.residual)},
-                       {"min_normal_force", num(p.min_normal_force)}, {"stop", stop_name(p.stop)}});
+                       {"min_normal_force", num(p.min_normal_force)}, {"stop", stop_name(p.stop)},
+                       {"stick_fraction", stick_fractions(p.stick_fraction, d == 2 ? 1 : 3)}});
     }
     j["points"] = pts;
     return j;
@@ -108,8 +125,8 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
 
 void write_field_csv(std::ostream& out, const Field& f) {
     out << std::setprecision(12);
-    if (f.point_part) out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop\n";
-    else out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop\n";
+    if (f.point_part) out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop,stick_1\n";
+    else out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop,stick_1,stick_2,stick_3\n";
     auto v = [](double x) { return std::isfinite(x) ? std::to_string(x) : std::string("nan"); };
     for (const auto& p : f.points) {
         out << p.q[0] << ',' << p.q[1] << ',';
@@ -117,20 +134,23 @@ void write_field_csv(std::ostream& out, const Field& f) {
         out << v(p.twist[0]) << ',' << v(p.twist[1]) << ',';
         if (!f.point_part) out << v(p.twist[2]) << ',';
         out << (p.converged ? 1 : 0) << ',' << p.periods << ',' << p.residual << ',' << p.min_normal_force << ','
-            << stop_name(p.stop) << '\n';
+            << stop_name(p.stop);
+        for (int i = 0; i < (f.point_part ? 1 : 3); ++i) out << ',' << v(p.stick_fraction[i]);
+        out << '\n';
     }
 }
 
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part) {
     out << std::setprecision(12);
-    if (point_part) out << "t,s_x,s_y,s_x_dot,s_y_dot,N1\n";
-    else out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3\n";
+    if (point_part) out << "t,s_x,s_y,s_x_dot,s_y_dot,N1,mode\n";
+    else out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n";
     for (const auto& s : tr.samples) {
         out << s.t << ',' << s.q[0] << ',' << s.q[1] << ',';
         if (!point_part) out << s.q[2] << ',';
         out << s.qd[0] << ',' << s.qd[1] << ',';
-        if (!point_part) out << s.qd[2] << ',' << s.n[0] << ',' << s.n[1] << ',' << s.n[2] << '\n';
-        else out << s.n[0] << '\n';
+        if (!point_part) out << s.qd[2] << ',' << s.n[0] << ',' << s.n[1] << ',' << s.n[2];
+        else out << s.n[0];
+        out << ',' << mode_name(s.mode) << '\n';
     }
 }
 

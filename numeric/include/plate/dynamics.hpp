@@ -72,6 +72,20 @@ struct Workspace {
     Vec3 n = Vec3::Zero();                 // [N1, N2, N3] (point part: N1 only)
     std::array<Vec2, 3> slip{};            // sliding velocity of each contact, P frame (text after 14)
     long evals = 0;                        // number of evaluations (right-hand sides)
+    // Stick-slip (modes.hpp). A sliding contact whose slip speed is at most hint_speed takes the
+    // unit direction hint[i] instead of v_i/|v_i| (undefined at zero slip): the direction in which a
+    // contact that has just broken away starts to slip. use_hints = false skips the test.
+    // Within a step the engine also passes each sliding contact's direction at the step's start
+    // (hint) and speed (hint_from): a slip that has fallen below a tenth of that speed and turned by
+    // more than 60 degrees has passed through zero within the step, and keeps the start's direction,
+    // so that the step across the zero is smooth and the event is located on its dense output.
+    bool use_hints = false;
+    double hint_speed = 0;
+    std::array<Vec2, 3> hint{};
+    std::array<double, 3> hint_from{};
+    std::array<Vec2, 3> f_held{};          // static friction of held contacts (pivot, stuck) [N], P frame
+    Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate
+    double tau_needed = 0;                 // stuck: its moment about s (z)
 };
 
 // Solves for q''_part and n at configuration q = (s_x, s_y, theta) and twist qd: the production

@@ -35,6 +35,7 @@ struct FieldPoint {
     double min_normal_force = 0;
     StopReason stop = StopReason::None;
     long rhs_evals = 0;
+    std::array<double, 3> stick_fraction{};   // of the cycle's period, per contact (modes.hpp)
 };
 
 struct Field {

@@ -39,10 +39,10 @@ struct LimitCycleOptions {
     double tol = 1e-7;          // accepted distance to the cycle, relative to v_ref
     int max_periods = 400;      // then "not converged"
     bool record = false;        // keep every accepted step (for plots and tests)
-    // Observation 1 makes the cycle independent of the initial twist. When a contact sticks
-    // before the cycle is reached (a transient the sliding model cannot follow), start again
-    // from other twists (slip speed v_ref along x, then y, then a spin) up to this many times.
-    // A cycle that sticks from every start is reported as sticking.
+    // Observation 1 makes the cycle independent of the initial twist. When contact is lost in the
+    // transient (a part released at rest can tip where its sliding cycle does not), start again from
+    // other twists (slip speed v_ref along x, then y, then a spin) up to this many times. A cycle
+    // that loses contact from every start is reported as contact lost.
     int restarts = 3;
     CycleSolver solver = CycleSolver::Shooting;   // the fastest on fig4's field (plate bench)
     int anderson_memory = 3;
@@ -63,9 +63,18 @@ struct LimitCycleSummary {
     double min_normal_force = 0;   // smallest N_i over the last period [N]
     double step_hint = 0;          // the step proposed at the end, relative to T: a first step
                                    // (IntegrationOptions::h0) for a neighbouring configuration
+    // Stick-slip over the cycle's last period: the fraction of the period each contact had zero slip
+    // (held: stuck, or the pivot), the mode at the period's start and every change of mode (t from
+    // the period's start). A part stuck all period long has stick fractions 1 and twist exactly 0.
+    std::array<double, 3> stick_fraction{};
+    Mode start_mode;
+    std::vector<ModeEvent> mode_events;
+    bool stuck_all_period() const {
+        return converged && start_mode.kind == ModeKind::Stuck && mode_events.empty();
+    }
     StopEvent stop;
     Stats stats;                   // accumulated over restarts
-    int restarts = 0;              // starts abandoned because a contact stuck in the transient
+    int restarts = 0;              // starts abandoned because contact was lost in the transient
     std::vector<StopEvent> transient_stops;   // why each abandoned start stopped
     std::vector<Sample> path;      // with record: every accepted step from t = 0
     std::string note;              // why no cycle was sought, if so

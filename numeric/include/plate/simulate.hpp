@@ -1,17 +1,19 @@
-// Integrating the dynamics in time: U- and full-dynamics trajectories (Section III-F/G),
-// with the model's assumptions watched at every accepted step.
+// Integrating the dynamics in time: U- and full-dynamics trajectories (Section III-F/G), through
+// stick-slip (modes.hpp): the part slides, pivots about a contact or rides the plate, and the
+// engine locates each change of mode as an event.
 //
 // Stops (never silently integrated through):
-//   ContactLost  a normal force N_i < 0 (Section III-F)
-//   Sticking     a contact reaches zero slip and static friction could hold it (Section IV-E)
-//   StepCollapse the adaptive step fell below h_min (the method cannot resolve the motion)
-//   StepLimit    more than max_steps steps
-//   NotConverged (limit cycles, fields) no cycle within the period cap
-// A contact whose slip passes through zero while friction cannot hold it (a slip reversal)
-// is a legitimate Coulomb transition: it is counted, not a stop.
+//   ContactLost        a normal force N_i reaches zero (the part would fly; Section III-F)
+//   StepCollapse       the adaptive step fell below h_min (the method cannot resolve the motion)
+//   StepLimit          more than max_steps steps
+//   EventAccumulation  more than a thousand mode changes within 1e-9 T (a Zeno point)
+//   NotConverged       (limit cycles, fields) no cycle within the period cap
+//   Sticking           only from the methods of the speed study that have no stick-slip model
+//                      (methods.hpp); the engine itself never stops at a stick
 #pragma once
 
 #include "plate/dynamics.hpp"
+#include "plate/modes.hpp"
 #include "plate/model.hpp"
 
 #include <string>
@@ -28,7 +30,7 @@ struct IntegrationOptions {
     long max_steps = 20'000'000;
 };
 
-enum class StopReason { None, ContactLost, Sticking, StepCollapse, StepLimit, NotConverged };
+enum class StopReason { None, ContactLost, Sticking, StepCollapse, StepLimit, NotConverged, EventAccumulation };
 const char* stop_name(StopReason r);
 
 struct StopEvent {
@@ -42,7 +44,8 @@ struct Stats {
     long rhs_evals = 0;
     long steps = 0;
     long rejected = 0;
-    long slip_reversals = 0;
+    long slip_reversals = 0;       // slips that reached zero and slid on (the stick test failed)
+    long mode_switches = 0;        // changes of contact mode (modes.hpp)
     double min_normal_force = 0;   // smallest N_i seen at accepted steps [N]
     // Adds the counts of another run (restarts, fallbacks); min_normal_force is left as it is.
     Stats& operator+=(const Stats& o) {
@@ -50,6 +53,7 @@ struct Stats {
         steps += o.steps;
         rejected += o.rejected;
         slip_reversals += o.slip_reversals;
+        mode_switches += o.mode_switches;
         return *this;
     }
 };
@@ -59,24 +63,33 @@ struct Sample {
     Vec3 q = Vec3::Zero();    // (s_x, s_y, theta)
     Vec3 qd = Vec3::Zero();   // (s_x', s_y', theta')
     Vec3 n = Vec3::Zero();    // (N1, N2, N3)
+    Mode mode;                // contact mode on the step that ended here
+};
+
+// A change of contact mode at time t.
+struct ModeEvent {
+    double t = 0;
+    Mode from, to;
 };
 
 struct Trajectory {
     std::vector<Sample> samples;   // every sample_dt, and the stop time
     StopEvent stop;
     Stats stats;
+    std::vector<ModeEvent> events;   // every change of contact mode
+    std::array<double, 3> held_time{};   // time each contact had zero slip [s]
 };
 
-// A part at rest relative to the plate rides with it while friction can supply the wrench that
-// keeps it there (stick_test_all, from the U-dynamics' b~ (33)-(34)). Returns the first time >= t0 at which it breaks away and starts sliding, or NaN
-// if it stays stuck for a whole period. Trajectories and limit cycles that start at rest
-// begin sliding at this time.
-double breakaway_time(const Scene& scene, const Vec3& q0, double t0);
+// A part at rest relative to the plate at q0 rides with it while friction can hold it (the gauge of
+// modes.hpp, from the needed wrench of `level`'s right-hand side; full dynamics: the plate tilted as
+// its zero-mean motion has it). Returns the first time >= t0 at which it breaks away, located as the
+// engine locates it, or NaN if it stays stuck for a whole period.
+double breakaway_time(const Scene& scene, const Vec3& q0, double t0, Dynamics level = Dynamics::U);
 
-// Simulates U-dynamics (32) or full dynamics (31) from configuration q0 and twist qd0
-// (relative to the plate) at t = 0 for `duration` seconds. Full dynamics start the plate on
-// its zero-mean periodic motion (PlateMotion::velocity/displacement). A start at rest (qd0 = 0)
-// rides with the plate until breakaway_time; a part that never breaks away stops as Sticking.
+// Simulates U-dynamics (32) or full dynamics (31) from configuration q0 and twist qd0 (relative to
+// the plate) at t = 0 for `duration` seconds, through stick-slip. Full dynamics start the plate on
+// its zero-mean periodic motion (PlateMotion::velocity/displacement). A start at rest (qd0 = 0) is
+// stuck while friction can hold the part.
 Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration,
                     double sample_dt, const IntegrationOptions& opt = {});
 

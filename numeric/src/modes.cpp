@@ -1,0 +1,347 @@
+#include "plate/modes.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace plate {
+namespace {
+
+inline Mat3 rot_z(double th) {
+    const double c = std::cos(th), s = std::sin(th);
+    Mat3 R;
+    R << c, -s, 0, s, c, 0, 0, 0, 1;
+    return R;
+}
+inline Vec2 perp(const Vec2& v) { return Vec2(-v.y(), v.x()); }   // e_z x v
+inline Vec2 horizontal_offset(const Part& P, double theta, int i) {
+    const double c = std::cos(theta), s = std::sin(theta);
+    return Vec2(c * P.c[i].x() - s * P.c[i].y(), s * P.c[i].x() + c * P.c[i].y());   // r_i = R2 c_i
+}
+inline double kappa(Dynamics level) { return level == Dynamics::ReducedU ? 0.0 : 1.0; }
+
+// Newton-Euler with contact k held (unknown f_k) and the others sliding along u_i:
+// unknowns [s_x'', s_y'', theta'', N1, N2, N3, f_kx, f_ky].
+void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                 const std::array<Vec2, 3>& u, Workspace& ws) {
+    const Part& P = sc.part;
+    const Vec6 b = rhs_b(sc, level, q, qd, ps);
+    const Mat3 R2t = rot_z(q[2]).transpose();
+    Eigen::Matrix<double, 8, 8> M = Eigen::Matrix<double, 8, 8>::Zero();
+    Eigen::Matrix<double, 8, 1> rhs = Eigen::Matrix<double, 8, 1>::Zero();
+    M(0, 0) = -P.m;
+    M(1, 1) = -P.m;
+    M.block<3, 1>(3, 2) = -P.J.col(2);   // -J' (31)
+    for (int i = 0; i < 3; ++i) {
+        Vec3 d = Vec3::UnitZ();   // (17) for a sliding contact; the normal alone for the held one
+        if (i != k) d.head<2>() -= P.mu[i] * u[i];
+        M.block<3, 1>(0, 3 + i) = d;
+        M.block<3, 1>(3, 3 + i) = P.c[i].cross(R2t * d);   // h_i (23)
+    }
+    for (int j = 0; j < 2; ++j) {
+        const Vec3 e = j == 0 ? Vec3::UnitX() : Vec3::UnitY();
+        M.block<3, 1>(0, 6 + j) = e;
+        M.block<3, 1>(3, 6 + j) = P.c[k].cross(R2t * e);
+    }
+    rhs.head<6>() = b;
+    const Vec2 r = horizontal_offset(P, q[2], k);
+    const double c2 = kappa(level) * qd[2] * qd[2];
+    M(6, 0) = 1; M(6, 2) = -r.y(); rhs[6] = c2 * r.x();
+    M(7, 1) = 1; M(7, 2) = r.x();  rhs[7] = c2 * r.y();
+    const Eigen::Matrix<double, 8, 1> z = M.partialPivLu().solve(rhs);
+    ws.b = b;
+    ws.qdd = z.head<3>();
+    ws.n = z.segment<3>(3);
+    for (int i = 0; i < 3; ++i) ws.f_held[i] = i == k ? Vec2(z[6], z[7]) : Vec2(-P.mu[i] * ws.n[i] * u[i]);
+}
+
+// q'' = 0: the needed friction total and moment, and the normal forces.
+void stuck_solve(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
+    const Part& P = sc.part;
+    const Vec6 b = rhs_b(sc, level, q, qd, ps);
+    ws.b = b;
+    ws.qdd.setZero();
+    ws.F_needed = b.head<2>();   // -m s'' + sum f_i = f_dagger,xy with s'' = 0
+    if (P.point) {
+        ws.tau_needed = 0;
+        ws.n = Vec3(b[2], 0, 0);
+        return;
+    }
+    ws.tau_needed = b[5];   // sum r_i x f_i = tau_dagger,z
+    // Rows z, torque x, torque y: the friction total F at height -h in S has moment (h F_Sy, -h F_Sx).
+    const Vec3 FS = rot_z(q[2]).transpose() * Vec3(b[0], b[1], 0);
+    const double h = P.s_z();
+    Mat3 M;
+    for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
+    ws.n = M.partialPivLu().solve(Vec3(b[3] - h * FS.y(), b[4] + h * FS.x(), b[2]));
+}
+
+}  // namespace
+
+std::string mode_name(const Mode& m) {
+    switch (m.kind) {
+        case ModeKind::Slide: return "slide";
+        case ModeKind::Pivot: return "pivot" + std::to_string(m.k + 1);
+        case ModeKind::Stuck: return "stuck";
+    }
+    return "?";
+}
+
+FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const Vec2& F, double tau) {
+    FrictionGauge g;
+    const double inf = std::numeric_limits<double>::infinity();
+    if (P.point) {
+        const double cap = P.mu[0] * std::max(n[0], 0.0);
+        const double need = F.norm();
+        g.gamma = need == 0 ? 0.0 : cap > 0 ? need / cap : inf;
+        g.f[0] = F;
+        if (need > 0) g.direction = Vec3(F.x() / need, F.y() / need, 0);
+        return g;
+    }
+    // Scaled coordinates of the Appendix: w = (F, tau / rho), R_i = r_i / rho.
+    const double rg = P.rho();
+    const Vec3 w(F.x(), F.y(), tau / rg);
+    const double wn = w.norm();
+    if (wn == 0) return g;
+    std::array<Vec2, 3> R;
+    std::array<double, 3> cap;
+    for (int i = 0; i < 3; ++i) {
+        R[i] = horizontal_offset(P, theta, i) / rg;
+        cap[i] = P.mu[i] * std::max(n[i], 0.0);
+    }
+    auto Gt = [&](int i, const Vec3& d) { return Vec2(d.x() - R[i].y() * d.z(), d.y() + R[i].x() * d.z()); };
+    auto Gf = [&](int i, const Vec2& f) { return Vec3(f.x(), f.y(), R[i].x() * f.y() - R[i].y() * f.x()); };
+    auto finish = [&](const Vec3& d, double h) {
+        g.gamma = h > 0 ? 1 / h : inf;
+        g.direction = Vec3(d.x(), d.y(), d.z() / rg);
+        g.direction /= g.direction.norm();
+    };
+    // Kinks: d a rotation about contact k, scaled onto d . w = 1. Optimal iff some g in the unit disk
+    // and c > 0 satisfy sum_{j != k} cap_j G_j u_j + cap_k G_k g = c w (then c = h(d), gamma = 1/c).
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 e(R[k].y(), -R[k].x(), 1);
+        const double s = w.dot(e);
+        if (!(std::abs(s) > 1e-14 * wn * e.norm()) || !(cap[k] > 0)) continue;
+        const Vec3 d = e / s;
+        Vec3 rhs = Vec3::Zero();
+        double h = 0;
+        std::array<Vec2, 3> u{};
+        bool ok = true;
+        for (int j = 0; j < 3 && ok; ++j) {
+            if (j == k) continue;
+            const Vec2 v = Gt(j, d);
+            const double nv = v.norm();
+            if (!(nv > 0)) { ok = false; break; }
+            u[j] = v / nv;
+            rhs -= cap[j] * Gf(j, u[j]);
+            h += cap[j] * nv;
+        }
+        if (!ok) continue;
+        Mat3 A;
+        A.col(0) = cap[k] * Gf(k, Vec2::UnitX());
+        A.col(1) = cap[k] * Gf(k, Vec2::UnitY());
+        A.col(2) = -w;
+        const Eigen::FullPivLU<Mat3> lu(A);
+        if (!lu.isInvertible()) continue;
+        const Vec3 x = lu.solve(rhs);
+        if (!(x[2] > 0) || x.head<2>().norm() > 1 + 1e-12) continue;
+        finish(d, h);
+        for (int j = 0; j < 3; ++j) g.f[j] = g.gamma * cap[j] * (j == k ? Vec2(x.head<2>()) : u[j]);
+        g.pivot = k;
+        return g;
+    }
+    // Smooth optimum: Newton on h(d0 + B y), d0 = w/|w|^2, B an orthonormal basis of w's complement.
+    const Vec3 d0 = w / (wn * wn);
+    const Vec3 a = w / wn;
+    const Vec3 t1 = (std::abs(a.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(a).normalized();
+    Eigen::Matrix<double, 3, 2> B;
+    B.col(0) = t1;
+    B.col(1) = a.cross(t1);
+    auto h_at = [&](const Vec3& d) {
+        double h = 0;
+        for (int i = 0; i < 3; ++i) h += cap[i] * Gt(i, d).norm();
+        return h;
+    };
+    Vec2 y = Vec2::Zero();
+    Vec3 d = d0;
+    double h = h_at(d);
+    for (int it = 0; it < 100; ++it) {
+        g.iterations = it + 1;
+        Vec3 grad = Vec3::Zero();
+        Mat3 H = Mat3::Zero();
+        for (int i = 0; i < 3; ++i) {
+            const Vec2 v = Gt(i, d);
+            const double nv = v.norm();
+            if (!(nv > 0) || !(cap[i] > 0)) continue;
+            const Vec2 u = v / nv;
+            grad += cap[i] * Gf(i, u);
+            // Hessian of cap |G^T d|: cap G (I - u u^T) G^T / |G^T d| = cap/|v| (G u_perp)(G u_perp)^T
+            const Vec3 gp = Gf(i, perp(u));
+            H += cap[i] / nv * gp * gp.transpose();
+        }
+        const Vec2 gy = B.transpose() * grad;
+        const Eigen::Matrix2d Hy = B.transpose() * H * B;
+        Vec2 step = -Hy.ldlt().solve(gy);
+        if (!step.allFinite()) step = -gy;
+        double alpha = 1;
+        const double slope = gy.dot(step);
+        Vec2 y1;
+        double h1 = h;
+        for (int ls = 0; ls < 60; ++ls, alpha *= 0.5) {
+            y1 = y + alpha * step;
+            h1 = h_at(d0 + B * y1);
+            if (h1 <= h + 1e-4 * alpha * slope) break;
+        }
+        const double moved = (alpha * step).norm();
+        if (h1 <= h) { y = y1; d = d0 + B * y; h = h1; }
+        if (moved <= 1e-14 * (1 + y.norm()) || h1 > h) break;
+    }
+    finish(d, h);
+    for (int i = 0; i < 3; ++i) {
+        const Vec2 v = Gt(i, d);
+        const double nv = v.norm();
+        g.f[i] = nv > 0 ? Vec2(g.gamma * cap[i] * v / nv) : Vec2::Zero();
+    }
+    return g;
+}
+
+Vec2 contact_acceleration(const Part& P, Dynamics level, int i, const Vec3& q, const Vec3& qd, const Vec3& qdd) {
+    if (P.point) return qdd.head<2>();
+    const Vec2 r = horizontal_offset(P, q[2], i);
+    return qdd.head<2>() + qdd[2] * perp(r) - kappa(level) * qd[2] * qd[2] * r;
+}
+
+void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                        const Mode& mode, Workspace& ws) {
+    const Part& P = sc.part;
+    if (ws.prepared != &sc) ws.prepare(sc);
+    switch (mode.kind) {
+        case ModeKind::Slide:
+            accelerations(sc, level, q, qd, ps, ws);
+            return;
+        case ModeKind::Stuck:
+            ++ws.evals;
+            slip_velocities(P, q, qd, ws.slip);
+            stuck_solve(sc, level, q, qd, ps, ws);
+            return;
+        case ModeKind::Pivot: {
+            ++ws.evals;
+            slip_velocities(P, q, qd, ws.slip);
+            // The sliding contacts move on circles about c_k: v_j = theta' e_z x (r_j - r_k), whose
+            // direction is the mode's sense times e_z x (r_j - r_k) (exact even at theta' = 0).
+            std::array<Vec2, 3> u{};
+            const Vec2 rk = horizontal_offset(P, q[2], mode.k);
+            for (int j = 0; j < 3; ++j)
+                if (j != mode.k) u[j] = mode.sense * perp(horizontal_offset(P, q[2], j) - rk).normalized();
+            pivot_solve(sc, level, mode.k, q, qd, ps, u, ws);
+            return;
+        }
+    }
+}
+
+ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& ps, unsigned zero,
+                       Workspace& ws, bool hold) {
+    const Part& P = sc.part;
+    const int nc = P.contacts();
+    ModeChoice out;
+    int count = 0, k = -1;
+    for (int i = 0; i < nc; ++i)
+        if (zero & (1u << i)) { ++count; k = i; }
+    auto normal_ok = [&]() {
+        int arg = 0;
+        if (ws.n.head(nc).minCoeff(&arg) < 0) {
+            out.lost = true;
+            out.lost_contact = arg;
+            return false;
+        }
+        return true;
+    };
+    // Slip directions that a break-away starts with, made consistent with the sliding dynamics:
+    // contact i's relative acceleration along its own slip direction (u_i <- a_i/|a_i|). Needed only
+    // when the state is off the stick boundary (a start at rest where friction cannot hold, a slip
+    // reversal); at a located event the rim's friction direction is already consistent.
+    auto refine_hints = [&](unsigned which) {
+        Mode slide;
+        for (int it = 0; it < 40; ++it) {
+            mode_accelerations(sc, level, q, qd, ps, slide, ws);
+            double change = 0;
+            for (int i = 0; i < nc; ++i) {
+                if (!(which & (1u << i))) continue;
+                const Vec2 a = contact_acceleration(P, level, i, q, qd, ws.qdd);
+                if (!(a.norm() > 0)) continue;
+                const Vec2 u = a / a.norm();
+                change = std::max(change, (u - ws.hint[i]).norm());
+                ws.hint[i] = u;
+            }
+            if (change < 1e-12) break;
+        }
+    };
+    ws.use_hints = true;
+    if (count == 1 && !P.point) {
+        // One contact at zero slip: project onto v_k = 0 (s' -= v_k), then can contact k pivot?
+        std::array<Vec2, 3> v;
+        slip_velocities(P, q, qd, v);
+        qd.head<2>() -= v[k];
+        if (qd[2] == 0) count = 3;   // the others are then at rest too
+        else {
+            Mode pivot{ModeKind::Pivot, k, qd[2] > 0 ? 1.0 : -1.0};
+            mode_accelerations(sc, level, q, qd, ps, pivot, ws);
+            const double cap = P.mu[k] * std::max(ws.n[k], 0.0), need = ws.f_held[k].norm();
+            out.gamma = cap > 0 ? need / cap : std::numeric_limits<double>::infinity();
+            if (need <= cap * (1 + 1e-12)) {
+                // Held; a negative normal force elsewhere then means the part would tip.
+                if (!normal_ok()) return out;
+                out.mode = pivot;
+                return out;
+            }
+            // A slip reversal: contact k slides on, opposite the friction it would have needed.
+            ws.hint[k] = -ws.f_held[k] / need;
+            refine_hints(1u << k);
+            out.mode = Mode{};
+            return out;
+        }
+    }
+    // Every slip zero: held if the friction disks can supply the needed wrench.
+    qd.setZero();
+    // The normal forces of the stuck state assume the needed friction total; where that friction
+    // cannot be had (gauge > 1) the part slides and its own normal forces decide contact.
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+    const FrictionGauge g = friction_gauge(P, q[2], ws.n, ws.F_needed, ws.tau_needed);
+    out.gamma = g.gamma;
+    if (hold && g.gamma <= 1 + 1e-12) {
+        if (!normal_ok()) return out;   // held, but the part would tip
+        out.mode = Mode{ModeKind::Stuck};
+        return out;
+    }
+    // Off the stick boundary (a start at rest where friction cannot hold, the twist passing through
+    // zero): the motion that starts is the consistent one -- a pivot about contact k turning with
+    // sense s whose static friction fits its disk and whose theta'' has sign s, or a slide whose every
+    // contact accelerates along its own slip direction. (At a located stick exit, gauge = 1 to
+    // rounding, the boundary point below is that motion.)
+    if (g.gamma > 1 + 1e-6 && !P.point) {
+        for (int kk = 0; kk < 3; ++kk)
+            for (double sense : {1.0, -1.0}) {
+                const Mode pv{ModeKind::Pivot, kk, sense};
+                mode_accelerations(sc, level, q, qd, ps, pv, ws);
+                if (ws.n.minCoeff() >= 0 && ws.f_held[kk].norm() <= P.mu[kk] * ws.n[kk] && sense * ws.qdd[2] > 0) {
+                    out.mode = pv;
+                    return out;
+                }
+            }
+    }
+    // Break-away: the emerging twist is opposite the direction the needed friction opposes.
+    if (g.pivot >= 0 && g.gamma <= 1 + 1e-6) {
+        out.mode = Mode{ModeKind::Pivot, g.pivot, g.direction[2] > 0 ? -1.0 : 1.0};
+        return out;
+    }
+    unsigned all = 0;
+    for (int i = 0; i < nc; ++i) {
+        const double fn = g.f[i].norm();
+        ws.hint[i] = fn > 0 ? Vec2(-g.f[i] / fn) : Vec2::Zero();
+        all |= 1u << i;
+    }
+    if (g.gamma > 1 + 1e-6) refine_hints(all);
+    out.mode = Mode{};
+    return out;
+}
+
+}  // namespace plate
