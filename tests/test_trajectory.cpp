@@ -127,3 +127,49 @@ TEST_CASE("a part that cannot break away rides the plate: stuck all along, not m
         CHECK(t.held_time[0] == Approx(1.0));
     }
 }
+
+TEST_CASE("fig1 from rest: stuck at t = 0, breaks away at the root of the stick condition, then slides for 5 s",
+          "[trajectory][stick]") {
+    // Point part (fig1_point at (-0.04, 0.03)): held while |F(t)| <= mu N(t), with the U-dynamics'
+    // needed force F = m (p'' + omega1' x s)_xy and N = m (p'' + omega1' x s + g e_z)_z (33). Its
+    // root, found here by bisection from the plate's harmonics alone, is the break-away time.
+    const Scene pt = scene("fig1_point");
+    const Vec3 s(-0.04, 0.03, 0);
+    auto margin = [&](double t) {
+        Vec3 pdd, wd;
+        pt.plate.acceleration(t, pdd, wd);
+        const Vec3 a = pdd + wd.cross(s);
+        return pt.part.mu[0] * (a.z() + pt.g) - a.head<2>().norm();
+    };
+    REQUIRE(margin(0) > 0);
+    double lo = 0, hi = 0;
+    while (margin(hi) > 0) hi += 1e-5;
+    for (int i = 0; i < 200; ++i) (margin(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+    const double tb_point = breakaway_time(pt, s, 0, Dynamics::U);
+    CHECK(tb_point == Approx(hi).epsilon(1e-9));
+    // Full dynamics: the plate's tilt at t ~ 0 changes the needed friction; the break-away comes later.
+    CHECK(breakaway_time(pt, s, 0, Dynamics::Full) > tb_point * 1.01);
+
+    // The rigid part of Fig. 1 at (-0.04, 0.03, 1.2): at rest it needs about an eighth of the friction
+    // it can have, breaks away near 0.77 ms (U) and later in full dynamics; after it every contact
+    // slides (no new stick) for at least 5 s.
+    const Scene sc = scene("fig1");
+    const Vec3 q0(-0.04, 0.03, 1.2);
+    Workspace ws;
+    mode_accelerations(sc, Dynamics::U, q0, Vec3::Zero(), plate_state(sc.plate, 0, Dynamics::U), Mode{ModeKind::Stuck}, ws);
+    const double gamma0 = friction_gauge(sc.part, q0[2], ws.n, ws.F_needed, ws.tau_needed).gamma;
+    CHECK(gamma0 > 0.08);
+    CHECK(gamma0 < 0.2);
+    const double tb_u = breakaway_time(sc, q0, 0, Dynamics::U), tb_full = breakaway_time(sc, q0, 0, Dynamics::Full);
+    CHECK(tb_u == Approx(0.00077).epsilon(0.01));
+    CHECK(tb_full > tb_u);
+    for (Dynamics level : {Dynamics::U, Dynamics::Full}) {
+        const Trajectory tr = simulate(sc, level, q0, Vec3::Zero(), 5.0, 0.05);
+        REQUIRE(tr.stop.reason == StopReason::None);
+        REQUIRE(tr.events.size() == 2u);   // slide -> stuck at the start, stuck -> slide at the break-away
+        CHECK(tr.events[0].to.kind == ModeKind::Stuck);
+        CHECK(tr.events[1].to.kind == ModeKind::Slide);
+        CHECK(tr.events[1].t == Approx(level == Dynamics::U ? tb_u : tb_full).epsilon(1e-6));
+        CHECK(tr.samples.back().mode.kind == ModeKind::Slide);
+    }
+}
