@@ -1,4 +1,5 @@
 #include "plate/dynamics.hpp"
+#include "plate/modes.hpp"
 
 #include <cmath>
 #include <limits>
@@ -474,38 +475,15 @@ StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, cons
 }
 
 StickTest stick_test_all(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {
-    const Part& P = sc.part;
-    if (P.point) return stick_test(sc, level, 0, q, qd, ps);
+    // The stuck mode's statics and the exact friction-disk gauge (modes.hpp).
+    Workspace ws;
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+    const int nc = sc.part.contacts();
     StickTest r;
-    const Vec6 b = rhs_b(sc, level, q, qd, ps);
-    const Mat3 R2 = rot_z(q[2]);
-    // Friction total in P (= f_xy) and in S; normal forces from rows z, torque x, torque y.
-    const Vec3 F(b[0], b[1], 0), FS = R2.transpose() * F;
-    const double h = P.s_z();   // contacts at z = -h in S
-    Mat3 M;
-    for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
-    const Vec3 n = M.partialPivLu().solve(Vec3(b[3] - h * FS.y(), b[4] + h * FS.x(), b[2]));
-    const double tau = b[5];   // about z (the same axis in S and P)
-    r.friction_needed = std::hypot(F.x(), F.y());
-    r.friction_available = 0;
-    for (int i = 0; i < 3; ++i) r.friction_available += P.mu[i] * std::max(n[i], 0.0);
-    if (n.minCoeff() < 0) return r;
-    // Support function of the achievable wrenches in (F_x, F_y, tau / rho):
-    // h(d) = sum_i mu_i N_i |(d_x - d_t r_iy / rho, d_y + d_t r_ix / rho)|.
-    const double rho = P.rho();
-    std::array<Vec2, 3> rr;
-    for (int i = 0; i < 3; ++i) rr[i] = (R2 * P.c[i]).head<2>() / rho;
-    const int K = 2000;
-    const double golden = kPi * (3 - std::sqrt(5.0));
-    for (int k = 0; k < K; ++k) {
-        const double z = 1 - (2 * k + 1.0) / K, rad = std::sqrt(1 - z * z), a = golden * k;
-        const Vec3 d(rad * std::cos(a), rad * std::sin(a), z);
-        double support = 0;
-        for (int i = 0; i < 3; ++i)
-            support += P.mu[i] * n[i] * Vec2(d.x() - d.z() * rr[i].y(), d.y() + d.z() * rr[i].x()).norm();
-        if (d.x() * F.x() + d.y() * F.y() + d.z() * tau / rho > support) return r;
-    }
-    r.sticks = true;
+    r.friction_needed = ws.F_needed.norm();
+    for (int i = 0; i < nc; ++i) r.friction_available += sc.part.mu[i] * std::max(ws.n[i], 0.0);
+    r.sticks = ws.n.head(nc).minCoeff() >= 0 &&
+               friction_gauge(sc.part, q[2], ws.n, ws.F_needed, ws.tau_needed).gamma <= 1;
     return r;
 }
 

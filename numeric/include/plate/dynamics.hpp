@@ -124,12 +124,11 @@ struct StickTest {
 StickTest stick_test(const Scene& scene, Dynamics level, int k, const Vec3& q, const Vec3& qd,
                      const PlateState& plate);
 
-// Would the whole part stay stuck to the plate (every contact at zero slip, q'' = 0)? The
-// required frictional wrench (f_xy, tau_z) follows from b; the normal forces then follow
-// exactly from the z force and the x, y torques (the friction total is known, so its moment
-// about the raised centre of mass is too). The part sticks if that wrench lies in the set of
-// wrenches the three friction disks |F_i| <= mu_i N_i can supply: tested through the set's
-// support function on 2000 directions (a necessary condition, exact up to that sampling).
+// Would the whole part stay stuck to the plate (every contact at zero slip, q'' = 0)? The needed
+// frictional wrench (f_xy, tau_z) follows from b; the normal forces then follow exactly from the z
+// force and the x, y torques (the friction total is known, so its moment about the raised centre of
+// mass is too). The part sticks if the normal forces are >= 0 and the friction-disk gauge of that
+// wrench is <= 1 (modes.hpp: exact, by duality).
 StickTest stick_test_all(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
                          const PlateState& plate);
 
