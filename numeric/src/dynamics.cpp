@@ -11,12 +11,6 @@
 namespace plate {
 namespace {
 
-inline Mat3 rot_z(double th) {
-    const double c = std::cos(th), s = std::sin(th);
-    Mat3 R;
-    R << c, -s, 0, s, c, 0, 0, 0, 1;
-    return R;   // R2 (2): S -> P
-}
 
 // u = factor * v for the regularised friction laws (FrictionLaw).
 inline double regularised_factor(FrictionLaw law, double eps, double speed) {
@@ -429,48 +423,21 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
 StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd,
                      const PlateState& ps) {
     const Part& P = sc.part;
+    Workspace ws;
     StickTest r;
-    const Vec6 b = rhs_b(sc, level, q, qd, ps);
-    if (P.point) {
-        // s'' = 0: the friction force must supply f_xy, and N = f_z.
-        r.friction_needed = b.head<2>().norm();
-        r.friction_available = P.mu[0] * b[2];
-        r.sticks = b[2] > 0 && r.friction_needed <= r.friction_available;
+    if (P.point) {   // s'' = 0: friction must supply f_xy, and N = f_z
+        mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+        r.friction_needed = ws.F_needed.norm();
+        r.friction_available = P.mu[0] * ws.n[0];
+        r.sticks = ws.n[0] > 0 && r.friction_needed <= r.friction_available;
         return r;
     }
-    // Unknowns [q''(3), N(3), F(2)]; contact k exerts N_k e_z + [F; 0].
-    std::array<Vec2, 3> v;
-    slip_velocities(P, q, qd, v);
-    const double c = std::cos(q[2]), s = std::sin(q[2]);
-    const Mat3 R2t = rot_z(q[2]).transpose();
-    Eigen::Matrix<double, 8, 8> M = Eigen::Matrix<double, 8, 8>::Zero();
-    Eigen::Matrix<double, 8, 1> rhs = Eigen::Matrix<double, 8, 1>::Zero();
-    M(0, 0) = -P.m;
-    M(1, 1) = -P.m;
-    M.block<3, 1>(3, 2) = -P.J.col(2);
-    for (int i = 0; i < 3; ++i) {
-        Vec3 d = Vec3::UnitZ();
-        if (i != k) {
-            const double vn = v[i].norm();
-            if (vn > 0) d.head<2>() -= P.mu[i] * v[i] / vn;
-        }
-        M.block<3, 1>(0, 3 + i) = d;
-        M.block<3, 1>(3, 3 + i) = P.c[i].cross(R2t * d);
-    }
-    for (int j = 0; j < 2; ++j) {
-        const Vec3 e = j == 0 ? Vec3::UnitX() : Vec3::UnitY();
-        M.block<3, 1>(0, 6 + j) = e;
-        M.block<3, 1>(3, 6 + j) = P.c[k].cross(R2t * e);
-    }
-    rhs.head<6>() = b;
-    // c_k does not accelerate relative to the plate: s'' + theta'' e_z x r - theta'^2 r = 0.
-    const double rx = c * P.c[k].x() - s * P.c[k].y(), ry = s * P.c[k].x() + c * P.c[k].y();
-    M(6, 0) = 1; M(6, 2) = -ry; rhs[6] = qd[2] * qd[2] * rx;
-    M(7, 1) = 1; M(7, 2) = rx;  rhs[7] = qd[2] * qd[2] * ry;
-    const Eigen::Matrix<double, 8, 1> z = M.partialPivLu().solve(rhs);
-    r.friction_needed = z.segment<2>(6).norm();
-    r.friction_available = P.mu[k] * z[3 + k];
-    r.sticks = z.segment<3>(3).minCoeff() >= 0 && r.friction_needed <= r.friction_available;
+    // The others turn about c_k with theta' (sense 0 at rest: no kinetic friction there).
+    const double sense = qd[2] > 0 ? 1.0 : qd[2] < 0 ? -1.0 : 0.0;
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Pivot, k, sense}, ws);
+    r.friction_needed = ws.f_held[k].norm();
+    r.friction_available = P.mu[k] * ws.n[k];
+    r.sticks = ws.n.minCoeff() >= 0 && r.friction_needed <= r.friction_available;
     return r;
 }
 

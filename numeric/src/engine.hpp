@@ -420,100 +420,77 @@ private:
 
     // Handles event ev at (t_, ys_): stops (contact lost) or chooses the next mode.
     bool event(int ev) {
-        const int nc = scene_.part.contacts();
-        if (ev < 3) {
-            stop = StopEvent{StopReason::ContactLost, ev, t_};
-            sys(ys_, fs_, t_);
-            n_ = model_.ws.n;
-            return false;
-        }
-        State y = this->y();
+        if (ev < 3) return lose(ev);
+        const State y = this->y();
         const Vec3 q = model_.q(y);
         Vec3 qd = model_.qd(y);
-        const PlateState ps = model_.plate(t_, y);
         const Mode from = model_.mode;
-        Workspace& ws = model_.ws;
-        unsigned zero = 0;
-        bool hold = true;
-        (void)nc;
         switch (from.kind) {
             case ModeKind::Slide: {
                 std::array<Vec2, 3> v;
                 slip_velocities(scene_.part, q, qd, v);
-                zero = 1u << (ev - 3);
-                for (int i = 0; i < nc; ++i)
+                unsigned zero = 1u << (ev - 3);
+                for (int i = 0; i < scene_.part.contacts(); ++i)
                     if (v[i].norm() <= std::max(1e-3 * slip0_norm(i), zero_abs_)) zero |= 1u << i;
-                return slide_zero(zero);
+                low_ = {0, 0, 0};
+                return switch_mode(zero, true);
             }
             case ModeKind::Pivot:
                 if (ev == 3 && std::abs(qd[2]) > 1e-14 * v_ref_ / scene_.part.rho()) {
                     // Contact k breaks away, opposite the static friction it carried (the rim's force).
-                    mode_accelerations(scene_, model_.level, q, qd, ps, from, ws);
+                    Workspace& ws = model_.ws;
+                    mode_accelerations(scene_, model_.level, q, qd, model_.plate(t_, y), from, ws);
                     const Vec2 f = ws.f_held[from.k];
                     std::array<Vec2, 3> v;
                     slip_velocities(scene_.part, q, qd, v);
                     qd.head<2>() -= v[from.k];
                     ws.hint[from.k] = f.norm() > 0 ? Vec2(-f / f.norm()) : Vec2::Zero();
-                    model_.mode = Mode{};
-                    model_.set_qd(y, qd);
-                    set(y);
-                    log_event(from);
-                    return check_burst();
+                    return enter(Mode{}, y, qd);
                 }
-                zero = 7;   // theta' reached zero: every slip is zero
-                break;
+                return switch_mode(7, true);   // theta' reached zero: every slip is zero
             case ModeKind::Stuck:
-                zero = 7;
-                hold = false;   // the gauge crossed 1: break away
-                break;
+                return switch_mode(7, false);   // the gauge crossed 1: break away
         }
-        return switch_mode(zero, hold);
+        return true;
     }
 
     // A lingering slip: held (pivot, stuck) if static friction can hold it there; else slide on.
     bool try_hold(unsigned zero) {
         low_ = {0, 0, 0};
-        State y = this->y();
+        const State y = this->y();
         Vec3 qd = model_.qd(y);
         const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
-        if (!c.lost && c.mode.kind != ModeKind::Slide) {
-            const Mode from = model_.mode;
-            model_.mode = c.mode;
-            model_.set_qd(y, qd);
-            set(y);
-            log_event(from);
-            return check_burst();
-        }
+        if (!c.lost && c.mode.kind != ModeKind::Slide) return enter(c.mode, y, qd);
         set(y);   // nothing changes: restore the workspace
         return true;
     }
 
-    // The slips of the contacts `zero` reached zero while sliding.
-    bool slide_zero(unsigned zero) {
-        low_ = {0, 0, 0};
-        return switch_mode(zero, true);
-    }
-
     // Chooses the mode at (t_, ys_) with the contacts `zero` at zero slip and goes on in it.
     bool switch_mode(unsigned zero, bool hold) {
-        State y = this->y();
-        const Vec3 q = model_.q(y);
+        const State y = this->y();
         Vec3 qd = model_.qd(y);
+        const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws, hold);
+        if (c.lost) return lose(c.lost_contact);
+        if (model_.mode.kind == ModeKind::Slide && c.mode.kind == ModeKind::Slide) ++stats.slip_reversals;
+        return enter(c.mode, y, qd);
+    }
+
+    // Goes on from state y (physical units) with twist qd in mode m.
+    bool enter(const Mode& m, State y, const Vec3& qd) {
         const Mode from = model_.mode;
-        Workspace& ws = model_.ws;
-        const ModeChoice c = choose_mode(scene_, model_.level, q, qd, model_.plate(t_, y), zero, ws, hold);
-        if (c.lost) {
-            stop = StopEvent{StopReason::ContactLost, c.lost_contact, t_};
-            sys(ys_, fs_, t_);
-            n_ = ws.n;
-            return false;
-        }
-        if (from.kind == ModeKind::Slide && c.mode.kind == ModeKind::Slide) ++stats.slip_reversals;
-        model_.mode = c.mode;
+        model_.mode = m;
         model_.set_qd(y, qd);
         set(y);
         log_event(from);
         return check_burst();
+    }
+
+    // Contact k is lost at (t_, ys_).
+    bool lose(int k) {
+        stop = StopEvent{StopReason::ContactLost, k, t_};
+        sys(ys_, fs_, t_);
+        n_ = model_.ws.n;
+        return false;
     }
 
     bool check_burst() {

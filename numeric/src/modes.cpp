@@ -6,12 +6,6 @@
 namespace plate {
 namespace {
 
-inline Mat3 rot_z(double th) {
-    const double c = std::cos(th), s = std::sin(th);
-    Mat3 R;
-    R << c, -s, 0, s, c, 0, 0, 0, 1;
-    return R;
-}
 inline Vec2 perp(const Vec2& v) { return Vec2(-v.y(), v.x()); }   // e_z x v
 inline Vec2 horizontal_offset(const Part& P, double theta, int i) {
     const double c = std::cos(theta), s = std::sin(theta);

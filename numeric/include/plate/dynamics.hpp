@@ -15,11 +15,20 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 
 namespace plate {
 
 enum class Dynamics { Full, U, ReducedU };
+
+// R2 (2): the part's orientation theta about z, S -> P.
+inline Mat3 rot_z(double theta) {
+    const double c = std::cos(theta), s = std::sin(theta);
+    Mat3 R;
+    R << c, -s, 0, s, c, 0, 0, 0, 1;
+    return R;
+}
 const char* dynamics_name(Dynamics d);
 
 // The plate's state as one evaluation sees it. R1 and omega1 enter only the full dynamics
@@ -113,9 +122,10 @@ void accelerations_reference(const Scene& scene, Dynamics level, const Vec3& q, 
 // Sliding velocity of each contact: s' + omega2^ R2 c_i (horizontal; P frame).
 void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v);
 
-// Would contact k stay stuck if its sliding velocity were zero now? Solves Newton-Euler with
-// contact k carrying an unknown tangential force F (the other contacts sliding) and the
-// constraint that c_k does not accelerate relative to the plate, then tests |F| <= mu_k N_k.
+// Would contact k stay stuck if its sliding velocity were zero now? The pivot mode's dynamics
+// (modes.hpp: Newton-Euler with contact k carrying an unknown tangential force F, the others sliding,
+// c_k not accelerating relative to the plate), then |F| <= mu_k N_k with every N_i >= 0. A point
+// part: the stuck mode's statics.
 struct StickTest {
     bool sticks = false;
     double friction_needed = 0;   // |F| [N]
