@@ -517,12 +517,15 @@ void write_speed_study(const SpeedOptions& opt) {
     c.timed("work-precision (b)", [&] { trajectory_chart(c, fig4, opt.full); });
     c.timed("work-precision (c)", [&] {
         // The configuration nearest the centre (along +x, theta = 0) whose cycle slides: fig6 sticks inside.
-        // (The engine now simulates through sticking; the other methods here model sliding only.)
+        // The other methods here model sliding only, so the run from rest must slide throughout: no
+        // change of mode but slip reversals (the engine now simulates through sticking).
         Vec3 q(0, 0, 0);
         for (double x = 0.02; x <= 0.06; x += 0.0025) {
             q = Vec3(x, 0, 0);
-            const LimitCycleSummary lc = limit_cycle(fig6, q);
-            if (lc.converged && lc.start_mode.kind == ModeKind::Slide && lc.mode_events.empty()) break;
+            LimitCycleOptions o;
+            o.solver = CycleSolver::PeriodByPeriod;
+            const LimitCycleSummary lc = limit_cycle(fig6, q, o);
+            if (lc.converged && lc.stats.mode_switches == lc.stats.slip_reversals) break;
         }
         c.html << "<h3>(c) fig6: near sticking at (" << fmt(q[0], 4) << ", 0, 0)</h3>\n<p>The first configuration outward "
                << "from the plate centre (steps of 2.5 mm along x) whose limit cycle slides throughout: closer in, a "
