@@ -173,3 +173,35 @@ TEST_CASE("fig1 from rest: stuck at t = 0, breaks away at the root of the stick 
         CHECK(tr.samples.back().mode.kind == ModeKind::Slide);
     }
 }
+
+TEST_CASE("friction never does positive work, in every mode (slide, pivot, stuck)", "[trajectory][stick]") {
+    // The friction power sum_i f_i . v_i follows from the motion alone: with J_xz = J_yz = 0 the
+    // planar rows of (31)/(32) give sum_i f_i = m s'' + f_dagger,xy and sum_i r_i x f_i =
+    // J_zz theta'' + tau_dagger,z, so P = (m s'' + f_dagger,xy) . s' + theta' (J_zz theta'' + tau_dagger,z)
+    // (v_i = s' + theta' e_z x r_i). Coulomb friction dissipates: P <= 0 to rounding.
+    struct Case { const char* scene; Vec3 q0; double duration; };
+    for (const Case& c : {Case{"fig6", Vec3(-0.05, 0.016666666666666663, 4.487989505128276), 0.2},
+                          Case{"fig1", Vec3(-0.04, 0.03, 1.2), 0.05}, Case{"fig1_point", Vec3(-0.04, 0.03, 0), 0.05}}) {
+        const Scene sc = scene(c.scene);
+        const Part& P = sc.part;
+        const Trajectory tr = simulate(sc, Dynamics::U, c.q0, Vec3::Zero(), c.duration, 2e-5);
+        REQUIRE(tr.stop.reason == StopReason::None);
+        std::array<int, 3> seen{};
+        double worst = -1e300, scale = 0;
+        Workspace ws;
+        for (const Sample& s : tr.samples) {
+            ++seen[static_cast<int>(s.mode.kind)];
+            mode_accelerations(sc, Dynamics::U, s.q, s.qd, plate_state(sc.plate, s.t, Dynamics::U), s.mode, ws);
+            const double power = (P.m * ws.qdd.head<2>() + ws.b.head<2>()).dot(s.qd.head<2>()) +
+                                 (P.point ? 0.0 : s.qd[2] * (P.J(2, 2) * ws.qdd[2] + ws.b[5]));
+            worst = std::max(worst, power);
+            scale = std::max(scale, P.mu.maxCoeff() * P.m * sc.g * sc.v_ref());
+        }
+        INFO(c.scene << ": largest friction power " << worst << " W (scale mu m g v_ref = " << scale << " W); samples in slide "
+                     << seen[0] << ", pivot " << seen[1] << ", stuck " << seen[2]);
+        CHECK(worst <= 1e-9 * scale);
+        CHECK(seen[0] > 0);
+        if (std::string(c.scene) == "fig6") CHECK(seen[1] > 0);
+        else CHECK(seen[2] > 0);
+    }
+}
