@@ -520,16 +520,21 @@ void write_speed_study(const SpeedOptions& opt) {
         // The other methods here model sliding only, so the run from rest must slide throughout: no
         // change of mode but slip reversals (the engine now simulates through sticking).
         Vec3 q(0, 0, 0);
+        int closer = 0;   // configurations tried closer in whose run sticks or pivots
         for (double x = 0.02; x <= 0.06; x += 0.0025) {
             q = Vec3(x, 0, 0);
             LimitCycleOptions o;
             o.solver = CycleSolver::PeriodByPeriod;
             const LimitCycleSummary lc = limit_cycle(fig6, q, o);
             if (lc.converged && lc.stats.mode_switches == lc.stats.slip_reversals) break;
+            ++closer;
         }
         c.html << "<h3>(c) fig6: near sticking at (" << fmt(q[0], 4) << ", 0, 0)</h3>\n<p>The first configuration outward "
-               << "from the plate centre (steps of 2.5 mm along x) whose limit cycle slides throughout: closer in, a "
-               << "contact sticks.</p>\n";
+               << "from x = 0.02 m (steps of 2.5 mm along x) whose run from rest slides throughout (the other methods here "
+               << "model sliding only)"
+               << (closer > 0 ? ": at the " + std::to_string(closer) + " configuration" + (closer > 1 ? "s" : "") +
+                                    " closer in the part sticks or pivots for part of the run.</p>\n"
+                              : ".</p>\n");
         twist_chart(c, fig6, q, "wp_stick", "(c) fig6: near-sticking twist", opt.full);
     });
     c.timed("limit-cycle solvers", [&] {
