@@ -15,6 +15,7 @@ namespace {
 // u = factor * v for the regularised friction laws (FrictionLaw).
 inline double regularised_factor(FrictionLaw law, double eps, double speed) {
     if (law == FrictionLaw::Tanh) return speed > 1e-8 * eps ? std::tanh(speed / eps) / speed : 1.0 / eps;
+    if (law == FrictionLaw::Sqrt) return 1.0 / std::hypot(speed, eps);
     return 1.0 / std::max(speed, eps);
 }
 
@@ -23,6 +24,10 @@ Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v)
     const double s = v.norm();
     const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
     if (law == FrictionLaw::Linear && s < eps) return I / eps;
+    if (law == FrictionLaw::Sqrt) {
+        const double r = std::hypot(s, eps);
+        return I / r - v * v.transpose() / (r * r * r);
+    }
     if (law == FrictionLaw::Tanh) {
         if (s < 1e-8 * eps) return I / eps;
         const Vec2 e = v / s;
@@ -50,6 +55,7 @@ const char* friction_law_name(FrictionLaw f) {
         case FrictionLaw::Coulomb: return "coulomb";
         case FrictionLaw::Tanh: return "tanh";
         case FrictionLaw::Linear: return "linear";
+        case FrictionLaw::Sqrt: return "sqrt";
     }
     return "?";
 }
@@ -200,7 +206,7 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
             const double s2 = vx[i] * vx[i] + vy[i] * vy[i];
             const double along = vx[i] * ws.hint[i].x() + vy[i] * ws.hint[i].y();
             const bool past_zero = s2 < 0.01 * ws.hint_from[i] * ws.hint_from[i] && (along <= 0 || along * along <= 0.25 * s2);
-            if (s2 <= hs2 || past_zero) { ux[i] = ws.hint[i].x(); uy[i] = ws.hint[i].y(); }
+            if (s2 <= hs2 || past_zero || (ws.creep >> i & 1u)) { ux[i] = ws.hint[i].x(); uy[i] = ws.hint[i].y(); }
         }
     }
     for (int i = nc; i < 3; ++i) ws.slip[i].setZero();

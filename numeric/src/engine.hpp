@@ -56,6 +56,11 @@ public:
         model_.ws.use_hints = true;
         model_.ws.hint_speed = std::max(10 * opt_.rtol, 1e-12) * v_ref_;
         zero_abs_ = std::max(1e3 * opt_.rtol, 1e-9) * v_ref_;
+        // A contact that breaks away creeps (Workspace::creep: its friction along the consistent
+        // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
+        // the error that leaves stays below creep_budget_ (creep_step).
+        model_.ws.creep_speed = 1e-2 * v_ref_;
+        creep_budget_ = 0.1 * opt_.rtol * v_ref_;
     }
 
     // Starts at (t0, y0) in physical units; the mode follows from the state (a contact with zero slip
@@ -112,7 +117,7 @@ public:
             const bool stuck = model_.mode.kind == ModeKind::Stuck;
             frozen_ = stuck && Model::kStuckFrozen;
             const double cap = stuck ? T / 200 : std::numeric_limits<double>::infinity();
-            const double want = frozen_ ? cap : std::min(dt_, cap);
+            const double want = frozen_ ? cap : std::min({dt_, cap, creep_h_});
             const bool clamp = t_ + want >= t_end;
             double dt = clamp ? t_end - t_ : want;
             double t1 = t_;
@@ -156,6 +161,14 @@ public:
                     continue;
                 }
                 if (tr < t_ev || (tr == t_ev && i < 3)) { t_ev = tr; ev = i; y_ev = yr; }
+            }
+            if (creep_inconsistent(slip1)) {
+                // A creeping contact's slip left its consistent direction within the step (the
+                // direction solved is not the one it moves along): retry the step sliding along v/|v|.
+                ++stats.rejected;
+                sys(ys_, fs_, t_);
+                --stats.steps;
+                continue;
             }
             if (swing && ev < 0) {
                 // A swing within one step: the step kept the start's friction direction past the
@@ -293,6 +306,7 @@ private:
             model_.mode = c.mode;
             model_.set_qd(y, qd);
         }
+        start_creep(y);
         set(y);
         if (min_n() < 0) {
             int k = 0;
@@ -315,7 +329,8 @@ private:
     void reference_directions(const std::array<Vec2, 3>& slip) {
         for (int i = 0; i < 3; ++i) {
             const double s = slip[i].norm();
-            ref_[i] = s > model_.ws.hint_speed ? Vec2(slip[i] / s) : model_.ws.hint[i];
+            const bool creeping = model_.ws.creep >> i & 1u;
+            ref_[i] = s > model_.ws.hint_speed && !creeping ? Vec2(slip[i] / s) : model_.ws.hint[i];
             // The friction direction a slip keeps near zero within the next step (dynamics.hpp).
             if (model_.mode.kind == ModeKind::Slide) {
                 model_.ws.hint[i] = ref_[i];
@@ -331,11 +346,100 @@ private:
         bool again = false;
         if (model_.mode.kind == ModeKind::Slide)
             for (int i = 0; i < scene_.part.contacts(); ++i) again |= slip[i].norm() < 0.1 * model_.ws.hint_from[i];
+        again |= creep_step(slip);
         reference_directions(slip);
         if (again) sys(ys_, fs_, t_);
         g0_ = g;
         if (model_.mode.kind == ModeKind::Slide)
             for (int i = 0; i < scene_.part.contacts(); ++i) g0_[3 + i] = slip[i].dot(ref_[i]);
+    }
+
+    // After an accepted step of a slide with creeping contacts. The creep leaves out the lag of the
+    // true slip direction behind the consistent one, lag ~ phi*' |v| / kappa (kappa = d(a x u)/d phi,
+    // the relaxation rate being kappa / |v|); the acceleration error is kappa times the lag,
+    // phi*' |v|, so over a step the velocity error is about |d phi*| |v| -- the consistent
+    // direction's turn over the step times the slip. Summed over the creep, it must stay below
+    // creep_budget_; the next step is limited so that it should (the increment grows about as the
+    // step squared: the turn with the step, the slip with it), and a contact whose budget is spent
+    // or whose slip exceeds creep_speed slides on along v/|v|. Returns true if a contact stopped
+    // creeping (the state is then evaluated again).
+    bool creep_step(const std::array<Vec2, 3>& slip) {
+        Workspace& ws = model_.ws;
+        if (model_.mode.kind != ModeKind::Slide) return false;
+        bool changed = false;
+        const double h = t_ - creep_t_;
+        creep_t_ = t_;
+        const double h_cap = creep_h_ == std::numeric_limits<double>::infinity() ? kCreepFirst * scene_.plate.T : 5 * h;
+        creep_h_ = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < scene_.part.contacts(); ++i) {
+            if (!(ws.creep >> i & 1u)) {
+                // A slip falling below zero_abs_ creeps on to zero along its consistent direction
+                // (where the deceleration vanishes with the slip, near a grazing stick, it need not
+                // reach zero soon, and v/|v| would make the steps collapse meanwhile). Its direction
+                // is solved at the next evaluation; the budget counts from there.
+                const double sn = slip[i].norm();
+                if (sn > 0 && sn < zero_abs_ && sn < std::abs(g0_[3 + i]) && !(creep_spent_ >> i & 1u)) {
+                    ws.creep |= 1u << i;
+                    ws.hint[i] = slip[i] / sn;
+                    creep_err_[i] = 0;
+                    creep_dir_[i] = Vec2::Zero();
+                    creep_h_ = std::min(creep_h_, kCreepFirst * scene_.plate.T);
+                    changed = true;
+                }
+                continue;
+            }
+            const Vec2& u = ws.hint[i];
+            const double turn = creep_dir_[i].isZero() ? 0.0 : std::atan2(std::abs(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x()), creep_dir_[i].dot(u));
+            const double sn = slip[i].norm(), inc = turn * sn;
+            creep_err_[i] += inc;
+            creep_dir_[i] = u;
+            if (creep_err_[i] > creep_budget_ || sn > ws.creep_speed) {
+                ws.creep &= ~(1u << i);
+                if (sn <= ws.creep_speed) creep_spent_ |= 1u << i;   // not again before its next event
+                changed = true;
+            } else {
+                creep_h_ = std::min(creep_h_, h_cap);
+                if (inc > 0 && h > 0) creep_h_ = std::min(creep_h_, h * std::sqrt((creep_budget_ - creep_err_[i]) / inc));
+            }
+        }
+        creep_h_ = std::max(creep_h_, h_min_);
+        return changed;
+    }
+    // Does a creeping contact's slip at the end of the step point away from its consistent direction
+    // (more than ~25 degrees)? Then the creep's premise fails (the slip does not move along the
+    // direction solved, e.g. a root on which it would decelerate while it grows): that contact
+    // stops creeping until its next event, and true is returned (the step is retried).
+    bool creep_inconsistent(const std::array<Vec2, 3>& slip) {
+        Workspace& ws = model_.ws;
+        if (!ws.creep || model_.mode.kind != ModeKind::Slide) return false;
+        bool off = false;
+        for (int i = 0; i < scene_.part.contacts(); ++i) {
+            const double sn = slip[i].norm();
+            if ((ws.creep >> i & 1u) && sn > ws.hint_speed && slip[i].dot(ws.hint[i]) < 0.9 * sn) {
+                ws.creep &= ~(1u << i);
+                creep_spent_ |= 1u << i;
+                off = true;
+            }
+        }
+        return off;
+    }
+    // Entering a mode at state y: in a slide, the contacts at zero slip (just broken away) creep.
+    void start_creep(const State& y) {
+        Workspace& ws = model_.ws;
+        ws.creep = 0;
+        creep_spent_ = 0;
+        creep_h_ = std::numeric_limits<double>::infinity();
+        creep_t_ = t_;
+        if (model_.mode.kind != ModeKind::Slide) return;
+        std::array<Vec2, 3> v;
+        slip_velocities(scene_.part, model_.q(y), model_.qd(y), v);
+        for (int i = 0; i < scene_.part.contacts(); ++i)
+            if (v[i].norm() <= ws.hint_speed && ws.hint[i].norm() > 0) {
+                ws.creep |= 1u << i;
+                creep_err_[i] = 0;
+                creep_dir_[i] = Vec2::Zero();   // (the direction is solved at the first evaluation)
+                creep_h_ = kCreepFirst * scene_.plate.T;
+            }
     }
 
     // Guards at scaled state ys (evaluated: ws already holds the evaluation there).
@@ -459,8 +563,12 @@ private:
         low_ = {0, 0, 0};
         const State y = this->y();
         Vec3 qd = model_.qd(y);
+        const unsigned creep = model_.ws.creep;
+        const std::array<Vec2, 3> hint = model_.ws.hint;
         const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
         if (!c.lost && c.mode.kind != ModeKind::Slide) return enter(c.mode, y, qd);
+        model_.ws.creep = creep;
+        model_.ws.hint = hint;
         set(y);   // nothing changes: restore the workspace
         return true;
     }
@@ -480,6 +588,7 @@ private:
         const Mode from = model_.mode;
         model_.mode = m;
         model_.set_qd(y, qd);
+        start_creep(y);
         set(y);
         log_event(from);
         return check_burst();
@@ -501,6 +610,12 @@ private:
         return true;
     }
 
+    std::array<double, 3> creep_err_{};
+    std::array<Vec2, 3> creep_dir_{};
+    double creep_budget_ = 0, creep_t_ = 0;
+    unsigned creep_spent_ = 0;
+    double creep_h_ = std::numeric_limits<double>::infinity();
+    static constexpr double kCreepFirst = 1e-4;   // the first step of a creep, relative to T
     static constexpr int kBurst = 1000;
     static constexpr int kLinger = 4;
     std::array<int, 3> low_{};

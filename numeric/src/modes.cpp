@@ -204,13 +204,69 @@ Vec2 contact_acceleration(const Part& P, Dynamics level, int i, const Vec3& q, c
     return qdd.head<2>() + qdd[2] * perp(r) - kappa(level) * qd[2] * qd[2] * r;
 }
 
+namespace {
+
+// Slide with creeping contacts (Workspace::creep): the direction u_j = (cos phi_j, sin phi_j) of each
+// creeping contact j is the one along which it then accelerates, c_j = a_j x u_j = 0 (the consistent
+// slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
+// first order at the rim's direction). Newton's method on the angles, from the last solution
+// (ws.hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
+void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                         Workspace& ws) {
+    const Part& P = sc.part;
+    int idx[3], m = 0;
+    for (int i = 0; i < P.contacts(); ++i)
+        if ((ws.creep >> i & 1u) && ws.hint[i].norm() > 0) idx[m++] = i;
+    ws.creep_iterations = 0;
+    accelerations(sc, level, q, qd, ps, ws);
+    if (m == 0) return;
+    auto residual = [&](Eigen::Vector3d& c) {
+        for (int j = 0; j < m; ++j) {
+            const Vec2 a = contact_acceleration(P, level, idx[j], q, qd, ws.qdd);
+            const Vec2& u = ws.hint[idx[j]];
+            c[j] = a.x() * u.y() - a.y() * u.x();
+        }
+    };
+    auto set_angles = [&](const Eigen::Vector3d& phi) {
+        for (int j = 0; j < m; ++j) ws.hint[idx[j]] = Vec2(std::cos(phi[j]), std::sin(phi[j]));
+    };
+    Eigen::Vector3d phi, c, cj;
+    for (int j = 0; j < m; ++j) phi[j] = std::atan2(ws.hint[idx[j]].y(), ws.hint[idx[j]].x());
+    residual(c);
+    constexpr double dphi = 1e-7;
+    for (int it = 0; it < 8; ++it) {
+        Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
+        for (int l = 0; l < m; ++l) {
+            Eigen::Vector3d p = phi;
+            p[l] += dphi;
+            set_angles(p);
+            accelerations(sc, level, q, qd, ps, ws);
+            residual(cj);
+            for (int j = 0; j < m; ++j) J(j, l) = (cj[j] - c[j]) / dphi;
+        }
+        Eigen::Vector3d step = Eigen::Vector3d::Zero();
+        step.head(m) = -J.topLeftCorner(m, m).partialPivLu().solve(c.head(m));
+        if (!step.allFinite()) step.setZero();       // a singular Jacobian: keep the last directions
+        step = step.cwiseMax(-0.5).cwiseMin(0.5);    // (a Newton step of at most ~30 degrees)
+        phi += step;
+        set_angles(phi);
+        accelerations(sc, level, q, qd, ps, ws);
+        ++ws.creep_iterations;
+        residual(c);
+        if (step.cwiseAbs().maxCoeff() < 1e-11) break;
+    }
+}
+
+}  // namespace
+
 void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                         const Mode& mode, Workspace& ws) {
     const Part& P = sc.part;
     if (ws.prepared != &sc) ws.prepare(sc);
     switch (mode.kind) {
         case ModeKind::Slide:
-            accelerations(sc, level, q, qd, ps, ws);
+            if (ws.creep) creep_accelerations(sc, level, q, qd, ps, ws);
+            else accelerations(sc, level, q, qd, ps, ws);
             return;
         case ModeKind::Stuck:
             ++ws.evals;
@@ -236,6 +292,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
                        Workspace& ws, bool hold) {
     const Part& P = sc.part;
     const int nc = P.contacts();
+    ws.creep = 0;   // every slide below has its directions set here
     ModeChoice out;
     int count = 0, k = -1;
     for (int i = 0; i < nc; ++i)

@@ -46,10 +46,11 @@ PlateState plate_state(const PlateMotion& plate, double t, Dynamics level,
 // How the friction force of a sliding contact depends on its sliding velocity v (17):
 //   Coulomb  exact kinetic Coulomb friction, direction v/|v| (discontinuous at v = 0)
 //   Tanh     regularised: (v/|v|) tanh(|v|/eps)
+//   Sqrt     regularised: v / sqrt(|v|^2 + eps^2) (the stick-slip reference of limit_cycle.hpp)
 //   Linear   regularised: v / max(|v|, eps) (a viscous law below eps)
 // The regularised laws change the model near zero slip: they trade the kink for an error of
 // order eps in the average twist (charted in the speed-accuracy report).
-enum class FrictionLaw { Coulomb, Tanh, Linear };
+enum class FrictionLaw { Coulomb, Tanh, Linear, Sqrt };
 const char* friction_law_name(FrictionLaw f);
 
 // Workspace ("Data"): scratch and results of the last evaluation. Preallocated; the
@@ -92,6 +93,15 @@ struct Workspace {
     double hint_speed = 0;
     std::array<Vec2, 3> hint{};
     std::array<double, 3> hint_from{};
+    // Creep: contact i (bit i of creep) has just broken away and slips slowly. Its friction
+    // direction relaxes towards the consistent one at a rate ~ |a'| / |v_i| (stiff as the slip
+    // vanishes), so it is taken as that direction itself: hint[i] solved in every evaluation so that
+    // the contact accelerates along it (mode_accelerations, the slow-manifold reduction of the
+    // direction). The engine sets the bits at a break-away and clears them between steps, once the
+    // slip exceeds creep_speed or the lag this ignores could matter (engine.hpp).
+    unsigned creep = 0;
+    double creep_speed = 0;
+    int creep_iterations = 0;              // Newton iterations of the last creep solve (diagnostics)
     std::array<Vec2, 3> f_held{};          // static friction of held contacts (pivot, stuck) [N], P frame
     Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate
     double tau_needed = 0;                 // stuck: its moment about s (z)

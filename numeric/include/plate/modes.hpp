@@ -70,7 +70,11 @@ FrictionGauge friction_gauge(const Part& part, double theta, const Vec3& n, cons
 
 // Mode-aware accelerations: fills ws.qdd and ws.n as accelerations() does, for any mode.
 //   Slide   accelerations(); a contact whose slip is below ws.hint_speed uses the unit direction
-//           ws.hint[i] (the break-away direction), since v/|v| is undefined at zero slip
+//           ws.hint[i] (the break-away direction), since v/|v| is undefined at zero slip; a creeping
+//           contact (ws.creep, slip below ws.creep_speed) the direction along which it accelerates,
+//           solved here (Newton on its angle): the slip direction's relaxation, at a rate
+//           ~ |d a/d phi| / |v| that makes explicit steps collapse as a slip grows from zero after a
+//           break-away, is left out (its error is bounded by the engine, engine.hpp)
 //   Pivot k Newton-Euler with contact k carrying the unknown f_k (ws.f_held[k]) and the
 //           constraint that c_k does not accelerate relative to the plate:
 //             s'' + theta'' e_z x r_k - kappa theta'^2 r_k = 0
@@ -94,7 +98,7 @@ struct ModeChoice {
     int lost_contact = -1;
     double gamma = 0;            // the gauge (zero twist) or |f_k|/(mu_k N_k) (pivot test)
 };
-// hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
+// Clears ws.creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
 // the gauge is 1 to rounding.
 ModeChoice choose_mode(const Scene& scene, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& plate,
                        unsigned zero, Workspace& ws, bool hold = true);
