@@ -393,13 +393,17 @@ private:
             const double sn = slip[i].norm(), inc = turn * sn;
             creep_err_[i] += inc;
             creep_dir_[i] = u;
-            if (creep_err_[i] > creep_budget_ || sn > ws.creep_speed) {
+            // The step the rest of the budget affords; where that is not even the last step's size,
+            // the creep ends (a budget shrinking the steps towards zero would never be spent).
+            const double afford = inc > 0 && h > 0 ? h * std::sqrt(std::max(creep_budget_ - creep_err_[i], 0.0) / inc)
+                                                   : std::numeric_limits<double>::infinity();
+            if (creep_err_[i] > creep_budget_ || sn > ws.creep_speed || afford < h) {
                 ws.creep &= ~(1u << i);
+                ws.creep_twist.setZero();
                 if (sn <= ws.creep_speed) creep_spent_ |= 1u << i;   // not again before its next event
                 changed = true;
             } else {
-                creep_h_ = std::min(creep_h_, h_cap);
-                if (inc > 0 && h > 0) creep_h_ = std::min(creep_h_, h * std::sqrt((creep_budget_ - creep_err_[i]) / inc));
+                creep_h_ = std::min({creep_h_, h_cap, afford});
             }
         }
         creep_h_ = std::max(creep_h_, h_min_);
@@ -417,6 +421,7 @@ private:
             const double sn = slip[i].norm();
             if ((ws.creep >> i & 1u) && sn > ws.hint_speed && slip[i].dot(ws.hint[i]) < 0.9 * sn) {
                 ws.creep &= ~(1u << i);
+                ws.creep_twist.setZero();
                 creep_spent_ |= 1u << i;
                 off = true;
             }
@@ -564,10 +569,12 @@ private:
         const State y = this->y();
         Vec3 qd = model_.qd(y);
         const unsigned creep = model_.ws.creep;
+        const Vec3 creep_twist = model_.ws.creep_twist;
         const std::array<Vec2, 3> hint = model_.ws.hint;
         const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
         if (!c.lost && c.mode.kind != ModeKind::Slide) return enter(c.mode, y, qd);
         model_.ws.creep = creep;
+        model_.ws.creep_twist = creep_twist;
         model_.ws.hint = hint;
         set(y);   // nothing changes: restore the workspace
         return true;

@@ -211,9 +211,67 @@ namespace {
 // slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
 // first order at the rim's direction). Newton's method on the angles, from the last solution
 // (ws.hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
+// Every contact creeping: the unknown is the direction xi of the twist (scaled: s_x', s_y', rho theta'),
+// the contacts' directions are its slips', and it is consistent when q'' (scaled) is parallel to xi
+// (Newton on two angles about xi, forward-difference Jacobian). Three independent angles would also
+// admit directions no rigid motion has (a contact decelerating while the twist grows).
+void set_twist_hints(const Part& P, double theta, const Vec3& xi, Workspace& ws) {
+    const double rho = P.rho();
+    for (int i = 0; i < P.contacts(); ++i) {
+        const Vec2 r = horizontal_offset(P, theta, i);
+        const Vec2 v(xi[0] - xi[2] / rho * r.y(), xi[1] + xi[2] / rho * r.x());
+        ws.hint[i] = v.norm() > 0 ? Vec2(v / v.norm()) : Vec2::Zero();
+    }
+}
+Vec3 scaled_qdd(const Part& P, const Workspace& ws) { return Vec3(ws.qdd[0], ws.qdd[1], P.rho() * ws.qdd[2]); }
+void tangent_basis(const Vec3& xi, Vec3& e1, Vec3& e2) {
+    e1 = std::abs(xi[0]) < 0.9 ? Vec3::UnitX().cross(xi).normalized() : Vec3::UnitY().cross(xi).normalized();
+    e2 = xi.cross(e1);
+}
+
+void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                               Workspace& ws) {
+    const Part& P = sc.part;
+    Vec3& xi = ws.creep_twist;
+    const Vec3 qs(qd[0], qd[1], P.rho() * qd[2]);
+    if (xi.isZero()) xi = qs.norm() > 0 ? Vec3(qs.normalized()) : Vec3::UnitX();
+    Vec3 e1, e2;
+    tangent_basis(xi, e1, e2);
+    auto at = [&](double a, double b) { return Vec3((xi + a * e1 + b * e2).normalized()); };
+    auto residual = [&](const Vec3& x) {
+        set_twist_hints(P, q[2], x, ws);
+        accelerations(sc, level, q, qd, ps, ws);
+        const Vec3 Q = scaled_qdd(P, ws);
+        const Vec3 r = Q - x.dot(Q) * x;   // zero iff q'' is parallel to x (in the plane about xi)
+        return Eigen::Vector2d(r.dot(e1), r.dot(e2));
+    };
+    double a = 0, b = 0;
+    Eigen::Vector2d c = residual(xi);
+    constexpr double d = 1e-7;
+    for (int it = 0; it < 8; ++it) {
+        Eigen::Matrix2d J;
+        J.col(0) = (residual(at(a + d, b)) - c) / d;
+        J.col(1) = (residual(at(a, b + d)) - c) / d;
+        Eigen::Vector2d step = -J.partialPivLu().solve(c);
+        if (!step.allFinite()) step.setZero();
+        step = step.cwiseMax(-0.3).cwiseMin(0.3);
+        a += step[0];
+        b += step[1];
+        c = residual(at(a, b));
+        ++ws.creep_iterations;
+        if (step.cwiseAbs().maxCoeff() < 1e-11) break;
+    }
+    xi = at(a, b);
+}
+
 void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                          Workspace& ws) {
     const Part& P = sc.part;
+    if (!P.point && (ws.creep & 7u) == 7u) {
+        ws.creep_iterations = 0;
+        twist_creep_accelerations(sc, level, q, qd, ps, ws);
+        return;
+    }
     int idx[3], m = 0;
     for (int i = 0; i < P.contacts(); ++i)
         if ((ws.creep >> i & 1u) && ws.hint[i].norm() > 0) idx[m++] = i;
@@ -293,6 +351,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
     const Part& P = sc.part;
     const int nc = P.contacts();
     ws.creep = 0;   // every slide below has its directions set here
+    ws.creep_twist.setZero();
     ModeChoice out;
     int count = 0, k = -1;
     for (int i = 0; i < nc; ++i)
@@ -390,7 +449,42 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
         ws.hint[i] = fn > 0 ? Vec2(-g.f[i] / fn) : Vec2::Zero();
         all |= 1u << i;
     }
-    if (g.gamma > 1 + 1e-6) refine_hints(all);
+    if (g.gamma > 1 + 1e-6) {
+        if (P.point) refine_hints(all);
+        else {
+            // The twist that starts: the direction xi (scaled) along which q'' points when the slips
+            // are xi's -- found by relaxing xi along q''(xi) (the direction a part released at rest
+            // takes, q' ~ t q''; the fixed-point iteration xi <- q''(xi) flips back and forth near the
+            // stick boundary), from the twist the needed friction opposes, reversed.
+            const double rho = P.rho();
+            Vec3 xi = -Vec3(g.direction[0], g.direction[1], rho * g.direction[2]);
+            xi = xi.norm() > 0 ? Vec3(xi.normalized()) : Vec3::UnitX();
+            // (The relaxation step shrinks where the residual grows: near a contact whose slip
+            // nearly vanishes -- a slide close to a pivot -- the flow is stiff.)
+            auto misfit = [&](const Vec3& x, Vec3& Q) {
+                set_twist_hints(P, q[2], x, ws);
+                mode_accelerations(sc, level, q, qd, ps, Mode{}, ws);
+                Q = scaled_qdd(P, ws);
+                const double lam = x.dot(Q);
+                return Q.norm() > 0 ? ((Q - lam * x).norm() + std::max(-lam, 0.0)) / Q.norm() : 0.0;
+            };
+            Vec3 Q;
+            double r = misfit(xi, Q), tau = 0.2;
+            for (int it = 0; it < 2000 && r > 1e-10 && tau > 1e-14; ++it) {
+                const Vec3 next = (xi + tau * Q.normalized()).normalized();
+                Vec3 Qn;
+                const double rn = misfit(next, Qn);
+                if (rn <= r) {
+                    xi = next; Q = Qn; r = rn;
+                    tau = std::min(0.5, 1.5 * tau);
+                } else {
+                    tau *= 0.3;
+                }
+            }
+            set_twist_hints(P, q[2], xi, ws);
+            ws.creep_twist = xi;
+        }
+    }
     out.mode = Mode{};
     return out;
 }

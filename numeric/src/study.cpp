@@ -316,4 +316,82 @@ void path_error(const Scene& sc, const std::vector<double>& a, const std::vector
     }
 }
 
+RegularisedReference regularised_reference(const Scene& sc, const Vec3& q0, const RegularisedOptions& opt) {
+    RegularisedReference out;
+    const auto t0 = Clock::now();
+    const double T = sc.plate.T, v = sc.v_ref();
+    const Vec3 S(v, v, v / sc.part.rho());   // the twist's scale
+    if (opt.eps.size() < 3) {
+        out.failure = "the reference needs at least three eps";
+        return out;
+    }
+    Vec3 start = Vec3::Zero();   // the cycle's start (physical), warm start for the next eps
+    for (double eps : opt.eps) {
+        const auto w = reduced_wrapped(sc, q0, FrictionLaw::Sqrt, eps * v);
+        const OdeSystem sys = reduced_from(w, sc);
+        MethodOptions mo;
+        mo.tol = opt.tol;
+        mo.h = 1e-3 * T;
+        mo.h_min = 1e-15 * T;
+        MethodRun run;
+        std::vector<double> y(6, 0.0);
+        for (int i = 0; i < 3; ++i) y[i] = start[i] / w->scale[i];
+        Vec3 prev(y[0], y[1], y[2]);
+        double r_prev = 0;
+        bool done = false;
+        int k = 1;
+        for (; k <= opt.max_periods && !done; ++k) {
+            y[3] = y[4] = y[5] = 0;
+            if (!integrate(Method::GslBsimp, sys, (k - 1) * T, k * T, y, mo, run)) break;
+            Vec3 qd(y[0], y[1], y[2]);
+            // residual in units of v_ref (the state is scaled by v_ref, v_ref, v_ref / rho)
+            const double res = (qd - prev).cwiseAbs().maxCoeff();
+            if (k >= 2 && r_prev > 0) {
+                const double c = std::min(res / r_prev, 0.99);
+                if (res * c / (1 - c) <= opt.cycle_tol || res == 0) {
+                    out.twists.push_back(Vec3(y[3] * w->scale[3], y[4] * w->scale[4], y[5] * w->scale[5]) / T);
+                    for (int i = 0; i < 3; ++i) start[i] = prev[i] * w->scale[i];
+                    done = true;
+                }
+            }
+            prev = qd;
+            r_prev = res;
+        }
+        out.rhs_evals += w->model.ws.evals;
+        out.periods.push_back(k - 1);
+        if (!run.ok || !done || w->min_n < 0) {
+            std::ostringstream m;
+            m << "regularised cycle at eps = " << eps << " v_ref: "
+              << (!run.ok ? run.failure : w->min_n < 0 ? std::string("contact lost") : std::string("not converged"));
+            out.failure = m.str();
+            out.seconds = seconds_since(t0);
+            return out;
+        }
+    }
+    // Richardson with the observed order on the last triples.
+    const std::size_t n = out.twists.size();
+    auto limit = [&](std::size_t i, double& p, double& corr) {
+        const double r = opt.eps[i] / opt.eps[i + 1];
+        const Vec3 d1 = (out.twists[i] - out.twists[i + 1]).cwiseQuotient(S);
+        const Vec3 d2 = (out.twists[i + 1] - out.twists[i + 2]).cwiseQuotient(S);
+        p = std::log(d1.norm() / d2.norm()) / std::log(r);
+        if (!(p > 0.1) || !std::isfinite(p)) p = 0.1;   // no observed convergence: a weak order, a large error
+        const Vec3 c = d2 / (std::pow(r, p) - 1);
+        corr = c.cwiseAbs().maxCoeff();
+        return Vec3(out.twists[i + 2] - c.cwiseProduct(S));
+    };
+    double p = 0, corr = 0;
+    out.twist = limit(n - 3, p, corr);
+    out.order = p;
+    out.error = corr;
+    if (n >= 4) {
+        double p0, c0;
+        const Vec3 before = limit(n - 4, p0, c0);
+        out.error += (out.twist - before).cwiseQuotient(S).cwiseAbs().maxCoeff();
+    }
+    out.ok = true;
+    out.seconds = seconds_since(t0);
+    return out;
+}
+
 }  // namespace plate

@@ -101,6 +101,10 @@ struct Workspace {
     // slip exceeds creep_speed or the lag this ignores could matter (engine.hpp).
     unsigned creep = 0;
     double creep_speed = 0;
+    // When every contact creeps (a break-away from rest relative to the plate, or an approach to it)
+    // the slips are those of one twist: its unit direction (s_x', s_y', rho theta'), solved instead of
+    // the contacts' angles (zero: none yet -- taken from the twist, or set by choose_mode).
+    Vec3 creep_twist = Vec3::Zero();
     int creep_iterations = 0;              // Newton iterations of the last creep solve (diagnostics)
     std::array<Vec2, 3> f_held{};          // static friction of held contacts (pivot, stuck) [N], P frame
     Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate

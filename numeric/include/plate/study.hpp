@@ -8,6 +8,7 @@
 #include "plate/limit_cycle.hpp"
 #include "plate/methods.hpp"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,35 @@ double field_max_error(const Scene& scene, const Field& f, const Field& ref, int
 // Final-sample and largest-over-samples configuration error.
 void path_error(const Scene& scene, const std::vector<double>& a, const std::vector<double>& b, double& final_error,
                 double& max_error);
+
+// THE REGULARISED-FRICTION REFERENCE for stick-slip: the asymptotic twist with Coulomb's law
+// replaced by f = -mu N v / sqrt(|v|^2 + eps^2) (FrictionLaw::Sqrt), which has no stick, no modes
+// and no events, integrated by GSL's implicit Bulirsch-Stoer (bsimp, with the generated Jacobian:
+// the regularised law is stiff, rate ~ mu g / eps) to `tol`, its cycle found period by period from
+// rest (each eps then from the previous eps's cycle) -- nothing of the engine is used. As eps -> 0
+// the twist tends to Coulomb's; near a break-away the error shrinks more slowly than eps, so the
+// order is *observed* from the last three eps (a geometric sequence of ratio r): with differences
+// d1 = x(e1) - x(e2), d2 = x(e2) - x(e3), p = log(|d1| / |d2|) / log r, and the limit is
+// x(e3) - d2 / (r^p - 1) (Richardson). `error` is that correction's size plus the change of the
+// limit from the previous triple: what the reference itself is worth.
+struct RegularisedOptions {
+    std::vector<double> eps{1e-5, 1e-6, 1e-7, 1e-8};   // relative to Scene::v_ref(), decreasing geometrically
+    double tol = 1e-12;          // bsimp, on the state scaled by (v_ref, v_ref, v_ref / rho)
+    double cycle_tol = 1e-11;    // the cycle's error estimate, relative to v_ref
+    int max_periods = 400;
+};
+struct RegularisedReference {
+    bool ok = false;
+    std::string failure;
+    std::vector<Vec3> twists;    // per eps [m/s, m/s, rad/s]
+    std::vector<int> periods;    // per eps
+    double order = 0;            // observed p
+    Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());   // extrapolated to eps = 0
+    double error = 0;            // relative to (v_ref, v_ref, v_ref / rho), max over components
+    long rhs_evals = 0;
+    double seconds = 0;
+};
+RegularisedReference regularised_reference(const Scene& scene, const Vec3& q0, const RegularisedOptions& opt = {});
 
 // The OdeSystem of the reduced U-dynamics at q0 in scaled coordinates, y = [q'/v, Q/(v T)], with
 // the generated Jacobian (twist_jacobian); exposed for tests of the methods.
