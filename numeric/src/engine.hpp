@@ -60,7 +60,7 @@ public:
         // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
         // the error that leaves stays below creep_budget_ (creep_step).
         model_.ws.creep_speed = 1e-2 * v_ref_;
-        creep_budget_ = 0.1 * opt_.rtol * v_ref_;
+        creep_budget_ = 10 * opt_.rtol * v_ref_;
     }
 
     // Starts at (t0, y0) in physical units; the mode follows from the state (a contact with zero slip

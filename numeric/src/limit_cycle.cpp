@@ -6,6 +6,7 @@
 #include <gsl/gsl_multiroots.h>
 
 #include <cmath>
+#include <algorithm>
 #include <deque>
 #include <sstream>
 #include <stdexcept>
@@ -144,7 +145,15 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
             r_prev = r;
             prev = qd;
             extrapolated = false;
-            if (anderson) {
+            const bool reset = std::any_of(e.events.begin(), e.events.end(),
+                                           [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
+            if (anderson && reset) {
+                // The part was stuck during the period: that resets its state, so the map is all but
+                // constant and the plain period is the best next start; extrapolating across the
+                // map's pieces threw the start off (157 periods instead of 4 on a heave + yaw scene).
+                X.clear();
+                Fx.clear();
+            } else if (anderson) {
                 // Plain periods until the map's own contraction is measured, then extrapolate.
                 X.push_back(start.cwiseQuotient(scale));
                 Fx.push_back(qd.cwiseQuotient(scale));

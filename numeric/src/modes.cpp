@@ -449,6 +449,12 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
         ws.hint[i] = fn > 0 ? Vec2(-g.f[i] / fn) : Vec2::Zero();
         all |= 1u << i;
     }
+    if (!P.point) {
+        // At a located stick exit (gauge 1) the twist that starts is opposite the one the rim's
+        // friction opposes; the creep's Newton refines it from there (engine.hpp).
+        const Vec3 d(g.direction[0], g.direction[1], P.rho() * g.direction[2]);
+        ws.creep_twist = d.norm() > 0 ? Vec3(-d.normalized()) : Vec3::Zero();
+    }
     if (g.gamma > 1 + 1e-6) {
         if (P.point) refine_hints(all);
         else {
