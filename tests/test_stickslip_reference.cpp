@@ -1,0 +1,87 @@
+// Stick-slip against an independent reference (issue 14, point 6): the regularised-friction law
+// f = -mu N v / sqrt(|v|^2 + eps^2) has no stick, no modes and no events; its cycles, integrated by
+// GSL's implicit Bulirsch-Stoer and extrapolated to eps -> 0 with the observed order
+// (regularised_reference, study.hpp), must give the event-driven engine's twists.
+#include "plate/field.hpp"
+#include "plate/scene_io.hpp"
+#include "plate/study.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace plate;
+
+namespace {
+
+Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+
+double twist_distance(const Scene& sc, const Vec3& a, const Vec3& b) {
+    const double v = sc.v_ref();
+    return (a - b).cwiseQuotient(Vec3(v, v, v / sc.part.rho())).cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+TEST_CASE("regularised reference: where nothing sticks it is today's twist at every eps",
+          "[stick][reference]") {
+    const Scene sc = scene("fig6");
+    // (0.05, 0.05, 0): fig6's corner slides all period long (the engine's mode record says so).
+    const Vec3 q(0.05, 0.05, 0);
+    LimitCycleOptions o;
+    o.integration.rtol = 1e-10;
+    o.tol = 1e-9;
+    const LimitCycleSummary lc = limit_cycle(sc, q, o);
+    REQUIRE(lc.converged);
+    REQUIRE(lc.stick_fraction[0] + lc.stick_fraction[1] + lc.stick_fraction[2] == 0.0);
+    const RegularisedReference r = regularised_reference(sc, q);
+    REQUIRE(r.ok);
+    // Away from zero slip the regularised law differs from Coulomb by eps^2 / (2 |v|^2) relative: below
+    // 1e-9 at the largest eps (1e-5 v_ref) for slips above 1e-2 v_ref, so every eps gives the twist.
+    for (const Vec3& t : r.twists) CHECK(twist_distance(sc, lc.twist, t) < 1e-8);
+}
+
+TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-friction limit to 1e-7 v_ref",
+          "[stick][reference]") {
+    // The configurations of fig6's default 7x7x7 grid whose cycle holds a contact (a pivot) but is
+    // never stuck as a whole, every fourth in grid order; the engine at rtol 1e-10 with cycles to 1e-9 (at 1e-9 one
+    // of them is 2e-7 off: the creep's error budget is 10 rtol v_ref).
+    // The bound: 1e-7 v_ref for the engine plus the reference's own error estimate (its Richardson
+    // correction and the change of the extrapolated limit from the previous triple of eps).
+    // (Cycles with a phase stuck as a whole are not in this test: there the regularised limit leaves
+    // the stuck state before the gauge reaches 1 on some configurations -- see the closing note.)
+    const Scene sc = scene("fig6");
+    const GridSpec grid;
+    int seen = 0, checked = 0;
+    double worst = 0;
+    for (int idx = 0; idx < grid.size(); ++idx) {
+        const int i = idx / (grid.ny * grid.nth), j = (idx / grid.nth) % grid.ny, k = idx % grid.nth;
+        const Vec3 q = grid.at(i, j, k);
+        const LimitCycleSummary first = limit_cycle(sc, q);   // the default settings select
+        REQUIRE(first.converged);
+        const LimitCycleSummary& lc = first;
+        const bool pivots = std::any_of(lc.stick_fraction.begin(), lc.stick_fraction.end(), [](double f) { return f > 0; });
+        const bool stuck = lc.start_mode.kind == ModeKind::Stuck ||
+                           std::any_of(lc.mode_events.begin(), lc.mode_events.end(),
+                                       [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
+        if (!pivots || stuck || seen++ % 4) continue;
+        LimitCycleOptions o;
+        o.integration.rtol = 1e-10;
+        o.tol = 1e-9;
+        const LimitCycleSummary tight = limit_cycle(sc, q, o);
+        REQUIRE(tight.converged);
+        const RegularisedReference r = regularised_reference(sc, q);
+        REQUIRE(r.ok);
+        const double d = twist_distance(sc, tight.twist, r.twist);
+        INFO("q = (" << q[0] << ", " << q[1] << ", " << q[2] << "): engine " << tight.twist.transpose() << ", reference "
+                     << r.twist.transpose() << " (order " << r.order << ", error " << r.error << ")");
+        CHECK(d <= 1e-7 + r.error);
+        // Near a stick the regularised law's error shrinks more slowly than eps: the observed order is below 1.
+        CHECK(r.order < 1.2);
+        worst = std::max(worst, d);
+        ++checked;
+    }
+    INFO("largest difference " << worst);
+    CHECK(checked >= 8);
+}
