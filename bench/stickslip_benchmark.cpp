@@ -1,0 +1,135 @@
+// Benchmark: stick-slip (issue 14). Not a test: nothing here passes or fails.
+//   (1) fields in one run: fig6 (78 of 343 configurations stick), heave_yaw (every configuration
+//       sticks) and the never-sticking fig4, wall time on 1 and all threads;
+//   (2) at equal accuracy, the event-driven engine against the regularised-friction method
+//       (f = -mu N v / sqrt(|v|^2 + eps^2) integrated by GSL's bsimp, the stiff method that works
+//       for it, see README): on a sample of fig6's sticking configurations, each method's error against
+//       the regularised reference extrapolated to eps = 0, and its time; the regularised method at the
+//       largest eps whose error stays below 1e-6 v_ref on the whole sample, against the engine.
+// Ratios are measured in this run; absolute figures come with the machine.
+#include "plate/field.hpp"
+#include "plate/output.hpp"
+#include "plate/scene_io.hpp"
+#include "plate/study.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace plate;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+
+double distance(const Scene& sc, const Vec3& a, const Vec3& b) {
+    const double v = sc.v_ref();
+    return (a - b).cwiseQuotient(Vec3(v, v, v / sc.part.rho())).cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+int main() {
+    std::printf("machine: %s\n", machine_description().c_str());
+
+    std::printf("\n(1) fields, 7x7x7 (point parts 7x7), default options (rtol 1e-8, cycle tol 1e-7)\n");
+    for (const char* name : {"fig6", "heave_yaw", "heave_yaw_point", "fig4"}) {
+        const Scene sc = scene(name);
+        for (int threads : {1, 0}) {
+            FieldOptions opt;
+            opt.threads = threads;
+            const Field f = compute_field(sc, GridSpec{}, opt);
+            int converged = 0, sticking = 0;
+            for (const auto& p : f.points) {
+                converged += p.converged;
+                sticking += *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) > 0;
+            }
+            std::printf("  %-16s %d thread(s): %.3f s wall, %d/%zu defined, %d stick during their cycle\n", name,
+                        f.threads, f.seconds, converged, f.points.size(), sticking);
+        }
+    }
+
+    std::printf("\n(2) fig6's sticking configurations, every 5th in grid order: error against the regularised\n"
+                "    reference (eps -> 0), relative to v_ref, and time per configuration\n");
+    const Scene sc = scene("fig6");
+    const GridSpec grid;
+    std::vector<Vec3> sample;
+    int seen = 0;
+    for (int idx = 0; idx < grid.size(); ++idx) {
+        const int i = idx / (grid.ny * grid.nth), j = (idx / grid.nth) % grid.ny, k = idx % grid.nth;
+        const Vec3 q = grid.at(i, j, k);
+        const LimitCycleSummary lc = limit_cycle(sc, q);
+        if (!lc.converged) continue;
+        if (*std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end()) > 0 && seen++ % 5 == 0)
+            sample.push_back(q);
+    }
+    std::vector<Vec3> ref(sample.size());
+    double t_ref = 0;
+    for (std::size_t n = 0; n < sample.size(); ++n) {
+        const RegularisedReference r = regularised_reference(sc, sample[n]);
+        ref[n] = r.twist;
+        t_ref += r.seconds;
+    }
+    std::printf("  %zu configurations; the reference took %.2f s in all\n", sample.size(), t_ref);
+
+    std::vector<double> err_engine, ms;
+    const auto t0 = Clock::now();
+    std::size_t at = 0;
+    for (std::size_t n = 0; n < sample.size(); ++n) {
+        const auto t1 = Clock::now();
+        const LimitCycleSummary lc = limit_cycle(sc, sample[n]);
+        ms.push_back(1e3 * since(t1));
+        err_engine.push_back(distance(sc, lc.twist, ref[n]));
+        if (err_engine.back() >= err_engine[at]) at = n;
+    }
+    const double t_engine = since(t0);
+    std::printf("  engine (events, rtol 1e-8):   %8.2f ms per configuration (slowest %.1f ms), largest error %.1e at "
+                "(%.4f, %.4f, %.3f)\n", 1e3 * t_engine / sample.size(), *std::max_element(ms.begin(), ms.end()),
+                err_engine[at], sample[at][0], sample[at][1], sample[at][2]);
+    std::sort(err_engine.begin(), err_engine.end());
+    std::sort(ms.begin(), ms.end());
+    std::printf("                                 median %.2f ms; error median %.1e, second largest %.1e\n",
+                ms[ms.size() / 2], err_engine[err_engine.size() / 2], err_engine[err_engine.size() - 2]);
+
+    double chosen_time = 0, chosen_eps = 0;
+    for (double eps : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7}) {
+        Solver s;
+        s.method = Method::GslBsimp;
+        s.law = FrictionLaw::Sqrt;
+        s.law_eps = eps;
+        double t = 0, worst = 0;
+        bool ok = true;
+        std::vector<double> errs, rms;
+        std::size_t at = 0;
+        for (std::size_t n = 0; n < sample.size(); ++n) {
+            const RunResult r = twist_run(sc, sample[n], s, 1e-10, 1e-8, 200'000'000);
+            t += r.seconds;
+            rms.push_back(1e3 * r.seconds);
+            ok = ok && r.ok;
+            if (!r.ok) continue;
+            errs.push_back(distance(sc, Vec3(r.value[0], r.value[1], r.value[2]), ref[n]));
+            if (errs.back() > worst) { worst = errs.back(); at = n; }
+        }
+        std::sort(errs.begin(), errs.end());
+        std::sort(rms.begin(), rms.end());
+        std::printf("  regularised eps %.0e v_ref:   %8.2f ms per configuration (median %.2f), error median %.1e, largest %.1e at "
+                    "(%.4f, %.4f, %.3f)%s\n", eps, 1e3 * t / sample.size(), rms[rms.size() / 2], errs.empty() ? 0.0 : errs[errs.size() / 2],
+                    worst, sample[at][0], sample[at][1], sample[at][2], ok ? "" : " (some runs failed)");
+        if (ok && worst <= 1e-6 && chosen_eps == 0) {
+            chosen_eps = eps;
+            chosen_time = t;
+        }
+    }
+    if (chosen_eps > 0)
+        std::printf("  at 1e-6 v_ref: the regularised method needs eps = %.0e v_ref and is %.1fx slower than the "
+                    "engine (largest engine error %.1e)\n",
+                    chosen_eps, chosen_time / t_engine, err_engine.back());
+    else
+        std::printf("  no eps tried reaches 1e-6 v_ref on the whole sample\n");
+    return 0;
+}
