@@ -147,7 +147,11 @@ TEST_CASE("Fig. 6: the field rotates the part everywhere with no holes and stick
         for (const auto& c : sc.part.c) r_min = std::min(r_min, (p.q.head<2>() + (R2 * c).head<2>()).norm());
         INFO("sticks at " << p.q.transpose() << ": nearest contact " << r_min << " m from the centre");
         CHECK(std::min(r_min, p.q.head<2>().norm()) < 0.03);
-        CHECK(held < 1);             // nowhere stuck all period long: the spin always breaks it away
+        // Nowhere stuck as a whole all period long: the spin always breaks the part away. (A single
+        // contact can be held all period: at (0, -0.05, 0) contact 1 lies 2 mm from the centre and the
+        // part swings about it, turning both ways -- the regularised-friction limit gives the same twist
+        // to 1.2e-7 v_ref.)
+        CHECK(std::min({p.stick_fraction[0], p.stick_fraction[1], p.stick_fraction[2]}) < 1);
     }
     CHECK(sticking > 0);   // the paper: Fig. 6 is the field with sticking configurations
     CHECK(find_fixed_points(sc, f).points.empty());

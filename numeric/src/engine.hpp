@@ -55,7 +55,7 @@ public:
         // break-away its direction is the hint choose_mode set).
         model_.ws.use_hints = true;
         model_.ws.hint_speed = std::max(10 * opt_.rtol, 1e-12) * v_ref_;
-        zero_abs_ = std::max(1e3 * opt_.rtol, 1e-9) * v_ref_;
+        zero_abs_ = std::max(3e2 * opt_.rtol, 1e-9) * v_ref_;
         // A contact that breaks away creeps (Workspace::creep: its friction along the consistent
         // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
         // the error that leaves stays below creep_budget_ (creep_step).
