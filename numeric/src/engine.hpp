@@ -198,11 +198,14 @@ public:
                 unsigned linger = 0;
                 if (model_.mode.kind == ModeKind::Slide)
                     for (int i = 0; i < nc; ++i) {
-                        // (a slip growing away from zero, as after a break-away, does not linger)
+                        // (a slip growing away from zero, as after a break-away, does not linger; one
+                        // that alternates between two values -- an explicit step unstable on the
+                        // direction's relaxation -- does: it is compared with the larger of the last two)
                         const double sn = slip1[i].norm();
-                        low_[i] = sn < zero_abs_ && sn <= slip_prev_[i] ? low_[i] + 1 : 0;
+                        low_[i] = sn < zero_abs_ && sn <= 1.01 * std::max(slip_prev_[i], slip_prev2_[i]) ? low_[i] + 1 : 0;
+                        slip_prev2_[i] = slip_prev_[i];
                         slip_prev_[i] = sn;
-                        if (low_[i] >= kLinger) linger |= 1u << i;
+                        if (low_[i] >= linger_need_[i]) linger |= 1u << i;
                     }
                 if (linger) {
                     for (int i = 0; i < nc; ++i)
@@ -434,6 +437,7 @@ private:
         Workspace& ws = model_.ws;
         ws.creep = 0;
         creep_spent_ = 0;
+        linger_need_ = {kLinger, kLinger, kLinger};
         creep_h_ = std::numeric_limits<double>::infinity();
         creep_t_ = t_;
         if (model_.mode.kind != ModeKind::Slide) return;
@@ -574,6 +578,9 @@ private:
         const std::array<Vec2, 3> hint = model_.ws.hint;
         const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
         if (!c.lost && c.mode.kind != ModeKind::Slide) return enter(c.mode, y, qd);
+        // Not held: wait twice as long before the next try (each costs a mode choice).
+        for (int i = 0; i < 3; ++i)
+            if (zero >> i & 1u) linger_need_[i] = std::min(2 * linger_need_[i], 1 << 20);
         model_.ws.creep = creep;
         model_.ws.creep_twist = creep_twist;
         model_.ws.hint = hint;
@@ -627,7 +634,8 @@ private:
     static constexpr int kBurst = 1000;
     static constexpr int kLinger = 4;
     std::array<int, 3> low_{};
-    std::array<double, 3> slip_prev_{};
+    std::array<double, 3> slip_prev_{}, slip_prev2_{};
+    std::array<int, 3> linger_need_{kLinger, kLinger, kLinger};
     Model& model_;
     const Scene& scene_;
     IntegrationOptions opt_;
