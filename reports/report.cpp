@@ -122,9 +122,9 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
     row("thin (Theorem 1)", thin);
     theorem = false;
     row("thick (beyond it)", thick);
-    c.html << "</table>\n<p>Thick parts are outside Theorem 1: V may rise (the normal forces depend on the twist), "
-              "yet in this campaign every cycle found was unique and attracting (Observation 1); the seeds above reproduce "
-              "the cases where V rose.</p>\n";
+    c.html << "</table>\n<p>Thick parts are outside Theorem 1: V may rise (the normal forces depend on the twist). "
+           << esc(observation1_sentence(thick.valid, thick.converged, thick.unique, thick.floquet_below_one))
+           << " The seeds above reproduce the cases where V rose.</p>\n";
     {   // V per period, log scale: a few thin cases and the worst thick one
         auto o = c.data("V.dat");
         int cols = 0;
@@ -397,6 +397,24 @@ void write_report(const ReportOptions& opt) {
               << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
     html << kSpeedEnd << "\n" << kImageCheck << "</body></html>\n";
     if (!html) throw std::runtime_error((c.dir / "index.html").string() + ": write failed");
+}
+
+std::string observation1_sentence(int valid, int converged, int unique, int attracting) {
+    if (valid <= 0) return "No thick case stayed in the model, so this campaign says nothing on Observation 1.";
+    if (converged == valid && unique == valid && attracting == valid)
+        return "In this campaign every cycle found was unique and attracting (Observation 1), in all " +
+               std::to_string(valid) + " cases.";
+    std::string s = "Observation 1 does not hold in this campaign for every case: of " + std::to_string(valid) + " cases, ";
+    std::string parts;
+    auto add = [&](int bad, const char* what) {
+        if (bad <= 0) return;
+        if (!parts.empty()) parts += ", ";
+        parts += std::to_string(bad) + " " + what;
+    };
+    add(valid - converged, "reached no cycle");
+    add(converged - unique, "reached another cycle from other initial twists");
+    add(converged - attracting, "had a Floquet multiplier of modulus 1 or more");
+    return s + parts + ".";
 }
 
 }  // namespace plate::report

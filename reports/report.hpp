@@ -19,6 +19,12 @@ struct ReportOptions {
 // Writes the report; throws std::runtime_error (with the file or tool named) on failure.
 void write_report(const ReportOptions& opt);
 
+// The report's sentence on Observation 1 for the thick parts (beyond Theorem 1), from the campaign's
+// counts: of `valid` cases, how many reached a cycle, how many of those from four more initial twists
+// reached the same one, and how many had every Floquet multiplier below 1 in modulus. It says "every
+// cycle found was unique and attracting" only when all of them did; otherwise how many did not.
+std::string observation1_sentence(int valid, int converged, int unique, int attracting);
+
 // The speed-accuracy study (`plate bench`): writes its charts into DIR and its section into
 // DIR/index.html (between the report's markers; a page of its own if there is no report yet).
 // Quick by default (minutes); `full` sweeps more settings, solvers and regularisation widths.
