@@ -7,10 +7,12 @@
 #include "derivation.hpp"
 #include "theorem1.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -271,7 +273,9 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                       {"fig1", Vec3(-0.04, 0.03, 1.2), 20, "Fig. 1(c)-(f): lines of fixed points at θ = 0, π"},
                       {"fig4", Vec3(0.04, -0.04, 1.0), 20, "Fig. 4: centring and orienting"},
                       {"fig5", Vec3(0.0, -0.04, 1.0), 4, "Fig. 5: transport along y, θ to 0 or π"},
-                      {"fig6", Vec3(0.03, 0.03, 0.5), 20, "Fig. 6: rotation"}};
+                      {"fig6", Vec3(0.03, 0.03, 0.5), 20, "Fig. 6: rotation"},
+                      {"heave_yaw", Vec3(0.03, 0.03, 0.5), 20, "Heave + rocking yaw: every configuration sticks"},
+                      {"heave_yaw_point", Vec3(0.03, 0.03, 0), 20, "Heave + rocking yaw, point part"}};
     for (const auto& f : figs) {
         const Scene sc = load_scene((src / "scenes" / (std::string(f.scene) + ".json")).string());
         GridSpec g;
@@ -301,7 +305,8 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             for (const auto& p : field.points) {
                 if (!p.converged) continue;
                 o << p.q[0] << ' ' << p.q[1] << ' ' << wrap_angle(p.q[2]) << ' ' << k * p.twist[0] << ' ' << k * p.twist[1] << ' '
-                  << (pt ? 0.0 : k * p.twist[2]) << '\n';
+                  << (pt ? 0.0 : k * p.twist[2]) << ' '
+                  << *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) << '\n';
             }
             auto t = c.data(n + "_traj.dat");
             for (const auto& s : tr.samples) t << s.q[0] << ' ' << s.q[1] << ' ' << wrap_angle(s.q[2]) << '\n';
@@ -329,12 +334,25 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             c.plot(n + "_yt", "set xlabel 's_y'\nset ylabel 'θ'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T + " u 2:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
                    "s_y–θ projection");
         }
-        int stuck = 0, lost = 0;
+        int stuck = 0, lost = 0, sticks = 0, held_all = 0;
         for (const auto& p : field.points) {
             stuck += p.stop == StopReason::Sticking;
             lost += p.stop == StopReason::ContactLost;
+            sticks += p.converged && *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) > 0;
+            held_all += p.converged && *std::min_element(p.stick_fraction.begin(), p.stick_fraction.begin() + sc.part.contacts()) >= 1;
         }
-        c.html << "<p>Configurations where the twist is undefined: " << stuck << " sticking, " << lost << " contact lost.</p>\n";
+        c.html << "<p>Configurations where the twist is undefined: " << stuck << " sticking, " << lost << " contact lost. "
+               << "Configurations whose cycle sticks (a contact held for part of the period): " << sticks << " of "
+               << field.points.size() << "; stuck as a whole all period long (twist exactly zero): " << held_all << ".</p>\n";
+        if (sticks > 0) {
+            // The largest stick fraction of the three contacts over the cycle, per configuration.
+            const std::string SF = "'data/" + n + "_field.dat'";
+            c.plot(n + "_stick", pt ? "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nset cblabel 'stick fraction'\nset cbrange [0:1]\n"
+                                      "plot " + SF + " u 1:2:7 w p pt 5 ps 2 palette notitle\n"
+                                    : "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nset cblabel 'stick fraction'\n"
+                                      "set cbrange [0:1]\nsplot " + SF + " u 1:2:3:7 w p pt 7 ps 1 palette notitle\n",
+                   std::string(f.what) + ": fraction of the cycle a contact is held (largest of the contacts)");
+        }
         c.html << "<table><tr><th>fixed point / line</th><th>at (from … to)</th><th>stability</th><th>eigenvalues (real parts)</th></tr>\n";
         for (const auto& p : fp.points) {
             c.html << "<tr><td>point</td><td>(" << fmt(p.q[0], 3) << ", " << fmt(p.q[1], 3) << (pt ? "" : ", " + fmt(p.q[2], 4)) << ")</td><td>"
