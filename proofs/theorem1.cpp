@@ -1,6 +1,7 @@
 #include "theorem1.hpp"
 
 #include "plate/dynamics.hpp"
+#include "plate/random_scene.hpp"
 
 #include <boost/numeric/odeint.hpp>
 
@@ -328,6 +329,19 @@ Conditioning condition_of_A(const Scene& sc, int samples, std::uint64_t seed) {
         c.min_singular = std::min(c.min_singular, sv[5] / sv[0]);
     }
     return c;
+}
+
+std::vector<CollinearScene> collinear_scenes(const std::vector<double>& ratios) {
+    std::vector<CollinearScene> out;
+    for (double e : ratios) {
+        CollinearScene c;
+        c.e_over_L = e;
+        c.scene = random_scene(3, RandomSceneOptions{true});
+        const double L = 0.03;
+        c.scene.part.c = {Vec3(-L, -e * L / 3, 0), Vec3(L, -e * L / 3, 0), Vec3(0, 2 * e * L / 3, 0)};
+        out.push_back(c);
+    }
+    return out;
 }
 
 }  // namespace plate::proofs

@@ -113,4 +113,13 @@ struct Conditioning {
 };
 Conditioning condition_of_A(const Scene& scene, int samples, std::uint64_t seed);
 
+// A's conditioning as the third contact approaches the line of the other two: a thin part (random
+// scene 3) with contacts (-L, -e L/3), (L, -e L/3), (0, 2 e L/3), L = 3 cm (centroid at s), for each
+// e/L in `ratios`; 20 sampled states each. cond(A) grows like L/e.
+struct CollinearScene {
+    double e_over_L = 0;
+    Scene scene;
+};
+std::vector<CollinearScene> collinear_scenes(const std::vector<double>& ratios);
+
 }  // namespace plate::proofs

@@ -216,10 +216,10 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
               "spin that keeps every contact moving along +y) get ever closer wrenches: the limit surface develops a vertex.</p>\n"
               "<table><tr><th>contacts (−L,0), (L,0), (0,e), e/L</th><th>cond(A), dimensionless</th><th>wrench gap / Σ μN</th>"
               "<th>convex and normal</th></tr>\n";
-    for (double e : {1.0, 0.1, 0.01, 0.001, 0.0}) {
-        Scene sc = random_scene(3, RandomSceneOptions{true});
-        const double L = 0.03;
-        sc.part.c = {Vec3(-L, -e * L / 3, 0), Vec3(L, -e * L / 3, 0), Vec3(0, 2 * e * L / 3, 0)};
+    const double L = 0.03;
+    for (const auto& cs : proofs::collinear_scenes({1.0, 0.1, 0.01, 0.001, 0.0})) {
+        const double e = cs.e_over_L;
+        const Scene& sc = cs.scene;
         const auto cond = proofs::condition_of_A(sc, 20, opt.seed);
         std::string gap = "–", cv = "–";
         if (e > 0) {

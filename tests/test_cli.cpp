@@ -222,6 +222,15 @@ TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]"
     CHECK(j["thin"]["passed"] == true);
     CHECK(j["thick"]["cases"] == 3);
     CHECK(j["limit_surfaces"]["convex_and_normal"] == 3);
+    // The conditioning the help promises: cond(A) grows like L/e toward collinear contacts (each tenth
+    // of e at least 5x), and A is singular at e = 0 (smallest singular value at rounding).
+    const auto& c = j["conditioning_of_A"];
+    REQUIRE(c.size() == 5);
+    for (int i = 1; i < 4; ++i) {
+        INFO("e/L = " << c[i]["e_over_L"].get<double>());
+        CHECK(c[i]["max_condition"].get<double>() > 5 * c[i - 1]["max_condition"].get<double>());
+    }
+    CHECK(c[4]["min_singular_over_max"].get<double>() < 1e-12);
 }
 
 TEST_CASE("plate report writes index.html whose every figure exists", "[cli][report]") {

@@ -362,7 +362,8 @@ int cmd_proofs(int argc, char** argv) {
                      "of the relative twist against its integration-error bound, convergence, uniqueness of the\n"
                      "cycle from further initial twists, Floquet multipliers (N thin parts, default 10000; M thick\n"
                      "parts beyond the theorem, default 1000); limit surfaces of K thin parts (default 200); the\n"
-                     "conditioning of A. JSON to stdout or --out FILE; exit code 0 even when a check fails.\n";
+                     "conditioning of A as a contact approaches the line of the other two (e/L = 1 ... 0).\n"
+                     "JSON to stdout or --out FILE; exit code 0 even when a check fails.\n";
         return 0;
     }
     if (!a.pos.empty()) throw UsageError("proofs takes no SCENE argument");
@@ -389,6 +390,13 @@ int cmd_proofs(int argc, char** argv) {
                            {"worst_monotonicity_violation", ls.worst_monotonicity},
                            {"min_separation", ls.min_separation}, {"min_strict_margin", ls.min_strict_margin},
                            {"passed", ls.passed()}};
+    // A's conditioning toward collinear contacts (dimensionless A, 20 sampled states per part).
+    j["conditioning_of_A"] = nlohmann::json::array();
+    for (const auto& cs : proofs::collinear_scenes({1.0, 0.1, 0.01, 0.001, 0.0})) {
+        const proofs::Conditioning c = proofs::condition_of_A(cs.scene, 20, seed);
+        j["conditioning_of_A"].push_back({{"e_over_L", cs.e_over_L}, {"max_condition", c.max_condition},
+                                          {"min_singular_over_max", c.min_singular}});
+    }
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
     return 0;
 }
