@@ -37,8 +37,9 @@ TEST_CASE("regularised reference: where nothing sticks it is today's twist at ev
     REQUIRE(lc.stick_fraction[0] + lc.stick_fraction[1] + lc.stick_fraction[2] == 0.0);
     const RegularisedReference r = regularised_reference(sc, q);
     REQUIRE(r.ok);
-    // Away from zero slip the regularised law differs from Coulomb by eps^2 / (2 |v|^2) relative: below
-    // 1e-9 at the largest eps (1e-5 v_ref) for slips above 1e-2 v_ref, so every eps gives the twist.
+    // Away from zero slip the regularised law differs from Coulomb by eps^2 / (2 |v|^2) relative: 5e-7 at
+    // the largest eps (1e-5 v_ref) for a slip of 1e-2 v_ref, far less for the slips here, which stay well
+    // above that (the difference is measured: below 1e-8 at every eps).
     for (const Vec3& t : r.twists) CHECK(twist_distance(sc, lc.twist, t) < 1e-8);
 }
 
@@ -50,10 +51,11 @@ TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-frictio
     // The bound: 1e-7 v_ref for the engine plus the reference's own error estimate (its Richardson
     // correction and the change of the extrapolated limit from the previous triple of eps).
     // (Cycles with a phase stuck as a whole are not in this test: there the regularised limit leaves
-    // the stuck state before the gauge reaches 1 on some configurations -- see the closing note.)
+    // the stuck state before the gauge reaches 1 on some configurations -- README, "Regularised-friction
+    // reference", and the report's table, which computes that difference in every run.)
     const Scene sc = scene("fig6");
     const GridSpec grid;
-    int seen = 0, checked = 0;
+    int seen = 0, checked = 0, substantial = 0;
     double worst = 0;
     for (int idx = 0; idx < grid.size(); ++idx) {
         const int i = idx / (grid.ny * grid.nth), j = (idx / grid.nth) % grid.ny, k = idx % grid.nth;
@@ -77,11 +79,17 @@ TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-frictio
         INFO("q = (" << q[0] << ", " << q[1] << ", " << q[2] << "): engine " << tight.twist.transpose() << ", reference "
                      << r.twist.transpose() << " (order " << r.order << ", error " << r.error << ")");
         CHECK(d <= 1e-7 + r.error);
+        // The reference itself must have converged in eps (a forced order of 0.1 means it did not, and
+        // would widen the bound above through r.error): an observed order well above that, a small error.
+        CHECK(r.order > 0.5);
+        CHECK(r.error < 1e-6);
         // Near a stick the regularised law's error shrinks more slowly than eps: the observed order is below 1.
         CHECK(r.order < 1.2);
         worst = std::max(worst, d);
         ++checked;
+        substantial += *std::max_element(tight.stick_fraction.begin(), tight.stick_fraction.end()) > 0.05;
     }
     INFO("largest difference " << worst);
     CHECK(checked >= 8);
+    CHECK(substantial >= 8);   // cycles in which a contact is held more than 5% of the period
 }
