@@ -402,9 +402,7 @@ private:
             const double afford = inc > 0 && h > 0 ? h * std::sqrt(std::max(creep_budget_ - creep_err_[i], 0.0) / inc)
                                                    : std::numeric_limits<double>::infinity();
             if (creep_err_[i] > creep_budget_ || sn > ws.creep_speed || afford < h) {
-                ws.creep &= ~(1u << i);
-                ws.creep_twist.setZero();
-                if (sn <= ws.creep_speed) creep_spent_ |= 1u << i;   // not again before its next event
+                stop_creep(i, sn <= ws.creep_speed);
                 changed = true;
             } else {
                 creep_h_ = std::min({creep_h_, h_cap, afford});
@@ -424,13 +422,18 @@ private:
         for (int i = 0; i < scene_.part.contacts(); ++i) {
             const double sn = slip[i].norm();
             if ((ws.creep >> i & 1u) && sn > ws.hint_speed && slip[i].dot(ws.hint[i]) < 0.9 * sn) {
-                ws.creep &= ~(1u << i);
-                ws.creep_twist.setZero();
-                creep_spent_ |= 1u << i;
+                stop_creep(i, true);
                 off = true;
             }
         }
         return off;
+    }
+    // Contact i slides on along v/|v| (spent: not to creep again before its next event); the twist's
+    // direction no longer describes every contact.
+    void stop_creep(int i, bool spent) {
+        model_.ws.creep &= ~(1u << i);
+        model_.ws.creep_twist.setZero();
+        if (spent) creep_spent_ |= 1u << i;
     }
     // Entering a mode at state y: in a slide, the contacts at zero slip (just broken away) creep.
     void start_creep(const State& y) {

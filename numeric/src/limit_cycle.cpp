@@ -5,8 +5,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_multiroots.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <sstream>
 #include <stdexcept>

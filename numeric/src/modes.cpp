@@ -206,15 +206,7 @@ Vec2 contact_acceleration(const Part& P, Dynamics level, int i, const Vec3& q, c
 
 namespace {
 
-// Slide with creeping contacts (Workspace::creep): the direction u_j = (cos phi_j, sin phi_j) of each
-// creeping contact j is the one along which it then accelerates, c_j = a_j x u_j = 0 (the consistent
-// slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
-// first order at the rim's direction). Newton's method on the angles, from the last solution
-// (ws.hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
-// Every contact creeping: the unknown is the direction xi of the twist (scaled: s_x', s_y', rho theta'),
-// the contacts' directions are its slips', and it is consistent when q'' (scaled) is parallel to xi
-// (Newton on two angles about xi, forward-difference Jacobian). Three independent angles would also
-// admit directions no rigid motion has (a contact decelerating while the twist grows).
+// The unit slip directions of the twist xi (scaled: s_x', s_y', rho theta') as the contacts' hints.
 void set_twist_hints(const Part& P, double theta, const Vec3& xi, Workspace& ws) {
     const double rho = P.rho();
     for (int i = 0; i < P.contacts(); ++i) {
@@ -229,6 +221,10 @@ void tangent_basis(const Vec3& xi, Vec3& e1, Vec3& e2) {
     e2 = xi.cross(e1);
 }
 
+// Every contact creeping: the unknown is the direction xi of the twist, the contacts' directions are its
+// slips', and it is consistent when q'' (scaled) is parallel to xi (Newton on two angles about xi,
+// forward-difference Jacobian). Three independent angles would also admit directions no rigid motion
+// has (a contact decelerating while the twist grows).
 void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                                Workspace& ws) {
     const Part& P = sc.part;
@@ -264,6 +260,11 @@ void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, c
     xi = at(a, b);
 }
 
+// Slide with creeping contacts (Workspace::creep): the direction u_j = (cos phi_j, sin phi_j) of each
+// creeping contact j is the one along which it then accelerates, c_j = a_j x u_j = 0 (the consistent
+// slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
+// first order at the rim's direction). Newton's method on the angles, from the last solution
+// (ws.hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
 void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                          Workspace& ws) {
     const Part& P = sc.part;
@@ -462,9 +463,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
             // are xi's -- found by relaxing xi along q''(xi) (the direction a part released at rest
             // takes, q' ~ t q''; the fixed-point iteration xi <- q''(xi) flips back and forth near the
             // stick boundary), from the twist the needed friction opposes, reversed.
-            const double rho = P.rho();
-            Vec3 xi = -Vec3(g.direction[0], g.direction[1], rho * g.direction[2]);
-            xi = xi.norm() > 0 ? Vec3(xi.normalized()) : Vec3::UnitX();
+            Vec3 xi = ws.creep_twist.isZero() ? Vec3(Vec3::UnitX()) : ws.creep_twist;
             // (The relaxation step shrinks where the residual grows: near a contact whose slip
             // nearly vanishes -- a slide close to a pivot -- the flow is stiff.)
             auto misfit = [&](const Vec3& x, Vec3& Q) {

@@ -142,6 +142,30 @@ OdeSystem reduced_from(const std::shared_ptr<ReducedW>& w, const Scene& sc) {
     return sys;
 }
 
+// Period by period on the scaled reduced state y = [q'/s, Q/s] (Q reset at each period's start) until
+// the contraction estimate r c / (1 - c) is at most cycle_tol (r: the change of q' over a period, in
+// v_ref). Returns the periods integrated when converged -- y then holds the last period's end and
+// *start its start -- or 0 (run.ok says whether the method failed).
+int periods_to_cycle(Method m, const OdeSystem& sys, double T, const MethodOptions& mo, MethodRun& run,
+                     double cycle_tol, int max_periods, std::vector<double>& y, Vec3* start = nullptr) {
+    Vec3 prev(y[0], y[1], y[2]);
+    double r_prev = 0;
+    for (int k = 1; k <= max_periods; ++k) {
+        y[3] = y[4] = y[5] = 0;
+        if (!integrate(m, sys, (k - 1) * T, k * T, y, mo, run)) return 0;
+        const Vec3 qd(y[0], y[1], y[2]);   // scaled: relative to v_ref (angular: times rho)
+        const double res = (qd - prev).cwiseAbs().maxCoeff();
+        const double c = r_prev > 0 ? std::min(res / r_prev, 0.99) : 0.99;
+        if (k >= 2 && (res == 0 || (r_prev > 0 && res * c / (1 - c) <= cycle_tol))) {
+            if (start) *start = prev;
+            return k;
+        }
+        prev = qd;
+        r_prev = res;
+    }
+    return 0;
+}
+
 std::shared_ptr<ReducedW> reduced_wrapped(const Scene& sc, const Vec3& q0, FrictionLaw law, double eps) {
     auto w = std::make_shared<ReducedW>(sc, q0);
     w->model.ws.law = law;
@@ -180,24 +204,11 @@ RunResult twist_run(const Scene& sc, const Vec3& q0, const Solver& s, double kno
     const MethodOptions mo = method_options(s, knob, T, max_evals);
     MethodRun run;
     std::vector<double> y(6, 0.0);
-    Vec3 prev = Vec3::Zero();
-    double r_prev = 0;
-    for (int k = 1; k <= 400; ++k) {
-        y[3] = y[4] = y[5] = 0;
-        if (!integrate(s.method, sys, (k - 1) * T, k * T, y, mo, run)) break;
-        const Vec3 qd(y[0], y[1], y[2]);   // scaled: relative to v_ref (angular: times rho)
-        const double res = (qd - prev).cwiseAbs().maxCoeff();
-        if (k >= 2 && r_prev > 0) {
-            const double c = std::min(res / r_prev, 0.99);
-            if (res * c / (1 - c) <= cycle_tol) {
-                r.ok = true;
-                r.value = {y[3] * w->scale[3] / T, y[4] * w->scale[4] / T, y[5] * w->scale[5] / T};
-                break;
-            }
-        }
-        prev = qd;
-        r_prev = res;
-        if (k == 400) run.failure = "not converged in 400 periods";
+    if (periods_to_cycle(s.method, sys, T, mo, run, cycle_tol, 400, y) > 0) {
+        r.ok = true;
+        r.value = {y[3] * w->scale[3] / T, y[4] * w->scale[4] / T, y[5] * w->scale[5] / T};
+    } else if (run.ok) {
+        run.failure = "not converged in 400 periods";
     }
     r.seconds = seconds_since(t0);
     r.rhs_evals = w->model.ws.evals;
@@ -336,29 +347,15 @@ RegularisedReference regularised_reference(const Scene& sc, const Vec3& q0, cons
         MethodRun run;
         std::vector<double> y(6, 0.0);
         for (int i = 0; i < 3; ++i) y[i] = start[i] / w->scale[i];
-        Vec3 prev(y[0], y[1], y[2]);
-        double r_prev = 0;
-        bool done = false;
-        int k = 1;
-        for (; k <= opt.max_periods && !done; ++k) {
-            y[3] = y[4] = y[5] = 0;
-            if (!integrate(Method::GslBsimp, sys, (k - 1) * T, k * T, y, mo, run)) break;
-            Vec3 qd(y[0], y[1], y[2]);
-            // residual in units of v_ref (the state is scaled by v_ref, v_ref, v_ref / rho)
-            const double res = (qd - prev).cwiseAbs().maxCoeff();
-            if (k >= 2 && r_prev > 0) {
-                const double c = std::min(res / r_prev, 0.99);
-                if (res * c / (1 - c) <= opt.cycle_tol || res == 0) {
-                    out.twists.push_back(Vec3(y[3] * w->scale[3], y[4] * w->scale[4], y[5] * w->scale[5]) / T);
-                    for (int i = 0; i < 3; ++i) start[i] = prev[i] * w->scale[i];
-                    done = true;
-                }
-            }
-            prev = qd;
-            r_prev = res;
+        Vec3 start_scaled;
+        const int periods = periods_to_cycle(Method::GslBsimp, sys, T, mo, run, opt.cycle_tol, opt.max_periods, y, &start_scaled);
+        const bool done = periods > 0;
+        if (done) {
+            out.twists.push_back(Vec3(y[3] * w->scale[3], y[4] * w->scale[4], y[5] * w->scale[5]) / T);
+            for (int i = 0; i < 3; ++i) start[i] = start_scaled[i] * w->scale[i];
         }
         out.rhs_evals += w->model.ws.evals;
-        out.periods.push_back(k - 1);
+        out.periods.push_back(periods);
         if (!run.ok || !done || w->min_n < 0) {
             std::ostringstream m;
             m << "regularised cycle at eps = " << eps << " v_ref: "
