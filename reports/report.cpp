@@ -327,7 +327,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                       {"fig4", Vec3(0.04, -0.04, 1.0), 20, "Fig. 4: centring and orienting"},
                       {"fig5", Vec3(0.0, -0.04, 1.0), 4, "Fig. 5: transport along y, θ to 0 or π"},
                       {"fig6", Vec3(0.03, 0.03, 0.5), 20, "Fig. 6: rotation"},
-                      {"heave_yaw", Vec3(0.03, 0.03, 0.5), 20, "Heave + rocking yaw: every configuration sticks"},
+                      {"heave_yaw", Vec3(0.03, 0.03, 0.5), 20, "Heave + rocking yaw (z and rz, one frequency)"},
                       {"heave_yaw_point", Vec3(0.03, 0.03, 0), 20, "Heave + rocking yaw, point part"}};
     for (const auto& f : figs) {
         const Scene sc = load_scene((src / "scenes" / (std::string(f.scene) + ".json")).string());
