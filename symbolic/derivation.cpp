@@ -91,7 +91,8 @@ Reduced reduce(const matrix& A, const std::array<realsymbol, 6>& b, const std::a
 Symbols::Symbols()
     : m("m"), g("g"), Jxx("Jxx"), Jxy("Jxy"), Jxz("Jxz"), Jyy("Jyy"), Jyz("Jyz"), Jzz("Jzz"), cz("cz"),
       ct("ct"), st("st"), thd("thd"), thdd("thdd"), sx("sx"), sy("sy"), sz("sz"), sxd("sxd"), syd("syd"),
-      sxdd("sxdd"), sydd("sydd"), vx("vx"), vy("vy"), xith("xith"), rho("rho") {
+      sxdd("sxdd"), sydd("sydd"), vx("vx"), vy("vy"), xith("xith"), rho("rho"), fx("fx"), fy("fy"), Fx("Fx"),
+      Fy("Fy"), tauz("tauz") {
     const char* ax[] = {"x", "y", "z"};
     for (int i = 0; i < 3; ++i) {
         cx[i] = realsymbol(idx("c", i, "x"));
@@ -175,10 +176,8 @@ Derivation derive() {
     find("(8)", is_zero(sub(J.D(R2), hat(w2).mul(R2))), "R2' = w2^ R2", "d/dt R2(theta) = w2^ R2, w2 = theta' e_z",
          "derived by differentiating (2) in theta");
 
-    // --- Contacts and forces (12)-(17) ------------------------------------------------------
+    // --- Contacts and their sliding velocities (text after (14)) ---------------------------
     const matrix s = col(S.sx, S.sy, S.sz), sd = col(S.sxd, S.syd, 0);
-    matrix Fsum = col(0, 0, 0);
-    matrix D(3, 3), H(3, 3);
     for (int i = 0; i < 3; ++i) {
         const matrix ci = col(S.cx[i], S.cy[i], S.cz);
         d.slip[i] = expand_all(J.D(s.add(R2.mul(ci))));     // velocity of c_i relative to the plate, in P
@@ -186,16 +185,12 @@ Derivation derive() {
         if (i == 0)
             find("text after (14)", is_zero(sub(d.slip[i], printed)), "P c_i' = s' + w2^ R2 c_i",
                  "d/dt (s + R2 c_i) in the plate frame", "the sliding velocity of each contact");
-        const matrix di = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0));  // (17), unit slip u_i
-        Fsum = Fsum.add(di.mul_scalar(S.N[i]));                                    // (13) + (14)
     }
 
     // --- Newton (15) in W, premultiplied by R1^T (forces are in P' coordinates) -------------
     const matrix pv = col(S.p[0], S.p[1], S.p[2]);
     const matrix Ws = pv.add(R1.mul(s));
     const matrix Wsdd = J.D(J.D(Ws));
-    // m W_s'' = R1 F - m g e_z  (12)  =>  F - R1^T (m W_s'' + m g e_z) = 0, using R1^T R1 = I.
-    const matrix EN = expand_all(Fsum.sub(R1.transpose().mul(Wsdd.mul_scalar(S.m).add(ez.mul_scalar(S.m * S.g)))));
 
     // --- Euler (21) in S' --------------------------------------------------------------------
     const matrix R = R1.mul(R2);
@@ -220,14 +215,30 @@ Derivation derive() {
                  "d/dt R2^T = -R2^T w2^, so the middle term carries R1^T, as (30) uses it; the printed R1 " +
                  "differs from R1^T unless the plate is level" + (corrected_ok ? "" : " [CORRECTED FORM FAILED]"));
     }
-    matrix Jm{{S.Jxx, S.Jxy, S.Jxz}, {S.Jxy, S.Jyy, S.Jyz}, {S.Jxz, S.Jyz, S.Jzz}};
-    matrix torque = col(0, 0, 0);
-    for (int i = 0; i < 3; ++i) {
-        const matrix ci = col(S.cx[i], S.cy[i], S.cz);
-        const matrix Fi = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0)).mul_scalar(S.N[i]);
-        torque = torque.add(cross(ci, R2.transpose().mul(Fi)));                      // (21) left side
-    }
-    const matrix EE = expand_all(torque.sub(Jm.mul(d.omega3_dot).add(cross(d.omega3, Jm.mul(d.omega3)))));
+    const matrix Jm{{S.Jxx, S.Jxy, S.Jxz}, {S.Jxy, S.Jyy, S.Jyz}, {S.Jxz, S.Jyz, S.Jzz}};
+
+    // Newton's (15) and Euler's (21) laws for given friction forces f_i (P frame, z = 0); the
+    // contact force of contact i is N_i e_z + f_i (13). Returns [Newton; Euler] (6x1), zero on the
+    // motion. m W_s'' = R1 F - m g e_z (12)  =>  F - R1^T (m W_s'' + m g e_z) = 0, using R1^T R1 = I.
+    auto newton_euler = [&](const std::array<matrix, 3>& f) {
+        matrix Fsum = col(0, 0, 0), torque = col(0, 0, 0);
+        for (int i = 0; i < 3; ++i) {
+            const matrix Fi = ez.mul_scalar(S.N[i]).add(f[i]);
+            Fsum = Fsum.add(Fi);                                                             // (14)
+            torque = torque.add(cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(Fi)));   // (21) left side
+        }
+        const matrix EN = Fsum.sub(R1.transpose().mul(Wsdd.mul_scalar(S.m).add(ez.mul_scalar(S.m * S.g))));
+        const matrix EE = torque.sub(Jm.mul(d.omega3_dot).add(cross(d.omega3, Jm.mul(d.omega3))));
+        matrix E(6, 1);
+        for (int r = 0; r < 3; ++r) {
+            E(r, 0) = EN(r, 0).expand();
+            E(3 + r, 0) = EE(r, 0).expand();
+        }
+        return E;
+    };
+    std::array<matrix, 3> kinetic;   // (17): f_i = -mu_i N_i u_i, u_i the unit slip direction
+    for (int i = 0; i < 3; ++i) kinetic[i] = col(-S.mu[i] * S.N[i] * S.ux[i], -S.mu[i] * S.N[i] * S.uy[i], 0);
+    const matrix Eq = newton_euler(kinetic);
 
     // --- A z = b (31) ------------------------------------------------------------------------
     const auto z = S.unknowns();
@@ -236,7 +247,7 @@ Derivation derive() {
     exmap zero;
     for (const auto& u : z) zero[u] = 0;
     for (int r = 0; r < 6; ++r) {
-        const ex E = r < 3 ? EN(r, 0) : EE(r - 3, 0);
+        const ex E = Eq(r, 0);
         for (int k = 0; k < 6; ++k) d.A(r, k) = E.diff(z[k]).expand();
         d.b_full(r, 0) = (-E.subs(zero)).expand();
         ex lin = -d.b_full(r, 0);
@@ -291,6 +302,150 @@ Derivation derive() {
                                .add(hat(w2).add(hat(A2)).mul(Jm).mul(w2.add(A2)));
         find("(30)", is_zero(sub(bE, t30)), "tau = J(-R2^T w2^ R1^T w1 + R2^T R1^T w1') + (w2^ + (R2^T R1^T w1)^) J (w2 + R2^T R1^T w1)",
              "J w3'|theta''=0 + w3^ J w3", "agrees (with R1^T in the first term, unlike (28))");
+    }
+
+    // --- Stick-slip modes (numeric/include/plate/modes.hpp) -------------------------------------
+    // Pivot k: contact k carries an unknown static friction f = (f_x, f_y) (P frame) instead of
+    // (17), and its slip stays zero, so its relative acceleration, the derivative of its sliding
+    // velocity, vanishes: two more rows. In the reduced U-dynamics (35) the configuration is
+    // frozen (R2 does not turn), so the same derivative is taken with theta' acting on nothing.
+    {
+        Jet frozen;
+        for (const auto& rule : J.rules)
+            if (!rule.first.is_equal(S.ct) && !rule.first.is_equal(S.st)) frozen.rules.push_back(rule);
+        const std::vector<realsymbol> zk = {S.sxdd, S.sydd, S.thdd, S.N[0], S.N[1], S.N[2], S.fx, S.fy};
+        exmap zero;
+        for (const auto& u : zk) zero[u] = 0;
+        for (int k = 0; k < 3; ++k) {
+            std::array<matrix, 3> f = kinetic;
+            f[k] = col(S.fx, S.fy, 0);
+            const matrix E = newton_euler(f);
+            const matrix c = J.D(d.slip[k]), cf = frozen.D(d.slip[k]);
+            if (!c(2, 0).is_zero()) throw std::logic_error("pivot constraint out of the plane");
+            matrix& A = d.pivot_A[k];
+            A = matrix(8, 8);
+            d.pivot_c[k] = matrix(2, 1);
+            for (int r = 0; r < 8; ++r) {
+                const ex e = r < 6 ? E(r, 0) : c(r - 6, 0);
+                ex lin = 0;
+                for (int j = 0; j < 8; ++j) {
+                    A(r, j) = e.diff(zk[j]).expand();
+                    lin += A(r, j) * zk[j];
+                }
+                const ex rest = (e - lin).expand();
+                if (!rest.subs(zero).is_equal(rest)) throw std::logic_error("pivot equations not linear in the unknowns");
+                // Friction does not enter b: the pivot's right side is the sliding one, (19)/(30).
+                if (r < 6 && !(rest + d.b_full(r, 0)).expand().is_zero())
+                    throw std::logic_error("pivot right-hand side differs from b");
+                // As for A: Newton's s'' coefficients are -m R1^T R1 = -m I on SO(3).
+                for (int j = 0; j < 2 && r < 3; ++j) {
+                    const ex expect = r == j ? ex(-S.m) : ex(0);
+                    if (!vanishes_on_rotations(A(r, j) - expect, S))
+                        throw std::logic_error("pivot: Newton's s'' coefficients are not -m I on SO(3)");
+                    A(r, j) = expect;
+                }
+                if (r >= 6) {
+                    d.pivot_c[k](r - 6, 0) = (-rest).expand();
+                    const ex ef = cf(r - 6, 0);
+                    for (int j = 0; j < 8; ++j)
+                        if (!(ef.diff(zk[j]) - A(r, j)).expand().is_zero())
+                            throw std::logic_error("frozen pivot constraint has other coefficients");
+                    if (!ef.subs(zero).expand().is_zero()) throw std::logic_error("frozen pivot constraint has a right side");
+                }
+            }
+        }
+        // The constraint is s'' + theta'' e_z x r_k - theta'^2 r_k = 0 (r_k = R2 c_k): check it.
+        {
+            const matrix rk = R2.mul(col(S.cx[0], S.cy[0], S.cz));
+            const matrix expect = col(S.sxdd - S.thdd * rk(1, 0) - S.thd * S.thd * rk(0, 0),
+                                      S.sydd + S.thdd * rk(0, 0) - S.thd * S.thd * rk(1, 0), 0);
+            find("pivot constraint", is_zero(sub(J.D(d.slip[0]), expect)), "(not in the paper)",
+                 "d/dt (s' + w2^ R2 c_k) = s'' + theta'' e_z x r_k - theta'^2 r_k = 0",
+                 "a contact held by static friction does not accelerate relative to the plate; the centripetal "
+                 "term theta'^2 r_k is absent in the reduced U-dynamics (35), whose configuration is frozen");
+        }
+
+        // Stuck: q'' = 0 and friction forces f_i = (f_ix, f_iy) of unknown distribution. The
+        // equations depend on the f_i only through the total F = sum f_i and the moment
+        // tau_z = sum r_i x f_i: every internal pair (equal and opposite forces along the line
+        // between two contacts) leaves them unchanged. So the normal forces and the needed friction
+        // wrench (F, tau_z) are determinate although the distribution is not.
+        std::array<realsymbol, 3> gx, gy;
+        std::array<matrix, 3> f;
+        for (int i = 0; i < 3; ++i) {
+            gx[i] = realsymbol(idx("f", i, "x"));
+            gy[i] = realsymbol(idx("f", i, "y"));
+            f[i] = col(gx[i], gy[i], 0);
+        }
+        exmap at_rest{{S.sxdd, 0}, {S.sydd, 0}, {S.thdd, 0}, {S.sxd, 0}, {S.syd, 0}, {S.thd, 0}};
+        const matrix E = newton_euler(f);
+        matrix lin(6, 1);   // the contact forces' part: E = lin - b at zero relative motion
+        for (int r = 0; r < 6; ++r) lin(r, 0) = (E(r, 0).subs(at_rest) + d.b_full(r, 0).subs(at_rest)).expand();
+        std::array<matrix, 3> r2;
+        for (int i = 0; i < 3; ++i) r2[i] = R2.mul(col(S.cx[i], S.cy[i], S.cz));
+        bool internal_ok = true;
+        for (int i = 0; i < 3; ++i) {
+            const int j = (i + 1) % 3;
+            exmap pair;
+            const ex ex_ = r2[j](0, 0) - r2[i](0, 0), ey = r2[j](1, 0) - r2[i](1, 0);
+            const realsymbol t("t");
+            pair[gx[i]] = gx[i] + t * ex_;
+            pair[gy[i]] = gy[i] + t * ey;
+            pair[gx[j]] = gx[j] - t * ex_;
+            pair[gy[j]] = gy[j] - t * ey;
+            for (int r = 0; r < 6; ++r) internal_ok = internal_ok && vanishes_on_rotations(lin(r, 0).subs(pair) - lin(r, 0), S);
+        }
+        if (!internal_ok) throw std::logic_error("the stuck equations depend on the friction distribution");
+        // f_1 = F - f_2 - f_3; then rows 1-5 hold F alone and row 6 is tau_z.
+        exmap total{{gx[0], S.Fx - gx[1] - gx[2]}, {gy[0], S.Fy - gy[1] - gy[2]}};
+        ex tau = 0;
+        for (int i = 0; i < 3; ++i) tau += r2[i](0, 0) * gy[i] - r2[i](1, 0) * gx[i];
+        lst eqs;
+        for (int r = 0; r < 6; ++r) {
+            ex e = lin(r, 0).subs(total).expand();
+            if (r == 5) {
+                const ex rest = (e - tau.subs(total)).expand();
+                if (!vanishes_on_rotations(rest.diff(gx[1]), S) || !vanishes_on_rotations(rest.diff(gy[1]), S) ||
+                    !vanishes_on_rotations(rest.diff(gx[2]), S) || !vanishes_on_rotations(rest.diff(gy[2]), S) ||
+                    !vanishes_on_rotations(rest.diff(S.Fx), S) || !vanishes_on_rotations(rest.diff(S.Fy), S))
+                    throw std::logic_error("the stuck yaw equation is not tau_z plus normal-force terms");
+                e = (rest.subs(exmap{{gx[1], 0}, {gy[1], 0}, {gx[2], 0}, {gy[2], 0}}) + S.tauz).expand();
+            }
+            for (int i = 1; i < 3; ++i)
+                if (!e.diff(gx[i]).is_zero() || !e.diff(gy[i]).is_zero())
+                    throw std::logic_error("the stuck equations depend on the friction distribution");
+            eqs.append(e == d.bsym[r]);
+        }
+        const ex sol = lsolve(eqs, lst{S.N[0], S.N[1], S.N[2], S.Fx, S.Fy, S.tauz});
+        // Written over the contacts' determinant (fixed here: normal() picks the sign of a
+        // denominator from GiNaC's run-dependent term order).
+        d.stuck_det = (S.cx[1] * S.cy[2] - S.cx[2] * S.cy[1] - S.cx[0] * S.cy[2] + S.cx[2] * S.cy[0] +
+                       S.cx[0] * S.cy[1] - S.cx[1] * S.cy[0]).expand();
+        d.stuck_solution = matrix(6, 1);
+        for (int r = 0; r < 6; ++r) {
+            const ex num = (sol.op(r).rhs() * d.stuck_det).normal().expand();
+            if (!is_a<add>(num) && !is_a<mul>(num) && !is_a<symbol>(num) && !is_a<numeric>(num))
+                throw std::logic_error("stuck solution: unexpected form");
+            if (!(num / d.stuck_det - sol.op(r).rhs()).normal().is_zero() || num.denom() != 1)
+                throw std::logic_error("stuck solution is not polynomial over the contacts' determinant");
+            d.stuck_solution(r, 0) = num;
+        }
+        find("stuck mode", internal_ok, "(not in the paper)",
+             "N (3), F = sum f_i, tau_z = sum r_i x f_i from Newton-Euler with q'' = 0",
+             "the friction distribution of a stuck part is indeterminate, but Newton-Euler depends on it only "
+             "through (F, tau_z): internal pairs of equal and opposite forces along the lines between contacts "
+             "change nothing (checked exactly). The part stays stuck while (F, tau_z) lies in the friction set, "
+             "whose support function is the dissipation power P of Appendix B");
+
+        // Break-away from stuck: the gauge max_d (d . w) / P(d) of the needed wrench w against the
+        // friction set, P(d) = sum_i mu_i N_i |G_i^T d| (the support function, Appendix B). Each term
+        // with its gradient and Hessian in d = (vx, vy, xith) drives the gauge's Newton iteration.
+        for (int i = 0; i < 3; ++i) {
+            const ex om = S.xith / S.rho;
+            const ex vix = S.vx - om * S.ry[i], viy = S.vy + om * S.rx[i];
+            d.support_speed[i] = sqrt(vix * vix + viy * viy);
+            d.support_term[i] = S.mu[i] * S.N[i] * d.support_speed[i];
+        }
     }
 
     // --- U-dynamics (32)-(34) -----------------------------------------------------------------

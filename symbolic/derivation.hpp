@@ -38,6 +38,8 @@ struct Symbols {
     // limit surface: twist relative to the plate in scaled coordinates, contact positions in P
     realsymbol vx, vy, xith, rho;
     std::array<realsymbol, 3> rx, ry;
+    // stick-slip: a pivot's static friction (P frame); a stuck part's needed friction wrench
+    realsymbol fx, fy, Fx, Fy, tauz;
 
     std::vector<realsymbol> unknowns() const { return {sxdd, sydd, thdd, N[0], N[1], N[2]}; }
 };
@@ -82,6 +84,18 @@ struct Derivation {
     // scaled: xi = (v_x, v_y, rho omega), w = (F_x, F_y, tau / rho); and its dissipation power.
     matrix wrench;                      // 3x1
     ex power;                           // sum mu_i N_i |v_i| (the wrench is -grad of it)
+    // Stick-slip modes (modes.hpp). Pivot k, unknowns z = (s_x'', s_y'', theta'', N1..3, f_x, f_y):
+    // pivot_A[k] z = [b; pivot_c[k]], rows Newton x y z, Euler x y z, then contact k's relative
+    // acceleration s'' + theta'' e_z x r_k - theta'^2 r_k = 0; pivot_c[k] = theta'^2 r_k (turning
+    // configuration; zero in the reduced U-dynamics, checked).
+    std::array<matrix, 3> pivot_A, pivot_c;
+    // Stuck (q'' = 0): (N1, N2, N3, F_x, F_y, tau_z) = stuck_solution / stuck_det in terms of bsym
+    // (stuck_det: the contacts' determinant, zero for collinear contacts).
+    matrix stuck_solution;
+    ex stuck_det;
+    // Support function of the friction set, P(d) = sum support_term[i] (Appendix B's power), with
+    // support_speed[i] = |v_i| = |G_i^T d|; limit-surface symbols (vx, vy, xith, rho, r_i).
+    std::array<ex, 3> support_term, support_speed;
     std::vector<Finding> findings;
 };
 

@@ -435,6 +435,56 @@ int main(int argc, char** argv) {
             for (int i = 0; i < 3; ++i) k.outputs.push_back({"z[" + std::to_string(i) + "]", d.point_solution(i, 0)});
             kernels.push_back(k);
         }
+        // Stick-slip modes (numeric/include/plate/modes.hpp).
+        for (int k = 0; k < 3; ++k) {
+            const std::string K = std::to_string(k + 1);
+            Kernel kp{"// Pivot about contact " + K + ": the system A z = [b; c] (8x8, row-major) of the mode, unknowns\n"
+                      "// z = (s_x'', s_y'', theta'', N1, N2, N3, f_x, f_y), f the static friction of contact " + K + " (P frame);\n"
+                      "// rows Newton x y z, Euler x y z, then the contact's relative acceleration\n"
+                      "// s'' + theta'' e_z x r_" + K + " - theta'^2 r_" + K + " = 0, c = theta'^2 r_" + K +
+                          " (zero in the reduced U-dynamics (35)).\n"
+                      "// The other contacts slide along their unit directions u_i.\n",
+                      "pivot" + K + "_system(const KernelInput& in, double* A, double* c)", in, {}, {}};
+            for (int r = 0; r < 8; ++r)
+                for (int j = 0; j < 8; ++j) kp.outputs.push_back({"A[" + std::to_string(8 * r + j) + "]", d.pivot_A[k](r, j)});
+            for (int r = 0; r < 2; ++r) kp.outputs.push_back({"c[" + std::to_string(r) + "]", d.pivot_c[k](r, 0)});
+            kernels.push_back(kp);
+        }
+        {
+            Kernel k{"// Stuck (q'' = 0): the normal forces n and the friction wrench the part needs, w = (F_x, F_y, tau_z)\n"
+                     "// (P frame; tau_z about the centre of mass), from b (any dynamics level). Determinate although\n"
+                     "// the friction distribution is not (the derivation checks it).\n",
+                     "stuck_solve(const KernelInput& in, const double* b, double* n, double* w)", with(in, "b", "b", 6), {}, {}};
+            // det bound first: 1/(a sum) would let GiNaC pull a sign out in a run-dependent way.
+            const realsymbol det("contacts_det"), inv("inv_det");
+            k.bindings.push_back({det, d.stuck_det});
+            k.bindings.push_back({inv, 1 / det});
+            for (int r = 0; r < 6; ++r)
+                k.outputs.push_back({(r < 3 ? "n[" : "w[") + std::to_string(r % 3) + "]", d.stuck_solution(r, 0) * inv});
+            kernels.push_back(k);
+        }
+        {
+            std::vector<std::string> wf(std::begin(kWrenchFields), std::end(kWrenchFields));
+            Kernel k{"// Support function of the friction set (the break-away test of a stuck part): for each contact,\n"
+                     "// s[i] = |G_i^T d|, the term mu_i N_i |G_i^T d|, its gradient g[3 i + j] and Hessian\n"
+                     "// H[6 i + (xx, xy, xt, yy, yt, tt)] in d = (vx, vy, xith) (scaled twist, Appendix B).\n"
+                     "// Undefined where s[i] = 0 (a kink of P): the caller tests s[i] first.\n",
+                     "friction_support(const WrenchInput& in, double* s, double* t, double* g, double* H)", inputs(wf, "in."), {}, {}};
+            const realsymbol dv[3] = {S.vx, S.vy, S.xith};
+            for (int i = 0; i < 3; ++i) {
+                const std::string I = std::to_string(i);
+                k.outputs.push_back({"s[" + I + "]", d.support_speed[i]});
+                k.outputs.push_back({"t[" + I + "]", d.support_term[i]});
+                int h = 0;
+                for (int a = 0; a < 3; ++a) {
+                    const ex ga = d.support_term[i].diff(dv[a]);
+                    k.outputs.push_back({"g[" + std::to_string(3 * i + a) + "]", ga});
+                    for (int b2 = a; b2 < 3; ++b2)
+                        k.outputs.push_back({"H[" + std::to_string(6 * i + h++) + "]", ga.diff(dv[b2])});
+                }
+            }
+            kernels.push_back(k);
+        }
         {
             std::vector<std::string> wf(std::begin(kWrenchFields), std::end(kWrenchFields));
             Kernel k{"// Appendix B: frictional wrench (F_x, F_y, tau/rho) on a thin part sliding with relative twist\n"

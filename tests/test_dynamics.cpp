@@ -2,6 +2,7 @@
 // Coulomb's deceleration, and Newton-Euler written directly in the world frame with the
 // accelerations obtained by finite differences of the kinematics.
 #include "plate/dynamics.hpp"
+#include "plate/modes.hpp"
 #include "plate/random_scene.hpp"
 
 #include "engine.hpp"   // dexp_inv, exp_so3, hat
@@ -119,8 +120,9 @@ struct WorldResidual {
     double force, torque;   // relative to m g and to m g |c|
 };
 
+// f: each contact's friction force in the plate frame (horizontal); n: the normal forces.
 WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                             const Vec3& qdd, const Vec3& n) {
+                             const Vec3& qdd, const Vec3& n, const std::array<Vec2, 3>& f) {
     const Part& P = sc.part;
     const double h = 1e-5;
     auto R1 = [&](double t) { return Mat3(detail::exp_so3(ps.w1 * t + 0.5 * ps.wd * t * t) * ps.R1); };
@@ -134,17 +136,33 @@ WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, con
     auto L = [&](double t) { return Vec3(R(t) * P.J * R(t).transpose() * Omega(t)); };
     const Vec3 a = (x(h) - 2 * x(0) + x(-h)) / (h * h);
     const Vec3 Ld = (L(h) - L(-h)) / (2 * h);
-    std::array<Vec2, 3> v;
-    slip_velocities(P, q, qd, v);
     Vec3 F = Vec3::Zero(), tau = Vec3::Zero();
     for (int i = 0; i < 3; ++i) {
-        const Vec2 u = v[i].normalized();
-        const Vec3 Fi = ps.R1 * Vec3(-P.mu[i] * n[i] * u.x(), -P.mu[i] * n[i] * u.y(), n[i]);
+        const Vec3 Fi = ps.R1 * Vec3(f[i].x(), f[i].y(), n[i]);
         F += Fi;
         tau += (R(0) * P.c[i]).cross(Fi);
     }
     const double mg = P.m * sc.g;
     return {(P.m * a - (F - mg * Vec3::UnitZ())).norm() / mg, (Ld - tau).norm() / (mg * P.c[0].norm())};
+}
+
+// Every contact sliding: Coulomb's f_i = -mu_i N_i v_i / |v_i| (17).
+WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                             const Vec3& qdd, const Vec3& n) {
+    std::array<Vec2, 3> v, f;
+    slip_velocities(sc.part, q, qd, v);
+    for (int i = 0; i < 3; ++i) f[i] = -sc.part.mu[i] * n[i] * v[i].normalized();
+    return world_residual(sc, q, qd, ps, qdd, n, f);
+}
+
+// A random tilted, turning plate state for the full dynamics.
+PlateState random_plate(Rng& r) {
+    PlateState ps;
+    ps.R1 = detail::exp_so3(Vec3(r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)));
+    ps.w1 = Vec3(r.uniform(-5, 5), r.uniform(-5, 5), r.uniform(-5, 5));
+    ps.pdd = Vec3(r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(-3, 3));
+    ps.wd = Vec3(r.uniform(-50, 50), r.uniform(-50, 50), r.uniform(-100, 100));
+    return ps;
 }
 
 TEST_CASE("full dynamics (31) satisfy Newton-Euler in the world frame", "[dynamics][full]") {
@@ -157,17 +175,67 @@ TEST_CASE("full dynamics (31) satisfy Newton-Euler in the world frame", "[dynami
         Rng r(seed * 31);
         const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
         const Vec3 qd(r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-30, 30));
-        PlateState ps;
-        ps.R1 = detail::exp_so3(Vec3(r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)));
-        ps.w1 = Vec3(r.uniform(-5, 5), r.uniform(-5, 5), r.uniform(-5, 5));
-        ps.pdd = Vec3(r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(-3, 3));
-        ps.wd = Vec3(r.uniform(-50, 50), r.uniform(-50, 50), r.uniform(-100, 100));
+        const PlateState ps = random_plate(r);
         Workspace ws;
         accelerations(sc, Dynamics::Full, q, qd, ps, ws);
         const WorldResidual res = world_residual(sc, q, qd, ps, ws.qdd, ws.n);
         CHECK(res.force < 1e-7);
         CHECK(res.torque < 1e-7);
     }
+}
+
+TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-Euler in the world frame",
+          "[dynamics][full][stick]") {
+    // The same independent check as above, for the held modes: a pivot's q'', N and static friction
+    // f_k with the other contacts sliding, and a stuck part's N with a friction distribution that
+    // supplies the needed wrench (F, tau_z) (the gauge's optimal one, scaled). Bounds as above.
+    // Also the held contact itself: its position in the plate frame, s(t) + R2(theta(t)) c_k,
+    // has zero second derivative (central differences, h = 1e-4 s: truncation
+    // h^2/12 |x^(4)| ~ 1e-9 theta'^4 |c| ~ 4e-5 m/s^2 at theta' = 30 rad/s; rounding 1e-9). Bound: 1e-4.
+    int pivots = 0, stucks = 0;
+    for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+        const Scene sc = random_scene(seed);
+        const Part& P = sc.part;
+        Rng r(seed * 57);
+        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const PlateState ps = random_plate(r);
+        Workspace ws;
+        for (int k = 0; k < 3; ++k) {
+            const double w = r.uniform(-30, 30);
+            const Vec2 rk = Eigen::Rotation2Dd(q[2]) * P.c[k].head<2>();
+            const Vec3 qd(w * rk.y(), -w * rk.x(), w);   // s' = -theta' e_z x r_k: contact k at rest
+            Mode mode;
+            mode.kind = ModeKind::Pivot;
+            mode.k = k;
+            mode.sense = w > 0 ? 1 : -1;
+            mode_accelerations(sc, Dynamics::Full, q, qd, ps, mode, ws);
+            const WorldResidual res = world_residual(sc, q, qd, ps, ws.qdd, ws.n, ws.f_held);
+            CHECK(res.force < 1e-7);
+            CHECK(res.torque < 1e-7);
+            // The sliding contacts' friction is kinetic, opposite their slip.
+            std::array<Vec2, 3> v;
+            slip_velocities(P, q, qd, v);
+            for (int j = 0; j < 3; ++j)
+                if (j != k) CHECK((ws.f_held[j] + P.mu[j] * ws.n[j] * v[j].normalized()).norm() < 1e-12 * P.m * sc.g);
+            const double hd = 1e-4;
+            auto xk = [&](double t) {
+                const Vec2 s(q[0] + qd[0] * t + 0.5 * ws.qdd[0] * t * t, q[1] + qd[1] * t + 0.5 * ws.qdd[1] * t * t);
+                return Vec2(s + Eigen::Rotation2Dd(q[2] + qd[2] * t + 0.5 * ws.qdd[2] * t * t) * P.c[k].head<2>());
+            };
+            CHECK((xk(hd) - 2 * xk(0) + xk(-hd)).norm() / (hd * hd) < 1e-4);
+            ++pivots;
+        }
+        const Mode stuck{ModeKind::Stuck, -1, 0};
+        mode_accelerations(sc, Dynamics::Full, q, Vec3::Zero(), ps, stuck, ws);
+        const FrictionGauge g = friction_gauge(P, q[2], ws.n, ws.F_needed, ws.tau_needed);
+        if (!(g.gamma > 0) || !std::isfinite(g.gamma) || (ws.n.array() <= 0).any()) continue;
+        const WorldResidual res = world_residual(sc, q, Vec3::Zero(), ps, Vec3::Zero(), ws.n, g.f);
+        CHECK(res.force < 1e-7);
+        CHECK(res.torque < 1e-7);
+        ++stucks;
+    }
+    CHECK(pivots == 90);
+    CHECK(stucks >= 20);
 }
 
 TEST_CASE("the printed (28), with R1 where R1^T belongs, violates Euler's equation", "[dynamics][full][paper]") {

@@ -194,6 +194,30 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
                             i < 2 ? 1.0 : in.m * in.g));
         }
 
+        // Stick-slip modes: the pivot systems and the stuck solve (with b = b_full), against GiNaC.
+        {
+            using System = void (*)(const gen::KernelInput&, double*, double*);
+            const System pivot[3] = {gen::pivot1_system, gen::pivot2_system, gen::pivot3_system};
+            for (int k = 0; k < 3; ++k) {
+                double Ap[64], cp[2];
+                pivot[k](in, Ap, cp);
+                for (int i = 0; i < 8; ++i)
+                    for (int j = 0; j < 8; ++j) {
+                        INFO("pivot " << k << " A(" << i << "," << j << ") " << Ap[8 * i + j] << " vs " << value(d.pivot_A[k](i, j)));
+                        CHECK(close(Ap[8 * i + j], value(d.pivot_A[k](i, j)), 1e-6));
+                    }
+                for (int i = 0; i < 2; ++i) CHECK(close(cp[i], value(d.pivot_c[k](i, 0)), 1e-3));
+            }
+            exmap bsub = sub;
+            for (int i = 0; i < 6; ++i) bsub[d.bsym[i]] = bF[i];
+            double ns[3], ws[3];
+            gen::stuck_solve(in, bF, ns, ws);
+            for (int i = 0; i < 6; ++i) {
+                const double expect = ex_to<numeric>((d.stuck_solution(i, 0) / d.stuck_det).subs(bsub).evalf()).to_double();
+                CHECK(close(i < 3 ? ns[i] : ws[i - 3], expect, in.m * in.g * (i == 5 ? 0.05 : 1.0)));
+            }
+        }
+
         // The thin part's specialised kernel against GiNaC's solve of the thin system.
         gen::KernelInput tin = in;
         exmap tsub = sub;
@@ -261,6 +285,25 @@ TEST_CASE("the limit-surface kernel is the derived wrench", "[kernels][symbolic]
             const double expect = ex_to<numeric>(d.wrench(i, 0).subs(sub).evalf()).to_double();
             CHECK(std::abs(w[i] - expect) <= 1e-12 * scale);
         }
+        // The support function's terms (the stuck part's break-away test) with gradient and Hessian.
+        double sp[3], tm[3], gr[9], he[18];
+        gen::friction_support(in, sp, tm, gr, he);
+        const realsymbol dv[3] = {S.vx, S.vy, S.xith};
+        for (int i = 0; i < 3; ++i) {
+            const double cap = (i == 0 ? in.mu1 * in.N1 : i == 1 ? in.mu2 * in.N2 : in.mu3 * in.N3);
+            CHECK(std::abs(sp[i] - ex_to<numeric>(d.support_speed[i].subs(sub).evalf()).to_double()) <= 1e-12 * sp[i]);
+            CHECK(std::abs(tm[i] - ex_to<numeric>(d.support_term[i].subs(sub).evalf()).to_double()) <= 1e-12 * tm[i]);
+            int h = 0;
+            for (int a = 0; a < 3; ++a) {
+                const ex ga = d.support_term[i].diff(dv[a]);
+                CHECK(std::abs(gr[3 * i + a] - ex_to<numeric>(ga.subs(sub).evalf()).to_double()) <= 1e-12 * cap * 10);
+                for (int b = a; b < 3; ++b, ++h)
+                    CHECK(std::abs(he[6 * i + h] - ex_to<numeric>(ga.diff(dv[b]).subs(sub).evalf()).to_double()) <=
+                          1e-11 * cap * 100 / sp[i]);
+            }
+            // The support function is the dissipated power, whose gradient is minus the wrench.
+        }
+        for (int a = 0; a < 3; ++a) CHECK(std::abs(gr[a] + gr[3 + a] + gr[6 + a] + w[a]) <= 1e-12 * scale);
         // Coulomb: each contact's force has magnitude mu N, so |(F_x, F_y)| <= sum mu_i N_i.
         CHECK(std::hypot(w[0], w[1]) <= in.mu1 * in.N1 + in.mu2 * in.N2 + in.mu3 * in.N3 + 1e-15);
     }

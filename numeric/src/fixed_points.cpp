@@ -1,5 +1,6 @@
 #include "plate/field.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace plate {
@@ -103,7 +104,10 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
     FixedPoints out;
     const GridSpec& g = field.grid;
     const int dim = sc.part.point ? 2 : 3;
-    ScaledField f{sc, opt.cycle, dim, sc.part.rho()};
+    LimitCycleOptions cycle = opt.cycle;   // field noise well below ftol (FixedPointOptions)
+    cycle.integration.rtol = std::min(cycle.integration.rtol, 1e-3 * opt.ftol);
+    cycle.tol = std::min(cycle.tol, 1e-2 * opt.ftol);
+    ScaledField f{sc, cycle, dim, sc.part.rho()};
     const double ftol = opt.ftol * sc.v_ref();
     double cell = std::min(g.dx() > 0 ? g.dx() : 1.0, g.dy() > 0 ? g.dy() : 1.0);
     if (dim == 3) cell = std::min(cell, f.rho * g.dth());

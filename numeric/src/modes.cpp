@@ -13,34 +13,38 @@ inline Vec2 horizontal_offset(const Part& P, double theta, int i) {
 }
 inline double kappa(Dynamics level) { return level == Dynamics::ReducedU ? 0.0 : 1.0; }
 
-// Newton-Euler with contact k held (unknown f_k) and the others sliding along u_i:
-// unknowns [s_x'', s_y'', theta'', N1, N2, N3, f_kx, f_ky].
+// The generated kernels' inputs for the current configuration and twist (ws prepared).
+gen::KernelInput mode_input(const Vec3& q, const Vec3& qd, const Workspace& ws) {
+    gen::KernelInput in = ws.in;
+    in.ct = std::cos(q[2]);
+    in.st = std::sin(q[2]);
+    in.sx = q[0];
+    in.sy = q[1];
+    in.sxd = qd[0];
+    in.syd = qd[1];
+    in.thd = qd[2];
+    return in;
+}
+
+// Newton-Euler with contact k held (unknown f_k) and the others sliding along u_i: the derived
+// system pivotK_system (symbolic/derivation.cpp), unknowns [s_x'', s_y'', theta'', N1, N2, N3, f_kx, f_ky].
 void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd, const PlateState& ps,
                  const std::array<Vec2, 3>& u, Workspace& ws) {
     const Part& P = sc.part;
     const Vec6 b = rhs_b(sc, level, q, qd, ps);
-    const Mat3 R2t = rot_z(q[2]).transpose();
-    Eigen::Matrix<double, 8, 8> M = Eigen::Matrix<double, 8, 8>::Zero();
-    Eigen::Matrix<double, 8, 1> rhs = Eigen::Matrix<double, 8, 1>::Zero();
-    M(0, 0) = -P.m;
-    M(1, 1) = -P.m;
-    M.block<3, 1>(3, 2) = -P.J.col(2);   // -J' (31)
-    for (int i = 0; i < 3; ++i) {
-        Vec3 d = Vec3::UnitZ();   // (17) for a sliding contact; the normal alone for the held one
-        if (i != k) d.head<2>() -= P.mu[i] * u[i];
-        M.block<3, 1>(0, 3 + i) = d;
-        M.block<3, 1>(3, 3 + i) = P.c[i].cross(R2t * d);   // h_i (23)
-    }
-    for (int j = 0; j < 2; ++j) {
-        const Vec3 e = j == 0 ? Vec3::UnitX() : Vec3::UnitY();
-        M.block<3, 1>(0, 6 + j) = e;
-        M.block<3, 1>(3, 6 + j) = P.c[k].cross(R2t * e);
-    }
+    gen::KernelInput in = mode_input(q, qd, ws);
+    in.u1x = u[0].x(); in.u1y = u[0].y();
+    in.u2x = u[1].x(); in.u2y = u[1].y();
+    in.u3x = u[2].x(); in.u3y = u[2].y();
+    Eigen::Matrix<double, 8, 8, Eigen::RowMajor> M;
+    double c[2];
+    using System = void (*)(const gen::KernelInput&, double*, double*);
+    static constexpr System system[3] = {gen::pivot1_system, gen::pivot2_system, gen::pivot3_system};
+    system[k](in, M.data(), c);
+    Eigen::Matrix<double, 8, 1> rhs;
     rhs.head<6>() = b;
-    const Vec2 r = horizontal_offset(P, q[2], k);
-    const double c2 = kappa(level) * qd[2] * qd[2];
-    M(6, 0) = 1; M(6, 2) = -r.y(); rhs[6] = c2 * r.x();
-    M(7, 1) = 1; M(7, 2) = r.x();  rhs[7] = c2 * r.y();
+    rhs[6] = kappa(level) * c[0];   // theta'^2 r_k; the reduced U-dynamics' frozen configuration has none
+    rhs[7] = kappa(level) * c[1];
     const Eigen::Matrix<double, 8, 1> z = M.partialPivLu().solve(rhs);
     ws.b = b;
     ws.qdd = z.head<3>();
@@ -48,25 +52,23 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
     for (int i = 0; i < 3; ++i) ws.f_held[i] = i == k ? Vec2(z[6], z[7]) : Vec2(-P.mu[i] * ws.n[i] * u[i]);
 }
 
-// q'' = 0: the needed friction total and moment, and the normal forces.
+// q'' = 0: the needed friction total and moment, and the normal forces (generated stuck_solve).
 void stuck_solve(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
     const Part& P = sc.part;
     const Vec6 b = rhs_b(sc, level, q, qd, ps);
     ws.b = b;
     ws.qdd.setZero();
-    ws.F_needed = b.head<2>();   // -m s'' + sum f_i = f_dagger,xy with s'' = 0
-    if (P.point) {
+    if (P.point) {   // one contact: N = b_z, F = b_xy (point_solve with s'' = 0)
+        ws.F_needed = b.head<2>();
         ws.tau_needed = 0;
         ws.n = Vec3(b[2], 0, 0);
         return;
     }
-    ws.tau_needed = b[5];   // sum r_i x f_i = tau_dagger,z
-    // Rows z, torque x, torque y: the friction total F at height -h in S has moment (h F_Sy, -h F_Sx).
-    const Vec3 FS = rot_z(q[2]).transpose() * Vec3(b[0], b[1], 0);
-    const double h = P.s_z();
-    Mat3 M;
-    for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
-    ws.n = M.partialPivLu().solve(Vec3(b[3] - h * FS.y(), b[4] + h * FS.x(), b[2]));
+    double n[3], w[3];
+    gen::stuck_solve(mode_input(q, qd, ws), b.data(), n, w);
+    ws.n = Vec3(n[0], n[1], n[2]);
+    ws.F_needed = Vec2(w[0], w[1]);
+    ws.tau_needed = w[2];
 }
 
 }  // namespace
@@ -150,9 +152,33 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     Eigen::Matrix<double, 3, 2> B;
     B.col(0) = t1;
     B.col(1) = a.cross(t1);
+    // The support function P(d) = sum_i mu_i N_i |G_i^T d| with its gradient and Hessian: the
+    // generated friction_support (a term is left out where its contact is at rest, a kink of P,
+    // where its subgradient 0 is a valid choice).
+    gen::WrenchInput win;
+    double* const wN[3] = {&win.N1, &win.N2, &win.N3};
+    double* const wx[3] = {&win.r1x, &win.r2x, &win.r3x};
+    double* const wy[3] = {&win.r1y, &win.r2y, &win.r3y};
+    double* const wmu[3] = {&win.mu1, &win.mu2, &win.mu3};
+    for (int i = 0; i < 3; ++i) {
+        *wN[i] = std::max(n[i], 0.0);
+        *wmu[i] = P.mu[i];
+        *wx[i] = R[i].x() * rg;
+        *wy[i] = R[i].y() * rg;
+    }
+    win.rho = rg;
+    double sp[3], term[3], gr[9], he[18];
+    auto support = [&](const Vec3& d) {
+        win.vx = d.x();
+        win.vy = d.y();
+        win.xith = d.z();
+        gen::friction_support(win, sp, term, gr, he);
+    };
     auto h_at = [&](const Vec3& d) {
+        support(d);
         double h = 0;
-        for (int i = 0; i < 3; ++i) h += cap[i] * Gt(i, d).norm();
+        for (int i = 0; i < 3; ++i)
+            if (sp[i] > 0) h += term[i];
         return h;
     };
     Vec2 y = Vec2::Zero();
@@ -162,15 +188,12 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
         g.iterations = it + 1;
         Vec3 grad = Vec3::Zero();
         Mat3 H = Mat3::Zero();
+        support(d);
         for (int i = 0; i < 3; ++i) {
-            const Vec2 v = Gt(i, d);
-            const double nv = v.norm();
-            if (!(nv > 0) || !(cap[i] > 0)) continue;
-            const Vec2 u = v / nv;
-            grad += cap[i] * Gf(i, u);
-            // Hessian of cap |G^T d|: cap G (I - u u^T) G^T / |G^T d| = cap/|v| (G u_perp)(G u_perp)^T
-            const Vec3 gp = Gf(i, perp(u));
-            H += cap[i] / nv * gp * gp.transpose();
+            if (!(sp[i] > 0) || !(cap[i] > 0)) continue;
+            grad += Vec3(gr[3 * i], gr[3 * i + 1], gr[3 * i + 2]);
+            const double* Hi = he + 6 * i;
+            H += (Mat3() << Hi[0], Hi[1], Hi[2], Hi[1], Hi[3], Hi[4], Hi[2], Hi[4], Hi[5]).finished();
         }
         const Vec2 gy = B.transpose() * grad;
         const Eigen::Matrix2d Hy = B.transpose() * H * B;

@@ -86,6 +86,10 @@ struct FixedLine {
 };
 
 struct FixedPointOptions {
+    // The cycles evaluated while refining. Newton needs a field whose noise is well below ftol: the
+    // twist of a cycle carries the integrator's error, measured at ~60 rtol v_ref (fig1 near its
+    // stable line: 6e-7 v_ref at rtol 1e-8, which made the line search fail at random), so the
+    // refinement runs at rtol <= 1e-3 ftol and cycle tol <= 1e-2 ftol whatever this asks for.
     LimitCycleOptions cycle;
     double ftol = 1e-6;      // |xi_a| accepted as zero, relative to v_ref
     int max_newton = 25;

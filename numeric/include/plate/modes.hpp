@@ -15,6 +15,14 @@
 // A point part has one contact: Slide or Stuck. The set is complete: every state has exactly
 // one Z, and a mode change is a change of Z (located as an event by the engine).
 //
+// DERIVED, NOT TYPED: symbolic/derivation.cpp derives each mode from the same Newton-Euler
+// equations as the sliding model -- the pivot's constraint by differentiating contact k's sliding
+// velocity (and checks that the frozen configuration of (35) drops theta'^2 r_k), the stuck
+// part's normal forces and needed wrench (and checks exactly that internal force pairs change
+// nothing, so they are determinate), the support function of the friction set with its gradient
+// and Hessian -- and generates the kernels pivotK_system, stuck_solve and friction_support used
+// here (numeric/generated/plate_kernels.hpp).
+//
 // TRANSITIONS (guards; each is positive while its mode holds, events are their roots):
 //   Slide -> Pivot k / Stuck   v_k reaches zero and the needed static friction lies in the disk
 //                              (pivot), or every slip reaches zero and the gauge is <= 1 (stuck)
