@@ -93,3 +93,59 @@ TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-frictio
     CHECK(checked >= 8);
     CHECK(substantial >= 8);   // cycles in which a contact is held more than 5% of the period
 }
+
+TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivot's is the period map's derivative",
+          "[limit_cycle][stick]") {
+    // Warm-started 1e-4 of the scales off a cycle (as a field's or a design's neighbour would), the
+    // shooting solver must reach the period-by-period cycle (tol 1e-10) within its tolerance,
+    // 1e-7 v_ref, with a monodromy of its own (not Anderson's fallback).
+    struct Case {
+        const char* scene;
+        Vec3 q;
+        bool full_stick;
+    };
+    const Case cases[] = {{"heave_yaw", Vec3(0.03, 0.02, 1.0), true},          // stuck, slides, stuck again
+                          {"fig6", Vec3(-0.05 + 1.0 / 60, 1.0 / 60, 2 * kPi * 5 / 7), false}};   // pivots about 1
+    for (const Case& c : cases) {
+        INFO(c.scene);
+        const Scene sc = scene(c.scene);
+        LimitCycleOptions plain;
+        plain.solver = CycleSolver::PeriodByPeriod;
+        plain.tol = 1e-10;
+        const LimitCycleSummary ref = limit_cycle(sc, c.q, plain);
+        REQUIRE(ref.converged);
+        const bool stuck = std::any_of(ref.mode_events.begin(), ref.mode_events.end(),
+                                       [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
+        const bool pivots = std::any_of(ref.mode_events.begin(), ref.mode_events.end(),
+                                        [](const ModeEvent& e) { return e.to.kind == ModeKind::Pivot; });
+        REQUIRE(stuck == c.full_stick);
+        REQUIRE((pivots || stuck));
+        const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
+        const Vec3 warm = ref.qd_start + Vec3(1e-4, -1e-4, 1e-4).cwiseProduct(S);
+        const LimitCycleSummary sh = limit_cycle(sc, c.q, LimitCycleOptions{}, warm);
+        REQUIRE(sh.converged);
+        CHECK(sh.has_monodromy);
+        CHECK((sh.twist - ref.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < 1e-7);
+        if (c.full_stick) {
+            CHECK(sh.monodromy.isZero(0));   // exactly: the end of the period forgets its start
+        } else {
+            // Central differences of the period map at the cycle (h = 1e-4 of the scales: truncation
+            // h^2 |P'''| and noise rtol/h ~ 1e-4 of |M|); the forward differences in the solver carry
+            // h |P''| on top: agreement to 2% of |M| (and a Floquet multiplier below 1: attracting).
+            Mat3 Mc;
+            const double h = 1e-4;
+            for (int j = 0; j < 3; ++j) {
+                Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
+                xp[j] += h * S[j];
+                xm[j] -= h * S[j];
+                REQUIRE(period_map(sc, c.q, xp, Pp));
+                REQUIRE(period_map(sc, c.q, xm, Pm));
+                Mc.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
+            }
+            INFO("shooting M\n" << sh.monodromy << "\ncentral differences\n" << Mc);
+            CHECK((sh.monodromy - Mc).norm() < 0.02 * Mc.norm());
+            CHECK(Mc.eigenvalues().cwiseAbs().maxCoeff() < 1);
+            CHECK(Mc.norm() > 0.1);   // not a full stick: the start matters
+        }
+    }
+}

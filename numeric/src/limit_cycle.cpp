@@ -327,6 +327,19 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
 // taken as 2 theta/(1 - 2 theta) |delta_k| (see the loop for the 2). Measured on fig4, where a line's
 // first point starts 0.025 v_ref from its cycle: theta alone under-estimated the error 5x there.
 // A step sequence that does not contract gives up (the caller falls back to Anderson).
+//
+// Across a change of contact mode (a period that starts held, or in which a contact sticks, pivots
+// or breaks away) the sliding variational equations do not hold: the monodromy then takes a
+// saltation at every switch (a projection onto the held contact's constraint where a slip reaches
+// zero, a jump from the shifted break-away time where one starts), and a full stick makes it zero.
+// Instead of those matrices we take their product, the derivative of the period map itself, by
+// forward differences of P (one_period from x + h e_j, h = 1e-4 of the scales): the map is
+// continuous and piecewise smooth, so the chord is as good as the exact monodromy for Newton, and
+// its error (h |P''| + rtol/h ~ 1e-4) only slows the contraction, which the stopping rule measures.
+// It costs one period per unknown; Anderson's fallback cost 9 periods per sticking cycle from a
+// neighbour's warm start on fig6 (its contraction estimate drowns in noise near the cycle).
+constexpr double kDifferenceMonodromyNear = 1e-3;   // |P(x) - x| / scale below which (see above)
+
 LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
     detail::ReducedModel model(sc, q0);
     detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
@@ -339,6 +352,9 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     LimitCycleSummary out;
     Vec3 x = point ? Vec3(qd0[0], qd0[1], 0) : qd0;
     bool refresh = true;
+    bool reset_prev = false;   // the last period stuck fully (its end is the cycle's start)
+    Stats fd_stats;   // the difference monodromies' periods
+    int fd_periods = 0;
     Mat3 M = Mat3::Zero(), Pa = Mat3::Zero();
     double d_prev = std::numeric_limits<double>::infinity();
     for (int k = 0; k < opt.max_periods; ++k) {
@@ -352,17 +368,16 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         // Jacobian per step: a chord needs no more, and the error estimate allows for it.
         Mat3 Phi = Mat3::Identity(), Psi = Mat3::Zero(), J;
         double t_prev = e.t();
-        const long switches = e.stats.mode_switches;
-        // The variational equations below are those of sliding: a period with a change of contact
-        // mode (or that starts held) is left to Anderson's iteration (limit_cycle falls back), whose
-        // periods converge in one step where the part sticks fully (the state after a full stick does
-        // not depend on the start).
-        if (e.mode().kind != ModeKind::Slide) break;
-        if (refresh) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
+        e.reset_log();
+        const Mode start_mode = e.mode();
+        // The variational equations below are those of sliding; a period that starts held or
+        // changes mode takes the difference monodromy instead (above).
+        const bool variational = refresh && start_mode.kind == ModeKind::Slide;
+        if (variational) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
         double min_n = e.n().head(nc).minCoeff();
         ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
             min_n = std::min(min_n, n.head(nc).minCoeff());
-            if (!refresh) return;
+            if (!variational) return;
             const double h = t - t_prev;
             Mat3 J1;
             twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), model.plate_at(t), jws, J1);
@@ -372,10 +387,59 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
             J = J1;
             t_prev = t;
         });
-        out.periods = k + 1;
-        if (!ok || e.stats.mode_switches != switches) break;
+        out.periods = k + 1 + fd_periods;
+        if (!ok) break;
         const auto z = e.y();
-        if (refresh) {
+        record_modes(out, e, start_mode, k * T, T);
+        const bool switched = start_mode.kind != ModeKind::Slide || !e.events.empty();
+        // A period in which the part was stuck as a whole forgets its start: P is constant near x,
+        // so M = 0 exactly and P(x) is the cycle's start (to the integration's noise). The period
+        // after it, from P(x), is then the cycle: when it sticks fully too, it is converged.
+        const bool full_stick = start_mode.kind == ModeKind::Stuck ||
+                                std::any_of(e.events.begin(), e.events.end(),
+                                            [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
+        if (full_stick) {
+            if (k >= 1 && reset_prev) {
+                out.twist = Vec3(z[3], z[4], z[5]) / T;
+                out.qd_start = x;
+                out.residual = (model.qd(z) - x).cwiseQuotient(S).cwiseAbs().maxCoeff();
+                out.error_estimate = out.residual;   // the noise between two images of P
+                out.min_normal_force = min_n;
+                out.has_monodromy = true;            // dP/dx = 0: every Floquet multiplier is 0
+                out.monodromy.setZero();
+                out.converged = true;
+                break;
+            }
+            reset_prev = true;
+            x = model.qd(z);
+            d_prev = std::numeric_limits<double>::infinity();
+            refresh = true;
+            continue;
+        }
+        reset_prev = false;
+        // A difference monodromy pays only near the cycle, where Newton then ends in a step or
+        // two; from further off (a neighbour's warm start in a field) Anderson's periods are
+        // cheaper (measured on fig6's field: 610 periods for its sticking cycles against 462).
+        if (refresh && switched && (model.qd(z) - x).cwiseQuotient(S).cwiseAbs().maxCoeff() > kDifferenceMonodromyNear) break;
+        if (refresh && switched) {
+            // Forward differences of the period map (and of its average) in the scaled twist.
+            const double h = 1e-4;
+            const Vec3 end = model.qd(z), avg = Vec3(z[3], z[4], z[5]) / T;
+            bool fd_ok = true;
+            M.setZero();
+            Pa.setZero();
+            for (int j = 0; j < (point ? 2 : 3) && fd_ok; ++j) {
+                Vec3 xj = x;
+                xj[j] += h * S[j];
+                const PeriodResult pj = one_period(sc, q0, xj, opt.integration, fd_stats);
+                fd_ok = pj.ok;
+                M.col(j) = (pj.end - end).cwiseQuotient(S) / h;
+                Pa.col(j) = (pj.average - avg).cwiseQuotient(S) / h;
+            }
+            fd_periods += point ? 2 : 3;
+            out.periods += point ? 2 : 3;
+            if (!fd_ok) break;
+        } else if (refresh) {
             M = S.asDiagonal().inverse() * Phi * S.asDiagonal();
             Pa = S.asDiagonal().inverse() * Psi * S.asDiagonal() / T;
         }
@@ -399,6 +463,17 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         out.min_normal_force = min_n;
         out.has_monodromy = true;
         out.monodromy = M;
+        // With a monodromy fresh at this start, dn is the linear estimate of the start's distance
+        // from the cycle; the twist's error is at most |d xi_a/dx| times it (before the correction
+        // Pa delta, which leaves only its second-order remainder), doubled for a difference
+        // monodromy's or a nonlinearity's error. Near the cycle this ends a warm start after one
+        // period (the period map's noise, ~rtol v_ref per switch, left the contraction
+        // theta below unmeasurable there).
+        if (was_fresh && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol) {
+            out.error_estimate = 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn;
+            out.converged = true;
+            break;
+        }
         if (k >= 1) {
             const double theta = d_prev > 0 ? dn / d_prev : 0.0;
             out.contraction = theta;
@@ -421,6 +496,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     }
     out.stop = e.stop;
     out.stats = e.stats;
+    out.stats += fd_stats;   // the difference monodromies' periods
     out.stats.rhs_evals += jws.evals;   // the Jacobians' evaluations
     out.step_hint = e.next_step() / T;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};

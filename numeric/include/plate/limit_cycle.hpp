@@ -29,6 +29,11 @@ namespace plate {
 //                   corrected to first order by its sensitivity to the start and the last step.
 //                   Needs a warm start near the cycle (fields predict one from solved neighbours);
 //                   without one (qd0 = 0), or with `record`, it is Anderson. Falls back to Anderson.
+//                   Through stick-slip: a period in which the part sticks as a whole has M = 0
+//                   exactly (its end does not depend on its start: the next period is the cycle);
+//                   one with a pivot or a partial stick takes M by forward differences of P, the
+//                   product of the sliding flows and the saltations at the switches, when its start
+//                   is within 1e-3 of the scales of its image (else Anderson's periods are cheaper).
 // The speed-accuracy study (plate bench) charts cost against accuracy for each.
 enum class CycleSolver { PeriodByPeriod, Anderson, Newton, Shooting };
 const char* cycle_solver_name(CycleSolver s);
@@ -56,7 +61,8 @@ struct LimitCycleSummary {
     double contraction = 0;     // c, per period
     Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // xi_a (36)
     Vec3 qd_start = Vec3::Zero();  // state at the start of the last period (a warm start)
-    // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers) in the
+    // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers; all zero
+    // for a cycle in which the part sticks as a whole) in the
     // scaled twist (v_ref, v_ref, v_ref / rho), at the start where it was last computed.
     bool has_monodromy = false;
     Mat3 monodromy = Mat3::Zero();
