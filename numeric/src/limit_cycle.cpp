@@ -474,7 +474,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
             out.converged = true;
             break;
         }
-        if (k >= 1) {
+        if (k >= 1 && std::isfinite(d_prev)) {   // (not after a full stick: no previous step)
             const double theta = d_prev > 0 ? dn / d_prev : 0.0;
             out.contraction = theta;
             // The next step contracts by about theta again on a chord, by less under Newton; but a
