@@ -473,7 +473,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
             continue;
         }
         out.twist = Vec3(z[3], z[4], z[5]) / T + (Pa * delta).cwiseProduct(S);
-        out.qd_start = x;
+        out.qd_start = x + delta.cwiseProduct(S);   // the Newton estimate of the cycle's start
         out.residual = r.cwiseAbs().maxCoeff();
         out.min_normal_force = min_n;
         out.has_monodromy = true;

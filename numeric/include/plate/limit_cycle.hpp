@@ -60,7 +60,7 @@ struct LimitCycleSummary {
     double error_estimate = 0;  // r_k c/(1-c), relative to v_ref
     double contraction = 0;     // c, per period
     Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // xi_a (36)
-    Vec3 qd_start = Vec3::Zero();  // state at the start of the last period (a warm start)
+    Vec3 qd_start = Vec3::Zero();  // the cycle's start (a warm start): the last period's start; shooting: its Newton update
     // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers; all zero
     // for a cycle in which the part sticks as a whole) in the
     // scaled twist (v_ref, v_ref, v_ref / rho), at the start where it was last computed.
