@@ -421,8 +421,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             for (int i = 0; i < (pt ? 2 : 3); ++i) c.html << fmt(l.eigenvalues[i].real(), 3) << " ";
             c.html << "</td></tr>\n";
         }
-        if (fp.points.empty() && fp.lines.empty()) c.html << "<tr><td colspan=4>none</td></tr>\n";
-        c.html << "</table>\n";
+        c.html << "</table>\n<p>" << esc(fixed_points_sentence(fp)) << ".</p>\n";
     }
     section_stick_reference(c, src);
 }

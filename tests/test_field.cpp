@@ -102,6 +102,18 @@ TEST_CASE("Fig. 4: stable fixed points near (0,0,0) and (0,0,pi), unstable near 
     }
     CHECK(stable == 2);
     CHECK(unstable == 2);
+    CHECK(fp.undefined_cells == 0);
+    CHECK(fp.cells == 6 * 6 * 7);   // 7x7 grid in (x, y), theta wrapping: 7 cells around
+    CHECK(fixed_points_sentence(fp) == "4 fixed points found");
+
+    // A datum made undefined (a corner with no cycle) is counted, not silently skipped: the cells
+    // sharing that corner are undefined and the sentence says where nothing was searched.
+    Field holed = f;
+    const int i = 3, j = 3, k = 0;   // (0, 0, 0): the stable point's corner
+    holed.points[holed.grid.index(i, j, k)].converged = false;
+    const FixedPoints fh = find_fixed_points(sc, holed);
+    CHECK(fh.undefined_cells == 8);   // the corner belongs to 2 x 2 cells in (x, y), 2 in theta
+    CHECK(fixed_points_sentence(fh).find("(8 of 252 cells undefined") != std::string::npos);
 }
 
 TEST_CASE("Fig. 5: transports along y while attracting theta to 0 or pi, no fixed points", "[field][paper]") {

@@ -162,7 +162,11 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
                     lo = lo.cwiseMin(v);
                     hi = hi.cwiseMax(v);
                 }
-                if (!ok) continue;
+                ++out.cells;
+                if (!ok) {
+                    ++out.undefined_cells;
+                    continue;
+                }
                 bool cand = true;
                 for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
                 if (!cand) continue;
@@ -242,6 +246,22 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
             }
     out.evaluations = f.evals;
     return out;
+}
+
+std::string fixed_points_sentence(const FixedPoints& fp) {
+    auto count = [](std::size_t n, const char* one, const char* many) {
+        return std::to_string(n) + " " + (n == 1 ? one : many);
+    };
+    std::string s;
+    if (fp.points.empty() && fp.lines.empty()) s = "no fixed point found";
+    else if (fp.lines.empty()) s = count(fp.points.size(), "fixed point", "fixed points") + " found";
+    else if (fp.points.empty()) s = count(fp.lines.size(), "line of fixed points", "lines of fixed points") + " found";
+    else s = count(fp.points.size(), "fixed point", "fixed points") + " and " +
+             count(fp.lines.size(), "line of fixed points", "lines of fixed points") + " found";
+    if (fp.undefined_cells > 0)
+        s += " in the defined part (" + std::to_string(fp.undefined_cells) + " of " + std::to_string(fp.cells) +
+             " cells undefined: a corner has no cycle)";
+    return s;
 }
 
 }  // namespace plate

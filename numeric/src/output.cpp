@@ -119,6 +119,9 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
     j["points"] = pts;
     j["lines"] = lines;
     j["candidate_cells"] = fp.candidates;
+    j["cells"] = fp.cells;
+    j["undefined_cells"] = fp.undefined_cells;   // skipped: a corner has no cycle
+    j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
     return j;
 }

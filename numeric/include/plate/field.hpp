@@ -100,6 +100,8 @@ struct FixedPoints {
     std::vector<FixedPoint> points;
     std::vector<FixedLine> lines;
     int candidates = 0;      // grid cells where every component changes sign
+    int cells = 0;           // grid cells searched
+    int undefined_cells = 0; // cells skipped because a corner's twist is undefined (no cycle there)
     long evaluations = 0;    // field evaluations spent refining
 };
 
@@ -108,6 +110,10 @@ struct FixedPoints {
 // Jacobian is singular is followed along its null direction and reported as a line when it
 // continues across the grid.
 FixedPoints find_fixed_points(const Scene& scene, const Field& field, const FixedPointOptions& opt = {});
+// What was found, in words that say what was not searched: "2 fixed points and 1 line", "no fixed
+// point", each followed, when some cells had an undefined corner, by "in the defined part (k of n
+// cells undefined)".
+std::string fixed_points_sentence(const FixedPoints& fp);
 
 // --- integral curves -----------------------------------------------------------------------
 // q' = xi_a(q) from q0 (classical RK4, step h), sampled every sample_dt. Stops where the field
