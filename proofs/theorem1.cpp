@@ -11,6 +11,7 @@
 #include <chrono>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <thread>
 #include <cmath>
 
@@ -130,6 +131,90 @@ double floquet_radius(const Scene& sc, const Vec3& q0, const Vec3& x0, double rt
     return Eigen::EigenSolver<Mat3>(J.topLeftCorner(3, 3)).eigenvalues().head(dim).cwiseAbs().maxCoeff();
 }
 
+DynamicsUnderTest production_dynamics() {
+    return [](const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Vec3& qdd, Vec3& n) {
+        Workspace ws;   // per call: a workspace caches its scene by address, and scenes come and go
+        accelerations(sc, Dynamics::U, q, qd, ps, ws);
+        qdd = ws.qdd;
+        n = ws.n;
+    };
+}
+
+void DynamicsTie::merge(const DynamicsTie& o) {
+    samples += o.samples;
+    worst_statics = std::max(worst_statics, o.worst_statics);
+    worst_wrench = std::max(worst_wrench, o.worst_wrench);
+    if (failure.empty()) failure = o.failure;
+}
+
+DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std::uint64_t seed,
+                               const DynamicsUnderTest& dynamics) {
+    DynamicsTie t;
+    const Part& P = sc.part;
+    const double mg = P.m * sc.g, rho = P.rho(), v = sc.v_ref();
+    const DynamicsUnderTest dyn = dynamics ? dynamics : production_dynamics();
+    Rng r(seed * 2654435761u + 3);
+    for (int k = 0; k < samples; ++k) {
+        const Vec3 q(q0[0] + r.uniform(-0.005, 0.005), q0[1] + r.uniform(-0.005, 0.005), q0[2] + r.uniform(-0.5, 0.5));
+        const Vec3 qd(r.uniform(-v, v), r.uniform(-v, v), r.uniform(-v, v) / rho);
+        const PlateState ps = plate_state(sc.plate, r.uniform(0, sc.plate.T), Dynamics::U);
+        Vec3 qdd, n;
+        dyn(sc, q, qd, ps, qdd, n);
+        // (33)-(34): f~ = m (p'' + w1' x s + g e_z), tau~ = J R2^T w1'.
+        const Vec3 s(q[0], q[1], P.s_z());
+        const Vec3 f = P.m * (ps.pdd + ps.wd.cross(s) + sc.g * Vec3::UnitZ());
+        const Mat3 R2 = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix();
+        const Vec3 tau = P.J * (R2.transpose() * ps.wd);
+        // Statics: rows sum c_iy N_i = tau_x, -sum c_ix N_i = tau_y, sum N_i = f_z, by Cramer's rule.
+        Mat3 M;
+        for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
+        const Vec3 rhs(tau.x(), tau.y(), f.z());
+        const double det = M.determinant();
+        Vec3 Ns;
+        for (int i = 0; i < 3; ++i) {
+            Mat3 Mi = M;
+            Mi.col(i) = rhs;
+            Ns[i] = Mi.determinant() / det;
+        }
+        // The limit surface (39): the generated thin_wrench with the statics' forces.
+        gen::WrenchInput in;
+        double* const Ni[3] = {&in.N1, &in.N2, &in.N3};
+        double* const rx[3] = {&in.r1x, &in.r2x, &in.r3x};
+        double* const ry[3] = {&in.r1y, &in.r2y, &in.r3y};
+        double* const mu[3] = {&in.mu1, &in.mu2, &in.mu3};
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 ri = R2 * P.c[i];
+            *Ni[i] = Ns[i];
+            *rx[i] = ri.x();
+            *ry[i] = ri.y();
+            *mu[i] = P.mu[i];
+        }
+        in.rho = rho;
+        in.vx = qd[0];
+        in.vy = qd[1];
+        in.xith = rho * qd[2];
+        double w[3];
+        gen::thin_wrench(in, w);
+        const Vec3 W(P.m * qdd[0] + f.x(), P.m * qdd[1] + f.y(), (P.J(2, 2) * qdd[2] + tau.z()) / rho);
+        const double es = (n - Ns).cwiseAbs().maxCoeff() / mg;
+        const double ew = (W - Vec3(w[0], w[1], w[2])).cwiseAbs().maxCoeff() / mg;
+        ++t.samples;
+        t.worst_statics = std::max(t.worst_statics, es);
+        t.worst_wrench = std::max(t.worst_wrench, ew);
+        if (!t.failure.empty()) continue;
+        std::ostringstream o;
+        o.precision(3);
+        if (!(es <= kTieTolerance))
+            o << "statics: the normal forces differ from an independent solve of the part's statics by " << es
+              << " m g (seed " << seed << ", sample " << k << ")";
+        else if (!(ew <= kTieTolerance))
+            o << "wrench: m q'' + b~ differs from the limit-surface wrench (39) of the relative twist by " << ew
+              << " m g (seed " << seed << ", sample " << k << ")";
+        t.failure = o.str();
+    }
+    return t;
+}
+
 namespace {
 
 ContractionCase run_case(const ContractionOptions& opt, std::uint64_t seed) {
@@ -144,6 +229,7 @@ ContractionCase run_case(const ContractionOptions& opt, std::uint64_t seed) {
     const Vec3 a = twist(), b = twist();
     ContractionCase c = contraction_case(sc, q0, a, b, opt.periods, opt.rtol);
     c.seed = seed;
+    if (sc.part.thin()) c.tie = check_dynamics_tie(sc, q0, opt.tie_samples, seed, opt.dynamics);
     if (!c.valid) return c;
     LimitCycleOptions lo;
     lo.integration.rtol = opt.rtol;
@@ -225,7 +311,9 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
             s.max_spectral_radius = std::max(s.max_spectral_radius, c.spectral_radius);
             if (!(c.monotone && c.converged && c.unique && c.spectral_radius < 1)) s.counterexamples.push_back(c.seed);
         }
+        s.tie.merge(c.tie);   // every case, valid or not: the dynamics are checked where they are defined
     }
+    s.tie_required = opt.thin;
     s.details = std::move(cases);
     if (!rates.empty()) {
         std::sort(rates.begin(), rates.end());
@@ -288,7 +376,7 @@ WrenchMap thin_wrench_map(const Scene& sc, const Vec3& q0, double t, double* fri
     };
 }
 
-LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed) {
+LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const DynamicsUnderTest& dynamics) {
     LimitSurfaceCampaign c;
     c.parts = parts;
     c.min_separation = c.min_strict_margin = parts > 0 ? 1e300 : 0;
@@ -296,8 +384,9 @@ LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed) {
     for (int k = 0; k < parts; ++k) {
         const Scene sc = random_scene(seed + 90'000'000 + static_cast<std::uint64_t>(k), RandomSceneOptions{true});
         double scale = 0;
-        const WrenchMap w = thin_wrench_map(sc, Vec3(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)),
-                                            r.uniform(0, sc.plate.T), &scale);
+        const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
+        const WrenchMap w = thin_wrench_map(sc, q0, r.uniform(0, sc.plate.T), &scale);
+        c.tie.merge(check_dynamics_tie(sc, q0, 10, seed + 90'000'000 + static_cast<std::uint64_t>(k), dynamics));
         const LimitSurfaceResult lr = check_limit_surface(w, scale, 300);
         c.convex += lr.convex_and_normal();
         c.strict += lr.strictly_convex();

@@ -14,6 +14,36 @@
 
 namespace plate::proofs {
 
+// --- The checks tied to the dynamics --------------------------------------------------------
+// The contraction (C) and limit-surface (B) checks below hold for *any* Coulomb friction with
+// velocity-independent normal forces >= 0: a wrong normal-force solve, a wrong b~ or a wrong mu
+// passes them. These tie them to the dynamics under test, at sampled states of a thin part in the
+// U-dynamics (b~ of (33)-(34) written here from the paper, not taken from the kernels):
+//   statics  its normal forces equal an independent solve of the part's statics -- Euler's x, y
+//            rows and Newton's z row, where for c_z = 0, J_xz = J_yz = 0 neither friction nor
+//            theta'' enters: sum c_iy N_i = tau~_x, -sum c_ix N_i = tau~_y, sum N_i = f~_z
+//            (Cramer's rule);
+//   wrench   its friction wrench by Newton-Euler, (m s'' + f~_xy, (J_zz theta'' + tau~_z) / rho),
+//            equals the limit-surface wrench (39) of its relative twist (s', rho theta'), the
+//            generated thin_wrench with the statics' normal forces and the scene's mu.
+// Both to rounding: 1e-10 of m g (cond(A) of these parts is below 30; measured residuals 1e-15).
+using DynamicsUnderTest =
+    std::function<void(const Scene&, const Vec3& q, const Vec3& qd, const PlateState& plate, Vec3& qdd, Vec3& n)>;
+DynamicsUnderTest production_dynamics();   // accelerations(), U-dynamics: the kernels the program runs
+
+struct DynamicsTie {
+    int samples = 0;
+    double worst_statics = 0;   // max |N - N_statics| / (m g)
+    double worst_wrench = 0;    // max |W_dynamics - w(xi)| / (m g)
+    std::string failure;        // the first check that failed, what and where ("" if none)
+    bool passed() const { return samples > 0 && failure.empty(); }
+    void merge(const DynamicsTie& o);
+};
+constexpr double kTieTolerance = 1e-10;
+// `samples` states of the thin `scene` near q0: random twists and plate times (seeded).
+DynamicsTie check_dynamics_tie(const Scene& scene, const Vec3& q0, int samples, std::uint64_t seed,
+                               const DynamicsUnderTest& dynamics);
+
 // --- C. Trajectory convergence ------------------------------------------------------------
 // Two copies of a part at one configuration, from different twists, integrated together on one
 // step sequence. V = 1/2 |xi_rel|^2 in the Appendix's scaled coordinates (xi_theta = rho omega).
@@ -32,6 +62,9 @@ struct ContractionOptions {
     int threads = 0;           // 0: all cores
     // Plate motions and parts come from random_scene; override for deliberately broken cases.
     std::function<void(Scene&)> modify;
+    // The dynamics the tie checks (above) hold against the paper; empty: production_dynamics().
+    DynamicsUnderTest dynamics;
+    int tie_samples = 10;      // per case
     std::function<void(int done, int total)> progress;   // called from workers, serialised
 };
 
@@ -48,6 +81,7 @@ struct ContractionCase {
     double cycle_spread = 0;        // largest distance between their cycle starts / v_ref
     int starts_left_model = 0;      // further starts whose transient stuck or lost contact (replaced)
     std::vector<double> V_periods;  // V at each period boundary
+    DynamicsTie tie;                // thin parts: the dynamics tied to statics and the limit surface
 };
 
 struct ContractionSummary {
@@ -58,8 +92,11 @@ struct ContractionSummary {
     double median_rate = 0, max_rate = 0, max_spectral_radius = 0;
     std::vector<ContractionCase> details;
     std::vector<std::uint64_t> counterexamples;   // valid cases failing any of the checks
+    DynamicsTie tie;                // over all cases (thin parts only; none for thick ones)
+    bool tie_required = true;       // thin parts: the tie must have been checked and passed
     bool passed() const {
-        return valid > 0 && monotone == valid && converged == valid && floquet_below_one == valid && unique == valid;
+        return valid > 0 && monotone == valid && converged == valid && floquet_below_one == valid && unique == valid &&
+               (!tie_required || tie.passed());
     }
 };
 
@@ -98,9 +135,10 @@ LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int dir
 struct LimitSurfaceCampaign {
     int parts = 0, convex = 0, strict = 0;
     double worst_max_work = 0, worst_monotonicity = 0, min_separation = 0, min_strict_margin = 0;
-    bool passed() const { return parts > 0 && convex == parts && strict == parts; }
+    DynamicsTie tie;                // each part's dynamics tied to its surface (10 states each)
+    bool passed() const { return parts > 0 && convex == parts && strict == parts && tie.passed(); }
 };
-LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed);
+LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const DynamicsUnderTest& dynamics = {});
 
 // The thin part of `scene` at configuration q0 and plate time t: its normal forces (38) and the
 // generated wrench kernel.

@@ -126,7 +126,14 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
     row("thin (Theorem 1)", thin);
     theorem = false;
     row("thick (beyond it)", thick);
-    c.html << "</table>\n<p>Thick parts are outside Theorem 1: V may rise (the normal forces depend on the twist). "
+    c.html << "</table>\n<p>These checks hold for any Coulomb friction with velocity-independent normal forces: they are "
+              "tied to the dynamics at " << thin.tie.samples << " sampled states of the thin parts, where the normal forces must "
+              "equal an independent solve of the part's statics and m q'' + b~ the limit-surface wrench (39) of the relative "
+              "twist, both to " << fmt(proofs::kTieTolerance, 1) << " m g: worst " << fmt(thin.tie.worst_statics, 2) << " and "
+           << fmt(thin.tie.worst_wrench, 2) << " m g, "
+           << (thin.tie.passed() ? verdict(true) : "<span class=\"fail\">" + esc(thin.tie.failure) + "</span>")
+           << " (a wrong normal force, a swapped lever arm and a wrong mu on one contact each fail it: test).</p>\n";
+    c.html << "<p>Thick parts are outside Theorem 1: V may rise (the normal forces depend on the twist). "
            << esc(observation1_sentence(thick.valid, thick.converged, thick.unique, thick.floquet_below_one))
            << " The seeds above reproduce the cases where V rose.</p>\n";
     {   // V per period, log scale: a few thin cases and the worst thick one
@@ -193,7 +200,10 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
               "violation</th><th>worst (40) violation</th><th>smallest strict margin</th><th>smallest wrench separation</th><th>verdict</th></tr><tr><td>"
            << ls.parts << "</td><td>" << ls.convex << "</td><td>" << ls.strict << "</td><td>" << fmt(ls.worst_max_work, 3) << "</td><td>"
            << fmt(ls.worst_monotonicity, 3) << "</td><td>" << fmt(ls.min_strict_margin, 3) << "</td><td>" << fmt(ls.min_separation, 3)
-           << "</td><td>" << verdict(ls.passed()) << "</td></tr></table>\n";
+           << "</td><td>" << verdict(ls.passed()) << "</td></tr></table>\n<p>Each part's dynamics tied to its surface at "
+           << ls.tie.samples << " states (statics and wrench, as above): worst " << fmt(ls.tie.worst_statics, 2) << " and "
+           << fmt(ls.tie.worst_wrench, 2) << " m g"
+           << (ls.tie.passed() ? "." : ": <span class=\"fail\">" + esc(ls.tie.failure) + "</span>") << "</p>\n";
     {
         const Scene sc = random_scene(opt.seed + 90'000'000, RandomSceneOptions{true});
         double scale = 0;

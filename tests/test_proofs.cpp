@@ -2,6 +2,7 @@
 // must catch.
 #include "theorem1.hpp"
 
+#include "plate/dynamics.hpp"
 #include "plate/scene_io.hpp"
 
 #include <catch2/catch.hpp>
@@ -23,6 +24,8 @@ TEST_CASE("Theorem 1: the relative twist of thin parts contracts (V never rises 
     CHECK(s.floquet_below_one == s.valid);
     CHECK(s.unique == s.valid);
     CHECK(s.max_rate < 1);
+    CHECK(s.tie.samples == 120);   // and tied to the dynamics (statics, limit surface) at every case
+    CHECK(s.tie.passed());
     CHECK(s.passed());
     CHECK(s.counterexamples.empty());
 }
@@ -145,4 +148,53 @@ TEST_CASE("Appendix D: the converged cycle repeats with period T", "[proofs][per
     Vec3 off;
     REQUIRE(period_map(sc, Vec3(0.01, 0, 0.3), lc.qd_start + Vec3(0.3 * v, 0, 0), off, io));
     CHECK((off - (lc.qd_start + Vec3(0.3 * v, 0, 0))).head<2>().norm() > 1e-3 * v);
+}
+
+TEST_CASE("the dynamics tie catches a wrong normal force, a swapped lever arm and a wrong mu, and says which check",
+          "[proofs][tie]") {
+    // Contraction, Floquet and limit-surface checks hold for any Coulomb friction with normal forces
+    // >= 0: each of these wrong models passes them. The tie (theorem1.hpp) must not.
+    ContractionOptions o;
+    o.cases = 6;
+    o.seed = 100;
+    const ContractionSummary good = check_contraction(o);
+    INFO("production: " << good.tie.failure);
+    CHECK(good.tie.samples == 60);
+    CHECK(good.tie.passed());
+    CHECK(good.tie.worst_statics < 1e-13);   // rounding (measured 3e-16), far below kTieTolerance
+    CHECK(good.tie.worst_wrench < 1e-13);
+    struct Mutation {
+        const char* what;
+        const char* caught_by;
+        DynamicsUnderTest dyn;
+    };
+    auto with = [](std::function<void(Scene&)> edit, std::function<void(Vec3&)> edit_n) -> DynamicsUnderTest {
+        return [edit, edit_n](const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Vec3& qdd, Vec3& n) {
+            Scene wrong = sc;
+            edit(wrong);
+            Workspace ws;
+            accelerations(wrong, Dynamics::U, q, qd, ps, ws);
+            qdd = ws.qdd;
+            n = ws.n;
+            edit_n(n);
+        };
+    };
+    const Mutation mutations[] = {
+        {"a normal force off by 1e-6", "statics", with([](Scene&) {}, [](Vec3& n) { n[1] *= 1 + 1e-6; })},
+        {"contact 1's lever arm with x and y swapped", "statics",
+         with([](Scene& s) { s.part.c[0] = Vec3(s.part.c[0].y(), s.part.c[0].x(), s.part.c[0].z()); }, [](Vec3&) {})},
+        {"mu of contact 3 scaled by 1.01", "wrench", with([](Scene& s) { s.part.mu[2] *= 1.01; }, [](Vec3&) {})},
+    };
+    for (const auto& m : mutations) {
+        INFO(m.what);
+        ContractionOptions bad = o;
+        bad.dynamics = m.dyn;
+        const ContractionSummary s = check_contraction(bad);
+        INFO("failure: " << s.tie.failure);
+        CHECK_FALSE(s.passed());
+        CHECK(s.tie.failure.rfind(m.caught_by, 0) == 0);   // the message starts with the check's name
+        const LimitSurfaceCampaign ls = check_limit_surfaces(5, 1, m.dyn);
+        CHECK_FALSE(ls.passed());
+        CHECK(ls.convex == ls.parts);   // the surface checks alone pass the wrong model
+    }
 }

@@ -331,6 +331,12 @@ int cmd_random_scene(int argc, char** argv) {
     return 0;
 }
 
+// The checks that tie Theorem 1's to the dynamics (statics, limit-surface wrench).
+nlohmann::json tie_json(const proofs::DynamicsTie& t) {
+    return {{"samples", t.samples}, {"worst_statics_over_mg", t.worst_statics}, {"worst_wrench_over_mg", t.worst_wrench},
+            {"tolerance", proofs::kTieTolerance}, {"failure", t.failure}, {"passed", t.passed()}};
+}
+
 nlohmann::json contraction_json(const proofs::ContractionSummary& s) {
     nlohmann::json j;
     j["cases"] = s.cases;
@@ -346,6 +352,7 @@ nlohmann::json contraction_json(const proofs::ContractionSummary& s) {
     j["max_floquet_radius"] = s.max_spectral_radius;
     j["counterexample_seeds"] = s.counterexamples;
     j["seconds"] = s.seconds;
+    j["dynamics_tie"] = tie_json(s.tie);
     j["passed"] = s.passed();
     nlohmann::json invalid = nlohmann::json::object();
     for (const auto& c : s.details)
@@ -389,7 +396,7 @@ int cmd_proofs(int argc, char** argv) {
                            {"strictly_convex", ls.strict}, {"worst_max_work_violation", ls.worst_max_work},
                            {"worst_monotonicity_violation", ls.worst_monotonicity},
                            {"min_separation", ls.min_separation}, {"min_strict_margin", ls.min_strict_margin},
-                           {"passed", ls.passed()}};
+                           {"dynamics_tie", tie_json(ls.tie)}, {"passed", ls.passed()}};
     // A's conditioning toward collinear contacts (dimensionless A, 20 sampled states per part).
     j["conditioning_of_A"] = nlohmann::json::array();
     for (const auto& cs : proofs::collinear_scenes({1.0, 0.1, 0.01, 0.001, 0.0})) {
