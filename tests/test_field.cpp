@@ -206,3 +206,28 @@ TEST_CASE("shooting fields: predicted warm starts, the same field on any number 
     // needs about 6.5 on fig4.
     CHECK(periods / g.size() < 3.5);
 }
+
+TEST_CASE("fixed points: regions where the part is stuck all period are not refined, and work is bounded",
+          "[field][stick]") {
+    // heave_yaw_point: the point part is stuck all period at 9 of 49 configurations (twist exactly 0:
+    // every such configuration is fixed). Their cells are counted and said, not searched by Newton.
+    const Scene hp = scene("heave_yaw_point");
+    const Field fh = compute_field(hp, GridSpec{});
+    int stuck = 0;
+    for (const auto& p : fh.points) stuck += p.converged && p.twist.isZero(0) && p.stick_fraction[0] == 1;
+    REQUIRE(stuck > 0);
+    const FixedPoints fp = find_fixed_points(hp, fh);
+    CHECK(fp.stuck_cells > 0);
+    CHECK(fp.stuck_cells <= 4 * stuck);   // each configuration is a corner of at most 4 cells
+    CHECK(fixed_points_sentence(fp).find("stuck all period") != std::string::npos);
+    // Bounded work: fig1's search needs ~1.4e6 right-hand sides; with 1e5 it stops, and says so.
+    const Scene f1 = scene("fig1");
+    const Field ff = compute_field(f1, GridSpec{});
+    FixedPointOptions o;
+    o.max_rhs_evaluations = 100'000;
+    const FixedPoints cut = find_fixed_points(f1, ff, o);
+    CHECK(cut.unsearched_cells > 0);
+    CHECK(cut.cells == 6 * 6 * 7);
+    CHECK(cut.rhs_evaluations < 100'000 + 50'000);   // at most one field evaluation beyond the budget
+    CHECK(fixed_points_sentence(cut).find("work budget") != std::string::npos);
+}

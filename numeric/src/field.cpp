@@ -14,10 +14,14 @@ double wrap_angle(double th) {
     return th <= -kPi ? th + 2 * kPi : th;
 }
 
-Vec3 field_at(const Scene& sc, const Vec3& q, const LimitCycleOptions& opt, Vec3* warm) {
+Vec3 field_at(const Scene& sc, const Vec3& q, const LimitCycleOptions& opt, Vec3* warm, long* rhs_evals) {
     const Vec3 qd0 = warm ? *warm : Vec3::Zero();
     LimitCycleSummary lc = limit_cycle(sc, q, opt, qd0);
-    if (!lc.converged && warm && !warm->isZero()) lc = limit_cycle(sc, q, opt);   // retry from rest
+    if (rhs_evals) *rhs_evals += lc.stats.rhs_evals;
+    if (!lc.converged && warm && !warm->isZero()) {   // retry from rest
+        lc = limit_cycle(sc, q, opt);
+        if (rhs_evals) *rhs_evals += lc.stats.rhs_evals;
+    }
     if (!lc.converged) {
         const bool stopped = lc.stop.reason != StopReason::None;
         throw FieldUndefined("asymptotic twist undefined at (" + std::to_string(q[0]) + ", " +

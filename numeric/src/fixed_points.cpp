@@ -11,12 +11,16 @@ using MatX = Eigen::MatrixXd;
 
 // The field in scaled coordinates z = (s_x, s_y, rho theta) with values (v_x, v_y, rho omega):
 // both in metres and metres per second, so that distances and singular values compare.
+struct BudgetSpent {};   // FixedPointOptions::max_rhs_evaluations reached
+
 struct ScaledField {
     const Scene& sc;
     const LimitCycleOptions& opt;
     int dim;
     double rho;
     long evals = 0;
+    long rhs_evals = 0;   // the cycles' work
+    long budget = 0;      // of rhs_evals (0: none); F throws BudgetSpent beyond it
     Vec3 warm = Vec3::Zero();
 
     Vec3 q_of(const VecX& z) const { return dim == 3 ? Vec3(z[0], z[1], z[2] / rho) : Vec3(z[0], z[1], 0); }
@@ -29,7 +33,8 @@ struct ScaledField {
     }
     VecX F(const VecX& z) {
         ++evals;
-        const Vec3 v = field_at(sc, q_of(z), opt, &warm);
+        if (budget > 0 && rhs_evals >= budget) throw BudgetSpent{};
+        const Vec3 v = field_at(sc, q_of(z), opt, &warm, &rhs_evals);
         VecX f(dim);
         f[0] = v[0];
         f[1] = v[1];
@@ -100,6 +105,14 @@ constexpr double kCut = 1e-3;
 
 }  // namespace
 
+// Stuck all period: every contact held the whole cycle, so the twist is exactly zero.
+static bool stuck_all_period(const FieldPoint& p, int dim) {
+    if (!p.converged || !p.twist.isZero(0)) return false;
+    for (int i = 0; i < (dim == 3 ? 3 : 1); ++i)
+        if (p.stick_fraction[i] < 1 - 1e-12) return false;
+    return true;
+}
+
 FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPointOptions& opt) {
     FixedPoints out;
     const GridSpec& g = field.grid;
@@ -147,104 +160,123 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
     };
 
     const int nk = dim == 3 ? g.nth : 1;
-    for (int i = 0; i + 1 < g.nx; ++i)
-        for (int j = 0; j + 1 < g.ny; ++j)
-            for (int k = 0; k < nk; ++k) {
-                if (dim == 3 && g.nth < 2) break;
-                // Corners of the cell; theta wraps.
-                Eigen::Vector3d lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-                bool ok = true;
-                for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
-                    const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
-                    const FieldPoint& p = field.points[g.index(ii, jj, kk)];
-                    if (!p.converged) { ok = false; break; }
-                    const Vec3 v(p.twist[0], p.twist[1], f.rho * p.twist[2]);
-                    lo = lo.cwiseMin(v);
-                    hi = hi.cwiseMax(v);
-                }
-                ++out.cells;
-                if (!ok) {
-                    ++out.undefined_cells;
-                    continue;
-                }
-                bool cand = true;
-                for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
-                if (!cand) continue;
-                ++out.candidates;
-                Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
-                VecX z = f.z_of(qc);
-                if (in_cell(qc)) continue;   // a zero already found lies in (or next to) this cell
-                f.warm.setZero();
-                try {
-                    if (!newton(f, z, ftol, opt.max_newton, cell, h, kCut)) continue;
-                } catch (const FieldUndefined&) {
-                    continue;
-                }
-                if (!inside(z) || known(z, 0.5 * cell)) continue;
+    f.budget = opt.max_rhs_evaluations;
+    try {
+        for (int i = 0; i + 1 < g.nx; ++i)
+            for (int j = 0; j + 1 < g.ny; ++j)
+                for (int k = 0; k < nk; ++k) {
+                    if (dim == 3 && g.nth < 2) break;
+                    // Corners of the cell; theta wraps.
+                    Eigen::Vector3d lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+                    bool ok = true;
+                    for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
+                        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
+                        const FieldPoint& p = field.points[g.index(ii, jj, kk)];
+                        if (!p.converged) { ok = false; break; }
+                        const Vec3 v(p.twist[0], p.twist[1], f.rho * p.twist[2]);
+                        lo = lo.cwiseMin(v);
+                        hi = hi.cwiseMax(v);
+                    }
+                    ++out.cells;
+                    if (!ok) {
+                        ++out.undefined_cells;
+                        continue;
+                    }
+                    bool stuck = false;
+                    for (int c = 0; c < (dim == 3 ? 8 : 4) && !stuck; ++c) {
+                        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
+                        stuck = stuck_all_period(field.points[g.index(ii, jj, kk)], dim);
+                    }
+                    if (stuck) {
+                        ++out.stuck_cells;
+                        continue;
+                    }
+                    bool cand = true;
+                    for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
+                    if (!cand) continue;
+                    ++out.candidates;
+                    Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
+                    VecX z = f.z_of(qc);
+                    if (in_cell(qc)) continue;   // a zero already found lies in (or next to) this cell
+                    f.warm.setZero();
+                    try {
+                        if (!newton(f, z, ftol, opt.max_newton, cell, h, kCut)) continue;
+                    } catch (const FieldUndefined&) {
+                        continue;
+                    }
+                    if (!inside(z) || known(z, 0.5 * cell)) continue;
+                    if (f.F(z).isZero(0)) continue;   // landed where the part is stuck all period (a region)
 
-                // Classify.
-                MatX Jm;
-                try { Jm = f.J(z, h); } catch (const FieldUndefined&) { continue; }
-                Eigen::EigenSolver<MatX> es(Jm);
-                const Eigen::VectorXcd ev = es.eigenvalues();
-                Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
-                ev3.head(dim) = ev;
-                Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullV);
-                const VecX s = svd.singularValues();
-                const Vec3 q = f.q_of(z);
+                    // Classify.
+                    MatX Jm;
+                    try { Jm = f.J(z, h); } catch (const FieldUndefined&) { continue; }
+                    Eigen::EigenSolver<MatX> es(Jm);
+                    const Eigen::VectorXcd ev = es.eigenvalues();
+                    Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
+                    ev3.head(dim) = ev;
+                    Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullV);
+                    const VecX s = svd.singularValues();
+                    const Vec3 q = f.q_of(z);
 
-                bool is_line = false;
-                if (s[dim - 1] < opt.null_ratio * s[0]) {
-                    // Follow the null direction both ways.
-                    FixedLine line;
-                    VecX v = svd.matrixV().col(dim - 1);
-                    std::vector<Vec3> fwd, bwd;
-                    for (int sgn : {1, -1}) {
-                        VecX zc = z, dir = sgn * v;
-                        double travelled = 0;
-                        for (int step = 0; step < 400; ++step) {
-                            VecX zn = zc + 0.5 * cell * dir;
-                            try {
-                                if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir, &Jm)) break;
-                            } catch (const FieldUndefined&) {
-                                break;
+                    bool is_line = false;
+                    if (s[dim - 1] < opt.null_ratio * s[0]) {
+                        // Follow the null direction both ways.
+                        FixedLine line;
+                        VecX v = svd.matrixV().col(dim - 1);
+                        std::vector<Vec3> fwd, bwd;
+                        for (int sgn : {1, -1}) {
+                            VecX zc = z, dir = sgn * v;
+                            double travelled = 0;
+                            for (int step = 0; step < 400; ++step) {
+                                VecX zn = zc + 0.5 * cell * dir;
+                                try {
+                                    if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir, &Jm)) break;
+                                } catch (const FieldUndefined&) {
+                                    break;
+                                }
+                                if (!inside(zn)) break;
+                                travelled += dist(zn, zc);
+                                dir = (zn - zc).normalized();
+                                zc = zn;
+                                (sgn > 0 ? fwd : bwd).push_back(f.q_of(zc));
+                                if (dim == 3 && travelled > 2 * kPi * f.rho + (g.x1 - g.x0) + (g.y1 - g.y0)) break;
                             }
-                            if (!inside(zn)) break;
-                            travelled += dist(zn, zc);
-                            dir = (zn - zc).normalized();
-                            zc = zn;
-                            (sgn > 0 ? fwd : bwd).push_back(f.q_of(zc));
-                            if (dim == 3 && travelled > 2 * kPi * f.rho + (g.x1 - g.x0) + (g.y1 - g.y0)) break;
+                        }
+                        if (fwd.size() + bwd.size() >= 2) {
+                            is_line = true;
+                            for (auto it = bwd.rbegin(); it != bwd.rend(); ++it) line.points.push_back(*it);
+                            line.points.push_back(q);
+                            for (const auto& p : fwd) line.points.push_back(p);
+                            for (auto& p : line.points) p[2] = wrap_angle(p[2]);
+                            line.direction = f.q_of(v);
+                            if (dim == 3) line.direction[2] = v[2] / f.rho;
+                            line.eigenvalues = ev3;
+                            int skip = 0;
+                            ev.cwiseAbs().minCoeff(&skip);
+                            line.stability = classify(ev, skip);
+                            for (std::size_t m = 1; m < line.points.size(); ++m)
+                                line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
+                            out.lines.push_back(line);
                         }
                     }
-                    if (fwd.size() + bwd.size() >= 2) {
-                        is_line = true;
-                        for (auto it = bwd.rbegin(); it != bwd.rend(); ++it) line.points.push_back(*it);
-                        line.points.push_back(q);
-                        for (const auto& p : fwd) line.points.push_back(p);
-                        for (auto& p : line.points) p[2] = wrap_angle(p[2]);
-                        line.direction = f.q_of(v);
-                        if (dim == 3) line.direction[2] = v[2] / f.rho;
-                        line.eigenvalues = ev3;
-                        int skip = 0;
-                        ev.cwiseAbs().minCoeff(&skip);
-                        line.stability = classify(ev, skip);
-                        for (std::size_t m = 1; m < line.points.size(); ++m)
-                            line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
-                        out.lines.push_back(line);
+                    if (!is_line) {
+                        FixedPoint fp;
+                        fp.q = q;
+                        fp.q[2] = dim == 3 ? wrap_angle(q[2]) : 0;
+                        fp.eigenvalues = ev3;
+                        fp.stability = classify(ev, -1);
+                        fp.residual = f.F(z).norm();
+                        out.points.push_back(fp);
                     }
                 }
-                if (!is_line) {
-                    FixedPoint fp;
-                    fp.q = q;
-                    fp.q[2] = dim == 3 ? wrap_angle(q[2]) : 0;
-                    fp.eigenvalues = ev3;
-                    fp.stability = classify(ev, -1);
-                    fp.residual = f.F(z).norm();
-                    out.points.push_back(fp);
-                }
-            }
+    } catch (const BudgetSpent&) {
+        // The budget is spent: the cell in progress and every later one are counted as not searched.
+        const int total = (g.nx - 1) * (g.ny - 1) * (dim == 3 && g.nth >= 2 ? nk : dim == 3 ? 0 : 1);
+        out.unsearched_cells = total - out.cells + 1;
+        out.cells = total;
+    }
     out.evaluations = f.evals;
+    out.rhs_evaluations = f.rhs_evals;
     return out;
 }
 
@@ -261,6 +293,13 @@ std::string fixed_points_sentence(const FixedPoints& fp) {
     if (fp.undefined_cells > 0)
         s += " in the defined part (" + std::to_string(fp.undefined_cells) + " of " + std::to_string(fp.cells) +
              " cells undefined: a corner has no cycle)";
+    if (fp.unsearched_cells > 0)
+        s += " (the search stopped at its work budget, FixedPointOptions::max_rhs_evaluations: " +
+             std::to_string(fp.unsearched_cells) + " of " + std::to_string(fp.cells) + " cells not searched)";
+    if (fp.stuck_cells > 0)
+        s += "; " + std::to_string(fp.stuck_cells) + " of " + std::to_string(fp.cells) +
+             " cells touch configurations where the part is stuck all period (it rides the plate: every such "
+             "configuration is fixed, a region rather than points)";
     return s;
 }
 

@@ -121,8 +121,11 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
     j["candidate_cells"] = fp.candidates;
     j["cells"] = fp.cells;
     j["undefined_cells"] = fp.undefined_cells;   // skipped: a corner has no cycle
+    j["unsearched_cells"] = fp.unsearched_cells;   // left when the evaluation budget was spent
+    j["stuck_cells"] = fp.stuck_cells;           // skipped: a corner is stuck all period (fixed region)
     j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
+    j["rhs_evaluations"] = fp.rhs_evaluations;
     return j;
 }
 

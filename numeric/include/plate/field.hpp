@@ -62,7 +62,8 @@ struct FieldUndefined : std::runtime_error {
     FieldUndefined(const std::string& what, StopReason why) : std::runtime_error(what), reason(why) {}
     StopReason reason;
 };
-Vec3 field_at(const Scene& scene, const Vec3& q, const LimitCycleOptions& opt, Vec3* warm = nullptr);
+Vec3 field_at(const Scene& scene, const Vec3& q, const LimitCycleOptions& opt, Vec3* warm = nullptr,
+              long* rhs_evals = nullptr);   // adds the work spent (right-hand sides) to *rhs_evals
 
 // --- fixed points ------------------------------------------------------------------------
 enum class Stability { Stable, Unstable, Saddle };
@@ -89,11 +90,17 @@ struct FixedPointOptions {
     // The cycles evaluated while refining. Newton needs a field whose noise is well below ftol: the
     // twist of a cycle carries the integrator's error, measured at ~60 rtol v_ref (fig1 near its
     // stable line: 6e-7 v_ref at rtol 1e-8, which made the line search fail at random), so the
-    // refinement runs at rtol <= 1e-3 ftol and cycle tol <= 1e-2 ftol whatever this asks for.
+    // refinement runs at rtol <= 1e-3 ftol and cycle tol <= 1e-2 ftol whatever this asks for (at
+    // 3e-3 ftol, noise ~0.2 ftol, fig1's line still broke).
     LimitCycleOptions cycle;
     double ftol = 1e-6;      // |xi_a| accepted as zero, relative to v_ref
     int max_newton = 25;
     double null_ratio = 0.02;  // singular value ratio that makes a line candidate
+    // Bounded work: no further cell is searched once the refinement's cycles have spent this many
+    // right-hand-side evaluations (0: no bound; deterministic, unlike a time limit); the cells left
+    // are counted and the summary says so. ~1e4 per sliding cycle at the refinement's tolerance,
+    // ~2e5 per sticking one (heave_yaw); fig1's four lines take 3e6, fig3_random's search 1.5e6.
+    long max_rhs_evaluations = 20'000'000;
 };
 
 struct FixedPoints {
@@ -102,7 +109,11 @@ struct FixedPoints {
     int candidates = 0;      // grid cells where every component changes sign
     int cells = 0;           // grid cells searched
     int undefined_cells = 0; // cells skipped because a corner's twist is undefined (no cycle there)
+    int unsearched_cells = 0;  // cells left when the evaluation budget was spent
+    int stuck_cells = 0;     // cells with a corner where the part is stuck all period (twist exactly 0:
+                             // every configuration there is fixed; a region, not points to refine)
     long evaluations = 0;    // field evaluations spent refining
+    long rhs_evaluations = 0;  // their cycles' right-hand-side evaluations
 };
 
 // Zeros of the field: candidate cells of `field` (every component changes sign), refined by
@@ -112,7 +123,7 @@ struct FixedPoints {
 FixedPoints find_fixed_points(const Scene& scene, const Field& field, const FixedPointOptions& opt = {});
 // What was found, in words that say what was not searched: "2 fixed points and 1 line", "no fixed
 // point", each followed, when some cells had an undefined corner, by "in the defined part (k of n
-// cells undefined)".
+// cells undefined)", and by the cells where the part is stuck all period.
 std::string fixed_points_sentence(const FixedPoints& fp);
 
 // --- integral curves -----------------------------------------------------------------------
