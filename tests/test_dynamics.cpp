@@ -223,6 +223,11 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
                 return Vec2(s + Eigen::Rotation2Dd(q[2] + qd[2] * t + 0.5 * ws.qdd[2] * t * t) * P.c[k].head<2>());
             };
             CHECK((xk(hd) - 2 * xk(0) + xk(-hd)).norm() / (hd * hd) < 1e-4);
+            // The reduced U-dynamics (35) freeze the configuration: the held contact's constraint is
+            // s'' + theta'' e_z x r_k = 0, without the centripetal theta'^2 r_k (written out here).
+            mode_accelerations(sc, Dynamics::ReducedU, q, qd, ps, mode, ws);
+            const Vec2 ak = ws.qdd.head<2>() + ws.qdd[2] * Vec2(-rk.y(), rk.x());
+            CHECK(ak.norm() < 1e-12 * sc.g);
             ++pivots;
         }
         const Mode stuck{ModeKind::Stuck, -1, 0};
@@ -232,6 +237,18 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
         const WorldResidual res = world_residual(sc, q, Vec3::Zero(), ps, Vec3::Zero(), ws.n, g.f);
         CHECK(res.force < 1e-7);
         CHECK(res.torque < 1e-7);
+        // The gauge itself, by weak duality (written here, not from modes.cpp): its distribution uses
+        // at most gamma of each disk, and its direction d certifies gamma = (d . w) / h(d), with
+        // h(d) = sum mu_i N_i |d_xy + d_theta e_z x r_i| the friction set's support function. A wrong
+        // capacity (mu dropped, or scaled) fails these where the residual above cannot see it.
+        double h = 0;
+        for (int i = 0; i < 3; ++i) {
+            CHECK(g.f[i].norm() <= g.gamma * P.mu[i] * ws.n[i] * (1 + 1e-9));
+            const Vec2 ri = Eigen::Rotation2Dd(q[2]) * P.c[i].head<2>();
+            h += P.mu[i] * ws.n[i] * (g.direction.head<2>() + g.direction[2] * Vec2(-ri.y(), ri.x())).norm();
+        }
+        const double dw = g.direction.head<2>().dot(ws.F_needed) + g.direction[2] * ws.tau_needed;
+        CHECK(std::abs(dw / h / g.gamma - 1) < 1e-9);
         ++stucks;
     }
     CHECK(pivots == 90);

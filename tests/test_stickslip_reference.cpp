@@ -126,26 +126,47 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         REQUIRE(sh.converged);
         CHECK(sh.has_monodromy);
         CHECK((sh.twist - ref.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < 1e-7);
+        // Central differences of the period map at the cycle, independently of the solver (h = 1e-4
+        // of the scales: truncation h^2 |P'''| and noise rtol/h ~ 1e-4 of |M|).
+        Mat3 Mc;
+        const double h = 1e-4;
+        for (int j = 0; j < 3; ++j) {
+            Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
+            xp[j] += h * S[j];
+            xm[j] -= h * S[j];
+            REQUIRE(period_map(sc, c.q, xp, Pp));
+            REQUIRE(period_map(sc, c.q, xm, Pm));
+            Mc.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
+        }
+        INFO("shooting M\n" << sh.monodromy << "\ncentral differences\n" << Mc);
         if (c.full_stick) {
-            CHECK(sh.monodromy.isZero(0));   // exactly: the end of the period forgets its start
+            CHECK(Mc.norm() < 1e-5);          // the period's end forgets its start (measured 1.4e-7)...
+            CHECK(sh.monodromy.isZero(0));    // ...and the solver says so
         } else {
-            // Central differences of the period map at the cycle (h = 1e-4 of the scales: truncation
-            // h^2 |P'''| and noise rtol/h ~ 1e-4 of |M|); the forward differences in the solver carry
-            // h |P''| on top: agreement to 2% of |M| (and a Floquet multiplier below 1: attracting).
-            Mat3 Mc;
-            const double h = 1e-4;
-            for (int j = 0; j < 3; ++j) {
-                Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
-                xp[j] += h * S[j];
-                xm[j] -= h * S[j];
-                REQUIRE(period_map(sc, c.q, xp, Pp));
-                REQUIRE(period_map(sc, c.q, xm, Pm));
-                Mc.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
-            }
-            INFO("shooting M\n" << sh.monodromy << "\ncentral differences\n" << Mc);
-            CHECK((sh.monodromy - Mc).norm() < 0.02 * Mc.norm());
+            // The solver's forward differences carry h |P''| on top (measured 4.7e-4 of |M|).
+            CHECK((sh.monodromy - Mc).norm() < 2e-3 * Mc.norm());
             CHECK(Mc.eigenvalues().cwiseAbs().maxCoeff() < 1);
             CHECK(Mc.norm() > 0.1);   // not a full stick: the start matters
         }
+    }
+    // From a start two scales off a sliding fig6 cycle (far steps, a fresh Newton step, then chord
+    // steps), at rtol 1e-10 so that the integration is not what is measured: the twist must agree
+    // with the period-by-period cycle at tol 1e-10 within the solver's tolerance, 1e-7 v_ref. An
+    // estimate that left out Pa's own error accepted one 2.6e-7 off from this start.
+    {
+        const Scene sc = scene("fig6");
+        const Vec3 q(-0.025, 0.025, 1.5 * kPi);
+        const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
+        LimitCycleOptions plain;
+        plain.solver = CycleSolver::PeriodByPeriod;
+        plain.tol = 1e-10;
+        plain.integration.rtol = 1e-10;
+        const LimitCycleSummary ref = limit_cycle(sc, q, plain);
+        REQUIRE(ref.converged);
+        LimitCycleOptions o;
+        o.integration.rtol = 1e-10;
+        const LimitCycleSummary sh = limit_cycle(sc, q, o, ref.qd_start + Vec3(-2, 2, 2).cwiseProduct(S));
+        REQUIRE(sh.converged);
+        CHECK((sh.twist - ref.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < 1e-7);   // measured 5e-10
     }
 }
