@@ -380,6 +380,15 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                << (pt ? "" : ", " + fmt(f.start[2], 3)) << ") for " << (tr.samples.empty() ? 0.0 : tr.samples.back().t)
                << " s" << (tr.stop.reason != StopReason::None ? " — stopped: " + esc(tr.stop.describe()) : std::string())
                << ".</p>\n";
+        {
+            // A paper figure's run must reach its full duration (a run that stops at once draws a dot).
+            const double want = opt.quick ? std::min(f.duration, 4.0) : f.duration;
+            const double reached = tr.samples.empty() ? 0.0 : tr.samples.back().t;
+            if (tr.stop.reason != StopReason::None || reached < want * (1 - 1e-9))
+                c.html << "<p><span class=\"fail\">FAIL: the run from rest stopped at t = " << fmt(reached, 4) << " s of "
+                       << fmt(want, 3) << " s" << (tr.stop.reason != StopReason::None ? " (" + esc(tr.stop.describe()) + ")" : "")
+                       << "</span></p>\n";
+        }
         const std::string F = "'data/" + n + "_field.dat'", T = "'data/" + n + "_traj.dat'";
         const std::string arrows = " w vec head size 0.004,20 lc rgb '#777777' notitle";
         if (pt) {
