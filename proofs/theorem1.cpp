@@ -131,6 +131,56 @@ double floquet_radius(const Scene& sc, const Vec3& q0, const Vec3& x0, double rt
     return Eigen::EigenSolver<Mat3>(J.topLeftCorner(3, 3)).eigenvalues().head(dim).cwiseAbs().maxCoeff();
 }
 
+// A thin part's statics in the U-dynamics, from the paper: (33)-(34) f~ = m (p'' + w1' x s + g e_z),
+// tau~ = J R2^T w1', and the rows sum c_iy N_i = tau~_x, -sum c_ix N_i = tau~_y, sum N_i = f~_z
+// (Cramer's rule). Independent of the kernels.
+static Vec3 statics_normal_forces(const Scene& sc, const Vec3& q, const PlateState& ps, Vec3& f, Vec3& tau) {
+    const Part& P = sc.part;
+    const Vec3 s(q[0], q[1], P.s_z());
+    f = P.m * (ps.pdd + ps.wd.cross(s) + sc.g * Vec3::UnitZ());
+    const Mat3 R2 = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix();
+    tau = P.J * (R2.transpose() * ps.wd);
+    Mat3 M;
+    for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
+    const Vec3 rhs(tau.x(), tau.y(), f.z());
+    const double det = M.determinant();
+    Vec3 Ns;
+    for (int i = 0; i < 3; ++i) {
+        Mat3 Mi = M;
+        Mi.col(i) = rhs;
+        Ns[i] = Mi.determinant() / det;
+    }
+    return Ns;
+}
+
+double FrictionSet::support_sampled(const Vec3& d, int angles) const {
+    double h = 0;
+    for (int i = 0; i < 3; ++i) {
+        double best = 0;
+        for (int k = 0; k < angles; ++k) {
+            const double a = 2 * kPi * k / angles;
+            const Vec2 f(cap[i] * std::cos(a), cap[i] * std::sin(a));
+            const Vec3 w(f.x(), f.y(), (r[i].x() * f.y() - r[i].y() * f.x()) / rho);   // G_i f
+            best = std::max(best, d.dot(w));
+        }
+        h += best;
+    }
+    return h;
+}
+
+FrictionSet thin_friction_set(const Scene& sc, const Vec3& q0, double t) {
+    FrictionSet fs;
+    Vec3 f, tau;
+    const Vec3 N = statics_normal_forces(sc, q0, plate_state(sc.plate, t, Dynamics::U), f, tau);
+    const Mat3 R2 = Eigen::AngleAxisd(q0[2], Vec3::UnitZ()).toRotationMatrix();
+    for (int i = 0; i < 3; ++i) {
+        fs.r[i] = (R2 * sc.part.c[i]).head<2>();
+        fs.cap[i] = sc.part.mu[i] * std::max(N[i], 0.0);
+    }
+    fs.rho = sc.part.rho();
+    return fs;
+}
+
 DynamicsUnderTest production_dynamics() {
     return [](const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Vec3& qdd, Vec3& n) {
         Workspace ws;   // per call: a workspace caches its scene by address, and scenes come and go
@@ -160,22 +210,9 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
         const PlateState ps = plate_state(sc.plate, r.uniform(0, sc.plate.T), Dynamics::U);
         Vec3 qdd, n;
         dyn(sc, q, qd, ps, qdd, n);
-        // (33)-(34): f~ = m (p'' + w1' x s + g e_z), tau~ = J R2^T w1'.
-        const Vec3 s(q[0], q[1], P.s_z());
-        const Vec3 f = P.m * (ps.pdd + ps.wd.cross(s) + sc.g * Vec3::UnitZ());
+        Vec3 f, tau;
+        const Vec3 Ns = statics_normal_forces(sc, q, ps, f, tau);
         const Mat3 R2 = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix();
-        const Vec3 tau = P.J * (R2.transpose() * ps.wd);
-        // Statics: rows sum c_iy N_i = tau_x, -sum c_ix N_i = tau_y, sum N_i = f_z, by Cramer's rule.
-        Mat3 M;
-        for (int i = 0; i < 3; ++i) M.col(i) = Vec3(P.c[i].y(), -P.c[i].x(), 1);
-        const Vec3 rhs(tau.x(), tau.y(), f.z());
-        const double det = M.determinant();
-        Vec3 Ns;
-        for (int i = 0; i < 3; ++i) {
-            Mat3 Mi = M;
-            Mi.col(i) = rhs;
-            Ns[i] = Mi.determinant() / det;
-        }
         // The limit surface (39): the generated thin_wrench with the statics' forces.
         gen::WrenchInput in;
         double* const Ni[3] = {&in.N1, &in.N2, &in.N3};
@@ -323,7 +360,8 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
     return s;
 }
 
-LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int directions, double separation) {
+LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int directions, double separation,
+                                       const FrictionSet* set) {
     LimitSurfaceResult r;
     r.directions = directions;
     std::vector<Vec3> xi(directions), w(directions);
@@ -335,11 +373,23 @@ LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int 
     }
     r.min_separation = 1e300;
     r.min_strict_margin = 1e300;
+    // Against the independent friction set: h_s(-xi_i), each disk's rim at 720 points.
+    constexpr int kAngles = 720;
+    std::vector<double> hs(directions, 0.0);
+    if (set) {
+        r.set_checked = true;
+        for (int i = 0; i < directions; ++i) {
+            hs[i] = set->support_sampled(-xi[i], kAngles);
+            r.support_violation = std::max(r.support_violation, (hs[i] - (-xi[i]).dot(w[i])) / scale);
+        }
+    }
+    const double outer = 1 / std::cos(kPi / kAngles);
     for (int i = 0; i < directions; ++i)
         for (int j = 0; j < directions; ++j) {
             if (i == j) continue;
             ++r.pairs;
             r.max_work_violation = std::max(r.max_work_violation, (xi[i].dot(w[i]) - xi[i].dot(w[j])) / scale);
+            if (set) r.outside_violation = std::max(r.outside_violation, ((-xi[i]).dot(w[j]) - hs[i] * outer) / scale);
             if ((xi[i] - xi[j]).norm() > separation)
                 r.min_strict_margin = std::min(r.min_strict_margin, (xi[i].dot(w[j]) - xi[i].dot(w[i])) / scale);
             if (j > i) {
@@ -385,10 +435,15 @@ LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const D
         const Scene sc = random_scene(seed + 90'000'000 + static_cast<std::uint64_t>(k), RandomSceneOptions{true});
         double scale = 0;
         const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
-        const WrenchMap w = thin_wrench_map(sc, q0, r.uniform(0, sc.plate.T), &scale);
+        const double t = r.uniform(0, sc.plate.T);
+        const WrenchMap w = thin_wrench_map(sc, q0, t, &scale);
         c.tie.merge(check_dynamics_tie(sc, q0, 10, seed + 90'000'000 + static_cast<std::uint64_t>(k), dynamics));
-        const LimitSurfaceResult lr = check_limit_surface(w, scale, 300);
+        const FrictionSet set = thin_friction_set(sc, q0, t);
+        const LimitSurfaceResult lr = check_limit_surface(w, scale, 300, 0.2, &set);
         c.convex += lr.convex_and_normal();
+        c.on_set += lr.on_friction_set();
+        c.worst_support = std::max(c.worst_support, lr.support_violation);
+        c.worst_outside = std::max(c.worst_outside, lr.outside_violation);
         c.strict += lr.strictly_convex();
         c.worst_max_work = std::max(c.worst_max_work, lr.max_work_violation);
         c.worst_monotonicity = std::max(c.worst_monotonicity, lr.monotonicity_violation);

@@ -117,6 +117,23 @@ double floquet_radius(const Scene& scene, const Vec3& q0, const Vec3& cycle_star
 //                 pairs at least `separation` apart stays away from zero.
 using WrenchMap = std::function<Vec3(const Vec3& xi)>;   // scaled twist -> (F_x, F_y, tau / rho)
 
+// The two checks above hold for *any* wrench of the form -sum c_i G_i v_i/|v_i| with c_i >= 0 (by
+// Cauchy-Schwarz): a wrong lever arm or mu in the kernel passes them. The friction set, built here
+// independently of the kernel: contact i can push with any force f, |f| <= mu_i N_i (N_i from the
+// part's statics, as in the tie above), giving the scaled wrench G_i f = (f, (r_i x f) / rho). Its
+// support function h(d) is sampled on each disk's rim at `angles` points (h_s <= h <= h_s / cos(pi /
+// angles)). The kernel's wrench for twist xi must be the set's support point in direction -xi
+// (maximum dissipation): -xi . w(xi) >= h_s(-xi), and every wrench must lie in the set:
+// -xi_i . w_j <= h_s(-xi_i) / cos(pi / angles) for all pairs.
+struct FrictionSet {
+    std::array<Vec2, 3> r{};   // contacts from the centre of mass, plate frame [m]
+    Vec3 cap = Vec3::Zero();   // mu_i N_i [N]
+    double rho = 1;            // radius of gyration [m]
+    double support_sampled(const Vec3& d, int angles) const;
+};
+// The thin part of `scene` at q0 and plate time t (U-dynamics, normal forces by statics).
+FrictionSet thin_friction_set(const Scene& scene, const Vec3& q0, double t);
+
 struct LimitSurfaceResult {
     int directions = 0;
     long pairs = 0;
@@ -124,19 +141,25 @@ struct LimitSurfaceResult {
     double monotonicity_violation = 0; // max (xi_i - xi_j).(w_i - w_j) / (sum mu N)
     double min_separation = 0;         // min |w_i - w_j| / (sum mu N) over well-separated pairs
     double min_strict_margin = 0;      // min (xi_i.w_j - xi_i.w_i) / (sum mu N) over them: > 0, no flat faces
+    // Against the independent friction set (when given): both <= 1e-12 pass.
+    bool set_checked = false;
+    double support_violation = 0;      // max (h_s(-xi) - (-xi . w(xi))) / (sum mu N): not the support point
+    double outside_violation = 0;      // max (-xi_i . w_j - h_s(-xi_i)/cos(pi/K)) / (sum mu N): outside the set
     bool convex_and_normal() const { return max_work_violation <= 1e-12 && monotonicity_violation <= 1e-12; }
     bool strictly_convex() const { return min_strict_margin > 0 && min_separation > 0; }
+    bool on_friction_set() const { return set_checked && support_violation <= 1e-12 && outside_violation <= 1e-12; }
 };
 
 LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int directions = 600,
-                                       double separation = 0.2);
+                                       double separation = 0.2, const FrictionSet* set = nullptr);
 // Limit surfaces of `parts` random thin parts (seeded), each at a random configuration and plate
 // time, 300 directions each.
 struct LimitSurfaceCampaign {
-    int parts = 0, convex = 0, strict = 0;
+    int parts = 0, convex = 0, strict = 0, on_set = 0;
     double worst_max_work = 0, worst_monotonicity = 0, min_separation = 0, min_strict_margin = 0;
+    double worst_support = 0, worst_outside = 0;   // against the independent friction set
     DynamicsTie tie;                // each part's dynamics tied to its surface (10 states each)
-    bool passed() const { return parts > 0 && convex == parts && strict == parts && tie.passed(); }
+    bool passed() const { return parts > 0 && convex == parts && strict == parts && on_set == parts && tie.passed(); }
 };
 LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const DynamicsUnderTest& dynamics = {});
 

@@ -200,7 +200,14 @@ void section_proofs(Ctx& c, const ReportOptions& opt) {
               "violation</th><th>worst (40) violation</th><th>smallest strict margin</th><th>smallest wrench separation</th><th>verdict</th></tr><tr><td>"
            << ls.parts << "</td><td>" << ls.convex << "</td><td>" << ls.strict << "</td><td>" << fmt(ls.worst_max_work, 3) << "</td><td>"
            << fmt(ls.worst_monotonicity, 3) << "</td><td>" << fmt(ls.min_strict_margin, 3) << "</td><td>" << fmt(ls.min_separation, 3)
-           << "</td><td>" << verdict(ls.passed()) << "</td></tr></table>\n<p>Each part's dynamics tied to its surface at "
+           << "</td><td>" << verdict(ls.passed()) << "</td></tr></table>\n<p>The first two inequalities hold for any wrench of "
+              "the form −Σ c<sub>i</sub> G<sub>i</sub> v<sub>i</sub>/|v<sub>i</sub>| with c<sub>i</sub> ≥ 0 (Cauchy-Schwarz), so a kernel "
+              "fed a wrong μ or lever arm passes them. What can fail: each part's friction set built independently (every "
+              "force of magnitude ≤ μ<sub>i</sub>N<sub>i</sub> at each contact, N from the part's statics, each disk's rim "
+              "sampled at 720 points): the kernel's wrench for ξ must be the set's support point in −ξ and inside the set. "
+           << ls.on_set << " of " << ls.parts << " parts: worst support-point error " << fmt(ls.worst_support, 2)
+           << ", worst excursion outside " << fmt(ls.worst_outside, 2) << " (of Σ μN; 1e-12 passes; a wrong μ or lever arm "
+              "fails it: test).</p>\n<p>Each part's dynamics tied to its surface at "
            << ls.tie.samples << " states (statics and wrench, as above): worst " << fmt(ls.tie.worst_statics, 2) << " and "
            << fmt(ls.tie.worst_wrench, 2) << " m g"
            << (ls.tie.passed() ? "." : ": <span class=\"fail\">" + esc(ls.tie.failure) + "</span>") << "</p>\n";

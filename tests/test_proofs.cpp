@@ -198,3 +198,56 @@ TEST_CASE("the dynamics tie catches a wrong normal force, a swapped lever arm an
         CHECK(ls.convex == ls.parts);   // the surface checks alone pass the wrong model
     }
 }
+
+TEST_CASE("the limit-surface check against the independent friction set catches kernels the convexity checks pass",
+          "[proofs][limit_surface][broken]") {
+    // The max-work and (40) checks hold for any wrench -sum c_i G_i v_i/|v_i| with c_i >= 0 (Cauchy-
+    // Schwarz): a wrench kernel fed a wrong mu or lever arm passes them. The support point of the
+    // friction set built from the part itself (thin_friction_set) does not.
+    const Scene sc = random_scene(2, RandomSceneOptions{true});
+    const Vec3 q0(0.01, -0.01, 0.5);
+    const double t = 0.01;
+    const FrictionSet set = thin_friction_set(sc, q0, t);
+    double scale = 0;
+    const LimitSurfaceResult good = check_limit_surface(thin_wrench_map(sc, q0, t, &scale), scale, 300, 0.2, &set);
+    CHECK(good.on_friction_set());
+    CHECK(good.convex_and_normal());
+    // The generated kernel, fed from the set with one input edited.
+    auto kernel = [&](std::function<void(gen::WrenchInput&)> edit) -> WrenchMap {
+        gen::WrenchInput in;
+        double* N[3] = {&in.N1, &in.N2, &in.N3};
+        double* rx[3] = {&in.r1x, &in.r2x, &in.r3x};
+        double* ry[3] = {&in.r1y, &in.r2y, &in.r3y};
+        double* mu[3] = {&in.mu1, &in.mu2, &in.mu3};
+        for (int i = 0; i < 3; ++i) {
+            *mu[i] = sc.part.mu[i];
+            *N[i] = set.cap[i] / sc.part.mu[i];
+            *rx[i] = set.r[i].x();
+            *ry[i] = set.r[i].y();
+        }
+        in.rho = set.rho;
+        edit(in);
+        return [in](const Vec3& xi) mutable {
+            in.vx = xi[0];
+            in.vy = xi[1];
+            in.xith = xi[2];
+            double w[3];
+            gen::thin_wrench(in, w);
+            return Vec3(w[0], w[1], w[2]);
+        };
+    };
+    const LimitSurfaceResult same = check_limit_surface(kernel([](gen::WrenchInput&) {}), scale, 300, 0.2, &set);
+    CHECK(same.on_friction_set());   // the kernel fed correctly is the set's support point
+    const std::pair<const char*, std::function<void(gen::WrenchInput&)>> wrong[] = {
+        {"mu of contact 3 x 1.1", [](gen::WrenchInput& in) { in.mu3 *= 1.1; }},
+        {"contact 1's lever arm with x and y swapped", [](gen::WrenchInput& in) { std::swap(in.r1x, in.r1y); }},
+        {"contact 2's lever arm x 1.1", [](gen::WrenchInput& in) { in.r2x *= 1.1; in.r2y *= 1.1; }},
+    };
+    for (const auto& [what, edit] : wrong) {
+        INFO(what);
+        const LimitSurfaceResult r = check_limit_surface(kernel(edit), scale, 300, 0.2, &set);
+        INFO("support " << r.support_violation << ", outside " << r.outside_violation);
+        CHECK(r.convex_and_normal());   // the old checks pass it ...
+        CHECK_FALSE(r.on_friction_set());   // ... the friction set does not
+    }
+}

@@ -396,6 +396,8 @@ int cmd_proofs(int argc, char** argv) {
                            {"strictly_convex", ls.strict}, {"worst_max_work_violation", ls.worst_max_work},
                            {"worst_monotonicity_violation", ls.worst_monotonicity},
                            {"min_separation", ls.min_separation}, {"min_strict_margin", ls.min_strict_margin},
+                           {"on_friction_set", ls.on_set}, {"worst_support_violation", ls.worst_support},
+                           {"worst_outside_violation", ls.worst_outside},
                            {"dynamics_tie", tie_json(ls.tie)}, {"passed", ls.passed()}};
     // A's conditioning toward collinear contacts (dimensionless A, 20 sampled states per part).
     j["conditioning_of_A"] = nlohmann::json::array();
