@@ -102,15 +102,45 @@ TEST_CASE("a part sliding in pure translation on a resting plate decelerates at 
 }
 
 TEST_CASE("thick part: the normal forces depend on the sliding direction (Appendix A coupling)", "[dynamics]") {
-    const Scene sc = resting(random_scene(5));
-    REQUIRE(!sc.part.thin());
-    Workspace ws;
-    accelerations(sc, Dynamics::U, Vec3::Zero(), Vec3(0.3, 0, 0), PlateState{}, ws);
-    const Vec3 n1 = ws.n;
-    accelerations(sc, Dynamics::U, Vec3::Zero(), Vec3(-0.3, 0, 0), PlateState{}, ws);
-    // Friction acting h below the centre of mass tips the part: a moment mu m g h.
-    const double moment = 0.3 * sc.part.m * sc.g * sc.part.s_z();
-    CHECK((n1 - ws.n).norm() > 0.1 * moment / 0.05);
+    // A thick part translating along +x or -x on a resting plate (theta = 0, theta' = 0): every
+    // contact slips along u = (+-1, 0), f_i = -mu_i N_i u, and Euler's law about the centre of mass,
+    // with the contacts c_i = (c_x, c_y, c_z) below it, reads (omega = 0, omega' = theta'' e_z):
+    //   sum c_iy N_i                          = J_xz theta''
+    //   sum (-c_z mu_i u_x - c_ix) N_i        = J_yz theta''
+    //   sum c_iy mu_i u_x N_i                 = J_zz theta''
+    //   sum N_i                               = m g
+    // a 4x4 statics solve written here, with each contact's own mu. Friction h = -c_z below the
+    // centre of mass tips the part: the normal forces differ between the two directions.
+    for (std::uint64_t seed : {5u, 6u, 7u}) {
+        Scene sc = resting(random_scene(seed));
+        REQUIRE(!sc.part.thin());
+        sc.part.mu = Vec3(0.2, 0.35, 0.5);   // distinct per contact
+        const Part& P = sc.part;
+        Vec3 last = Vec3::Zero();
+        for (double ux : {1.0, -1.0}) {
+            Workspace ws;
+            accelerations(sc, Dynamics::U, Vec3::Zero(), Vec3(0.3 * ux, 0, 0), PlateState{}, ws);
+            Eigen::Matrix4d M;
+            Eigen::Vector4d rhs(0, 0, 0, P.m * sc.g);
+            for (int i = 0; i < 3; ++i) {
+                const Vec3& c = P.c[i];
+                M(0, i) = c.y();
+                M(1, i) = -c.z() * P.mu[i] * ux - c.x();
+                M(2, i) = c.y() * P.mu[i] * ux;
+                M(3, i) = 1;
+            }
+            M(0, 3) = -P.J(0, 2);
+            M(1, 3) = -P.J(1, 2);
+            M(2, 3) = -P.J(2, 2);
+            M(3, 3) = 0;
+            const Eigen::Vector4d z = M.fullPivLu().solve(rhs);
+            INFO("seed " << seed << ", u_x = " << ux << ": N " << ws.n.transpose() << " vs " << z.head<3>().transpose());
+            CHECK((ws.n - z.head<3>()).norm() < 1e-12 * P.m * sc.g);
+            CHECK(std::abs(ws.qdd[2] - z[3]) < 1e-10 * std::max(1.0, std::abs(z[3])));
+            if (ux < 0) CHECK((last - ws.n).norm() > 1e-3 * P.m * sc.g);   // the coupling is there
+            last = ws.n;
+        }
+    }
 }
 
 // Newton-Euler in the world frame W: m a_s = R1 sum F_i - m g e_z and dL/dt = sum r_i x R1 F_i,
