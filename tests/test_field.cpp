@@ -1,5 +1,6 @@
 // Asymptotic twist fields and their fixed points against the paper's claims (Section IV-D, V).
 #include "plate/field.hpp"
+#include "plate/study.hpp"
 #include "plate/scene_io.hpp"
 
 #include <catch2/catch.hpp>
@@ -33,11 +34,21 @@ TEST_CASE("field: grid, parallel evaluation and warm starts give the single-conf
     g.nth = 3;
     const Field f = compute_field(sc, g);
     REQUIRE(f.points.size() == 12u);
+    const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
+    Solver independent;   // GSL's rk8pd, exact Coulomb, its own period-by-period cycle loop
+    independent.method = Method::GslRk8pd;
     for (const auto& p : f.points) {
         REQUIRE(p.converged);
+        INFO("at " << p.q.transpose());
         const LimitCycleSummary lc = limit_cycle(sc, p.q);   // from rest, alone
-        // Both within tol = 1e-7 v_ref of the cycle average; integration errors ~1e-8 v_ref.
-        CHECK((lc.twist - p.twist).head<2>().norm() < 1e-6 * sc.v_ref());
+        // Both within tol = 1e-7 v_ref of the cycle average (up to ~3x the estimate, measured on
+        // fig6); integration errors ~1e-8 v_ref. All three components, scaled.
+        CHECK((lc.twist - p.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < 3e-7);
+        // Pinned independently: the same twist by another integrator and cycle loop at 1e-12
+        // (nothing of the engine; measured agreement 5e-8).
+        const RunResult r = twist_run(sc, p.q, independent, 1e-12, 1e-12);
+        REQUIRE(r.ok);
+        CHECK((p.twist - Vec3(r.value[0], r.value[1], r.value[2])).cwiseQuotient(S).cwiseAbs().maxCoeff() < 3e-7);
     }
     CHECK(f.threads >= 1);
 }
