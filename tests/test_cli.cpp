@@ -203,15 +203,18 @@ TEST_CASE("a simulation that leaves the model stops with exit code 3 and says wh
     CHECK(fs::exists(out));   // the trajectory up to the loss of contact
 }
 
-TEST_CASE("plate simulate --dynamics auto states its choice and every rung's error", "[cli][hierarchy]") {
+TEST_CASE("plate simulate --dynamics auto states its choice, decided up front, and --verify measures it", "[cli][hierarchy]") {
     const fs::path out = tmpdir() / "auto.csv";
-    const Run r = run("simulate " + kScenes + "fig4.json --dynamics auto --model-tol 0.05 --from 0.04 -0.04 1.0 --time 0.5 --out " +
+    const Run r = run("simulate " + kScenes + "fig4.json --dynamics auto --model-tol 0.05 --from 0.04 -0.04 1.0 --time 0.5 --verify --out " +
                       out.string());
     INFO(r.err);
     CHECK(r.code == 0);
-    CHECK(r.err.find("auto model (tolerance 0.05): picked") != std::string::npos);
-    CHECK(r.err.find("thin / u: error") != std::string::npos);
+    CHECK(r.err.find("auto model, decided up front (tolerance 0.05): picked") != std::string::npos);
+    CHECK(r.err.find("estimates: |xi|") != std::string::npos);
     CHECK(fs::exists(out));
+    const Run bad = run("simulate " + kScenes + "fig4.json --dynamics full --from 0 0 0 --time 0.1 --verify");
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--verify goes with --dynamics auto") != std::string::npos);
 }
 
 TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]") {

@@ -255,7 +255,7 @@ int cmd_simulate(int argc, char** argv) {
     Args a(argc, argv, merge(with_config({{"--dynamics", 1}, {"--time", 1}, {"--sample", 1}, {"--out", 1},
                                           {"--rtol", 1}},
                                          {"--from", "--twist"}, d),
-                             {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}}));
+                             {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}, {"--verify", 0}}));
     if (a.help) {
         std::cout << "usage: plate simulate SCENE --dynamics full|u|field|auto --from SX SY THETA --time T\n"
                      "                      [--twist VX VY OMEGA] [--sample DT] [--out FILE] [--rtol X]\n"
@@ -263,8 +263,10 @@ int cmd_simulate(int argc, char** argv) {
                      "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
                      "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps).\n"
                      "auto: the cheapest of point/thin/thick part x field/u/full dynamics whose final configuration\n"
-                     "is within --model-tol E (default 1e-2; of rho and radians) of the scene's part under full\n"
-                     "dynamics, measured on this question; the choice and every rung's error go to stderr.\n"
+                     "is predicted within --model-tol E (default 1e-2; of rho and radians) of the scene's part\n"
+                     "under full dynamics, decided up front from a few limit cycles at --from and the scene's\n"
+                     "dimensionless numbers (hierarchy.hpp); --verify also runs the full model and reports the\n"
+                     "measured error. The choice and its estimates go to stderr.\n"
                      "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
                      "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05), and the contact mode on the\n"
                      "step that ended there (slide, pivot1-3, stuck: stick-slip is simulated through). Exit code 3\n"
@@ -286,14 +288,27 @@ int cmd_simulate(int argc, char** argv) {
     Trajectory tr;
     ProgressPrinter prog{"simulate"};
     Scene used = sc;
+    bool verify_auto = false;
     if (dyn == "auto") {
         if (!qd0.isZero()) throw UsageError("--dynamics auto answers from rest: drop --twist");
         const double tol = a.num("--model-tol", 0, 1e-2);
         if (!(tol > 0)) throw UsageError("--model-tol must be > 0");
-        const ModelChoice mc = choose_model(sc, q0, T, tol);
-        std::cerr << mc.explain();
-        used = simplified(sc, mc.picked.part);
-        dyn = mc.picked.dynamics == Dynamics::Full ? "full" : mc.picked.dynamics == Dynamics::U ? "u" : "field";
+        const ModelEstimate est = estimate_model_errors(sc, q0, T);
+        PartModel part;
+        Dynamics d;
+        const double predicted = a_priori_pick(sc, est, tol, part, d);
+        Rung picked;
+        picked.part = part;
+        picked.dynamics = d;
+        std::cerr << "auto model, decided up front (tolerance " << tol << "): picked " << picked.name()
+                  << " (predicted error " << predicted << ")\n  estimates: |xi| " << est.xi << "/s, point " << est.e_point
+                  << ", thin " << est.e_thin << ", eps_U " << est.eps_U << ", transient offset " << est.offset
+                  << ", growth " << est.growth() << (est.ok ? "" : " (" + est.note + ")") << "\n";
+        used = simplified(sc, part);
+        dyn = d == Dynamics::Full ? "full" : d == Dynamics::U ? "u" : "field";
+        verify_auto = a.has("--verify") && picked.name() != Rung{}.name();
+    } else if (a.has("--verify")) {
+        throw UsageError("--verify goes with --dynamics auto");
     }
     const Scene& sc_run = used;
     if (dyn == "field") {
@@ -303,6 +318,17 @@ int cmd_simulate(int argc, char** argv) {
         tr = field_curve(sc_run, q0, T, dt, lo);
     } else {
         tr = simulate(sc_run, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, dt, io);
+    }
+    if (verify_auto && tr.stop.reason == StopReason::None && !tr.samples.empty()) {
+        const Trajectory ref = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), T, T, io);
+        if (ref.stop.reason == StopReason::None && !ref.samples.empty()) {
+            const Vec3 dq = tr.samples.back().q - ref.samples.back().q;
+            std::cerr << "  verified against the full model: measured error "
+                      << std::max({std::abs(dq[0]) / sc.part.rho(), std::abs(dq[1]) / sc.part.rho(), std::abs(wrap_angle(dq[2]))})
+                      << "\n";
+        } else {
+            std::cerr << "  verify: the full model stopped: " << ref.stop.describe() << "\n";
+        }
     }
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); });
     if (tr.stop.reason != StopReason::None) {
