@@ -194,18 +194,23 @@ ModelEstimate estimate_model_errors(const Scene& sc, const Vec3& q0, double dura
         }
     }
     // What U-dynamics drop, against friction's mu g.
+    // The tilt comes from rotations about horizontal axes; the plate's angular velocity (Coriolis,
+    // centripetal) from every rotation, a spin about z included.
     double tilt = 0, w1 = 0;
-    for (const auto& h : sc.plate.harmonics)
-        if (h.axis == Axis::rx || h.axis == Axis::ry) {
-            tilt += std::abs(h.amp) / std::pow(h.n * w, 2);
+    bool rotates = false;
+    for (const auto& h : sc.plate.harmonics) {
+        if (h.axis == Axis::rx || h.axis == Axis::ry) tilt += std::abs(h.amp) / std::pow(h.n * w, 2);
+        if (h.axis == Axis::rx || h.axis == Axis::ry || h.axis == Axis::rz) {
             w1 += std::abs(h.amp) / (h.n * w);
+            rotates = rotates || h.amp != 0;
         }
+    }
     const double mu = sc.part.point ? sc.part.mu[0] : sc.part.mu.mean();
     const double s = std::hypot(q0[0], q0[1]) + 0.05 * rho;
     e.eps_U = (sc.g * tilt + 2 * w1 * sc.v_ref() + w1 * w1 * s) / std::max(mu * sc.g, 1e-12);
     // From rest the two differ most in the transient (the tilted plate delays the break-away and
     // shifts the phase the cycle is entered at): run both through it, a few periods, and compare.
-    if (e.eps_U > 0) {
+    if (rotates) {
         const double t_tr = std::min(duration, std::max(2.0, static_cast<double>(lc.periods)) * T);
         const Trajectory tu = simulate(sc, Dynamics::U, q0, Vec3::Zero(), t_tr, t_tr);
         const Trajectory tf = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), t_tr, t_tr);
