@@ -484,7 +484,8 @@ void failure_map(Ctx& c, const Scene& base, bool full) {
         }
     }
     c.html << "<p>fig4's part at q = (0.02, -0.01, 0.5); each cell is one run at tolerance 1e-8 (RK4: 200 steps per "
-              "period) compared with the engine at 1e-11. <span style=\"background:#cfc\">ok</span>: error &le; 1e-5; "
+              "period) compared with the engine at 1e-11. Every method starts at rest and, where its run loses contact, "
+              "starts again from the engine's other twists (the same restart rule). <span style=\"background:#cfc\">ok</span>: error &le; 1e-5; "
               "<span style=\"background:#ffc\">detected</span>: the run stopped and said why (sticking, contact lost); "
               "<span style=\"background:#fcc\">wrong</span>: a twist returned where the model fails, or off by more than "
               "1e-5; <span style=\"background:#ddd\">method failed</span>: tiny steps, budget, no convergence. Each cell "

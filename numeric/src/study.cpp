@@ -199,28 +199,44 @@ RunResult twist_run(const Scene& sc, const Vec3& q0, const Solver& s, double kno
         else r.value = {lc.twist[0], lc.twist[1], lc.twist[2]};
         return r;
     }
-    const auto w = reduced_wrapped(sc, q0, s.law, s.law_eps * sc.v_ref());
-    const OdeSystem sys = reduced_from(w, sc);
+    // The same start and restart rule as the engine's (limit_cycle): from rest, and where the run
+    // loses contact (a method integrates through it; the engine stops), again from the same other
+    // twists -- slip speed v_ref along x, then y, then a spin (a point part: the diagonal) -- up to
+    // LimitCycleOptions::restarts times; contact lost from every start is what is reported.
+    const double v = sc.v_ref(), wz = v / sc.part.rho();
+    const Vec3 starts[] = {Vec3::Zero(), Vec3(v, 0, 0), Vec3(0, v, 0),
+                           sc.part.point ? Vec3(-v, -v, 0) : Vec3(0, 0, wz)};
+    const int n_starts = 1 + std::min(LimitCycleOptions{}.restarts, 3);
     const MethodOptions mo = method_options(s, knob, T, max_evals);
-    MethodRun run;
-    std::vector<double> y(6, 0.0);
-    if (periods_to_cycle(s.method, sys, T, mo, run, cycle_tol, 400, y) > 0) {
-        r.ok = true;
-        r.value = {y[3] * w->scale[3] / T, y[4] * w->scale[4] / T, y[5] * w->scale[5] / T};
-    } else if (run.ok) {
-        run.failure = "not converged in 400 periods";
+    for (int k = 0; k < n_starts; ++k) {
+        const auto w = reduced_wrapped(sc, q0, s.law, s.law_eps * sc.v_ref());
+        const OdeSystem sys = reduced_from(w, sc);
+        MethodRun run;
+        std::vector<double> y(6, 0.0);
+        for (int i = 0; i < 3; ++i) y[i] = starts[k][i] / w->scale[i];
+        r.ok = false;
+        r.failure.clear();
+        if (periods_to_cycle(s.method, sys, T, mo, run, cycle_tol, 400, y) > 0) {
+            r.ok = true;
+            r.value = {y[3] * w->scale[3] / T, y[4] * w->scale[4] / T, y[5] * w->scale[5] / T};
+        } else if (run.ok) {
+            run.failure = "not converged in 400 periods";
+        }
+        r.rhs_evals += w->model.ws.evals;
+        r.jac_evals += run.jac_evals;
+        if (!run.ok || !run.failure.empty()) {
+            r.ok = false;
+            r.failure = run.failure;
+        }
+        if (r.ok && w->min_n < 0) {
+            r.ok = false;
+            r.failure = "contact lost (a normal force went negative; the method integrated through it)";
+            if (k + 1 < n_starts) continue;   // the engine's rule: start again from another twist
+            r.failure += k > 0 ? " from every start" : "";
+        }
+        break;
     }
     r.seconds = seconds_since(t0);
-    r.rhs_evals = w->model.ws.evals;
-    r.jac_evals = run.jac_evals;
-    if (!run.ok || !run.failure.empty()) {
-        r.ok = false;
-        r.failure = run.failure;
-    }
-    if (r.ok && w->min_n < 0) {
-        r.ok = false;
-        r.failure = "contact lost (a normal force went negative; the method integrated through it)";
-    }
     return r;
 }
 
