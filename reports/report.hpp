@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace plate::report {
 
@@ -24,6 +25,10 @@ void write_report(const ReportOptions& opt);
 // reached the same one, and how many had every Floquet multiplier below 1 in modulus. It says "every
 // cycle found was unique and attracting" only when all of them did; otherwise how many did not.
 std::string observation1_sentence(int valid, int converged, int unique, int attracting);
+// The collinear-contacts paragraph: from A's condition numbers and the two twists' wrench gaps at
+// e/L = 1, 0.1, ... (e > 0), and sigma_min/sigma_max at e = 0. It says "grows like L/e" and "develops
+// a vertex" only when each tenth of e/L multiplies cond(A) and divides the gap by at least 5.
+std::string collinear_sentence(const std::vector<double>& conds, const std::vector<double>& gaps, double singular);
 
 // The speed-accuracy study (`plate bench`): writes its charts into DIR and its section into
 // DIR/index.html (between the report's markers; a page of its own if there is no report yet).

@@ -19,3 +19,17 @@ TEST_CASE("report: the Observation 1 sentence follows the campaign's counts", "[
     CHECK(observation1_sentence(1000, 990, 990, 990).find("10 reached no cycle") != std::string::npos);
     CHECK(observation1_sentence(0, 0, 0, 0).find("says nothing") != std::string::npos);
 }
+
+TEST_CASE("report: the collinear-contacts sentence follows the conditioning and the wrench gaps", "[report][text]") {
+    using plate::report::collinear_sentence;
+    // As measured (proofs JSON): cond(A) 3.0, 20, 199, 1995 for e/L = 1 .. 1e-3; gaps shrinking ~10x.
+    const std::string good = collinear_sentence({3.0, 20, 199, 1995}, {0.5, 0.05, 0.005, 0.0005}, 1e-17);
+    CHECK(good.find("grows at least") != std::string::npos);
+    CHECK(good.find("singular at e = 0") != std::string::npos);
+    CHECK(good.find("develops a vertex") != std::string::npos);
+    // Data that do not show it: the claims are gone.
+    const std::string flat = collinear_sentence({3.0, 4.0, 5.0, 6.0}, {0.5, 0.4, 0.3, 0.2}, 0.1);
+    CHECK(flat.find("does not grow like L/e") != std::string::npos);
+    CHECK(flat.find("develops a vertex") == std::string::npos);
+    CHECK(flat.find("not singular") != std::string::npos);
+}
