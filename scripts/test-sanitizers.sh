@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# The C++ tests under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/), a named
+# representative subset so that CI stays well under its budget: the stick-slip engine and its
+# modes, the Theorem 1 checks, the generated kernels, limit cycles, the a-priori model choice and
+# the fields. Any sanitizer report fails the run (halt_on_error; UBSan made fatal).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLATE_SANITIZE=ON >/dev/null
+cmake --build build-asan -j"$(nproc)" --target plate_tests plate
+export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+for tags in "[stick]" "[proofs]" "[kernels]" "[limit_cycle]" "[auto]" "[field]"; do
+  echo "sanitizers: $tags" >&2
+  build-asan/tests/plate_tests "$tags"
+done
