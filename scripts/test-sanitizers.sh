@@ -5,7 +5,8 @@
 # the fields. Any sanitizer report fails the run (halt_on_error; UBSan made fatal).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLATE_SANITIZE=ON >/dev/null
+# -O1 -g1: line tables for the reports, less to compile than -O2 -g (the stage took 13 of CI's 18 minutes)
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" -DPLATE_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$(nproc)" --target plate_tests plate
 export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
