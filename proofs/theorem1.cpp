@@ -214,27 +214,12 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
         const Vec3 Ns = statics_normal_forces(sc, q, ps, f, tau);
         const Mat3 R2 = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix();
         // The limit surface (39): the generated thin_wrench with the statics' forces.
-        gen::WrenchInput in;
-        double* const Ni[3] = {&in.N1, &in.N2, &in.N3};
-        double* const rx[3] = {&in.r1x, &in.r2x, &in.r3x};
-        double* const ry[3] = {&in.r1y, &in.r2y, &in.r3y};
-        double* const mu[3] = {&in.mu1, &in.mu2, &in.mu3};
-        for (int i = 0; i < 3; ++i) {
-            const Vec3 ri = R2 * P.c[i];
-            *Ni[i] = Ns[i];
-            *rx[i] = ri.x();
-            *ry[i] = ri.y();
-            *mu[i] = P.mu[i];
-        }
-        in.rho = rho;
-        in.vx = qd[0];
-        in.vy = qd[1];
-        in.xith = rho * qd[2];
-        double w[3];
-        gen::thin_wrench(in, w);
+        std::array<Vec2, 3> r2;
+        for (int i = 0; i < 3; ++i) r2[i] = (R2 * P.c[i]).head<2>();
+        const Vec3 w = wrench_map(wrench_input(r2, Ns, P.mu, rho))(Vec3(qd[0], qd[1], rho * qd[2]));
         const Vec3 W(P.m * qdd[0] + f.x(), P.m * qdd[1] + f.y(), (P.J(2, 2) * qdd[2] + tau.z()) / rho);
         const double es = (n - Ns).cwiseAbs().maxCoeff() / mg;
-        const double ew = (W - Vec3(w[0], w[1], w[2])).cwiseAbs().maxCoeff() / mg;
+        const double ew = (W - w).cwiseAbs().maxCoeff() / mg;
         ++t.samples;
         t.worst_statics = std::max(t.worst_statics, es);
         t.worst_wrench = std::max(t.worst_wrench, ew);
@@ -404,18 +389,11 @@ LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int 
 WrenchMap thin_wrench_map(const Scene& sc, const Vec3& q0, double t, double* friction_scale) {
     Workspace ws;
     accelerations(sc, Dynamics::ReducedU, q0, Vec3(0.1, 0.05, 1), plate_state(sc.plate, t, Dynamics::ReducedU), ws);
-    gen::WrenchInput in;
-    in.N1 = ws.n[0];
-    in.N2 = ws.n[1];
-    in.N3 = ws.n[2];
-    in.r1x = ws.r[0].x(); in.r1y = ws.r[0].y();
-    in.r2x = ws.r[1].x(); in.r2y = ws.r[1].y();
-    in.r3x = ws.r[2].x(); in.r3y = ws.r[2].y();
-    in.mu1 = sc.part.mu[0];
-    in.mu2 = sc.part.mu[1];
-    in.mu3 = sc.part.mu[2];
-    in.rho = sc.part.rho();
-    if (friction_scale) *friction_scale = in.mu1 * in.N1 + in.mu2 * in.N2 + in.mu3 * in.N3;
+    if (friction_scale) *friction_scale = sc.part.mu.dot(ws.n);
+    return wrench_map(wrench_input(ws.r, ws.n, sc.part.mu, sc.part.rho()));
+}
+
+WrenchMap wrench_map(gen::WrenchInput in) {
     return [in](const Vec3& xi) mutable {
         in.vx = xi[0];
         in.vy = xi[1];

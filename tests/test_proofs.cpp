@@ -214,27 +214,9 @@ TEST_CASE("the limit-surface check against the independent friction set catches 
     CHECK(good.convex_and_normal());
     // The generated kernel, fed from the set with one input edited.
     auto kernel = [&](std::function<void(gen::WrenchInput&)> edit) -> WrenchMap {
-        gen::WrenchInput in;
-        double* N[3] = {&in.N1, &in.N2, &in.N3};
-        double* rx[3] = {&in.r1x, &in.r2x, &in.r3x};
-        double* ry[3] = {&in.r1y, &in.r2y, &in.r3y};
-        double* mu[3] = {&in.mu1, &in.mu2, &in.mu3};
-        for (int i = 0; i < 3; ++i) {
-            *mu[i] = sc.part.mu[i];
-            *N[i] = set.cap[i] / sc.part.mu[i];
-            *rx[i] = set.r[i].x();
-            *ry[i] = set.r[i].y();
-        }
-        in.rho = set.rho;
+        gen::WrenchInput in = wrench_input(set.r, set.cap.cwiseQuotient(sc.part.mu), sc.part.mu, set.rho);
         edit(in);
-        return [in](const Vec3& xi) mutable {
-            in.vx = xi[0];
-            in.vy = xi[1];
-            in.xith = xi[2];
-            double w[3];
-            gen::thin_wrench(in, w);
-            return Vec3(w[0], w[1], w[2]);
-        };
+        return wrench_map(in);
     };
     const LimitSurfaceResult same = check_limit_surface(kernel([](gen::WrenchInput&) {}), scale, 300, 0.2, &set);
     CHECK(same.on_friction_set());   // the kernel fed correctly is the set's support point

@@ -116,6 +116,17 @@ Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const
     return b;
 }
 
+gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho) {
+    gen::WrenchInput in;
+    in.N1 = n[0]; in.N2 = n[1]; in.N3 = n[2];
+    in.r1x = r[0].x(); in.r1y = r[0].y();
+    in.r2x = r[1].x(); in.r2y = r[1].y();
+    in.r3x = r[2].x(); in.r3y = r[2].y();
+    in.mu1 = mu[0]; in.mu2 = mu[1]; in.mu3 = mu[2];
+    in.rho = rho;
+    return in;
+}
+
 void Workspace::prepare(const Scene& sc) {
     const Part& P = sc.part;
     prepared = &sc;

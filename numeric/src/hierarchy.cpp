@@ -160,26 +160,26 @@ ModelEstimate estimate_model_errors(const Scene& sc, const Vec3& q0, double dura
     auto scaled = [&](const Vec3& v) { return std::max(v.head<2>().norm() / rho, std::abs(v[2])); };
     e.work += lc.stats.rhs_evals;
     e.xi = scaled(lc.twist);
+    // A recorded run's transient offset from the curve: its displacement X = int q' dt (trapezoidal
+    // on the recorded steps) less xi_a times its duration.
+    auto offset_of = [](const LimitCycleSummary& c) {
+        Vec3 X = Vec3::Zero();
+        for (std::size_t i = 1; i < c.path.size(); ++i) X += 0.5 * (c.path[i].qd + c.path[i - 1].qd) * (c.path[i].t - c.path[i - 1].t);
+        return Vec3(X - c.twist * c.path.back().t);
+    };
     const double t_last = lc.path.back().t;
-    Vec3 X = Vec3::Zero(), disp = Vec3::Zero();
+    const Vec3 own_offset = offset_of(lc);
+    e.offset = scaled(own_offset);
+    e.transient = scaled(own_offset + lc.twist * t_last);
+    // The excursion about the curve within the last period.
+    Vec3 disp = Vec3::Zero();
     for (std::size_t i = 1; i < lc.path.size(); ++i) {
-        const double h = lc.path[i].t - lc.path[i - 1].t;
-        const Vec3 mid = 0.5 * (lc.path[i].qd + lc.path[i - 1].qd);
-        X += mid * h;
         if (lc.path[i - 1].t < t_last - T - 1e-12) continue;
-        disp += (mid - lc.twist) * h;
+        disp += (0.5 * (lc.path[i].qd + lc.path[i - 1].qd) - lc.twist) * (lc.path[i].t - lc.path[i - 1].t);
         e.excursion = std::max(e.excursion, scaled(disp));
     }
-    e.offset = scaled(X - lc.twist * t_last);
-    e.transient = scaled(X);
     // The simplified parts' cycles at q0 from rest, as the reference starts: their drift differs by
     // |xi_p - xi| D, and their transients end displaced by the difference of the offsets.
-    auto offset_of = [&](const LimitCycleSummary& c) {
-        Vec3 Xp = Vec3::Zero();
-        for (std::size_t i = 1; i < c.path.size(); ++i) Xp += 0.5 * (c.path[i].qd + c.path[i - 1].qd) * (c.path[i].t - c.path[i - 1].t);
-        return Vec3(Xp - c.twist * c.path.back().t);
-    };
-    const Vec3 own_offset = X - lc.twist * t_last;
     const double inf = std::numeric_limits<double>::infinity();
     if (!sc.part.point) {
         const LimitCycleSummary pt = limit_cycle(simplified(sc, PartModel::Point), q0, lo);

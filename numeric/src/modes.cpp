@@ -155,18 +155,7 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     // The support function P(d) = sum_i mu_i N_i |G_i^T d| with its gradient and Hessian: the
     // generated friction_support (a term is left out where its contact is at rest, a kink of P,
     // where its subgradient 0 is a valid choice).
-    gen::WrenchInput win;
-    double* const wN[3] = {&win.N1, &win.N2, &win.N3};
-    double* const wx[3] = {&win.r1x, &win.r2x, &win.r3x};
-    double* const wy[3] = {&win.r1y, &win.r2y, &win.r3y};
-    double* const wmu[3] = {&win.mu1, &win.mu2, &win.mu3};
-    for (int i = 0; i < 3; ++i) {
-        *wN[i] = std::max(n[i], 0.0);
-        *wmu[i] = P.mu[i];
-        *wx[i] = R[i].x() * rg;
-        *wy[i] = R[i].y() * rg;
-    }
-    win.rho = rg;
+    gen::WrenchInput win = wrench_input({R[0] * rg, R[1] * rg, R[2] * rg}, n.cwiseMax(0.0), P.mu, rg);
     double sp[3], term[3], gr[9], he[18];
     auto support = [&](const Vec3& d) {
         win.vx = d.x();

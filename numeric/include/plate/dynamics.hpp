@@ -159,6 +159,11 @@ StickTest stick_test_all(const Scene& scene, Dynamics level, const Vec3& q, cons
 // Right-hand side b of (31)/(32) for a rigid part (exposed for tests and the kernels).
 Vec6 rhs_b(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate);
 
+// The inputs of the generated limit-surface kernels (thin_wrench, friction_support): contacts r_i
+// from the centre of mass (plate frame, horizontal), normal forces n, friction coefficients mu and
+// the radius of gyration; the twist (vx, vy, xith) is left at zero for the caller.
+gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho);
+
 // DERIVATION NOTES (where the printed paper differs from the derivation):
 //  (28) prints -R2^T w2^ R1 w1; differentiating (27) gives -R2^T w2^ R1^T w1 (R1 transposed),
 //       as (30) has it.
