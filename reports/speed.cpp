@@ -294,8 +294,8 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
     else if (!std::isfinite(tr)) c.html << "the engine takes " << fmt(1e3 * te, 3) << " ms; no other run here reaches it";
     else c.html << "the engine takes " << fmt(1e3 * te, 3) << " ms, the cheapest other run (" << esc(best) << ") "
                 << fmt(1e3 * tr, 3) << " ms: " << fmt(tr / te, 2) << "x the engine's time";
-    c.html << ". A regularised line levels off at its width's error (the law itself differs from Coulomb's by about "
-              "eps near a stick); the fixed steps must resolve the law's time scale eps/(mu g) or go unstable.</p>\n";
+    c.html << ". (Why a regularised line cannot go below some level: the law itself differs from Coulomb's by about "
+              "eps near a stick, whatever the integrator; and fixed steps must resolve its time scale eps/(mu g).)</p>\n";
 }
 
 // Limit-cycle solvers on fig4's 343-configuration field, and the ratio against period-by-period RK4.
