@@ -142,10 +142,13 @@ TEST_CASE("bad input: exit code 2, the file and the field named, no output file"
         {fig4_with("\"mass\": 0.0216", "\"mass\": -0.0216"), "part.mass: expected a positive"},
         {fig4_with("[0, 1.23e-6, 0]", "[0, -1.23e-6, 0]"), "part.inertia: expected a symmetric positive definite"},
         {fig4_with("[0.3, 0.3, 0.3]", "[0.3, 0.3, -0.3]"), "part.friction: expected friction coefficients >= 0"},
-        {fig4_with("[0, 0.03, -0.002]", "[0, -0.03, -0.002]"), "part.contacts: expected non-collinear"},
+        {fig4_with("[0, 0.03, -0.002]", "[0, -0.03, -0.002]"), "part.contacts: nearly collinear"},
         {fig4_with("[0, 0.03, -0.002]", "[0, 0.03, 0.001]"), "part.contacts: expected coplanar"},
         {fig4_with("\"period\": 0.05", "\"period\": 0"), "plate.period: expected a positive"},
         {fig4_with("\"amp\": 20,", "\"amp\": NaN,"), "malformed JSON"},
+        // issue 18: the mis-scaled part (a tonne with fig4's inertia) and the tipped one
+        {fig4_with("\"mass\": 0.0216", "\"mass\": 1000"), "part.inertia: radius of gyration"},
+        {fig4_with("[-0.01, -0.03, -0.002]", "[0.001, -0.03, -0.002]"), "the part tips over"},
     };
     int k = 0;
     for (const auto& c : cases) {
@@ -258,4 +261,15 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
     const std::size_t stopped = html.find("FAIL: the run from rest stopped");
     INFO((stopped == std::string::npos ? std::string() : html.substr(stopped, 200)));
     CHECK(stopped == std::string::npos);
+}
+
+TEST_CASE("a scene outside the intended regime runs with a warning on stderr", "[cli][precheck]") {
+    const fs::path scene = tmpdir() / "sticky.json";
+    std::ofstream(scene) << fig4_with("[0.3, 0.3, 0.3]", "[0.3, 2.5, 0.3]");
+    const Run r = run("twist " + scene.string() + " --at 0 0 0");
+    INFO(r.err);
+    CHECK(r.code == 0);
+    CHECK(r.err.find("warning: " + scene.string() + ": part.friction: 2.5 is above 2") != std::string::npos);
+    CHECK(nlohmann::json::parse(r.out).contains("twist"));
+    CHECK(run("twist " + kScenes + "fig4.json --at 0 0 0").err.empty());   // the shipped scene: none
 }

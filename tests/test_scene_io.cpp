@@ -81,7 +81,7 @@ TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
         {replace(kGood, "[[1.084e-5, 0, 0]", "[[-1.084e-5, 0, 0]"), "part.inertia: expected a symmetric positive definite"},
         {replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, -0.1, 0.3]"), "part.friction: expected friction coefficients >= 0"},
         {replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 0.3]"), "part.friction: expected one number or an array of 3"},
-        {replace(kGood, "[0, 0.03, -0.002]", "[0, -0.03, -0.002]"), "part.contacts: expected non-collinear"},
+        {replace(kGood, "[0, 0.03, -0.002]", "[0, -0.03, -0.002]"), "part.contacts: nearly collinear"},
         {replace(kGood, "[0, 0.03, -0.002]", "[0, 0.03, -0.004]"), "part.contacts: expected coplanar"},
         {replace(kGood, "[0, 0.03, -0.002]", "[0, 0.03]"), "part.contacts[1]: expected an array of 3 numbers"},
         {replace(kGood, "\"period\": 0.05", "\"period\": 0"), "plate.period: expected a positive number"},
@@ -103,4 +103,79 @@ TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
             CHECK(msg.find(c.expect) != std::string::npos);
         }
     }
+}
+
+TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible inertia, collinear contacts, "
+          "friction out of range", "[scene][input][precheck]") {
+    // kGood's contacts (0.01, -0.03), (0, 0.03), (-0.01, -0.03): at rest N_i / (m g) are the
+    // barycentric coordinates of the origin, 1/4, 1/2, 1/4. Moving contact 1 to x = 0.03 (and 3 to
+    // x = 0.02) puts the origin outside the triangle: the line through contacts 2 and 3 passes
+    // x = 0.01 at y = 0, so the origin lies beyond it, and contact 1 would pull.
+    struct Case {
+        std::string text, expect;
+    };
+    const Case cases[] = {
+        {replace(replace(kGood, "[0.01, -0.03, -0.002]", "[0.03, -0.03, -0.002]"), "[-0.01, -0.03, -0.002]",
+                 "[0.02, -0.03, -0.002]"),
+         "part.contacts: the part tips over"},
+        // Contact 3 at x = +1e-4: N_1 / (m g) = -0.03 x3 / (0.06 (0.01 - x3)) = -0.5%: just outside.
+        {replace(kGood, "[-0.01, -0.03, -0.002]", "[0.0001, -0.03, -0.002]"), "part.contacts: the part tips over"},
+        // mass in grams: rho = sqrt(1.2e-5 / 21.6) = 7.5e-4 m against a reach of 0.0316 m (ratio 1/42,
+        // inside the range); a tonne: rho = 1.1e-4 m, ratio 1/290, outside.
+        {replace(kGood, "\"mass\": 0.0216", "\"mass\": 1000"), "part.inertia: radius of gyration"},
+        // 1.2e-5 about z with 1e-6 and 1e-6 about x and y: 1e-6 + 1e-6 < 1.2e-5.
+        {replace(replace(kGood, "[[1.084e-5, 0, 0]", "[[1e-6, 0, 0]"), "[0, 1.23e-6, 0]", "[0, 1e-6, 0]"),
+         "part.inertia: principal moments"},
+        // contact 2 moved to within 1e-8 m of the line y = -0.03 through the other two: cond ~ L/e ~ 6e6.
+        {replace(kGood, "[0, 0.03, -0.002]", "[0, -0.02999999, -0.002]"), "part.contacts: nearly collinear"},
+        {replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 11, 0.3]"), "part.friction: friction coefficient 11 above 10"},
+    };
+    for (const auto& c : cases) {
+        INFO(c.text);
+        try {
+            parse_scene(c.text, "bad.json");
+            FAIL("accepted a bad scene");
+        } catch (const InputError& e) {
+            const std::string msg = e.what();
+            INFO(msg);
+            CHECK(msg.rfind("bad.json", 0) == 0);
+            CHECK(msg.find(c.expect) != std::string::npos);
+        }
+    }
+    // Inside each bound the scene is accepted: 21.6 kg with the same inertia (ratio 1/42); friction 10;
+    // principal moments 1e-6, 1.1e-5, 1.2e-5 (1e-6 + 1.1e-5 = 1.2e-5, the triangle's edge).
+    CHECK_NOTHROW(parse_scene(replace(kGood, "\"mass\": 0.0216", "\"mass\": 21.6"), "ok.json"));
+    // Contact 3 at x = -1e-4: N_1 / (m g) = +0.5%, inside (and warned about: close to tipping).
+    const Scene edge = parse_scene(replace(kGood, "[-0.01, -0.03, -0.002]", "[-0.0001, -0.03, -0.002]"), "ok.json");
+    CHECK_FALSE(scene_warnings(edge).empty());
+    CHECK_NOTHROW(parse_scene(replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 10, 0.3]"), "ok.json"));
+    CHECK_NOTHROW(parse_scene(replace(replace(kGood, "[[1.084e-5, 0, 0]", "[[1e-6, 0, 0]"), "[0, 1.23e-6, 0]", "[0, 1.1e-5, 0]"),
+                              "ok.json"));
+}
+
+TEST_CASE("scene warnings: admissible scenes outside the intended regime", "[scene][precheck]") {
+    // The shipped scenes are in the regime: no warning.
+    for (const char* n : {"fig1", "fig1_point", "fig3_random", "fig4", "fig5", "fig6", "heave_yaw"})
+        CHECK(scene_warnings(load_scene(std::string(PLATE_SOURCE_DIR "/scenes/") + n + ".json")).empty());
+    auto has = [](const std::vector<std::string>& w, const std::string& s) {
+        for (const auto& x : w)
+            if (x.find(s) != std::string::npos) return true;
+        return false;
+    };
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 2.5, 0.3]"), "w.json")),
+              "part.friction: 2.5 is above 2"));
+    // Contact 2 moved to (0, 0.000303): the origin lies 0.03 above the base y = -0.03 of a triangle
+    // 0.030303 high, so contact 2 carries 0.03 / 0.030303 = 99% of the weight and contacts 1 and 3
+    // 0.5% each: close to tipping (below 2%).
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "[0, 0.03, -0.002]", "[0, 0.000303, -0.002]"), "w.json")),
+              "close to tipping over"));
+    // 9.81 m/s^2 of heave: the downward acceleration reaches g.
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"axis\": \"x\", \"n\": 1, \"amp\": 20",
+                                                 "\"axis\": \"z\", \"n\": 1, \"amp\": 9.81"), "w.json")),
+              "at least g"));
+    // v_ref = max(mu g, 20) / omega = 20 / (2 pi / 0.05) = 0.159 m/s; with a 5 s period, v_ref T is
+    // 20 * 5^2 / (2 pi) = 79.6 m against a reach of 0.0316 m.
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"period\": 0.05", "\"period\": 5"), "w.json")),
+              "times its size"));
+    CHECK(scene_warnings(parse_scene(kGood, "ok.json")).empty());
 }

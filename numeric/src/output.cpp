@@ -183,10 +183,11 @@ std::string machine_description() {
     return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
-void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write,
+                       std::ostream& standard_output) {
     if (path == "-") {
-        write(std::cout);
-        std::cout.flush();
+        write(standard_output);
+        standard_output.flush();
         return;
     }
     const std::string tmp = path + ".tmp";

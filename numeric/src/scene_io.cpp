@@ -193,17 +193,97 @@ void validate_scene(const Scene& s) {
                                             std::to_string(i) + " has z different from contact 0");
         if (p.c[0].z() > 1e-12 * size)
             r.fail("part.contacts", "expected z <= 0: the centre of mass cannot lie below the plate surface");
-        const Vec3 e1 = p.c[1] - p.c[0], e2 = p.c[2] - p.c[0];
-        const double area2 = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-        if (area2 <= 1e-6 * size * size)
-            r.fail("part.contacts", "expected non-collinear contacts (assumption 2): the triangle has no area");
+        // Nearly collinear contacts: the normal forces come from the solve of
+        //   [1 1 1; x_i / L; y_i / L] N = [m g; ...]
+        // (the plate at rest; in motion the same geometry), whose relative rounding error is
+        // cond * eps. Above kMaxContactCondition it would exceed 1e-10, the tightest integration
+        // tolerance the references use: the results would not carry the accuracy asked for.
+        Mat3 A;
+        for (int i = 0; i < 3; ++i) A.col(i) = Vec3(1, p.c[i].x() / size, p.c[i].y() / size);
+        const Eigen::JacobiSVD<Mat3> svd(A);
+        const double cond = svd.singularValues()[0] / svd.singularValues()[2];
+        if (!(cond <= kMaxContactCondition))
+            r.fail("part.contacts", "nearly collinear contacts (assumption 2): the normal-force solve's condition number is " +
+                                        Reader::fmt(cond) + ", above " + Reader::fmt(kMaxContactCondition) +
+                                        " (1e-10 / machine epsilon): its rounding would exceed the integration tolerance");
+        // At rest on a level plate N_i / (m g) are the barycentric coordinates of the centre of
+        // mass's projection in the support triangle: one below zero means the part tips over.
+        const Vec3 share = A.colPivHouseholderQr().solve(Vec3(1, 0, 0));
+        int k = 0;
+        share.minCoeff(&k);
+        if (share[k] < 0)
+            r.fail("part.contacts", "the part tips over: the centre of mass's projection (0, 0) lies outside the support "
+                                    "triangle (at rest contact " + std::to_string(k + 1) + " would need a normal force of " +
+                                    Reader::fmt(share[k]) + " m g)");
+        // Inertia of a rigid body: principal moments satisfy the triangle inequality.
+        const Vec3 lam = Eigen::SelfAdjointEigenSolver<Mat3>(p.J).eigenvalues();   // ascending
+        if (lam[0] + lam[1] < lam[2] * (1 - 1e-9))
+            r.fail("part.inertia", "principal moments " + Reader::fmt(lam[0]) + ", " + Reader::fmt(lam[1]) + ", " +
+                                       Reader::fmt(lam[2]) + " violate the triangle inequality A + B >= C: no rigid body "
+                                       "has this inertia");
+        // Inertia against mass and size: the radius of gyration about z against the contacts'
+        // distance from the centre of mass. Real parts lie within two orders of magnitude of each
+        // other (a ring on close feet, a hub on long legs); beyond that it is a unit error.
+        double reach = 0;
+        for (int i = 0; i < 3; ++i) reach = std::max(reach, p.c[i].head<2>().norm());
+        const double rho = std::sqrt(p.J(2, 2) / p.m);
+        if (!(rho >= reach / kGyrationRange && rho <= reach * kGyrationRange))
+            r.fail("part.inertia", "radius of gyration sqrt(J_zz / m) = " + Reader::fmt(rho) + " m against contacts up to " +
+                                       Reader::fmt(reach) + " m from the centre of mass: a ratio outside 1/" +
+                                       Reader::fmt(kGyrationRange) + " to " + Reader::fmt(kGyrationRange) +
+                                       " is almost surely a unit error (mass in kg, inertia in kg m^2, lengths in m)");
     }
+    for (int i = 0; i < p.contacts(); ++i)
+        if (p.mu[i] > kMaxFriction)
+            r.fail("part.friction", "friction coefficient " + Reader::fmt(p.mu[i]) + " above " + Reader::fmt(kMaxFriction) +
+                                        ": no pair of materials grips that hard (dry contacts lie below ~2)");
     if (!(std::isfinite(s.plate.T) && s.plate.T > 0)) r.fail("plate.period", "expected a positive finite number");
     for (std::size_t k = 0; k < s.plate.harmonics.size(); ++k) {
         const auto& h = s.plate.harmonics[k];
         if (!std::isfinite(h.amp) || !std::isfinite(h.phase) || h.n < 1)
             r.fail("plate.harmonics[" + std::to_string(k) + "]", "expected finite amp and phase, n >= 1");
     }
+}
+
+std::vector<std::string> scene_warnings(const Scene& s) {
+    std::vector<std::string> w;
+    const Part& p = s.part;
+    const std::string src = s.source.empty() ? std::string("(scene)") : s.source;
+    for (int i = 0; i < p.contacts(); ++i)
+        if (p.mu[i] > kHighFriction) {
+            w.push_back(src + ": part.friction: " + Reader::fmt(p.mu[i]) + " is above " + Reader::fmt(kHighFriction) +
+                        ", more than dry contacts usually have");
+            break;
+        }
+    double reach = 0;
+    if (!p.point) {
+        Mat3 A;
+        double size = 0;
+        for (int i = 0; i < 3; ++i) {
+            reach = std::max(reach, p.c[i].head<2>().norm());
+            for (int j = 0; j < i; ++j) size = std::max(size, (p.c[i] - p.c[j]).norm());
+        }
+        for (int i = 0; i < 3; ++i) A.col(i) = Vec3(1, p.c[i].x() / size, p.c[i].y() / size);
+        const Vec3 share = A.colPivHouseholderQr().solve(Vec3(1, 0, 0));
+        int k = 0;
+        if (share.minCoeff(&k) < kNearTipping)
+            w.push_back(src + ": part.contacts: at rest contact " + std::to_string(k + 1) + " carries only " +
+                        Reader::fmt(100 * share[k]) + "% of the weight: the part is close to tipping over");
+    }
+    double down = 0;
+    for (const auto& h : s.plate.harmonics)
+        if (h.axis == Axis::z) down += std::abs(h.amp);
+    if (down >= s.g)
+        w.push_back(src + ": plate.harmonics: the vertical acceleration can reach " + Reader::fmt(down) +
+                    " m/s^2 downward, at least g: the part may leave the plate (commands then stop with 'contact lost')");
+    if (reach > 0) {
+        const double travel = s.v_ref() * s.plate.T;
+        if (travel > kTravelPerPeriod * reach)
+            w.push_back(src + ": the slip-speed scale v_ref = " + Reader::fmt(s.v_ref()) + " m/s moves the part " +
+                        Reader::fmt(travel) + " m per period, more than " + Reader::fmt(kTravelPerPeriod) +
+                        " times its size: it would cross a plate of practical size within a few periods");
+    }
+    return w;
 }
 
 nlohmann::json scene_to_json(const Scene& s) {

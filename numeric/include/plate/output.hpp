@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <functional>
+#include <iostream>
 #include <ostream>
 #include <string>
 
@@ -33,7 +34,8 @@ struct ProgressPrinter {
 std::string machine_description();
 
 // Calls write(stream) on a temporary file and renames it to `path`; on any exception the
-// temporary is removed and the exception rethrown. path "-" writes to stdout.
-void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write);
+// temporary is removed and the exception rethrown. path "-" writes to `standard_output`.
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write,
+                       std::ostream& standard_output = std::cout);
 
 }  // namespace plate

@@ -13,6 +13,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace plate {
 
@@ -23,8 +24,22 @@ struct InputError : std::runtime_error {
 
 Scene load_scene(const std::string& path);               // throws InputError
 Scene parse_scene(const std::string& text, const std::string& source);  // throws InputError
-// Checks the physical admissibility of a scene built in code (same checks as the reader).
+// Checks the physical admissibility of a scene built in code (same checks as the reader):
+// finite positive mass, gravity and period; a symmetric positive definite inertia whose principal
+// moments satisfy the triangle inequality and whose radius of gyration about z lies within
+// kGyrationRange of the contacts' reach (else: a unit error); contacts coplanar, below the centre
+// of mass, not nearly collinear (the normal-force solve's condition number at most
+// kMaxContactCondition) and around it (else the part tips over); friction in [0, kMaxFriction].
 void validate_scene(const Scene& scene);                 // throws InputError
+// Admissible but outside the intended regime (the CLI prints them): friction above
+// kHighFriction, a contact with less than kNearTipping of the weight at rest, a downward plate
+// acceleration that can reach g, a slip-speed scale that moves the part more than
+// kTravelPerPeriod times its size per period.
+std::vector<std::string> scene_warnings(const Scene& scene);
+inline constexpr double kMaxContactCondition = 1e-10 / 2.220446049250313e-16;
+inline constexpr double kGyrationRange = 100;
+inline constexpr double kMaxFriction = 10, kHighFriction = 2;
+inline constexpr double kNearTipping = 0.02, kTravelPerPeriod = 10;
 // The scene in the file form above (parse_scene(scene_to_json(s).dump()) gives s back).
 nlohmann::json scene_to_json(const Scene& scene);
 

@@ -1,7 +1,9 @@
-// plate: the command-line program. See `plate --help`.
+// plate: the command-line program (apps/main.cpp runs it). See `plate --help`.
 // Exit codes: 0 success; 2 bad input (usage, scene file); 3 a simulation left the model's
 // assumptions (contact lost, sticking, step collapse) -- its output up to that time is kept;
 // 1 any other failure.
+#include "cli.hpp"
+
 #include "plate/field.hpp"
 #include "plate/hierarchy.hpp"
 #include "plate/output.hpp"
@@ -21,9 +23,13 @@
 #include <string>
 #include <vector>
 
-using namespace plate;
-
+namespace plate::cli {
 namespace {
+
+struct Io {
+    std::ostream& out;
+    std::ostream& err;
+};
 
 const char* kUsage =
     "plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch)\n"
@@ -97,9 +103,12 @@ struct Args {
     std::string str(const std::string& k, const std::string& def) const { return has(k) ? opt.at(k)[0] : def; }
 };
 
-Scene scene_arg(const Args& a) {
+// The scene file; its warnings (scene_warnings: admissible, outside the intended regime) to err.
+Scene scene_arg(const Args& a, Io& cio) {
     if (a.pos.size() != 1) throw UsageError("expected exactly one SCENE file");
-    return load_scene(a.pos[0]);
+    Scene sc = load_scene(a.pos[0]);
+    for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
+    return sc;
 }
 
 // Reads --NAME with 3 numbers (rigid) or 2 (point part; a third is rejected).
@@ -179,11 +188,11 @@ GridSpec grid_opts(const Args& a) {
     return g;
 }
 
-int cmd_twist(int argc, char** argv) {
+int cmd_twist(int argc, char** argv, Io& cio) {
     const int d = config_arity(argc, argv);
     Args a(argc, argv, merge(with_config({}, {"--at", "--from"}, d), kCycleOpts));
     if (a.help) {
-        std::cout << "usage: plate twist SCENE --at SX SY THETA [--from VX VY OMEGA] [--tol X] [--rtol X]\n"
+        cio.out << "usage: plate twist SCENE --at SX SY THETA [--from VX VY OMEGA] [--tol X] [--rtol X]\n"
                      "                   [--max-periods N]\n"
                      "Asymptotic twist (36) of the reduced U-dynamics limit cycle at (SX, SY, THETA), starting\n"
                      "from the part twist --from (default: at rest relative to the plate). Point parts: --at SX SY.\n"
@@ -191,18 +200,18 @@ int cmd_twist(int argc, char** argv) {
                      "--rtol: integrator tolerance (default 1e-8); --max-periods (default 400).\n";
         return 0;
     }
-    const Scene sc = scene_arg(a);
+    const Scene sc = scene_arg(a, cio);
     const Vec3 q = config_arg(a, "--at", sc, true);
     const Vec3 qd = config_arg(a, "--from", sc, false);
     const LimitCycleSummary lc = limit_cycle(sc, q, cycle_opts(a), qd);
-    std::cout << to_json(sc, q, lc).dump(2) << std::endl;
+    cio.out << to_json(sc, q, lc).dump(2) << std::endl;
     return 0;
 }
 
-int cmd_field(int argc, char** argv) {
+int cmd_field(int argc, char** argv, Io& cio) {
     Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--format", 1}, {"--out", 1}}));
     if (a.help) {
-        std::cout << "usage: plate field SCENE [--grid N] [--nx N] [--ny N] [--ntheta N] [--x MIN MAX]\n"
+        cio.out << "usage: plate field SCENE [--grid N] [--nx N] [--ny N] [--ntheta N] [--x MIN MAX]\n"
                      "                   [--y MIN MAX] [--theta0 T] [--format json|csv] [--out FILE]\n"
                      "                   [--threads N] [--tol X] [--rtol X] [--max-periods N]\n"
                      "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.05,0.05]^2 m x [0, 2pi)),\n"
@@ -210,7 +219,7 @@ int cmd_field(int argc, char** argv) {
                      "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n";
         return 0;
     }
-    const Scene sc = scene_arg(a);
+    const Scene sc = scene_arg(a, cio);
     const GridSpec g = grid_opts(a);
     const std::string format = a.str("--format", "json");
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
@@ -223,20 +232,20 @@ int cmd_field(int argc, char** argv) {
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) {
         if (format == "csv") write_field_csv(out, f);
         else out << to_json(sc, f).dump(1) << "\n";
-    });
+    }, cio.out);
     return 0;
 }
 
-int cmd_fixed_points(int argc, char** argv) {
+int cmd_fixed_points(int argc, char** argv, Io& cio) {
     Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--out", 1}}));
     if (a.help) {
-        std::cout << "usage: plate fixed-points SCENE [grid options as for field] [--out FILE]\n"
+        cio.out << "usage: plate fixed-points SCENE [grid options as for field] [--out FILE]\n"
                      "Computes the field, finds cells where every component changes sign, refines the zeros\n"
                      "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
                      "and reports curves of zeros as lines. JSON to stdout or --out FILE.\n";
         return 0;
     }
-    const Scene sc = scene_arg(a);
+    const Scene sc = scene_arg(a, cio);
     FieldOptions fo;
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
@@ -246,18 +255,18 @@ int cmd_fixed_points(int argc, char** argv) {
     FixedPointOptions fpo;
     fpo.cycle = fo.cycle;
     const FixedPoints fp = find_fixed_points(sc, f, fpo);
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; });
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
-int cmd_simulate(int argc, char** argv) {
+int cmd_simulate(int argc, char** argv, Io& cio) {
     const int d = config_arity(argc, argv);
     Args a(argc, argv, merge(with_config({{"--dynamics", 1}, {"--time", 1}, {"--sample", 1}, {"--out", 1},
                                           {"--rtol", 1}},
                                          {"--from", "--twist"}, d),
                              {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}, {"--verify", 0}}));
     if (a.help) {
-        std::cout << "usage: plate simulate SCENE --dynamics full|u|field|auto --from SX SY THETA --time T\n"
+        cio.out << "usage: plate simulate SCENE --dynamics full|u|field|auto --from SX SY THETA --time T\n"
                      "                      [--twist VX VY OMEGA] [--sample DT] [--out FILE] [--rtol X]\n"
                      "Trajectory from configuration --from with part twist --twist relative to the plate\n"
                      "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
@@ -273,7 +282,7 @@ int cmd_simulate(int argc, char** argv) {
                      "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n";
         return 0;
     }
-    const Scene sc = scene_arg(a);
+    const Scene sc = scene_arg(a, cio);
     std::string dyn = a.str("--dynamics", "");
     if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "auto")
         throw UsageError("--dynamics: expected full, u, field or auto");
@@ -300,7 +309,7 @@ int cmd_simulate(int argc, char** argv) {
         Rung picked;
         picked.part = part;
         picked.dynamics = d;
-        std::cerr << "auto model, decided up front (tolerance " << tol << "): picked " << picked.name()
+        cio.err << "auto model, decided up front (tolerance " << tol << "): picked " << picked.name()
                   << " (predicted error " << predicted << ")\n  estimates: |xi| " << est.xi << "/s, point " << est.e_point
                   << ", thin " << est.e_thin << ", eps_U " << est.eps_U << ", transient offset " << est.offset
                   << ", growth " << est.growth() << (est.ok ? "" : " (" + est.note + ")") << "\n";
@@ -323,25 +332,25 @@ int cmd_simulate(int argc, char** argv) {
         const Trajectory ref = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), T, T, io);
         if (ref.stop.reason == StopReason::None && !ref.samples.empty()) {
             const Vec3 dq = tr.samples.back().q - ref.samples.back().q;
-            std::cerr << "  verified against the full model: measured error "
+            cio.err << "  verified against the full model: measured error "
                       << std::max({std::abs(dq[0]) / sc.part.rho(), std::abs(dq[1]) / sc.part.rho(), std::abs(wrap_angle(dq[2]))})
                       << "\n";
         } else {
-            std::cerr << "  verify: the full model stopped: " << ref.stop.describe() << "\n";
+            cio.err << "  verify: the full model stopped: " << ref.stop.describe() << "\n";
         }
     }
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); });
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio.out);
     if (tr.stop.reason != StopReason::None) {
-        std::cerr << "plate simulate: " << a.pos[0] << ": stopped: " << tr.stop.describe() << std::endl;
+        cio.err << "plate simulate: " << a.pos[0] << ": stopped: " << tr.stop.describe() << std::endl;
         return tr.stop.reason == StopReason::ContactLost ? 3 : 1;
     }
     return 0;
 }
 
-int cmd_random_scene(int argc, char** argv) {
+int cmd_random_scene(int argc, char** argv, Io& cio) {
     Args a(argc, argv, {{"--seed", 1}, {"--thin", 0}, {"--point", 0}, {"--out", 1}});
     if (a.help) {
-        std::cout << "usage: plate random-scene --seed N [--thin | --point] [--out FILE]\n"
+        cio.out << "usage: plate random-scene --seed N [--thin | --point] [--out FILE]\n"
                      "A random part (thick by default) and a random plate motion (harmonics 1-2 on every axis,\n"
                      "vertical acceleration kept below 0.6 g within 3 cm of the centre), reproducible by seed.\n";
         return 0;
@@ -353,7 +362,7 @@ int cmd_random_scene(int argc, char** argv) {
     ro.point = a.has("--point");
     if (ro.thin && ro.point) throw UsageError("--thin and --point exclude each other");
     const Scene sc = random_scene(static_cast<std::uint64_t>(a.integer("--seed", 0, 0, 1L << 62)), ro);
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << scene_to_json(sc).dump(2) << "\n"; });
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << scene_to_json(sc).dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
@@ -387,10 +396,10 @@ nlohmann::json contraction_json(const proofs::ContractionSummary& s) {
     return j;
 }
 
-int cmd_proofs(int argc, char** argv) {
+int cmd_proofs(int argc, char** argv, Io& cio) {
     Args a(argc, argv, {{"--thin", 1}, {"--thick", 1}, {"--surfaces", 1}, {"--seed", 1}, {"--threads", 1}, {"--out", 1}});
     if (a.help) {
-        std::cout << "usage: plate proofs [--thin N] [--thick M] [--surfaces K] [--seed S] [--threads T] [--out FILE]\n"
+        cio.out << "usage: plate proofs [--thin N] [--thick M] [--surfaces K] [--seed S] [--threads T] [--out FILE]\n"
                      "Numerical checks of Theorem 1 on seeded random parts and plate motions: Lyapunov contraction\n"
                      "of the relative twist against its integration-error bound, convergence, uniqueness of the\n"
                      "cycle from further initial twists, Floquet multipliers (N thin parts, default 10000; M thick\n"
@@ -432,14 +441,14 @@ int cmd_proofs(int argc, char** argv) {
         j["conditioning_of_A"].push_back({{"e_over_L", cs.e_over_L}, {"max_condition", c.max_condition},
                                           {"min_singular_over_max", c.min_singular}});
     }
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
-int cmd_report(int argc, char** argv) {
+int cmd_report(int argc, char** argv, Io& cio) {
     Args a(argc, argv, {{"--out", 1}, {"--seed", 1}, {"--quick", 0}, {"--threads", 1}, {"--source", 1}});
     if (a.help) {
-        std::cout << "usage: plate report --out DIR [--quick] [--seed S] [--threads T] [--source ROOT]\n"
+        cio.out << "usage: plate report --out DIR [--quick] [--seed S] [--threads T] [--source ROOT]\n"
                      "Writes DIR/index.html and its figures: the derivation and its findings, kernel equivalence,\n"
                      "Theorem 1 checks (10^4 thin, 10^3 thick parts; --quick: a few), limit surfaces, Fig. 3, and the\n"
                      "paper's fields with full-dynamics trajectories and fixed-point tables. ROOT: the project folder\n"
@@ -455,14 +464,14 @@ int cmd_report(int argc, char** argv) {
     o.quick = a.has("--quick");
     o.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
     report::write_report(o);
-    std::cerr << "report: " << o.out << "/index.html" << std::endl;
+    cio.err << "report: " << o.out << "/index.html" << std::endl;
     return 0;
 }
 
-int cmd_bench(int argc, char** argv) {
+int cmd_bench(int argc, char** argv, Io& cio) {
     Args a(argc, argv, {{"--out", 1}, {"--full", 0}, {"--source", 1}});
     if (a.help) {
-        std::cout << "usage: plate bench --out DIR [--full] [--source ROOT]\n"
+        cio.out << "usage: plate bench --out DIR [--full] [--source ROOT]\n"
                      "The speed-accuracy study: work-precision charts (every method and friction treatment on (a) an\n"
                      "asymptotic twist of fig4, (b) fig4's 20 s full-dynamics trajectory, (c) a near-sticking twist of\n"
                      "fig6) against reference solutions; the limit-cycle solvers on fig4's field against period-by-\n"
@@ -478,37 +487,40 @@ int cmd_bench(int argc, char** argv) {
     o.source_dir = a.str("--source", PLATE_SOURCE_DIR);
     o.full = a.has("--full");
     report::write_speed_study(o);
-    std::cerr << "bench: " << o.out << "/index.html" << std::endl;
+    cio.err << "bench: " << o.out << "/index.html" << std::endl;
     return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
+    Io cio{out, err};
     if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-        std::cout << kUsage;
+        cio.out << kUsage;
         return argc < 2 ? 2 : 0;
     }
     const std::string cmd = argv[1];
     try {
-        if (cmd == "twist") return cmd_twist(argc - 2, argv + 2);
-        if (cmd == "field") return cmd_field(argc - 2, argv + 2);
-        if (cmd == "fixed-points") return cmd_fixed_points(argc - 2, argv + 2);
-        if (cmd == "simulate") return cmd_simulate(argc - 2, argv + 2);
-        if (cmd == "random-scene") return cmd_random_scene(argc - 2, argv + 2);
-        if (cmd == "proofs") return cmd_proofs(argc - 2, argv + 2);
-        if (cmd == "report") return cmd_report(argc - 2, argv + 2);
-        if (cmd == "bench") return cmd_bench(argc - 2, argv + 2);
-        std::cerr << "plate: unknown command '" << cmd << "'\n" << kUsage;
+        if (cmd == "twist") return cmd_twist(argc - 2, argv + 2, cio);
+        if (cmd == "field") return cmd_field(argc - 2, argv + 2, cio);
+        if (cmd == "fixed-points") return cmd_fixed_points(argc - 2, argv + 2, cio);
+        if (cmd == "simulate") return cmd_simulate(argc - 2, argv + 2, cio);
+        if (cmd == "random-scene") return cmd_random_scene(argc - 2, argv + 2, cio);
+        if (cmd == "proofs") return cmd_proofs(argc - 2, argv + 2, cio);
+        if (cmd == "report") return cmd_report(argc - 2, argv + 2, cio);
+        if (cmd == "bench") return cmd_bench(argc - 2, argv + 2, cio);
+        cio.err << "plate: unknown command '" << cmd << "'\n" << kUsage;
         return 2;
     } catch (const InputError& e) {
-        std::cerr << "plate " << cmd << ": " << e.what() << std::endl;
+        cio.err << "plate " << cmd << ": " << e.what() << std::endl;
         return 2;
     } catch (const UsageError& e) {
-        std::cerr << "plate " << cmd << ": " << e.what() << " (see plate " << cmd << " --help)" << std::endl;
+        cio.err << "plate " << cmd << ": " << e.what() << " (see plate " << cmd << " --help)" << std::endl;
         return 2;
     } catch (const std::exception& e) {
-        std::cerr << "plate " << cmd << ": error: " << e.what() << std::endl;
+        cio.err << "plate " << cmd << ": error: " << e.what() << std::endl;
         return 1;
     }
 }
+
+}  // namespace plate::cli
