@@ -20,6 +20,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,15 @@ struct Io {
     std::ostream& out;
     std::ostream& err;
 };
+
+constexpr double kMaxRows = 1e7;   // rows of a trajectory CSV
+
+std::string fmt(double x) {
+    std::ostringstream s;
+    s.precision(3);
+    s << x;
+    return s.str();
+}
 
 const char* kUsage =
     "plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch)\n"
@@ -152,6 +162,7 @@ LimitCycleOptions cycle_opts(const Args& a) {
     o.tol = a.num("--tol", 0, o.tol);
     o.integration.rtol = a.num("--rtol", 0, o.integration.rtol);
     o.max_periods = static_cast<int>(a.integer("--max-periods", o.max_periods, 2, 100000));
+    o.max_rhs_evaluations = a.integer("--max-rhs", o.max_rhs_evaluations, 1000, 1'000'000'000'000L);
     if (a.has("--cycle-solver")) {
         try {
             o.solver = parse_cycle_solver(a.str("--cycle-solver", ""));
@@ -164,7 +175,8 @@ LimitCycleOptions cycle_opts(const Args& a) {
     return o;
 }
 
-const std::map<std::string, int> kCycleOpts = {{"--tol", 1}, {"--rtol", 1}, {"--max-periods", 1}, {"--cycle-solver", 1}};
+const std::map<std::string, int> kCycleOpts = {{"--tol", 1}, {"--rtol", 1}, {"--max-periods", 1}, {"--cycle-solver", 1},
+                                               {"--max-rhs", 1}};
 const std::map<std::string, int> kGridOpts = {{"--grid", 1}, {"--nx", 1}, {"--ny", 1}, {"--ntheta", 1}, {"--x", 2},
                                               {"--y", 2}, {"--theta0", 1}, {"--threads", 1}};
 
@@ -197,7 +209,8 @@ int cmd_twist(int argc, char** argv, Io& cio) {
                      "Asymptotic twist (36) of the reduced U-dynamics limit cycle at (SX, SY, THETA), starting\n"
                      "from the part twist --from (default: at rest relative to the plate). Point parts: --at SX SY.\n"
                      "--tol: accepted distance to the cycle relative to the slip-speed scale (default 1e-7);\n"
-                     "--rtol: integrator tolerance (default 1e-8); --max-periods (default 400).\n";
+                     "--rtol: integrator tolerance (default 1e-8); --max-periods (default 400); --max-rhs: the work\n"
+                     "budget of the cycle in right-hand sides (default 2e7, about 3 s; then stop: step_limit).\n";
         return 0;
     }
     const Scene sc = scene_arg(a, cio);
@@ -264,7 +277,7 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
     Args a(argc, argv, merge(with_config({{"--dynamics", 1}, {"--time", 1}, {"--sample", 1}, {"--out", 1},
                                           {"--rtol", 1}},
                                          {"--from", "--twist"}, d),
-                             {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}, {"--verify", 0}}));
+                             {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}, {"--verify", 0}, {"--max-steps", 1}}));
     if (a.help) {
         cio.out << "usage: plate simulate SCENE --dynamics full|u|field|auto --from SX SY THETA --time T\n"
                      "                      [--twist VX VY OMEGA] [--sample DT] [--out FILE] [--rtol X]\n"
@@ -279,7 +292,10 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
                      "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
                      "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05), and the contact mode on the\n"
                      "step that ended there (slide, pivot1-3, stuck: stick-slip is simulated through). Exit code 3\n"
-                     "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n";
+                     "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n"
+                     "--max-steps N: the work budget (integrator steps; for field, RK4 steps of the curve; default\n"
+                     "2e7, field 1e4). The work is estimated up front from one plate period (or one RK4 step) and a\n"
+                     "run that would exceed the budget is refused with the estimate (exit 2); at most 10^7 rows.\n";
         return 0;
     }
     const Scene sc = scene_arg(a, cio);
@@ -320,6 +336,43 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
         throw UsageError("--verify goes with --dynamics auto");
     }
     const Scene& sc_run = used;
+    // Bounded work (issue 18): rows, then the steps extrapolated from one period (one RK4 step of a
+    // field curve) run first, against the budget.
+    const double rows = std::ceil(T / dt) + 1;
+    if (rows > kMaxRows)
+        throw UsageError("--time / --sample give " + fmt(rows) + " rows, above the limit of " + fmt(kMaxRows) +
+                         ": sample less often");
+    const bool field_dyn = dyn == "field";
+    const long budget = a.integer("--max-steps", field_dyn ? 10'000 : io.max_steps, 1, 1'000'000'000'000L);
+    io.max_steps = budget;
+    {
+        const auto t0 = std::chrono::steady_clock::now();
+        double steps = 0, pilot_steps = 0;
+        std::string what;
+        if (field_dyn) {
+            // RK4 steps of 0.05 s, and at least one per sample.
+            LimitCycleOptions lo;
+            lo.tol = a.num("--tol", 0, lo.tol);
+            const double h = std::min(0.05, dt), span = std::min(T, h);
+            const Trajectory pilot = field_curve(sc_run, q0, span, span, lo);
+            pilot_steps = 1;
+            steps = std::ceil(T / h);
+            what = fmt(steps) + " RK4 steps of the field curve (one per 0.05 s, and per --sample)";
+        } else {
+            const double span = std::min(T, sc_run.plate.T);
+            const Trajectory pilot =
+                simulate(sc_run, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, span, span, io);
+            pilot_steps = std::max<double>(pilot.stats.steps, 1);
+            steps = pilot_steps * T / span;
+            what = fmt(steps) + " integrator steps (" + fmt(T / sc_run.plate.T) + " plate periods at " + fmt(pilot_steps) +
+                   " steps each)";
+        }
+        const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (steps > budget)
+            throw UsageError("--time " + fmt(T) + " s would take about " + what + ", about " +
+                             fmt(secs / pilot_steps * steps) + " s here, above the budget of " +
+                             fmt(static_cast<double>(budget)) + " steps: raise it with --max-steps or shorten --time");
+    }
     if (dyn == "field") {
         if (!qd0.isZero()) throw UsageError("--twist has no meaning for --dynamics field");
         LimitCycleOptions lo;

@@ -391,7 +391,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             auto t = c.data(n + "_traj.dat");
             for (const auto& s : tr.samples) t << s.q[0] << ' ' << s.q[1] << ' ' << wrap_angle(s.q[2]) << '\n';
         }
-        c.html << "<h3>" << f.what << " (<code>" << n << "</code>)</h3>\n<p>Field on " << field.grid.nx << "×" << field.grid.ny
+        c.html << scene_heading(f.what, sc.name, n + ".json") << "\n<p>Field on " << field.grid.nx << "×" << field.grid.ny
                << (pt ? "" : "×" + std::to_string(field.grid.nth)) << " configurations (" << fmt(field.seconds, 3)
                << " s); red: full-dynamics run from rest at (" << f.start[0] << ", " << f.start[1]
                << (pt ? "" : ", " + fmt(f.start[2], 3)) << ") for " << (tr.samples.empty() ? 0.0 : tr.samples.back().t)
@@ -526,6 +526,10 @@ std::string collinear_sentence(const std::vector<double>& conds, const std::vect
     else
         o << "; the two twists' wrenches do not approach each other like e (at least " << shrink << "x per tenth).";
     return o.str();
+}
+
+std::string scene_heading(const std::string& title, const std::string& scene_name, const std::string& file) {
+    return "<h3>" + esc(title) + " (<code>" + esc(scene_name) + "</code>, <code>scenes/" + esc(file) + "</code>)</h3>";
 }
 
 std::string observation1_sentence(int valid, int converged, int unique, int attracting) {

@@ -30,6 +30,10 @@ std::string observation1_sentence(int valid, int converged, int unique, int attr
 // a vertex" only when each tenth of e/L multiplies cond(A) and divides the gap by at least 5.
 std::string collinear_sentence(const std::vector<double>& conds, const std::vector<double>& gaps, double singular);
 
+// The heading of a field's section: the figure's title and the scene's own name (from its file,
+// user text: escaped for HTML, as everything a user supplies that reaches the page).
+std::string scene_heading(const std::string& title, const std::string& scene_name, const std::string& file);
+
 // The speed-accuracy study (`plate bench`): writes its charts into DIR and its section into
 // DIR/index.html (between the report's markers; a page of its own if there is no report yet).
 // Quick by default (minutes); `full` sweeps more settings, solvers and regularisation widths.

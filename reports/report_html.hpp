@@ -28,6 +28,8 @@ inline std::string esc(const std::string& s) {
         if (c == '<') o += "&lt;";
         else if (c == '>') o += "&gt;";
         else if (c == '&') o += "&amp;";
+        else if (c == '"') o += "&quot;";
+        else if (c == '\'') o += "&#39;";
         else o += c;
     }
     return o;

@@ -33,3 +33,11 @@ TEST_CASE("report: the collinear-contacts sentence follows the conditioning and 
     CHECK(flat.find("develops a vertex") == std::string::npos);
     CHECK(flat.find("not singular") != std::string::npos);
 }
+
+TEST_CASE("report: user text reaching the page is escaped (a script in a scene name stays text)", "[report][text]") {
+    const std::string h = plate::report::scene_heading("Fig. 6: rotation", "<script>alert(\"x\")</script>", "a'b.json");
+    CHECK(h.find("<script>") == std::string::npos);
+    CHECK(h.find("&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt;") != std::string::npos);
+    CHECK(h.find("a&#39;b.json") != std::string::npos);
+    CHECK(h.rfind("<h3>Fig. 6: rotation (<code>", 0) == 0);
+}

@@ -109,7 +109,7 @@ public:
         if (stop.reason != StopReason::None) return false;
         const double T = scene_.plate.T;
         while (t_ < t_end) {
-            if (stats.steps >= opt_.max_steps) {
+            if (stats.steps >= opt_.max_steps || stats.rhs_evals >= 10 * opt_.max_steps) {
                 stop = StopEvent{StopReason::StepLimit, -1, t_};
                 return false;
             }

@@ -119,6 +119,10 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
             out.periods = k;
             out.min_normal_force = min_n;
             if (!ok) break;
+            if (e.stats.rhs_evals > opt.max_rhs_evaluations) {
+                e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
+                break;
+            }
             y = e.y();
             const Vec3 qd = model.qd(y);
             out.twist = Vec3(y[3], y[4], y[5]) / T;   // (36)
@@ -395,6 +399,10 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         });
         out.periods = k + 1 + fd_periods;
         if (!ok) break;
+        if (e.stats.rhs_evals + fd_stats.rhs_evals + jws.evals > opt.max_rhs_evaluations) {
+            e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
+            break;
+        }
         const auto z = e.y();
         record_modes(out, e, start_mode, k * T, T);
         const bool switched = start_mode.kind != ModeKind::Slide || !e.events.empty();
@@ -536,7 +544,10 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
 
 }  // namespace
 
-LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt_in, const Vec3& qd0) {
+    // Within one period the engine's own budget applies: no more than the cycle's.
+    LimitCycleOptions opt = opt_in;
+    opt.integration.max_steps = std::min(opt.integration.max_steps, std::max(1L, opt.max_rhs_evaluations / 10));
     if (sc.part.mu.head(sc.part.contacts()).maxCoeff() <= 0) {
         // Without friction q'' = -(p'' + omega1' x s)_xy is periodic with zero mean: every initial
         // twist is periodic and none attracts the others, so the asymptotic twist is undefined.
@@ -559,10 +570,13 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
         LimitCycleSummary fast = shoot ? shooting_cycle(sc, q0, opt, qd0)
                                  : opt.solver == CycleSolver::Newton ? newton_cycle(sc, q0, opt, qd0)
                                                                      : one_start(sc, q0, opt, qd0);
-        if (fast.converged || fast.periods >= opt.max_periods) return fast;   // the cap is for all of it
+        if (fast.converged || fast.periods >= opt.max_periods || fast.stats.rhs_evals >= opt.max_rhs_evaluations ||
+            fast.stop.reason == StopReason::StepLimit)
+            return fast;   // the caps are for all of it
         LimitCycleOptions plain = opt;
         plain.solver = shoot ? CycleSolver::Anderson : CycleSolver::PeriodByPeriod;
         plain.max_periods = opt.max_periods - fast.periods;
+        plain.max_rhs_evaluations = opt.max_rhs_evaluations - fast.stats.rhs_evals;
         LimitCycleSummary out = limit_cycle(sc, q0, plain, qd0);
         out.stats += fast.stats;
         out.periods += fast.periods;
@@ -573,9 +587,11 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     const Vec3 kicks[] = {Vec3(v, 0, 0), Vec3(0, v, 0), Vec3(0, 0, sc.part.point ? 0 : w)};
     std::vector<StopEvent> stops;
     Stats total = out.stats;
-    for (int r = 0; r < std::min(opt.restarts, 3) && out.contact_lost(); ++r) {
+    for (int r = 0; r < std::min(opt.restarts, 3) && out.contact_lost() && total.rhs_evals < opt.max_rhs_evaluations; ++r) {
         stops.push_back(out.stop);
-        out = one_start(sc, q0, opt, r == 2 && sc.part.point ? Vec3(-v, -v, 0) : kicks[r]);
+        LimitCycleOptions rest = opt;
+        rest.max_rhs_evaluations = opt.max_rhs_evaluations - total.rhs_evals;
+        out = one_start(sc, q0, rest, r == 2 && sc.part.point ? Vec3(-v, -v, 0) : kicks[r]);
         total += out.stats;
         out.restarts = r + 1;
     }

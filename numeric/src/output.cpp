@@ -130,16 +130,24 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
 }
 
 void write_field_csv(std::ostream& out, const Field& f) {
-    out << std::setprecision(12);
+    // 17 significant digits (the numbers read back to the same doubles); an undefined twist (no
+    // cycle there: converged = 0, stop says why) is left empty, not "nan".
+    out << std::setprecision(17);
     if (f.point_part) out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop,stick_1\n";
     else out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop,stick_1,stick_2,stick_3\n";
-    auto v = [](double x) { return std::isfinite(x) ? std::to_string(x) : std::string("nan"); };
+    auto v = [](double x) {
+        if (!std::isfinite(x)) return std::string();
+        std::ostringstream s;
+        s.precision(17);
+        s << x;
+        return s.str();
+    };
     for (const auto& p : f.points) {
         out << p.q[0] << ',' << p.q[1] << ',';
         if (!f.point_part) out << p.q[2] << ',';
         out << v(p.twist[0]) << ',' << v(p.twist[1]) << ',';
         if (!f.point_part) out << v(p.twist[2]) << ',';
-        out << (p.converged ? 1 : 0) << ',' << p.periods << ',' << p.residual << ',' << p.min_normal_force << ','
+        out << (p.converged ? 1 : 0) << ',' << p.periods << ',' << v(p.residual) << ',' << v(p.min_normal_force) << ','
             << stop_name(p.stop);
         for (int i = 0; i < (f.point_part ? 1 : 3); ++i) out << ',' << v(p.stick_fraction[i]);
         out << '\n';
@@ -147,15 +155,30 @@ void write_field_csv(std::ostream& out, const Field& f) {
 }
 
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part) {
-    out << std::setprecision(12);
+    // 17 significant digits: the numbers read back to the same doubles. A quantity the dynamics
+    // does not define (the normal forces of a field integral curve) is left empty, not "nan".
+    out << std::setprecision(17);
+    auto num = [&](double x) -> std::ostream& {
+        if (std::isfinite(x)) out << x;
+        return out;
+    };
     if (point_part) out << "t,s_x,s_y,s_x_dot,s_y_dot,N1,mode\n";
     else out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n";
     for (const auto& s : tr.samples) {
-        out << s.t << ',' << s.q[0] << ',' << s.q[1] << ',';
-        if (!point_part) out << s.q[2] << ',';
-        out << s.qd[0] << ',' << s.qd[1] << ',';
-        if (!point_part) out << s.qd[2] << ',' << s.n[0] << ',' << s.n[1] << ',' << s.n[2];
-        else out << s.n[0];
+        num(s.t) << ',';
+        num(s.q[0]) << ',';
+        num(s.q[1]) << ',';
+        if (!point_part) num(s.q[2]) << ',';
+        num(s.qd[0]) << ',';
+        num(s.qd[1]) << ',';
+        if (!point_part) {
+            num(s.qd[2]) << ',';
+            num(s.n[0]) << ',';
+            num(s.n[1]) << ',';
+            num(s.n[2]);
+        } else {
+            num(s.n[0]);
+        }
         out << ',' << mode_name(s.mode) << '\n';
     }
 }

@@ -238,10 +238,24 @@ void validate_scene(const Scene& s) {
             r.fail("part.friction", "friction coefficient " + Reader::fmt(p.mu[i]) + " above " + Reader::fmt(kMaxFriction) +
                                         ": no pair of materials grips that hard (dry contacts lie below ~2)");
     if (!(std::isfinite(s.plate.T) && s.plate.T > 0)) r.fail("plate.period", "expected a positive finite number");
+    // Ranges of the model's world (a rigid part on a rigid plate under Coulomb friction): outside
+    // them the numbers are unit errors or outside the physics, and products such as m g or mu N
+    // would lose the range of a double in the solves.
+    if (s.g > kMaxGravity) r.fail("gravity", Reader::fmt(s.g) + " m/s^2 is above " + Reader::fmt(kMaxGravity) + " m/s^2 (about 100 g)");
+    if (p.m < kMassRange[0] || p.m > kMassRange[1])
+        r.fail("part.mass", Reader::fmt(p.m) + " kg is outside " + Reader::fmt(kMassRange[0]) + " to " +
+                                Reader::fmt(kMassRange[1]) + " kg (a microgram to a thousand tonnes)");
+    if (s.plate.T < kPeriodRange[0] || s.plate.T > kPeriodRange[1])
+        r.fail("plate.period", Reader::fmt(s.plate.T) + " s is outside " + Reader::fmt(kPeriodRange[0]) + " to " +
+                                   Reader::fmt(kPeriodRange[1]) + " s (100 kHz to a thousandth of a hertz): a rigid plate " +
+                                   "under Coulomb friction is not a model of it");
     for (std::size_t k = 0; k < s.plate.harmonics.size(); ++k) {
         const auto& h = s.plate.harmonics[k];
         if (!std::isfinite(h.amp) || !std::isfinite(h.phase) || h.n < 1)
             r.fail("plate.harmonics[" + std::to_string(k) + "]", "expected finite amp and phase, n >= 1");
+        if (std::abs(h.amp) > kMaxAmplitude)
+            r.fail("plate.harmonics[" + std::to_string(k) + "].amp", Reader::fmt(h.amp) + " is above " +
+                                                                         Reader::fmt(kMaxAmplitude) + " (m/s^2 or rad/s^2) in size");
     }
 }
 

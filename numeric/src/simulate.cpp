@@ -36,7 +36,7 @@ std::string StopEvent::describe() const {
         case StopReason::StepCollapse:
             s << "step size collapsed at t = " << t << " s (the method cannot resolve the motion)";
             break;
-        case StopReason::StepLimit: s << "step limit reached at t = " << t << " s"; break;
+        case StopReason::StepLimit: s << "work budget (steps or right-hand sides) spent at t = " << t << " s"; break;
         case StopReason::NotConverged: s << "limit cycle not converged within the period cap"; break;
         case StopReason::EventAccumulation:
             s << "contact modes change without end at t = " << t << " s (an accumulation point of events)";

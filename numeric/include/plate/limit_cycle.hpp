@@ -51,6 +51,9 @@ struct LimitCycleOptions {
     int restarts = 3;
     CycleSolver solver = CycleSolver::Shooting;   // the fastest on fig4's field (plate bench)
     int anderson_memory = 3;
+    // The work budget of one cycle, all its periods, restarts and fallbacks together: right-hand
+    // sides (a cycle takes 10^3 to 10^5; 2e7 is about 3 s). Then StepLimit ("work budget").
+    long max_rhs_evaluations = 20'000'000;
 };
 
 struct LimitCycleSummary {

@@ -27,6 +27,8 @@ struct IntegrationOptions {
     double h_min = 1e-12;      // smallest step, relative to the period T
     double h0 = 0;             // first step, relative to T; 0: a small one from rtol (a neighbouring
                                // run's LimitCycleSummary::step_hint saves the ramp-up)
+    // The work budget of one run: accepted steps, and right-hand sides (rejected tries, event
+    // location, creep solves) at ten per step; then StepLimit.
     long max_steps = 20'000'000;
 };
 

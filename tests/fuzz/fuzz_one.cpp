@@ -1,0 +1,133 @@
+#include "fuzz_one.hpp"
+
+#include "cli.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+#include <vector>
+
+namespace plate::fuzz {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string* g_input = nullptr;   // for the messages of a failed check (and the alarm)
+
+[[noreturn]] void fail(const std::string& why, const std::string& detail) {
+    std::fprintf(stderr, "\nfuzz check failed: %s\n%s\n--- input ---\n%s\n--- end ---\n", why.c_str(), detail.c_str(),
+                 g_input ? g_input->c_str() : "");
+    std::abort();
+}
+
+extern "C" void on_alarm(int) {
+    static const char msg[] = "\nfuzz check failed: hang (no result within the time limit); the input follows\n";
+    ssize_t w = ::write(2, msg, sizeof msg - 1);
+    if (g_input) w = ::write(2, g_input->data(), g_input->size());
+    (void)w;
+    std::abort();
+}
+
+const fs::path& workdir() {
+    static const fs::path d = [] {
+        fs::path p = fs::temp_directory_path() / ("plate_fuzz_" + std::to_string(::getpid()));
+        fs::create_directories(p);
+        std::signal(SIGALRM, on_alarm);
+        return p;
+    }();
+    return d;
+}
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+bool number(const std::string& s, double& x) {
+    char* end = nullptr;
+    x = std::strtod(s.c_str(), &end);
+    return !s.empty() && *end == '\0';
+}
+
+}  // namespace
+
+Outcome run_one(const std::string& input) {
+    Outcome o;
+    g_input = &input;
+    const std::size_t nl = input.find('\n');
+    std::istringstream line(input.substr(0, nl));
+    const std::string scene_text = nl == std::string::npos ? std::string() : input.substr(nl + 1);
+    std::vector<std::string> args;
+    for (std::string t; line >> t;) args.push_back(t);
+    static const std::set<std::string> commands = {"twist", "field", "fixed-points", "simulate", "random-scene"};
+    if (args.empty() || !commands.count(args[0]) || args.size() > 40) return o;
+    const fs::path scene = workdir() / "scene.json", out = workdir() / "out";
+    bool help = false, has_grid = false, has_periods = false;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        std::string& a = args[i];
+        if (a.find('/') != std::string::npos) return o;
+        if (a == "SCENE") a = scene.string();
+        if (a == "OUT") a = out.string();
+        help |= a == "--help" || a == "-h";
+        has_grid |= a == "--grid";
+        has_periods |= a == "--max-periods";
+        if (i == 0) continue;
+        double x = 0;
+        const std::string& k = args[i - 1];
+        if (!number(a, x)) continue;
+        if ((k == "--grid" || k == "--nx" || k == "--ny" || k == "--ntheta") && x > 3) return o;
+        if (k == "--max-periods" && x > 40) return o;
+        if (k == "--time" && x > 0.5) return o;
+        if (k == "--threads" && (x > 2 || x == 0)) return o;
+    }
+    if ((args[0] == "field" || args[0] == "fixed-points") && !has_grid) args.insert(args.begin() + 1, {"--grid", "2"});
+    if ((args[0] == "twist" || args[0] == "field" || args[0] == "fixed-points") && !has_periods)
+        args.insert(args.begin() + 1, {"--max-periods", "40"});
+    for (const fs::path& p : {scene, out, fs::path(out.string() + ".tmp")}) fs::remove(p);
+    std::ofstream(scene, std::ios::binary) << scene_text;
+
+    std::vector<std::string> argv_s = {"plate"};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& s : argv_s) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    std::ostringstream so, se;
+    ::alarm(kSecondsPerInput);
+    o.code = cli::run(static_cast<int>(argv_s.size()), argv.data(), so, se);
+    ::alarm(0);
+    o.verdict = Verdict::Ran;
+
+    const std::string err = se.str();
+    std::string detail = "exit " + std::to_string(o.code) + "; stderr:\n" + err;
+    if (o.code < 0 || o.code > 3) fail("exit code outside 0-3", detail);
+    // A failure ends with the program's own message (warnings may come before it).
+    const std::size_t last = err.find_last_of('\n', err.size() >= 2 ? err.size() - 2 : 0);
+    const std::string last_line = err.substr(last == std::string::npos ? 0 : last + 1);
+    if (o.code != 0 && last_line.rfind("plate ", 0) != 0) fail("a failure without the program's message", detail);
+    if (fs::exists(out.string() + ".tmp")) fail("a temporary output left behind", detail);
+    if (o.code == 2 && fs::exists(out)) fail("an output file left after bad input", detail);
+    if (o.code == 0 && !help) {
+        static const std::regex nonfinite(R"((^|[^A-Za-z_])-?(nan|inf|infinity)([^A-Za-z_]|$))", std::regex::icase);
+        const std::string file = fs::exists(out) ? slurp(out) : std::string(), printed = so.str();
+        for (const std::string* text : {&printed, &file})
+            if (std::regex_search(*text, nonfinite)) fail("NaN or Inf in the output of a run that exited 0", detail + "\noutput:\n" + text->substr(0, 2000));
+        for (const std::string* text : {&printed, &file}) {
+            if (text->empty() || ((*text)[0] != '{' && (*text)[0] != '[')) continue;
+            if (!nlohmann::json::accept(*text)) fail("malformed JSON output", detail);
+        }
+    }
+    g_input = nullptr;
+    return o;
+}
+
+}  // namespace plate::fuzz
