@@ -74,6 +74,8 @@ TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
         {"{ \"name\": ", "bad.json:1:"},                                                      // malformed
         {replace(kGood, "\"gravity\": 9.81,", ""), "gravity: missing"},                        // missing
         {replace(kGood, "\"name\": \"t\",", "\"name\": \"t\", \"colour\": 1,"), "colour: unknown field"},
+        // a control character in a field name is escaped: the message stays on one line (found by the fuzzer)
+        {replace(kGood, "\"name\": \"t\",", "\"name\": \"t\", \"col\\nour\": 1,"), "col\\nour: unknown field"},
         {replace(kGood, "\"mass\": 0.0216", "\"mass\": -1"), "part.mass: expected a positive number"},
         {replace(kGood, "\"mass\": 0.0216", "\"mass\": 0"), "part.mass: expected a positive number"},
         {replace(kGood, "[0, 0, 1.20e-5]]", "[0, 0, 1.20e-5], [1, 2, 3]]"), "part.inertia: expected a 3x3"},

@@ -16,7 +16,24 @@ struct Reader {
     std::string source;
 
     [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-        throw InputError(source + ": " + field + ": " + what);
+        throw InputError(source + ": " + printable(field) + ": " + what);
+    }
+    // A field name as typed, control characters escaped (a message stays on one line).
+    static std::string printable(const std::string& s) {
+        std::string o;
+        for (unsigned char c : s) {
+            if (c == '\n') o += "\\n";
+            else if (c == '\t') o += "\\t";
+            else if (c < 0x20 || c == 0x7f) {
+                static const char* hex = "0123456789abcdef";
+                o += "\\x";
+                o += hex[c >> 4];
+                o += hex[c & 15];
+            } else {
+                o += static_cast<char>(c);
+            }
+        }
+        return o;
     }
 
     void only_keys(const json& obj, const std::string& field, const std::set<std::string>& allowed,
