@@ -469,6 +469,9 @@ void write_report(const ReportOptions& opt) {
     Ctx c;
     c.dir = opt.out;
     fs::create_directories(c.dir / "data");
+    // The page appears complete or not at all: an older page goes first (a killed run must not leave it
+    // beside new figures), the new one is written to a temporary and renamed at the end.
+    fs::remove(c.dir / "index.html");
     const fs::path src = opt.source_dir;
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream body;
@@ -488,7 +491,7 @@ void write_report(const ReportOptions& opt) {
                 "<script src=\"katex/contrib/auto-render.js\"></script><script>document.addEventListener('DOMContentLoaded',"
                 "function(){renderMathInElement(document.body,{delimiters:[{left:'$$',right:'$$',display:true}],throwOnError:false});});</script>\n";
     }
-    std::ofstream html(c.dir / "index.html");
+    std::ostringstream html;
     html << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: verification report</title>\n" << kStyle << katex
          << "</head><body>\n<h1>Sliding manipulation on a 6-DoF plate: verification report</h1>\n";
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
@@ -503,7 +506,7 @@ void write_report(const ReportOptions& opt) {
     else html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
               << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
     html << kSpeedEnd << "\n" << kImageCheck << "</body></html>\n";
-    if (!html) throw std::runtime_error((c.dir / "index.html").string() + ": write failed");
+    write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
 }
 
 std::string collinear_sentence(const std::vector<double>& conds, const std::vector<double>& gaps, double singular) {

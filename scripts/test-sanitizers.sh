@@ -2,15 +2,19 @@
 # The C++ tests under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/), a named
 # representative subset so that CI stays well under its budget: the stick-slip engine and its
 # modes, the Theorem 1 checks, the generated kernels, limit cycles, the a-priori model choice and
-# the fields. Any sanitizer report fails the run (halt_on_error; UBSan made fatal).
+# the fields; then the fuzz target's replay. Any sanitizer report fails the run (halt_on_error; UBSan
+# made fatal).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # -O1 -g1: line tables for the reports, less to compile than -O2 -g (the stage took 13 of CI's 18 minutes)
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" -DPLATE_SANITIZE=ON >/dev/null
-cmake --build build-asan -j"$(nproc)" --target plate_tests plate
+cmake --build build-asan -j"$(nproc)" --target plate_tests plate plate_fuzz_replay
 export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 for tags in "[stick]" "[proofs]" "[kernels]" "[limit_cycle]" "[auto]" "[field]"; do
   echo "sanitizers: $tags" >&2
   build-asan/tests/plate_tests "$tags"
 done
+# The fuzz target's replay: the committed corpus and 10^4 new seeded mutants (tests/fuzz/).
+echo "sanitizers: fuzz replay" >&2
+build-asan/tests/plate_fuzz_replay tests/fuzz/corpus --mutants 10000 --seed 1

@@ -273,3 +273,46 @@ TEST_CASE("a scene outside the intended regime runs with a warning on stderr", "
     CHECK(nlohmann::json::parse(r.out).contains("twist"));
     CHECK(run("twist " + kScenes + "fig4.json --at 0 0 0").err.empty());   // the shipped scene: none
 }
+
+TEST_CASE("a long command interrupted mid-way leaves no output that looks complete", "[cli][atomic]") {
+    // Each command below runs for well over 5 s on this machine; it is stopped after 1.5 s by SIGTERM
+    // (the program removes its temporary and dies of the signal) and by SIGKILL (nothing can run:
+    // the final name must still not exist; a temporary keeps its .tmp name). The exit status shows
+    // the command was stopped rather than finished (timeout's 124 or 137), else the check proves nothing.
+    const fs::path d = tmpdir() / "killed";
+    fs::create_directories(d);
+    struct Job {
+        std::string args;
+        fs::path result;
+    };
+    const Job jobs[] = {
+        {"field " + kScenes + "fig6.json --grid 21 --out " + (d / "field.json").string(), d / "field.json"},
+        {"fixed-points " + kScenes + "fig6.json --grid 21 --out " + (d / "fp.json").string(), d / "fp.json"},
+        {"simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 2000 --out " +
+             (d / "traj.csv").string(), d / "traj.csv"},
+        {"proofs --out " + (d / "proofs.json").string(), d / "proofs.json"},
+        {"report --quick --out " + (d / "report").string(), d / "report" / "index.html"},
+    };
+    for (const char* sig : {"TERM", "KILL"}) {
+        for (const Job& j : jobs) {
+            fs::remove(j.result);
+            fs::remove(j.result.string() + ".tmp");
+            const std::string cmd = std::string("timeout -s ") + sig + " 1.5 " + PLATE_EXE + " " + j.args +
+                                    " > /dev/null 2> " + (tmpdir() / "stderr").string();
+            const int st = std::system(cmd.c_str());
+            const int code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+            INFO(sig << ": " << j.args << " -> " << code);
+            REQUIRE((code == 124 || code == 137));
+            CHECK_FALSE(fs::exists(j.result));
+            if (std::string(sig) == "TERM") CHECK_FALSE(fs::exists(j.result.string() + ".tmp"));
+        }
+    }
+    // A report killed after an earlier one completed does not leave the old page beside new figures.
+    REQUIRE(run("report --quick --out " + (d / "report").string()).code == 0);
+    REQUIRE(fs::exists(d / "report" / "index.html"));
+    const std::string cmd = std::string("timeout -s KILL 1.5 ") + PLATE_EXE + " report --quick --out " + (d / "report").string() +
+                            " > /dev/null 2>&1";
+    const int st = std::system(cmd.c_str());
+    REQUIRE((WIFEXITED(st) && WEXITSTATUS(st) == 137));
+    CHECK_FALSE(fs::exists(d / "report" / "index.html"));
+}

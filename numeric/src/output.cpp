@@ -1,6 +1,9 @@
 #include "plate/output.hpp"
 
 #include <cmath>
+#include <csignal>
+#include <cstring>
+#include <unistd.h>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -206,6 +209,23 @@ std::string machine_description() {
     return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
+namespace {
+// The temporary of the write in progress, for the interrupt handler (one at a time: the program's
+// outputs are written from its main thread).
+char g_tmp[4096];
+volatile std::sig_atomic_t g_has_tmp = 0;
+
+extern "C" void remove_tmp_and_die(int sig) {
+    if (g_has_tmp) ::unlink(g_tmp);
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+}
+}  // namespace
+
+void install_interrupt_cleanup() {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, remove_tmp_and_die);
+}
+
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write,
                        std::ostream& standard_output) {
     if (path == "-") {
@@ -214,6 +234,15 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
         return;
     }
     const std::string tmp = path + ".tmp";
+    const bool tracked = tmp.size() < sizeof g_tmp;
+    if (tracked) {
+        std::memcpy(g_tmp, tmp.c_str(), tmp.size() + 1);
+        g_has_tmp = 1;
+    }
+    struct Untrack {
+        bool on;
+        ~Untrack() { if (on) g_has_tmp = 0; }
+    } untrack{tracked};
     try {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         if (!out) throw std::runtime_error(path + ": cannot open for writing");

@@ -37,5 +37,9 @@ std::string machine_description();
 // temporary is removed and the exception rethrown. path "-" writes to `standard_output`.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write,
                        std::ostream& standard_output = std::cout);
+// For programs (apps/main.cpp), not libraries: on SIGINT, SIGTERM or SIGHUP remove the temporary of
+// a write_file_atomic in progress, then die of the signal. (SIGKILL leaves the temporary, under its
+// .tmp name: nothing that looks complete.)
+void install_interrupt_cleanup();
 
 }  // namespace plate
