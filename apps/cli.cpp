@@ -221,15 +221,35 @@ int cmd_twist(int argc, char** argv, Io& cio) {
     return 0;
 }
 
+// Bounded work for a field (issue 18): one cycle at the grid's centre from rest, run first; the field
+// costs about half of it per configuration (warm starts), and a field over the budget --max-work
+// (right-hand sides, default 2e9: minutes on two cores) is refused with the estimate.
+void check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, const Args& a) {
+    const long budget = a.integer("--max-work", 2'000'000'000L, 1000, 1'000'000'000'000'000L);
+    const auto t0 = std::chrono::steady_clock::now();
+    const Vec3 centre((g.x0 + g.x1) / 2, (g.y0 + g.y1) / 2, g.th0);
+    const LimitCycleSummary pilot = limit_cycle(sc, centre, lo);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double per = 0.5 * std::max<double>(pilot.stats.rhs_evals, 1), n = static_cast<double>(g.size());
+    if (per * n > static_cast<double>(budget))
+        throw UsageError("a " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" + std::to_string(g.nth) +
+                         " grid would take about " + fmt(per * n) + " right-hand sides (" + fmt(per) +
+                         " per configuration, from one cycle at the grid's centre: about " + fmt(0.5 * secs * n) +
+                         " s on one core here), above the budget of " + fmt(static_cast<double>(budget)) +
+                         ": raise it with --max-work or use a coarser grid");
+}
+
 int cmd_field(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--format", 1}, {"--out", 1}}));
+    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--format", 1}, {"--out", 1}, {"--max-work", 1}}));
     if (a.help) {
         cio.out << "usage: plate field SCENE [--grid N] [--nx N] [--ny N] [--ntheta N] [--x MIN MAX]\n"
                      "                   [--y MIN MAX] [--theta0 T] [--format json|csv] [--out FILE]\n"
                      "                   [--threads N] [--tol X] [--rtol X] [--max-periods N]\n"
                      "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.05,0.05]^2 m x [0, 2pi)),\n"
                      "theta covering a full turn. Point parts: asymptotic velocity field on (s_x, s_y).\n"
-                     "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n";
+                     "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n"
+                     "--max-work N: the budget in right-hand sides (default 2e9); the work is estimated up front\n"
+                     "from one cycle and a larger field is refused with the estimate (exit 2).\n";
         return 0;
     }
     const Scene sc = scene_arg(a, cio);
@@ -239,6 +259,7 @@ int cmd_field(int argc, char** argv, Io& cio) {
     FieldOptions fo;
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+    check_field_work(sc, g, fo.cycle, a);
     ProgressPrinter prog{"field"};
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
@@ -250,21 +271,23 @@ int cmd_field(int argc, char** argv, Io& cio) {
 }
 
 int cmd_fixed_points(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--out", 1}}));
+    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--out", 1}, {"--max-work", 1}}));
     if (a.help) {
         cio.out << "usage: plate fixed-points SCENE [grid options as for field] [--out FILE]\n"
                      "Computes the field, finds cells where every component changes sign, refines the zeros\n"
                      "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
-                     "and reports curves of zeros as lines. JSON to stdout or --out FILE.\n";
+                     "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field.\n";
         return 0;
     }
     const Scene sc = scene_arg(a, cio);
     FieldOptions fo;
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+    const GridSpec g = grid_opts(a);
+    check_field_work(sc, g, fo.cycle, a);   // (the refinement has its own budget, FixedPointOptions)
     ProgressPrinter prog{"field"};
     fo.progress = std::ref(prog);
-    const Field f = compute_field(sc, grid_opts(a), fo);
+    const Field f = compute_field(sc, g, fo);
     FixedPointOptions fpo;
     fpo.cycle = fo.cycle;
     const FixedPoints fp = find_fixed_points(sc, f, fpo);

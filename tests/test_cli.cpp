@@ -316,3 +316,28 @@ TEST_CASE("a long command interrupted mid-way leaves no output that looks comple
     REQUIRE((WIFEXITED(st) && WEXITSTATUS(st) == 137));
     CHECK_FALSE(fs::exists(d / "report" / "index.html"));
 }
+
+TEST_CASE("bounded work: a run over its budget is refused up front with the estimate, or stops with the reason",
+          "[cli][budget]") {
+    const std::string f1 = kScenes + "fig1.json", f6 = kScenes + "fig6.json";
+    // 10^6 s of fig1 is 2e7 plate periods of ~100 steps: ~2e9 steps against the default 2e7.
+    Run r = run("simulate " + f1 + " --dynamics full --from -0.04 0.03 1.2 --time 1e6 --sample 1e3");
+    CHECK(r.code == 2);
+    CHECK(r.err.find("plate periods") != std::string::npos);
+    CHECK(r.err.find("raise it with --max-steps") != std::string::npos);
+    // ... and the same run with a budget that allows it is not refused up front (1 s: 20 periods).
+    CHECK(run("simulate " + f1 + " --dynamics full --from -0.04 0.03 1.2 --time 1 --max-steps 100000").code == 0);
+    CHECK(run("simulate " + f1 + " --dynamics full --from -0.04 0.03 1.2 --time 1 --max-steps 100").code == 2);
+    r = run("simulate " + f1 + " --dynamics u --from 0 0 0 --time 1 --sample 1e-8");
+    CHECK(r.code == 2);
+    CHECK(r.err.find("rows, above the limit") != std::string::npos);
+    r = run("field " + f6 + " --grid 201");
+    CHECK(r.code == 2);
+    CHECK(r.err.find("raise it with --max-work") != std::string::npos);
+    // A cycle whose budget is spent says so (fig6 at a pivoting configuration needs ~10^4 right-hand sides).
+    r = run("twist " + f6 + " --at 0.05 -0.0333 0.898 --max-rhs 2000");
+    CHECK(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["converged"] == false);
+    CHECK(j["stop"] == "step_limit");
+}
