@@ -276,7 +276,8 @@ int cmd_fixed_points(int argc, char** argv, Io& cio) {
         cio.out << "usage: plate fixed-points SCENE [grid options as for field] [--out FILE]\n"
                      "Computes the field, finds cells where every component changes sign, refines the zeros\n"
                      "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
-                     "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field.\n";
+                     "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field;\n"
+                     "the refinement's own budget is the smaller of it and 2e7 right-hand sides.\n";
         return 0;
     }
     const Scene sc = scene_arg(a, cio);
@@ -290,6 +291,7 @@ int cmd_fixed_points(int argc, char** argv, Io& cio) {
     const Field f = compute_field(sc, g, fo);
     FixedPointOptions fpo;
     fpo.cycle = fo.cycle;
+    if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.integer("--max-work", 0, 1000, 1'000'000'000'000'000L));
     const FixedPoints fp = find_fixed_points(sc, f, fpo);
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
     return 0;

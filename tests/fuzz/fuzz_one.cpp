@@ -72,7 +72,7 @@ Outcome run_one(const std::string& input) {
     static const std::set<std::string> commands = {"twist", "field", "fixed-points", "simulate", "random-scene"};
     if (args.empty() || !commands.count(args[0]) || args.size() > 40) return o;
     const fs::path scene = workdir() / "scene.json", out = workdir() / "out";
-    bool help = false, has_grid = false, has_periods = false;
+    bool help = false, has_grid = false, has_periods = false, has_rhs = false, has_work = false, has_steps = false;
     for (std::size_t i = 0; i < args.size(); ++i) {
         std::string& a = args[i];
         if (a.find('/') != std::string::npos) return o;
@@ -81,18 +81,25 @@ Outcome run_one(const std::string& input) {
         help |= a == "--help" || a == "-h";
         has_grid |= a == "--grid";
         has_periods |= a == "--max-periods";
+        has_rhs |= a == "--max-rhs";
+        has_work |= a == "--max-work";
+        has_steps |= a == "--max-steps";
         if (i == 0) continue;
         double x = 0;
         const std::string& k = args[i - 1];
         if (!number(a, x)) continue;
         if ((k == "--grid" || k == "--nx" || k == "--ny" || k == "--ntheta") && x > 3) return o;
         if (k == "--max-periods" && x > 40) return o;
+        if ((k == "--max-rhs" && x > 3e5) || (k == "--max-work" && x > 3e6) || (k == "--max-steps" && x > 1e5)) return o;
         if (k == "--time" && x > 0.5) return o;
         if (k == "--threads" && (x > 2 || x == 0)) return o;
     }
     if ((args[0] == "field" || args[0] == "fixed-points") && !has_grid) args.insert(args.begin() + 1, {"--grid", "2"});
-    if ((args[0] == "twist" || args[0] == "field" || args[0] == "fixed-points") && !has_periods)
-        args.insert(args.begin() + 1, {"--max-periods", "40"});
+    const bool cycles = args[0] == "twist" || args[0] == "field" || args[0] == "fixed-points";
+    if (cycles && !has_periods) args.insert(args.begin() + 1, {"--max-periods", "40"});
+    if (cycles && !has_rhs) args.insert(args.begin() + 1, {"--max-rhs", "300000"});
+    if ((args[0] == "field" || args[0] == "fixed-points") && !has_work) args.insert(args.begin() + 1, {"--max-work", "3000000"});
+    if (args[0] == "simulate" && !has_steps) args.insert(args.begin() + 1, {"--max-steps", "100000"});
     for (const fs::path& p : {scene, out, fs::path(out.string() + ".tmp")}) fs::remove(p);
     std::ofstream(scene, std::ios::binary) << scene_text;
 
@@ -128,6 +135,11 @@ Outcome run_one(const std::string& input) {
     }
     g_input = nullptr;
     return o;
+}
+
+void cleanup() {
+    std::error_code ec;
+    fs::remove_all(workdir(), ec);
 }
 
 }  // namespace plate::fuzz

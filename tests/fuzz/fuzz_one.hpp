@@ -8,9 +8,10 @@
 //   - an output file left after bad input (exit 2), or a temporary (.tmp) left after any run.
 // Input: the first line holds the arguments (`field SCENE --grid 2 --out OUT`); SCENE and OUT
 // stand for files the harness provides; the rest of the input is the scene file's bytes.
-// Work is bounded so that a run takes milliseconds, not minutes: grids at most 3 per axis (2 if
-// none is given), at most 40 periods per cycle (unless less is asked), simulated time at most 0.5 s,
-// 2 threads. report, bench and proofs read no scene and run for minutes by design; their options
+// Work is bounded so that a run takes milliseconds, not minutes, through the program's own budgets:
+// grids at most 3 per axis (2 if none is given), at most 40 periods and 3e5 right-hand sides per
+// cycle, 3e6 per field or fixed-point search, 10^5 steps and 0.5 s of simulated time per
+// trajectory, 2 threads (inputs asking for more are skipped). report, bench and proofs read no scene and run for minutes by design; their options
 // go through the same parser as the commands fuzzed here, so they are left out. Arguments with a
 // '/' are skipped (a mutant must not write outside the harness's folder).
 #pragma once
@@ -28,6 +29,8 @@ struct Outcome {
 
 // Runs one input; aborts (after printing why, and the input) if a check fails.
 Outcome run_one(const std::string& input);
+// Removes the harness's folder (its scene and output files).
+void cleanup();
 
 constexpr int kSecondsPerInput = 60;   // a hang: generous for an ASan build on a busy machine
 

@@ -156,13 +156,21 @@ int main(int argc, char** argv) {
         else if (k == "--save") save = argv[i + 1];
         else { std::fprintf(stderr, "unknown option %s\n", k.c_str()); return 2; }
     }
+    // Every file under CORPUS_DIR is replayed; the seeds at its top level (hand-written, valid
+    // commands on the shipped scenes) are the mutants' parents. found/ holds what libFuzzer added
+    // (mostly broken inputs that reach new code; as parents they would make nearly every mutant a
+    // parse error).
     std::vector<fs::path> files;
-    for (const auto& e : fs::directory_iterator(argv[1]))
+    for (const auto& e : fs::recursive_directory_iterator(argv[1]))
         if (e.is_regular_file()) files.push_back(e.path());
     std::sort(files.begin(), files.end());
     if (files.empty()) { std::fprintf(stderr, "%s: empty corpus\n", argv[1]); return 2; }
-    std::vector<std::string> corpus;
-    for (const auto& f : files) corpus.push_back(slurp(f));
+    std::vector<std::string> corpus, parents;
+    for (const auto& f : files) {
+        corpus.push_back(slurp(f));
+        if (f.parent_path() == fs::path(argv[1])) parents.push_back(corpus.back());
+    }
+    if (parents.empty()) parents = corpus;
     std::map<int, long> codes;
     long skipped = 0;
     auto tally = [&](const plate::fuzz::Outcome& o) {
@@ -174,7 +182,7 @@ int main(int argc, char** argv) {
     Mutator m(seed);
     std::map<std::string, int> seen;
     for (long n = 0; n < mutants; ++n) {
-        const std::string in = m.mutate(corpus[m.pick(corpus.size())]);
+        const std::string in = m.mutate(parents[m.pick(parents.size())]);
         const plate::fuzz::Outcome o = plate::fuzz::run_one(in);
         tally(o);
         if (!save.empty() && o.verdict == plate::fuzz::Verdict::Ran && seen[std::to_string(o.code)]++ < 3) {
@@ -186,5 +194,6 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(seed), skipped);
     for (const auto& [c, k] : codes) std::printf("; exit %d: %ld", c, k);
     std::printf("\nno crash, hang, unexplained failure, non-finite output or partial file\n");
+    plate::fuzz::cleanup();
     return 0;
 }
