@@ -224,7 +224,7 @@ int cmd_twist(int argc, char** argv, Io& cio) {
 // Bounded work for a field (issue 18): one cycle at the grid's centre from rest, run first; the field
 // costs about half of it per configuration (warm starts), and a field over the budget --max-work
 // (right-hand sides, default 2e9: minutes on two cores) is refused with the estimate.
-void check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, const Args& a) {
+long check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, const Args& a) {
     const long budget = a.integer("--max-work", 2'000'000'000L, 1000, 1'000'000'000'000'000L);
     const auto t0 = std::chrono::steady_clock::now();
     const Vec3 centre((g.x0 + g.x1) / 2, (g.y0 + g.y1) / 2, g.th0);
@@ -237,6 +237,17 @@ void check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOption
                          " per configuration, from one cycle at the grid's centre: about " + fmt(0.5 * secs * n) +
                          " s on one core here), above the budget of " + fmt(static_cast<double>(budget)) +
                          ": raise it with --max-work or use a coarser grid");
+    return budget;
+}
+
+// A field whose budget ran out while it was computed (the estimate from one cycle was low): not a result.
+void require_within_budget(const Field& f, long budget) {
+    if (!f.budget_spent) return;
+    int left = 0;
+    for (const auto& p : f.points) left += p.stop == StopReason::StepLimit && p.rhs_evals == 0;
+    throw std::runtime_error("the work budget of " + fmt(static_cast<double>(budget)) + " right-hand sides was spent with " +
+                             std::to_string(left) + " of " + std::to_string(f.points.size()) +
+                             " configurations not started (the up-front estimate from one cycle was low): raise --max-work");
 }
 
 int cmd_field(int argc, char** argv, Io& cio) {
@@ -249,7 +260,8 @@ int cmd_field(int argc, char** argv, Io& cio) {
                      "theta covering a full turn. Point parts: asymptotic velocity field on (s_x, s_y).\n"
                      "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n"
                      "--max-work N: the budget in right-hand sides (default 2e9); the work is estimated up front\n"
-                     "from one cycle and a larger field is refused with the estimate (exit 2).\n";
+                     "from one cycle and a larger field is refused with the estimate (exit 2); a field that spends\n"
+                     "it anyway stops there (exit 1, no output).\n";
         return 0;
     }
     const Scene sc = scene_arg(a, cio);
@@ -259,10 +271,11 @@ int cmd_field(int argc, char** argv, Io& cio) {
     FieldOptions fo;
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
-    check_field_work(sc, g, fo.cycle, a);
+    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a);
     ProgressPrinter prog{"field"};
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
+    require_within_budget(f, fo.max_rhs_evaluations);
     write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) {
         if (format == "csv") write_field_csv(out, f);
         else out << to_json(sc, f).dump(1) << "\n";
@@ -285,10 +298,11 @@ int cmd_fixed_points(int argc, char** argv, Io& cio) {
     fo.cycle = cycle_opts(a);
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
     const GridSpec g = grid_opts(a);
-    check_field_work(sc, g, fo.cycle, a);   // (the refinement has its own budget, FixedPointOptions)
+    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a);   // (the refinement has its own budget)
     ProgressPrinter prog{"field"};
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
+    require_within_budget(f, fo.max_rhs_evaluations);
     FixedPointOptions fpo;
     fpo.cycle = fo.cycle;
     if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.integer("--max-work", 0, 1000, 1'000'000'000'000'000L));

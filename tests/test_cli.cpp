@@ -334,6 +334,15 @@ TEST_CASE("bounded work: a run over its budget is refused up front with the esti
     r = run("field " + f6 + " --grid 201");
     CHECK(r.code == 2);
     CHECK(r.err.find("raise it with --max-work") != std::string::npos);
+    // fig6's field: one cycle at the centre (1.2e3 right-hand sides) predicts 4e5 for the grid, the
+    // field takes 2.3e6: with a budget of 5e5 it passes the estimate and stops when the budget is spent,
+    // with no output (exit 1).
+    const fs::path out = tmpdir() / "budget-field.json";
+    fs::remove(out);
+    r = run("field " + f6 + " --max-work 500000 --out " + out.string());
+    CHECK(r.code == 1);
+    CHECK(r.err.find("raise --max-work") != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
     // A cycle whose budget is spent says so (fig6 at a pivoting configuration needs ~10^4 right-hand sides).
     r = run("twist " + f6 + " --at 0.05 -0.0333 0.898 --max-rhs 2000");
     CHECK(r.code == 0);

@@ -52,10 +52,22 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
 
     // Solves one point from `warm`; with warm starts, the first step is the one the previous point of
     // the same task ended with (h0: its step hint, updated here), which saves the step-size ramp-up.
+    std::atomic<long> spent{0};
+    std::atomic<bool> over{false};
     auto solve = [&](int i, int j, int k, const Vec3& warm, double& h0) {
         const int idx = grid.index(i, j, k);
         FieldPoint& p = f.points[idx];
         p.q = grid.at(i, j, k);
+        if (opt.max_rhs_evaluations > 0 && spent.load() >= opt.max_rhs_evaluations) {
+            over = true;
+            LimitCycleSummary none;
+            none.stop = StopEvent{StopReason::StepLimit, -1, 0};
+            p.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
+            p.converged = false;
+            p.stop = StopReason::StepLimit;
+            ++done;
+            return none;
+        }
         LimitCycleOptions o = opt.cycle;
         if (opt.warm_start) o.integration.h0 = h0;
         LimitCycleSummary lc = limit_cycle(sc, p.q, o, warm);
@@ -72,6 +84,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         p.min_normal_force = lc.min_normal_force;
         p.stop = lc.stop.reason;
         p.rhs_evals = lc.stats.rhs_evals;
+        spent += lc.stats.rhs_evals;
         p.stick_fraction = lc.stick_fraction;
         if (lc.converged) start[idx] = lc.qd_start.cwiseQuotient(S);
         const int d = ++done;
@@ -159,6 +172,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     worker();
     for (auto& t : pool) t.join();
     for (const auto& p : f.points) f.rhs_evals += p.rhs_evals;
+    f.budget_spent = over;
     f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return f;
 }

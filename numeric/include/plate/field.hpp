@@ -45,6 +45,7 @@ struct Field {
     double seconds = 0;               // wall time
     long rhs_evals = 0;
     int threads = 0;
+    bool budget_spent = false;        // FieldOptions::max_rhs_evaluations was reached
 };
 
 struct FieldOptions {
@@ -52,6 +53,10 @@ struct FieldOptions {
     int threads = 0;           // 0: all cores
     bool warm_start = true;    // start each theta from the previous theta's cycle
     std::function<void(int done, int total)> progress;   // called from worker threads, serialised
+    // The field's work budget in right-hand sides (0: none). Once spent, the configurations not yet
+    // started are left undefined with stop StepLimit and Field::budget_spent is set (which ones
+    // depends on the threads' order: such a field is not a result, see the CLI).
+    long max_rhs_evaluations = 0;
 };
 
 Field compute_field(const Scene& scene, GridSpec grid, const FieldOptions& opt = {});
