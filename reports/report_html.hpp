@@ -13,6 +13,11 @@
 #include <string>
 #include <vector>
 
+#include <cerrno>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 namespace plate::report::html {
 namespace fs = std::filesystem;
 
@@ -35,6 +40,24 @@ inline std::string esc(const std::string& s) {
     return o;
 }
 
+
+// gnuplot SCRIPT run in folder `dir`, stderr to `log`, without a shell (a folder's name is data, not
+// a command: an apostrophe in --out once ran what followed it).
+inline bool run_gnuplot(const fs::path& dir, const std::string& script, const fs::path& log) {
+    const pid_t pid = ::fork();
+    if (pid < 0) return false;
+    if (pid == 0) {
+        if (::chdir(dir.c_str()) != 0) ::_exit(127);
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) ::dup2(fd, 2);
+        ::execlp("gnuplot", "gnuplot", script.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR) return false;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
 
 struct Ctx {
     fs::path dir;
@@ -60,8 +83,7 @@ struct Ctx {
         const fs::path gp = dir / "data" / (name + ".gp");
         std::ofstream(gp) << "set terminal svg size " << size << " dynamic background rgb 'white' font 'sans,11'\n"
                           << "set output '" << name << ".svg'\n" << script;
-        const std::string cmd = "cd '" + dir.string() + "' && gnuplot 'data/" + name + ".gp' 2> 'data/" + name + ".log'";
-        if (std::system(cmd.c_str()) != 0 || !fs::exists(dir / (name + ".svg")))
+        if (!run_gnuplot(dir, "data/" + name + ".gp", dir / "data" / (name + ".log")) || !fs::exists(dir / (name + ".svg")))
             throw std::runtime_error("gnuplot failed on " + gp.string() + " (see data/" + name + ".log)");
         html << "<figure><img src=\"" << name << ".svg\" alt=\"" << esc(caption) << "\"><figcaption>" << caption
              << "</figcaption></figure>\n";

@@ -17,4 +17,4 @@ for tags in "[stick]" "[proofs]" "[kernels]" "[limit_cycle]" "[auto]" "[field]";
 done
 # The fuzz target's replay: the committed corpus and 10^4 new seeded mutants (tests/fuzz/).
 echo "sanitizers: fuzz replay" >&2
-build-asan/tests/plate_fuzz_replay tests/fuzz/corpus --mutants 10000 --seed 1
+(cd build-asan && tests/plate_fuzz_replay ../tests/fuzz/corpus --mutants 10000 --seed 1)

@@ -274,11 +274,12 @@ TEST_CASE("a scene outside the intended regime runs with a warning on stderr", "
     CHECK(run("twist " + kScenes + "fig4.json --at 0 0 0").err.empty());   // the shipped scene: none
 }
 
-TEST_CASE("a long command interrupted mid-way leaves no output that looks complete", "[cli][atomic]") {
-    // Each command below runs for well over 5 s on this machine; it is stopped after 1.5 s by SIGTERM
-    // (the program removes its temporary and dies of the signal) and by SIGKILL (nothing can run:
-    // the final name must still not exist; a temporary keeps its .tmp name). The exit status shows
-    // the command was stopped rather than finished (timeout's 124 or 137), else the check proves nothing.
+TEST_CASE("a command interrupted while it writes leaves no output that looks complete", "[cli][atomic]") {
+    // The test hook PLATE_TEST_PAUSE_BEFORE_RENAME holds each command with its output complete under
+    // the temporary name, just before the rename; the test waits for that moment (the hook's line on
+    // stderr) and sends SIGTERM (the program removes its temporary and dies of the signal: nothing is
+    // left) or SIGKILL (nothing can run: the temporary stays, under its .tmp name, and the final name
+    // must not exist). A program that wrote to the final name directly would leave it here.
     const fs::path d = tmpdir() / "killed";
     fs::create_directories(d);
     struct Job {
@@ -286,35 +287,57 @@ TEST_CASE("a long command interrupted mid-way leaves no output that looks comple
         fs::path result;
     };
     const Job jobs[] = {
-        {"field " + kScenes + "fig6.json --grid 21 --out " + (d / "field.json").string(), d / "field.json"},
-        {"fixed-points " + kScenes + "fig6.json --grid 21 --out " + (d / "fp.json").string(), d / "fp.json"},
-        {"simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 2000 --out " +
+        {"field " + kScenes + "fig4.json --grid 3 --out " + (d / "field.json").string(), d / "field.json"},
+        {"fixed-points " + kScenes + "fig4.json --grid 3 --out " + (d / "fp.json").string(), d / "fp.json"},
+        {"simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 1 --out " +
              (d / "traj.csv").string(), d / "traj.csv"},
-        {"proofs --out " + (d / "proofs.json").string(), d / "proofs.json"},
+        {"proofs --thin 4 --thick 2 --surfaces 2 --out " + (d / "proofs.json").string(), d / "proofs.json"},
+        {"random-scene --seed 3 --out " + (d / "scene.json").string(), d / "scene.json"},
         {"report --quick --out " + (d / "report").string(), d / "report" / "index.html"},
     };
+    const fs::path err = tmpdir() / "paused.err";
     for (const char* sig : {"TERM", "KILL"}) {
         for (const Job& j : jobs) {
             fs::remove(j.result);
             fs::remove(j.result.string() + ".tmp");
-            const std::string cmd = std::string("timeout -s ") + sig + " 1.5 " + PLATE_EXE + " " + j.args +
-                                    " > /dev/null 2> " + (tmpdir() / "stderr").string();
-            const int st = std::system(cmd.c_str());
-            const int code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-            INFO(sig << ": " << j.args << " -> " << code);
-            REQUIRE((code == 124 || code == 137));
+            // bash: start, wait (up to 10 min) for the pause, signal, reap; prints the exit status.
+            const std::string script =
+                "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " " + j.args + " > /dev/null 2> " +
+                err.string() + " & p=$!; for i in $(seq 6000); do grep -q 'paused before rename' " + err.string() +
+                " && break; sleep 0.1; done; kill -" + sig + " $p; wait $p; echo $?";
+            const fs::path status = tmpdir() / "status", sh = tmpdir() / "interrupt.sh";
+            std::ofstream(sh) << script << "\n";
+            REQUIRE(std::system(("bash " + sh.string() + " > " + status.string()).c_str()) == 0);
+            const std::string code = slurp(status);
+            INFO(sig << ": " << j.args << " -> exit status " << code << "\n" << slurp(err));
+            REQUIRE(slurp(err).find("paused before rename: " + j.result.string()) != std::string::npos);
+            CHECK(std::stoi(code) == (std::string(sig) == "TERM" ? 143 : 137));   // died of the signal
             CHECK_FALSE(fs::exists(j.result));
-            if (std::string(sig) == "TERM") CHECK_FALSE(fs::exists(j.result.string() + ".tmp"));
+            CHECK(fs::exists(j.result.string() + ".tmp") == (std::string(sig) == "KILL"));
+            fs::remove(j.result.string() + ".tmp");
         }
     }
-    // A report killed after an earlier one completed does not leave the old page beside new figures.
+    // A report interrupted after an earlier one completed does not leave the old page beside new figures.
     REQUIRE(run("report --quick --out " + (d / "report").string()).code == 0);
     REQUIRE(fs::exists(d / "report" / "index.html"));
-    const std::string cmd = std::string("timeout -s KILL 1.5 ") + PLATE_EXE + " report --quick --out " + (d / "report").string() +
-                            " > /dev/null 2>&1";
-    const int st = std::system(cmd.c_str());
-    REQUIRE((WIFEXITED(st) && WEXITSTATUS(st) == 137));
+    const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " report --quick --out " +
+                               (d / "report").string() + " > /dev/null 2> " + err.string() +
+                               " & p=$!; for i in $(seq 6000); do grep -q paused " + err.string() +
+                               " && break; sleep 0.1; done; kill -KILL $p; wait $p";
+    std::ofstream(tmpdir() / "interrupt.sh") << script << "\n";
+    CHECK(std::system(("bash " + (tmpdir() / "interrupt.sh").string()).c_str()) != -1);
     CHECK_FALSE(fs::exists(d / "report" / "index.html"));
+}
+
+TEST_CASE("a report folder whose name holds quotes and a shell command is only a name", "[cli][atomic]") {
+    const fs::path d = tmpdir() / "rep'; touch PWNED; echo 'x";
+    const fs::path witness = fs::current_path() / "PWNED";
+    fs::remove(witness);
+    const std::string cmd = std::string(PLATE_EXE) + " report --quick --out \"" + d.string() + "\" > /dev/null 2>&1";
+    CHECK(std::system(cmd.c_str()) == 0);
+    CHECK(fs::exists(d / "index.html"));
+    CHECK_FALSE(fs::exists(witness));
+    CHECK_FALSE(fs::exists(d.parent_path() / "PWNED"));
 }
 
 TEST_CASE("bounded work: a run over its budget is refused up front with the estimate, or stops with the reason",
@@ -334,12 +357,12 @@ TEST_CASE("bounded work: a run over its budget is refused up front with the esti
     r = run("field " + f6 + " --grid 201");
     CHECK(r.code == 2);
     CHECK(r.err.find("raise it with --max-work") != std::string::npos);
-    // fig6's field: one cycle at the centre (1.2e3 right-hand sides) predicts 4e5 for the grid, the
-    // field takes 2.3e6: with a budget of 5e5 it passes the estimate and stops when the budget is spent,
-    // with no output (exit 1).
+    // heave_yaw's field: five cycles from rest predict about 1e6 right-hand sides for the grid, the
+    // field takes 4.3e6 (its warm starts stick, and the sticking cycles cost more): with a budget of
+    // 2e6 it passes the estimate and stops when the budget is spent, with no output (exit 1).
     const fs::path out = tmpdir() / "budget-field.json";
     fs::remove(out);
-    r = run("field " + f6 + " --max-work 500000 --out " + out.string());
+    r = run("field " + kScenes + "heave_yaw.json --max-work 2000000 --out " + out.string());
     CHECK(r.code == 1);
     CHECK(r.err.find("raise --max-work") != std::string::npos);
     CHECK_FALSE(fs::exists(out));

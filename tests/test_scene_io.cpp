@@ -128,8 +128,22 @@ TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible in
         // 1.2e-5 about z with 1e-6 and 1e-6 about x and y: 1e-6 + 1e-6 < 1.2e-5.
         {replace(replace(kGood, "[[1.084e-5, 0, 0]", "[[1e-6, 0, 0]"), "[0, 1.23e-6, 0]", "[0, 1e-6, 0]"),
          "part.inertia: principal moments"},
-        // contact 2 moved to within 1e-8 m of the line y = -0.03 through the other two: cond ~ L/e ~ 6e6.
-        {replace(kGood, "[0, 0.03, -0.002]", "[0, -0.02999999, -0.002]"), "part.contacts: nearly collinear"},
+        // a sliver around the centre of mass, (-0.03, -e), (0.03, -e), (0, 2e): cond = 8.5e5 at e = 5e-8
+        // (refused), 4.2e5 at e = 1e-7 (accepted, below)
+        {replace(replace(replace(kGood, "[0.01, -0.03, -0.002]", "[-0.03, -5e-8, -0.002]"), "[0, 0.03, -0.002]",
+                         "[0.03, -5e-8, -0.002]"), "[-0.01, -0.03, -0.002]", "[0, 1e-7, -0.002]"),
+         "part.contacts: nearly collinear"},
+        // principal moments 1e-6 + 1.09e-5 < 1.2e-5, 0.8% past the triangle's edge (1.1e-5 is accepted, below)
+        {replace(replace(kGood, "[[1.084e-5, 0, 0]", "[[1e-6, 0, 0]"), "[0, 1.23e-6, 0]", "[0, 1.09e-5, 0]"),
+         "part.inertia: principal moments"},
+        // the other side of the gyration range: 1e-5 kg with fig4's inertia, rho = 1.1 m against 0.0316 m
+        // (ratio 35: inside) -- 1e-6 kg: rho = 3.5 m, ratio 110, outside
+        {replace(kGood, "\"mass\": 0.0216", "\"mass\": 1e-6"), "part.inertia: radius of gyration"},
+        // the model's ranges
+        {replace(kGood, "\"mass\": 0.0216", "\"mass\": 2e6"), "part.mass: 2e+06 kg is outside"},
+        {replace(kGood, "\"period\": 0.05", "\"period\": 5e-6"), "plate.period: 5e-06 s is outside"},
+        {replace(kGood, "\"gravity\": 9.81", "\"gravity\": 2000"), "gravity: 2000 m/s^2 is above"},
+        {replace(kGood, "\"amp\": 20", "\"amp\": -2e6"), "plate.harmonics[0].amp: -2e+06 is above"},
         {replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 11, 0.3]"), "part.friction: friction coefficient 11 above 10"},
     };
     for (const auto& c : cases) {
@@ -151,6 +165,17 @@ TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible in
     const Scene edge = parse_scene(replace(kGood, "[-0.01, -0.03, -0.002]", "[-0.0001, -0.03, -0.002]"), "ok.json");
     CHECK_FALSE(scene_warnings(edge).empty());
     CHECK_NOTHROW(parse_scene(replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 10, 0.3]"), "ok.json"));
+    CHECK_NOTHROW(parse_scene(replace(replace(replace(kGood, "[0.01, -0.03, -0.002]", "[-0.03, -1e-7, -0.002]"),
+                                              "[0, 0.03, -0.002]", "[0.03, -1e-7, -0.002]"),
+                                      "[-0.01, -0.03, -0.002]", "[0, 2e-7, -0.002]"),
+                              "ok.json"));
+    CHECK_NOTHROW(parse_scene(replace(kGood, "\"mass\": 0.0216", "\"mass\": 1e-5"), "ok.json"));
+    // The mass range on a point part (no inertia to compare with): 1e6 kg accepted, 2e6 refused.
+    const std::string point = R"({"name": "p", "gravity": 9.81, "part": {"mass": 1e6, "friction": 0.2},
+        "plate": {"period": 0.05, "harmonics": []}})";
+    CHECK_NOTHROW(parse_scene(point, "ok.json"));
+    CHECK_THROWS_WITH(parse_scene(replace(point, "1e6", "2e6"), "bad.json"), Catch::Contains("part.mass: 2e+06 kg is outside"));
+    CHECK_NOTHROW(parse_scene(replace(kGood, "\"period\": 0.05", "\"period\": 1e-5"), "ok.json"));
     CHECK_NOTHROW(parse_scene(replace(replace(kGood, "[[1.084e-5, 0, 0]", "[[1e-6, 0, 0]"), "[0, 1.23e-6, 0]", "[0, 1.1e-5, 0]"),
                               "ok.json"));
 }
@@ -180,4 +205,17 @@ TEST_CASE("scene warnings: admissible scenes outside the intended regime", "[sce
     CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"period\": 0.05", "\"period\": 5"), "w.json")),
               "times its size"));
     CHECK(scene_warnings(parse_scene(kGood, "ok.json")).empty());
+    // Grams typed as kilograms: 21.6 kg with fig4's inertia, ratio 1/42: accepted, but warned about.
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"mass\": 0.0216", "\"mass\": 21.6"), "w.json")),
+              "check the units"));
+    // A sliver 2e-7 m wide around the centre of mass: accepted, and friction (mu h = 6e-4 m) can tip it.
+    CHECK(has(scene_warnings(parse_scene(replace(replace(replace(kGood, "[0.01, -0.03, -0.002]", "[-0.03, -1e-7, -0.002]"),
+                                                         "[0, 0.03, -0.002]", "[0.03, -1e-7, -0.002]"),
+                                                 "[-0.01, -0.03, -0.002]", "[0, 2e-7, -0.002]"),
+                                         "w.json")),
+              "sliding friction can tip the part"));
+    // The tilt counts too: rx of 400 rad/s^2 at contacts 0.03 m off the axis gives 12 m/s^2 downward.
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"axis\": \"x\", \"n\": 1, \"amp\": 20",
+                                                 "\"axis\": \"rx\", \"n\": 1, \"amp\": 400"), "w.json")),
+              "at least g"));
 }

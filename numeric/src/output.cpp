@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <unistd.h>
 #include <cstdio>
@@ -192,7 +193,7 @@ void ProgressPrinter::operator()(int done, int total) {
     if ((el > 1.5 && std::chrono::duration<double>(now - last).count() > every) || (shown && done == total)) {
         std::ostringstream s;
         s << what << ": " << done << "/" << total << " (" << std::fixed << std::setprecision(1) << el << " s)\n";
-        std::cerr << s.str() << std::flush;
+        *to << s.str() << std::flush;
         last = now;
         shown = true;
     }
@@ -249,6 +250,13 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
         write(out);
         out.close();
         if (!out) throw std::runtime_error(path + ": write failed");
+        // Test hook (tests/test_cli.cpp, [atomic]): hold the complete temporary before the rename,
+        // so that a test can interrupt the program exactly there.
+        if (const char* pause = std::getenv("PLATE_TEST_PAUSE_BEFORE_RENAME")) {
+            std::fprintf(stderr, "paused before rename: %s\n", path.c_str());
+            std::fflush(stderr);
+            std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(pause)));
+        }
         if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename into place");
     } catch (...) {
         std::remove(tmp.c_str());

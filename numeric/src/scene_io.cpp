@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -186,6 +187,18 @@ void validate_scene(const Scene& s) {
     const Part& p = s.part;
     if (!(std::isfinite(s.g) && s.g > 0)) r.fail("gravity", "expected a positive finite number");
     if (!(std::isfinite(p.m) && p.m > 0)) r.fail("part.mass", "expected a positive finite number");
+    // Ranges of the model's world (a rigid part on a rigid plate under Coulomb friction): outside
+    // them the numbers are unit errors or outside the physics, and products such as m g or mu N
+    // would lose the range of a double in the solves.
+    if (s.g > kMaxGravity) r.fail("gravity", Reader::fmt(s.g) + " m/s^2 is above " + Reader::fmt(kMaxGravity) + " m/s^2 (about 100 g)");
+    if (p.m < kMassRange[0] || p.m > kMassRange[1])
+        r.fail("part.mass", Reader::fmt(p.m) + " kg is outside " + Reader::fmt(kMassRange[0]) + " to " +
+                                Reader::fmt(kMassRange[1]) + " kg (a microgram to a thousand tonnes)");
+    if (!(std::isfinite(s.plate.T) && s.plate.T > 0)) r.fail("plate.period", "expected a positive finite number");
+    if (s.plate.T < kPeriodRange[0] || s.plate.T > kPeriodRange[1])
+        r.fail("plate.period", Reader::fmt(s.plate.T) + " s is outside " + Reader::fmt(kPeriodRange[0]) + " to " +
+                                   Reader::fmt(kPeriodRange[1]) + " s (100 kHz to a thousandth of a hertz): a rigid plate " +
+                                   "under Coulomb friction is not a model of it");
     for (int i = 0; i < p.contacts(); ++i)
         if (!(std::isfinite(p.mu[i]) && p.mu[i] >= 0))
             r.fail("part.friction", "expected finite friction coefficients >= 0");
@@ -255,17 +268,7 @@ void validate_scene(const Scene& s) {
             r.fail("part.friction", "friction coefficient " + Reader::fmt(p.mu[i]) + " above " + Reader::fmt(kMaxFriction) +
                                         ": no pair of materials grips that hard (dry contacts lie below ~2)");
     if (!(std::isfinite(s.plate.T) && s.plate.T > 0)) r.fail("plate.period", "expected a positive finite number");
-    // Ranges of the model's world (a rigid part on a rigid plate under Coulomb friction): outside
-    // them the numbers are unit errors or outside the physics, and products such as m g or mu N
-    // would lose the range of a double in the solves.
-    if (s.g > kMaxGravity) r.fail("gravity", Reader::fmt(s.g) + " m/s^2 is above " + Reader::fmt(kMaxGravity) + " m/s^2 (about 100 g)");
-    if (p.m < kMassRange[0] || p.m > kMassRange[1])
-        r.fail("part.mass", Reader::fmt(p.m) + " kg is outside " + Reader::fmt(kMassRange[0]) + " to " +
-                                Reader::fmt(kMassRange[1]) + " kg (a microgram to a thousand tonnes)");
-    if (s.plate.T < kPeriodRange[0] || s.plate.T > kPeriodRange[1])
-        r.fail("plate.period", Reader::fmt(s.plate.T) + " s is outside " + Reader::fmt(kPeriodRange[0]) + " to " +
-                                   Reader::fmt(kPeriodRange[1]) + " s (100 kHz to a thousandth of a hertz): a rigid plate " +
-                                   "under Coulomb friction is not a model of it");
+
     for (std::size_t k = 0; k < s.plate.harmonics.size(); ++k) {
         const auto& h = s.plate.harmonics[k];
         if (!std::isfinite(h.amp) || !std::isfinite(h.phase) || h.n < 1)
@@ -301,12 +304,39 @@ std::vector<std::string> scene_warnings(const Scene& s) {
             w.push_back(src + ": part.contacts: at rest contact " + std::to_string(k + 1) + " carries only " +
                         Reader::fmt(100 * share[k]) + "% of the weight: the part is close to tipping over");
     }
+    // The downward acceleration at a contact of the part at the plate's centre: -(p''_z + (omega1' x
+    // c_i)_z), its largest over 400 instants of a period (linear in u: no centripetal part).
     double down = 0;
-    for (const auto& h : s.plate.harmonics)
-        if (h.axis == Axis::z) down += std::abs(h.amp);
+    for (int k = 0; k < 400; ++k) {
+        Vec3 pdd, wd;
+        s.plate.acceleration(s.plate.T * k / 400, pdd, wd);
+        for (int i = 0; i < p.contacts(); ++i) {
+            const Vec3 r = p.point ? Vec3::Zero() : Vec3(p.c[i].x(), p.c[i].y(), 0);
+            down = std::max(down, -(pdd.z() + wd.cross(r).z()));
+        }
+    }
     if (down >= s.g)
-        w.push_back(src + ": plate.harmonics: the vertical acceleration can reach " + Reader::fmt(down) +
-                    " m/s^2 downward, at least g: the part may leave the plate (commands then stop with 'contact lost')");
+        w.push_back(src + ": plate.harmonics: the vertical acceleration at a contact can reach " + Reader::fmt(down) +
+                    " m/s^2 downward at the plate's centre, at least g: the part may leave the plate (commands then stop with "
+                    "'contact lost')");
+    if (!p.point) {
+        // Dynamic tipping: friction mu N at the contacts, a height h below the centre of mass, tips the
+        // part about a support edge at distance d from the centre of mass's projection once mu h > d.
+        double d = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < 3; ++i) {
+            const Vec2 a = p.c[i].head<2>(), b = p.c[(i + 1) % 3].head<2>(), e = b - a;
+            d = std::min(d, std::abs(e.x() * a.y() - e.y() * a.x()) / e.norm());
+        }
+        const double h = p.s_z(), mu = p.mu.maxCoeff();
+        if (mu * h > d)
+            w.push_back(src + ": part.contacts: sliding friction can tip the part: mu h = " + Reader::fmt(mu * h) +
+                        " m exceeds the distance " + Reader::fmt(d) + " m from the centre of mass to the nearest support edge");
+        const double rho = std::sqrt(p.J(2, 2) / p.m);
+        if (rho < reach / kGyrationWarn || rho > reach * kGyrationWarn)
+            w.push_back(src + ": part.inertia: radius of gyration sqrt(J_zz / m) = " + Reader::fmt(rho) +
+                        " m against contacts up to " + Reader::fmt(reach) + " m from the centre of mass, a ratio beyond " +
+                        Reader::fmt(kGyrationWarn) + ": check the units (a mass in grams gives about 1/30 of the ratio)");
+    }
     if (reach > 0) {
         const double travel = s.v_ref() * s.plate.T;
         if (travel > kTravelPerPeriod * reach)

@@ -2,6 +2,8 @@
 
 #include "cli.hpp"
 
+#include "plate/scene_io.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <csignal>
@@ -9,7 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
+#include <cctype>
 #include <set>
 #include <sstream>
 #include <unistd.h>
@@ -21,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string* g_input = nullptr;   // for the messages of a failed check (and the alarm)
+int seconds_per_input = kSecondsPerInput;
 
 [[noreturn]] void fail(const std::string& why, const std::string& detail) {
     std::fprintf(stderr, "\nfuzz check failed: %s\n%s\n--- input ---\n%s\n--- end ---\n", why.c_str(), detail.c_str(),
@@ -76,6 +79,9 @@ Outcome run_one(const std::string& input) {
     for (std::size_t i = 0; i < args.size(); ++i) {
         std::string& a = args[i];
         if (a.find('/') != std::string::npos) return o;
+        // Files are written only where the harness says: --out OUT or standard output.
+        if (i > 0 && args[i - 1] == "--out" && a != "OUT" && a != "-") return o;
+        if (a == "--out" && i + 1 == args.size()) return o;
         if (a == "SCENE") a = scene.string();
         if (a == "OUT") a = out.string();
         help |= a == "--help" || a == "-h";
@@ -109,7 +115,7 @@ Outcome run_one(const std::string& input) {
     for (auto& s : argv_s) argv.push_back(s.data());
     argv.push_back(nullptr);
     std::ostringstream so, se;
-    ::alarm(kSecondsPerInput);
+    ::alarm(static_cast<unsigned>(seconds_per_input));
     o.code = cli::run(static_cast<int>(argv_s.size()), argv.data(), so, se);
     ::alarm(0);
     o.verdict = Verdict::Ran;
@@ -124,18 +130,52 @@ Outcome run_one(const std::string& input) {
     if (fs::exists(out.string() + ".tmp")) fail("a temporary output left behind", detail);
     if (o.code == 2 && fs::exists(out)) fail("an output file left after bad input", detail);
     if (o.code == 0 && !help) {
-        static const std::regex nonfinite(R"((^|[^A-Za-z_])-?(nan|inf|infinity)([^A-Za-z_]|$))", std::regex::icase);
+        // "nan", "inf" or "infinity" as a word, any case
+        auto nonfinite_word = [](const std::string& t) {
+            std::size_t i = 0;
+            while (i < t.size()) {
+                if (!std::isalpha(static_cast<unsigned char>(t[i])) && t[i] != '_') { ++i; continue; }
+                std::size_t j = i;
+                while (j < t.size() && (std::isalpha(static_cast<unsigned char>(t[j])) || t[j] == '_')) ++j;
+                std::string w = t.substr(i, j - i);
+                for (char& c : w) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+                if (w == "nan" || w == "inf" || w == "infinity") return true;
+                i = j;
+            }
+            return false;
+        };
         const std::string file = fs::exists(out) ? slurp(out) : std::string(), printed = so.str();
         for (const std::string* text : {&printed, &file})
-            if (std::regex_search(*text, nonfinite)) fail("NaN or Inf in the output of a run that exited 0", detail + "\noutput:\n" + text->substr(0, 2000));
+            if (nonfinite_word(*text)) fail("NaN or Inf in the output of a run that exited 0", detail + "\noutput:\n" + text->substr(0, 2000));
         for (const std::string* text : {&printed, &file}) {
             if (text->empty() || ((*text)[0] != '{' && (*text)[0] != '[')) continue;
-            if (!nlohmann::json::accept(*text)) fail("malformed JSON output", detail);
+            const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+            if (j.is_discarded()) fail("malformed JSON output", detail);
+            // JSON writes NaN as null: a defined result must have no null in it.
+            auto defined_twist = [&](const nlohmann::json& x) {
+                if (x.contains("converged") && x["converged"] == true && x.contains("twist"))
+                    for (const auto& v : x["twist"])
+                        if (!v.is_number()) fail("a converged twist with a non-finite component (null)", detail);
+            };
+            if (j.is_object()) {
+                defined_twist(j);
+                if (j.contains("points"))
+                    for (const auto& p : j["points"]) defined_twist(p);
+                if (args[0] == "random-scene") {
+                    try {
+                        parse_scene(*text, "random-scene output");
+                    } catch (const std::exception& e) {
+                        fail("random-scene wrote a scene it cannot read back", detail + "\n" + e.what());
+                    }
+                }
+            }
         }
     }
     g_input = nullptr;
     return o;
 }
+
+void set_seconds_per_input(int s) { seconds_per_input = s; }
 
 void cleanup() {
     std::error_code ec;

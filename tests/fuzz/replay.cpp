@@ -4,7 +4,7 @@
 // types, missing and unknown fields, dropped and repeated options) plus raw byte edits. Any failed
 // check aborts with the input (fuzz_one.cpp). Built in the plain and the sanitizer builds; ctest
 // runs it (tests/CMakeLists.txt).
-//   plate_fuzz_replay CORPUS_DIR [--mutants N] [--seed S] [--save DIR]
+//   plate_fuzz_replay CORPUS_DIR [--mutants N] [--seed S] [--seconds HANG] [--save DIR]
 // --save writes every mutant that ran (not skipped) with a new exit code or stderr first line to
 // DIR, to grow the corpus.
 #include "fuzz_one.hpp"
@@ -143,7 +143,7 @@ struct Mutator {
 
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: plate_fuzz_replay CORPUS_DIR [--mutants N] [--seed S] [--save DIR]\n");
+        std::fprintf(stderr, "usage: plate_fuzz_replay CORPUS_DIR [--mutants N] [--seed S] [--seconds HANG] [--save DIR]\n");
         return 2;
     }
     long mutants = 0;
@@ -154,6 +154,7 @@ int main(int argc, char** argv) {
         if (k == "--mutants") mutants = std::atol(argv[i + 1]);
         else if (k == "--seed") seed = std::strtoull(argv[i + 1], nullptr, 10);
         else if (k == "--save") save = argv[i + 1];
+        else if (k == "--seconds") plate::fuzz::set_seconds_per_input(std::atoi(argv[i + 1]));
         else { std::fprintf(stderr, "unknown option %s\n", k.c_str()); return 2; }
     }
     // Every file under CORPUS_DIR is replayed; the seeds at its top level (hand-written, valid

@@ -27,6 +27,7 @@ struct ProgressPrinter {
     double every = 1.0;
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last = start;
     bool shown = false;
+    std::ostream* to = &std::cerr;
     void operator()(int done, int total);
 };
 

@@ -33,12 +33,14 @@ Scene parse_scene(const std::string& text, const std::string& source);  // throw
 // mass, gravity, period and amplitudes in the model's ranges (below).
 void validate_scene(const Scene& scene);                 // throws InputError
 // Admissible but outside the intended regime (the CLI prints them): friction above
-// kHighFriction, a contact with less than kNearTipping of the weight at rest, a downward plate
-// acceleration that can reach g, a slip-speed scale that moves the part more than
-// kTravelPerPeriod times its size per period.
+// kHighFriction, a contact with less than kNearTipping of the weight at rest, sliding friction
+// able to tip the part (mu h beyond the centre of mass's distance to a support edge), a radius of
+// gyration beyond kGyrationWarn of the contacts' reach (units?), a downward acceleration at a
+// contact that can reach g, a slip-speed scale that moves the part more than kTravelPerPeriod
+// times its size per period.
 std::vector<std::string> scene_warnings(const Scene& scene);
 inline constexpr double kMaxContactCondition = 1e-10 / 2.220446049250313e-16;
-inline constexpr double kGyrationRange = 100;
+inline constexpr double kGyrationRange = 100, kGyrationWarn = 10;
 inline constexpr double kMaxFriction = 10, kHighFriction = 2;
 inline constexpr double kNearTipping = 0.02, kTravelPerPeriod = 10;
 inline constexpr double kMassRange[2] = {1e-9, 1e6};       // kg
