@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <cstdlib>
 #include <cstring>
 #include <iomanip>
@@ -33,6 +34,18 @@ struct Io {
 };
 
 constexpr double kMaxRows = 1e7;   // rows of a trajectory CSV
+
+// The folder with scenes/ (the report's inputs): an installed program's PREFIX/share/plate beside
+// PREFIX/bin, else the source tree it was built from (relocatable: nothing else is compiled in).
+std::string data_root() {
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+        const std::filesystem::path share = exe.parent_path().parent_path() / "share" / "plate";
+        if (std::filesystem::exists(share / "scenes", ec)) return share.string();
+    }
+    return PLATE_SOURCE_DIR;
+}
 constexpr long kCliCycleBudget = 2'000'000;   // right-hand sides per cycle (--max-rhs)
 
 std::string fmt(double x) {
@@ -45,7 +58,7 @@ std::string fmt(double x) {
 const char* kUsage =
     "plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch)\n"
     "\n"
-    "usage: plate COMMAND SCENE [options]      plate COMMAND --help for its options\n"
+    "usage: plate COMMAND SCENE [options]      plate COMMAND --help for its options; plate --version\n"
     "\n"
     "commands:\n"
     "  twist         asymptotic twist (36) at one configuration, as JSON\n"
@@ -567,7 +580,7 @@ int cmd_report(int argc, char** argv, Io& cio) {
     if (!a.has("--out")) throw UsageError("missing --out DIR");
     report::ReportOptions o;
     o.out = a.str("--out", "");
-    o.source_dir = a.str("--source", PLATE_SOURCE_DIR);
+    o.source_dir = a.str("--source", data_root());
     o.seed = static_cast<std::uint64_t>(a.integer("--seed", 1, 0, 1L << 40));
     o.quick = a.has("--quick");
     o.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
@@ -592,7 +605,7 @@ int cmd_bench(int argc, char** argv, Io& cio) {
     if (!a.has("--out")) throw UsageError("missing --out DIR");
     report::SpeedOptions o;
     o.out = a.str("--out", "");
-    o.source_dir = a.str("--source", PLATE_SOURCE_DIR);
+    o.source_dir = a.str("--source", data_root());
     o.full = a.has("--full");
     report::write_speed_study(o);
     cio.err << "bench: " << o.out << "/index.html" << std::endl;
@@ -603,6 +616,10 @@ int cmd_bench(int argc, char** argv, Io& cio) {
 
 int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
     Io cio{out, err};
+    if (argc >= 2 && !std::strcmp(argv[1], "--version")) {
+        cio.out << "plate " << PLATE_VERSION << " (scenes and report inputs: " << data_root() << ")\n";
+        return 0;
+    }
     if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
         cio.out << kUsage;
         return argc < 2 ? 2 : 0;

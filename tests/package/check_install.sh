@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The package (issue 17, point 2): install the build into a temporary prefix, move the prefix
+# elsewhere (relocatable), run the installed plate from / and check it finds its scenes beside
+# itself, then build a consumer project with find_package(plate CONFIG) against it and check it
+# computes the same twist as the installed program.
+#   check_install.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd); src=$(cd "$2" && pwd)
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+cmake --install "$build" --prefix "$work/first" > /dev/null
+mv "$work/first" "$work/moved"
+prefix="$work/moved"
+cd /
+version=$("$prefix/bin/plate" --version)
+echo "$version"
+case "$version" in *"$prefix/share/plate"*) ;; *) echo "installed plate does not use its own share/plate"; exit 1;; esac
+"$prefix/bin/plate" twist "$prefix/share/plate/scenes/fig4.json" --at 0.02 0.01 0.5 > "$work/twist.json"
+cmake -S "$src/tests/package/consumer" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > /dev/null
+cmake --build "$work/consumer" > /dev/null
+read -r ok tx ty tw < <("$work/consumer/consumer" "$prefix/share/plate/scenes/fig4.json")
+[ "$ok" = 1 ] || { echo "consumer: cycle not converged"; exit 1; }
+python3 - "$work/twist.json" "$tx" "$ty" "$tw" <<'PY'
+import json, sys
+t = json.load(open(sys.argv[1]))["twist"]
+c = [float(x) for x in sys.argv[2:5]]
+assert t == c, f"installed plate {t} vs consumer {c}"
+print("consumer and installed plate agree:", c)
+PY
