@@ -297,7 +297,7 @@ int cmd_field(int argc, char** argv, Io& cio) {
     fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
     fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a);
     ProgressPrinter prog{"field"};
-    prog.to = &cio.err;
+    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
     require_within_budget(f, fo.max_rhs_evaluations);
@@ -325,7 +325,7 @@ int cmd_fixed_points(int argc, char** argv, Io& cio) {
     const GridSpec g = grid_opts(a);
     fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a);   // (the refinement has its own budget)
     ProgressPrinter prog{"field"};
-    prog.to = &cio.err;
+    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
     require_within_budget(f, fo.max_rhs_evaluations);
@@ -377,7 +377,7 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
     io.rtol = a.num("--rtol", 0, io.rtol);
     Trajectory tr;
     ProgressPrinter prog{"simulate"};
-    prog.to = &cio.err;
+    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
     Scene used = sc;
     bool verify_auto = false;
     if (dyn == "auto") {

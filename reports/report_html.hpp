@@ -2,6 +2,8 @@
 // (gnuplot SVGs beside the page, data files under data/), the style sheet.
 #pragma once
 
+#include "plate/output.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -68,7 +70,7 @@ struct Ctx {
     template <class F>
     void timed(const std::string& what, F&& f) {
         const auto t0 = std::chrono::steady_clock::now();
-        std::fprintf(stderr, "report: %s...\n", what.c_str());
+        plate::progress_line("report: %s...\n", what.c_str());
         f();
         timings.push_back({what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
     }

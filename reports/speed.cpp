@@ -177,7 +177,7 @@ void twist_chart(Ctx& c, const Scene& sc, const Vec3& q0, const std::string& id,
             mark_wrong(r);
             l.runs.push_back(r);
         }
-        std::fprintf(stderr, "bench: %s %s done\n", id.c_str(), s.label().c_str());
+        progress_line("bench: %s %s done\n", id.c_str(), s.label().c_str());
         lines.push_back(l);
     }
     work_precision(c, id, title, lines, false);
@@ -217,7 +217,7 @@ void trajectory_chart(Ctx& c, const Scene& sc, bool full) {
             mark_wrong(r);
             l.runs.push_back(r);
         }
-        std::fprintf(stderr, "bench: trajectory %s done\n", s.label().c_str());
+        progress_line("bench: trajectory %s done\n", s.label().c_str());
         lines.push_back(l);
     }
     work_precision(c, "wp_traj", "(b) fig4: 20 s of full dynamics from rest", lines, true);
@@ -258,7 +258,7 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
             mark_wrong(r);
             l.runs.push_back(r);
         }
-        std::fprintf(stderr, "bench: (d) %s done\n", s.label().c_str());
+        progress_line("bench: (d) %s done\n", s.label().c_str());
         lines.push_back(l);
     };
     sweep(eng, {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10});
@@ -359,7 +359,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
                 }
             }
         }
-        std::fprintf(stderr, "bench: field by %s done\n", name.c_str());
+        progress_line("bench: field by %s done\n", name.c_str());
     }
     c.html << "</table>\n";
     // Period-by-period fixed-step RK4 from rest (no warm start): for each cycle tolerance the smallest
@@ -400,7 +400,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
         rko << "\n";   // a break in the chart's line between cycle tolerances
     }
     c.html << "</table>\n";
-    std::fprintf(stderr, "bench: RK4 baseline done\n");
+    progress_line("bench: RK4 baseline done\n");
     std::ostringstream gp;
     gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the field'\n"
           "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first " << kTarget << " to graph 1, first "
@@ -551,7 +551,7 @@ void failure_map(Ctx& c, const Scene& base, bool full) {
             c.html << "</tr>\n";
         }
         c.html << "</table>\n";
-        std::fprintf(stderr, "bench: failure map '%s' done\n", sw.name.c_str());
+        progress_line("bench: failure map '%s' done\n", sw.name.c_str());
     }
 }
 
@@ -596,7 +596,7 @@ void hierarchy(Ctx& c, const fs::path& src, bool full) {
                    << "</td></tr>\n";
             first = false;
         }
-        std::fprintf(stderr, "bench: hierarchy %s done\n", q.scene);
+        progress_line("bench: hierarchy %s done\n", q.scene);
     }
     c.html << "</table>\n<p>The prediction bounds the measured error for " << bounded << " of " << compared
            << " rungs here (the validation on seeded random scenes is a test: at least 95%).</p>\n";

@@ -373,3 +373,18 @@ TEST_CASE("bounded work: a run over its budget is refused up front with the esti
     CHECK(j["converged"] == false);
     CHECK(j["stop"] == "step_limit");
 }
+
+TEST_CASE("progress lines only for a person watching: quiet when stderr is not a terminal", "[cli][progress]") {
+    // fig6 on a 21x21x21 grid runs for several seconds: long enough for the printer (after 1.5 s; the
+    // forced run shows that it is).
+    const std::string cmd = "field " + kScenes + "fig6.json --grid 21 --out " + (tmpdir() / "progress.json").string();
+    const Run quiet = run(cmd);   // stderr is a file here
+    CHECK(quiet.code == 0);
+    CHECK(quiet.err.find("field: ") == std::string::npos);
+    const Run asked = run(cmd + " PLATE_PROGRESS=1");   // (an argument: must be refused, see below)
+    CHECK(asked.code == 2);
+    const fs::path o = tmpdir() / "stdout", e = tmpdir() / "stderr";
+    const std::string forced = "PLATE_PROGRESS=1 " + std::string(PLATE_EXE) + " " + cmd + " > " + o.string() + " 2> " + e.string();
+    REQUIRE(std::system(forced.c_str()) == 0);
+    CHECK(slurp(e).find("field: ") != std::string::npos);
+}

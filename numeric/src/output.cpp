@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstdarg>
 #include <cstdlib>
 #include <cstring>
 #include <unistd.h>
@@ -187,7 +188,24 @@ void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_pa
     }
 }
 
+bool progress_wanted() {
+    static const bool wanted = [] {
+        if (const char* e = std::getenv("PLATE_PROGRESS")) return std::string(e) != "0";
+        return ::isatty(2) == 1;
+    }();
+    return wanted;
+}
+
+void progress_line(const char* format, ...) {
+    if (!progress_wanted()) return;
+    va_list args;
+    va_start(args, format);
+    std::vfprintf(stderr, format, args);
+    va_end(args);
+}
+
 void ProgressPrinter::operator()(int done, int total) {
+    if (to == nullptr || (to == &std::cerr && !progress_wanted())) return;
     const auto now = std::chrono::steady_clock::now();
     const double el = std::chrono::duration<double>(now - start).count();
     if ((el > 1.5 && std::chrono::duration<double>(now - last).count() > every) || (shown && done == total)) {

@@ -22,12 +22,18 @@ void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_pa
 
 // Progress on stderr for long runs: silent for the first 1.5 s, then a line at most every
 // `every` seconds, and the final count if anything was shown.
+// Progress lines go to stderr only when it is a terminal (a person watching); in pipes, logs and
+// CI they would be noise. PLATE_PROGRESS=1 forces them, =0 silences them.
+bool progress_wanted();
+// A progress line (printf-style) on stderr when progress_wanted().
+void progress_line(const char* format, ...) __attribute__((format(printf, 1, 2)));
+
 struct ProgressPrinter {
     std::string what;
     double every = 1.0;
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last = start;
     bool shown = false;
-    std::ostream* to = &std::cerr;
+    std::ostream* to = &std::cerr;   // nullptr: silent
     void operator()(int done, int total);
 };
 
