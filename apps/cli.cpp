@@ -566,6 +566,13 @@ int cmd_proofs(int argc, char** argv, Io& cio) {
     return 0;
 }
 
+// The output folder of report and bench, which take no SCENE.
+std::string out_dir_arg(const Args& a, const std::string& cmd) {
+    if (!a.pos.empty()) throw UsageError(cmd + " takes no SCENE argument");
+    if (!a.has("--out")) throw UsageError("missing --out DIR");
+    return a.str("--out", "");
+}
+
 int cmd_report(int argc, char** argv, Io& cio) {
     Args a(argc, argv, {{"--out", 1}, {"--seed", 1}, {"--quick", 0}, {"--threads", 1}, {"--source", 1}});
     if (a.help) {
@@ -576,10 +583,8 @@ int cmd_report(int argc, char** argv, Io& cio) {
                      "(scenes/, reports/generated/), default the one this program was built from.\n";
         return 0;
     }
-    if (!a.pos.empty()) throw UsageError("report takes no SCENE argument");
-    if (!a.has("--out")) throw UsageError("missing --out DIR");
     report::ReportOptions o;
-    o.out = a.str("--out", "");
+    o.out = out_dir_arg(a, "report");
     o.source_dir = a.str("--source", data_root());
     o.seed = static_cast<std::uint64_t>(a.integer("--seed", 1, 0, 1L << 40));
     o.quick = a.has("--quick");
@@ -601,10 +606,8 @@ int cmd_bench(int argc, char** argv, Io& cio) {
                      "(minutes); --full sweeps more settings.\n";
         return 0;
     }
-    if (!a.pos.empty()) throw UsageError("bench takes no SCENE argument");
-    if (!a.has("--out")) throw UsageError("missing --out DIR");
     report::SpeedOptions o;
-    o.out = a.str("--out", "");
+    o.out = out_dir_arg(a, "bench");
     o.source_dir = a.str("--source", data_root());
     o.full = a.has("--full");
     report::write_speed_study(o);

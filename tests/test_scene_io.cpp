@@ -25,6 +25,26 @@ std::string replace(std::string s, const std::string& from, const std::string& t
     return s.replace(p, from.size(), to);
 }
 
+// Scenes the reader must refuse: the message starts with the file and contains `expect`.
+struct Refused {
+    std::string text, expect;
+};
+template <std::size_t N>
+void check_refused(const Refused (&cases)[N]) {
+    for (const auto& c : cases) {
+        INFO(c.text);
+        try {
+            parse_scene(c.text, "bad.json");
+            FAIL("accepted a bad scene");
+        } catch (const InputError& e) {
+            const std::string msg = e.what();
+            INFO(msg);
+            CHECK(msg.rfind("bad.json", 0) == 0);
+            CHECK(msg.find(c.expect) != std::string::npos);
+        }
+    }
+}
+
 }  // namespace
 
 TEST_CASE("shipped scenes state the paper's parts and plate motions", "[scene]") {
@@ -67,10 +87,7 @@ TEST_CASE("friction may be one number, a point part has mass and friction only",
 }
 
 TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
-    struct Case {
-        std::string text, expect;
-    };
-    const Case cases[] = {
+    const Refused cases[] = {
         {"{ \"name\": ", "bad.json:1:"},                                                      // malformed
         {replace(kGood, "\"gravity\": 9.81,", ""), "gravity: missing"},                        // missing
         {replace(kGood, "\"name\": \"t\",", "\"name\": \"t\", \"colour\": 1,"), "colour: unknown field"},
@@ -93,18 +110,7 @@ TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
         {replace(kGood, "\"amp\": 20", "\"amp\": 1e999"), "number overflow parsing '1e999'"},
         {replace(kGood, "\"amp\": 20", "\"amp\": \"20\""), "plate.harmonics[0].amp: expected a number"},
     };
-    for (const auto& c : cases) {
-        INFO(c.text);
-        try {
-            parse_scene(c.text, "bad.json");
-            FAIL("accepted a bad scene");
-        } catch (const InputError& e) {
-            const std::string msg = e.what();
-            INFO(msg);
-            CHECK(msg.rfind("bad.json", 0) == 0);
-            CHECK(msg.find(c.expect) != std::string::npos);
-        }
-    }
+    check_refused(cases);
 }
 
 TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible inertia, collinear contacts, "
@@ -113,10 +119,7 @@ TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible in
     // barycentric coordinates of the origin, 1/4, 1/2, 1/4. Moving contact 1 to x = 0.03 (and 3 to
     // x = 0.02) puts the origin outside the triangle: the line through contacts 2 and 3 passes
     // x = 0.01 at y = 0, so the origin lies beyond it, and contact 1 would pull.
-    struct Case {
-        std::string text, expect;
-    };
-    const Case cases[] = {
+    const Refused cases[] = {
         {replace(replace(kGood, "[0.01, -0.03, -0.002]", "[0.03, -0.03, -0.002]"), "[-0.01, -0.03, -0.002]",
                  "[0.02, -0.03, -0.002]"),
          "part.contacts: the part tips over"},
@@ -146,18 +149,7 @@ TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible in
         {replace(kGood, "\"amp\": 20", "\"amp\": -2e6"), "plate.harmonics[0].amp: -2e+06 is above"},
         {replace(kGood, "[0.3, 0.3, 0.3]", "[0.3, 11, 0.3]"), "part.friction: friction coefficient 11 above 10"},
     };
-    for (const auto& c : cases) {
-        INFO(c.text);
-        try {
-            parse_scene(c.text, "bad.json");
-            FAIL("accepted a bad scene");
-        } catch (const InputError& e) {
-            const std::string msg = e.what();
-            INFO(msg);
-            CHECK(msg.rfind("bad.json", 0) == 0);
-            CHECK(msg.find(c.expect) != std::string::npos);
-        }
-    }
+    check_refused(cases);
     // Inside each bound the scene is accepted: 21.6 kg with the same inertia (ratio 1/42); friction 10;
     // principal moments 1e-6, 1.1e-5, 1.2e-5 (1e-6 + 1.1e-5 = 1.2e-5, the triangle's edge).
     CHECK_NOTHROW(parse_scene(replace(kGood, "\"mass\": 0.0216", "\"mass\": 21.6"), "ok.json"));

@@ -87,6 +87,30 @@ struct Reader {
     }
 };
 
+// The support triangle of a rigid part's contacts (finite; none for a point part): its size L (the
+// longest side), the contacts' reach from the centre of mass, the matrix of the static normal-force
+// solve [1 1 1; x_i / L; y_i / L], the shares N_i / (m g) at rest on a level plate (the barycentric
+// coordinates of the centre of mass's projection) and its distance to the nearest edge.
+struct Support {
+    double size = 0, reach = 0, edge = std::numeric_limits<double>::infinity();
+    Mat3 A = Mat3::Zero();
+    Vec3 share = Vec3::Zero();
+    explicit Support(const Part& p) {
+        if (p.point) return;
+        for (int i = 0; i < 3; ++i) {
+            reach = std::max(reach, p.c[i].head<2>().norm());
+            for (int j = 0; j < i; ++j) size = std::max(size, (p.c[i] - p.c[j]).norm());
+        }
+        if (size <= 0) return;
+        for (int i = 0; i < 3; ++i) {
+            A.col(i) = Vec3(1, p.c[i].x() / size, p.c[i].y() / size);
+            const Vec2 a = p.c[i].head<2>(), e = p.c[(i + 1) % 3].head<2>() - a;
+            edge = std::min(edge, std::abs(e.x() * a.y() - e.y() * a.x()) / e.norm());
+        }
+        share = A.colPivHouseholderQr().solve(Vec3(1, 0, 0));
+    }
+};
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& source) {
@@ -211,11 +235,10 @@ void validate_scene(const Scene& s) {
         if (scale <= 0 || llt.info() != Eigen::Success ||
             Eigen::SelfAdjointEigenSolver<Mat3>(p.J).eigenvalues().minCoeff() <= 1e-12 * scale)
             r.fail("part.inertia", "expected a symmetric positive definite matrix");
-        double size = 0;
-        for (int i = 0; i < 3; ++i) {
+        for (int i = 0; i < 3; ++i)
             if (!p.c[i].allFinite()) r.fail("part.contacts[" + std::to_string(i) + "]", "expected finite numbers");
-            for (int j = 0; j < i; ++j) size = std::max(size, (p.c[i] - p.c[j]).norm());
-        }
+        const Support sup(p);
+        const double size = sup.size;
         if (size <= 0) r.fail("part.contacts", "expected three distinct contact points");
         for (int i = 1; i < 3; ++i)
             if (std::abs(p.c[i].z() - p.c[0].z()) > 1e-9 * size)
@@ -228,9 +251,7 @@ void validate_scene(const Scene& s) {
         // (the plate at rest; in motion the same geometry), whose relative rounding error is
         // cond * eps. Above kMaxContactCondition it would exceed 1e-10, the tightest integration
         // tolerance the references use: the results would not carry the accuracy asked for.
-        Mat3 A;
-        for (int i = 0; i < 3; ++i) A.col(i) = Vec3(1, p.c[i].x() / size, p.c[i].y() / size);
-        const Eigen::JacobiSVD<Mat3> svd(A);
+        const Eigen::JacobiSVD<Mat3> svd(sup.A);
         const double cond = svd.singularValues()[0] / svd.singularValues()[2];
         if (!(cond <= kMaxContactCondition))
             r.fail("part.contacts", "nearly collinear contacts (assumption 2): the normal-force solve's condition number is " +
@@ -238,7 +259,7 @@ void validate_scene(const Scene& s) {
                                         " (1e-10 / machine epsilon): its rounding would exceed the integration tolerance");
         // At rest on a level plate N_i / (m g) are the barycentric coordinates of the centre of
         // mass's projection in the support triangle: one below zero means the part tips over.
-        const Vec3 share = A.colPivHouseholderQr().solve(Vec3(1, 0, 0));
+        const Vec3& share = sup.share;
         int k = 0;
         share.minCoeff(&k);
         if (share[k] < 0)
@@ -254,9 +275,7 @@ void validate_scene(const Scene& s) {
         // Inertia against mass and size: the radius of gyration about z against the contacts'
         // distance from the centre of mass. Real parts lie within two orders of magnitude of each
         // other (a ring on close feet, a hub on long legs); beyond that it is a unit error.
-        double reach = 0;
-        for (int i = 0; i < 3; ++i) reach = std::max(reach, p.c[i].head<2>().norm());
-        const double rho = std::sqrt(p.J(2, 2) / p.m);
+        const double reach = sup.reach, rho = p.rho();
         if (!(rho >= reach / kGyrationRange && rho <= reach * kGyrationRange))
             r.fail("part.inertia", "radius of gyration sqrt(J_zz / m) = " + Reader::fmt(rho) + " m against contacts up to " +
                                        Reader::fmt(reach) + " m from the centre of mass: a ratio outside 1/" +
@@ -267,7 +286,6 @@ void validate_scene(const Scene& s) {
         if (p.mu[i] > kMaxFriction)
             r.fail("part.friction", "friction coefficient " + Reader::fmt(p.mu[i]) + " above " + Reader::fmt(kMaxFriction) +
                                         ": no pair of materials grips that hard (dry contacts lie below ~2)");
-    if (!(std::isfinite(s.plate.T) && s.plate.T > 0)) r.fail("plate.period", "expected a positive finite number");
 
     for (std::size_t k = 0; k < s.plate.harmonics.size(); ++k) {
         const auto& h = s.plate.harmonics[k];
@@ -289,16 +307,10 @@ std::vector<std::string> scene_warnings(const Scene& s) {
                         ", more than dry contacts usually have");
             break;
         }
-    double reach = 0;
+    const Support sup(p);
+    const double reach = sup.reach;
     if (!p.point) {
-        Mat3 A;
-        double size = 0;
-        for (int i = 0; i < 3; ++i) {
-            reach = std::max(reach, p.c[i].head<2>().norm());
-            for (int j = 0; j < i; ++j) size = std::max(size, (p.c[i] - p.c[j]).norm());
-        }
-        for (int i = 0; i < 3; ++i) A.col(i) = Vec3(1, p.c[i].x() / size, p.c[i].y() / size);
-        const Vec3 share = A.colPivHouseholderQr().solve(Vec3(1, 0, 0));
+        const Vec3& share = sup.share;
         int k = 0;
         if (share.minCoeff(&k) < kNearTipping)
             w.push_back(src + ": part.contacts: at rest contact " + std::to_string(k + 1) + " carries only " +
@@ -322,16 +334,11 @@ std::vector<std::string> scene_warnings(const Scene& s) {
     if (!p.point) {
         // Dynamic tipping: friction mu N at the contacts, a height h below the centre of mass, tips the
         // part about a support edge at distance d from the centre of mass's projection once mu h > d.
-        double d = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < 3; ++i) {
-            const Vec2 a = p.c[i].head<2>(), b = p.c[(i + 1) % 3].head<2>(), e = b - a;
-            d = std::min(d, std::abs(e.x() * a.y() - e.y() * a.x()) / e.norm());
-        }
-        const double h = p.s_z(), mu = p.mu.maxCoeff();
+        const double d = sup.edge, h = p.s_z(), mu = p.mu.maxCoeff();
         if (mu * h > d)
             w.push_back(src + ": part.contacts: sliding friction can tip the part: mu h = " + Reader::fmt(mu * h) +
                         " m exceeds the distance " + Reader::fmt(d) + " m from the centre of mass to the nearest support edge");
-        const double rho = std::sqrt(p.J(2, 2) / p.m);
+        const double rho = p.rho();
         if (rho < reach / kGyrationWarn || rho > reach * kGyrationWarn)
             w.push_back(src + ": part.inertia: radius of gyration sqrt(J_zz / m) = " + Reader::fmt(rho) +
                         " m against contacts up to " + Reader::fmt(reach) + " m from the centre of mass, a ratio beyond " +
