@@ -49,9 +49,9 @@ inline bool run_gnuplot(const fs::path& dir, const std::string& script, const fs
     const pid_t pid = ::fork();
     if (pid < 0) return false;
     if (pid == 0) {
-        if (::chdir(dir.c_str()) != 0) ::_exit(127);
-        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);   // (before chdir: log may be relative)
         if (fd >= 0) ::dup2(fd, 2);
+        if (::chdir(dir.c_str()) != 0) ::_exit(127);
         ::execlp("gnuplot", "gnuplot", script.c_str(), static_cast<char*>(nullptr));
         ::_exit(127);
     }

@@ -338,6 +338,11 @@ TEST_CASE("a report folder whose name holds quotes and a shell command is only a
     CHECK(fs::exists(d / "index.html"));
     CHECK_FALSE(fs::exists(witness));
     CHECK_FALSE(fs::exists(d.parent_path() / "PWNED"));
+    // A relative folder: gnuplot's messages still go to each figure's log (data/NAME.log), not the terminal.
+    fs::remove_all(tmpdir() / "relative-report");
+    const std::string rel = "cd " + tmpdir().string() + " && " + PLATE_EXE + " report --quick --out relative-report > /dev/null 2>&1";
+    CHECK(std::system(rel.c_str()) == 0);
+    CHECK(fs::exists(tmpdir() / "relative-report" / "data" / "fig1_xt.log"));
 }
 
 TEST_CASE("bounded work: a run over its budget is refused up front with the estimate, or stops with the reason",
