@@ -126,7 +126,7 @@ using WrenchMap = std::function<Vec3(const Vec3& xi)>;   // scaled twist -> (F_x
 // (maximum dissipation): -xi . w(xi) >= h_s(-xi), and every wrench must lie in the set:
 // -xi_i . w_j <= h_s(-xi_i) / cos(pi / angles) for all pairs.
 struct FrictionSet {
-    std::array<Vec2, 3> r{};   // contacts from the centre of mass, plate frame [m]
+    std::array<Vec2, 3> r = zeros<Vec2>();   // contacts from the centre of mass, plate frame [m]
     Vec3 cap = Vec3::Zero();   // mu_i N_i [N]
     double rho = 1;            // radius of gyration [m]
     double support_sampled(const Vec3& d, int angles) const;

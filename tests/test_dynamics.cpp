@@ -2,6 +2,7 @@
 // Coulomb's deceleration, and Newton-Euler written directly in the world frame with the
 // accelerations obtained by finite differences of the kinematics.
 #include "plate/dynamics.hpp"
+#include "plate/field.hpp"
 #include "plate/modes.hpp"
 #include "plate/random_scene.hpp"
 
@@ -10,6 +11,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <new>
 
 using namespace plate;
 
@@ -37,6 +40,43 @@ Vec3 normal_forces_38(const Part& P, const Vec3& rhs) {
 double rel(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
 
 }  // namespace
+
+// Eigen's fixed-size vectors are not zeroed by value-initialisation ({}): a point part's contacts
+// were garbage, read by Workspace::prepare (thin()), and a point part shaken at mu = 0.29 ran away
+// (relative speed growing by mu g T every period) or not depending on the process's environment.
+// Built on storage filled with 0xFF bytes (NaN), every default member must still be zero.
+template <class T, class Check>
+void on_poisoned_storage(Check check) {
+    alignas(T) unsigned char buf[sizeof(T)];
+    std::memset(buf, 0xFF, sizeof buf);
+    T* x = new (buf) T;   // default-initialised, as `Scene sc;` (T() would zero the storage first)
+    check(*x);
+    x->~T();
+}
+
+TEST_CASE("default model and workspace members are zero, not what the memory held", "[dynamics][init]") {
+    on_poisoned_storage<Part>([](const Part& p) {
+        for (const Vec3& c : p.c) CHECK(c == Vec3::Zero());
+        CHECK(p.J.isZero());
+        CHECK(p.mu.isZero());
+    });
+    on_poisoned_storage<Scene>([](const Scene& s) {
+        for (const Vec3& c : s.part.c) CHECK(c == Vec3::Zero());
+    });
+    on_poisoned_storage<Workspace>([](const Workspace& ws) {
+        for (int i = 0; i < 3; ++i) {
+            CHECK(ws.r[i] == Vec2::Zero());
+            CHECK(ws.slip[i] == Vec2::Zero());
+            CHECK(ws.hint[i] == Vec2::Zero());
+            CHECK(ws.f_held[i] == Vec2::Zero());
+        }
+    });
+    on_poisoned_storage<FrictionGauge>([](const FrictionGauge& g) {
+        for (const Vec2& f : g.f) CHECK(f == Vec2::Zero());
+    });
+    on_poisoned_storage<FixedPoint>([](const FixedPoint& p) { CHECK(p.eigenvalues.isZero()); });
+    on_poisoned_storage<FixedLine>([](const FixedLine& l) { CHECK(l.eigenvalues.isZero()); });
+}
 
 TEST_CASE("plate at rest, thin part: normal forces solve (38) and sum to m g, whatever the twist", "[dynamics]") {
     for (std::uint64_t seed = 1; seed <= 50; ++seed) {

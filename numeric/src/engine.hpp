@@ -629,7 +629,7 @@ private:
     }
 
     std::array<double, 3> creep_err_{};
-    std::array<Vec2, 3> creep_dir_{};
+    std::array<Vec2, 3> creep_dir_ = zeros<Vec2>();
     double creep_budget_ = 0, creep_t_ = 0;
     unsigned creep_spent_ = 0;
     double creep_h_ = std::numeric_limits<double>::infinity();
@@ -650,7 +650,7 @@ private:
     double v_ref_ = 0, h_min_ = 0, zero_abs_ = 0;
     bool frozen_ = false;
     Guards g0_{};
-    std::array<Vec2, 3> ref_{};
+    std::array<Vec2, 3> ref_ = zeros<Vec2>();
     Vec3 n_ = Vec3::Zero();
     int burst_ = 0;
     double last_event_t_ = -std::numeric_limits<double>::infinity();

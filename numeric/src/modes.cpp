@@ -120,7 +120,7 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
         const Vec3 d = e / s;
         Vec3 rhs = Vec3::Zero();
         double h = 0;
-        std::array<Vec2, 3> u{};
+        std::array<Vec2, 3> u = zeros<Vec2>();
         bool ok = true;
         for (int j = 0; j < 3 && ok; ++j) {
             if (j == k) continue;
@@ -349,7 +349,7 @@ void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Ve
             slip_velocities(P, q, qd, ws.slip);
             // The sliding contacts move on circles about c_k: v_j = theta' e_z x (r_j - r_k), whose
             // direction is the mode's sense times e_z x (r_j - r_k) (exact even at theta' = 0).
-            std::array<Vec2, 3> u{};
+            std::array<Vec2, 3> u = zeros<Vec2>();
             const Vec2 rk = horizontal_offset(P, q[2], mode.k);
             for (int j = 0; j < 3; ++j)
                 if (j != mode.k) u[j] = mode.sense * perp(horizontal_offset(P, q[2], j) - rk).normalized();

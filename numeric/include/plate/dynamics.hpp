@@ -68,7 +68,7 @@ struct Workspace {
     std::array<double, 9> M38_inv_rowmajor{};
     double det_floor = 0;                  // thick part: below it, the cofactor solution gives way to LU
     double theta = std::numeric_limits<double>::quiet_NaN();   // of the cached cos/sin in `in`
-    std::array<Vec2, 3> r{};               // R2 c_i (horizontal) at that theta
+    std::array<Vec2, 3> r = zeros<Vec2>();               // R2 c_i (horizontal) at that theta
     // Reduced U-dynamics (35): the slots of the generated reduced_U_*_config kernel for the frozen
     // configuration C_q (computed when q changes; NaN = none yet).
     Vec3 C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -80,7 +80,7 @@ struct Workspace {
     Eigen::PartialPivLU<Mat6> lu{6};
     Vec3 qdd = Vec3::Zero();               // [s_x'', s_y'', theta'']
     Vec3 n = Vec3::Zero();                 // [N1, N2, N3] (point part: N1 only)
-    std::array<Vec2, 3> slip{};            // sliding velocity of each contact, P frame (text after 14)
+    std::array<Vec2, 3> slip = zeros<Vec2>();            // sliding velocity of each contact, P frame (text after 14)
     long evals = 0;                        // number of evaluations (right-hand sides)
     // Stick-slip (modes.hpp). A sliding contact whose slip speed is at most hint_speed takes the
     // unit direction hint[i] instead of v_i/|v_i| (undefined at zero slip): the direction in which a
@@ -91,7 +91,7 @@ struct Workspace {
     // so that the step across the zero is smooth and the event is located on its dense output.
     bool use_hints = false;
     double hint_speed = 0;
-    std::array<Vec2, 3> hint{};
+    std::array<Vec2, 3> hint = zeros<Vec2>();
     std::array<double, 3> hint_from{};
     // Creep: contact i (bit i of creep) has just broken away and slips slowly. Its friction
     // direction relaxes towards the consistent one at a rate ~ |a'| / |v_i| (stiff as the slip
@@ -106,7 +106,7 @@ struct Workspace {
     // the contacts' angles (zero: none yet -- taken from the twist, or set by choose_mode).
     Vec3 creep_twist = Vec3::Zero();
     int creep_iterations = 0;              // Newton iterations of the last creep solve (diagnostics)
-    std::array<Vec2, 3> f_held{};          // static friction of held contacts (pivot, stuck) [N], P frame
+    std::array<Vec2, 3> f_held = zeros<Vec2>();          // static friction of held contacts (pivot, stuck) [N], P frame
     Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate
     double tau_needed = 0;                 // stuck: its moment about s (z)
 };

@@ -76,7 +76,7 @@ const char* stability_name(Stability s);
 
 struct FixedPoint {
     Vec3 q = Vec3::Zero();                 // theta in (-pi, pi]
-    Eigen::Vector3cd eigenvalues;          // of the field's Jacobian (point part: 2 used)
+    Eigen::Vector3cd eigenvalues = Eigen::Vector3cd::Zero();   // of the field's Jacobian (point part: 2 used)
     Stability stability = Stability::Saddle;
     double residual = 0;                   // |xi_a(q)| [m/s, angular times rho]
 };
@@ -87,7 +87,7 @@ struct FixedLine {
     std::vector<Vec3> points;
     Vec3 direction = Vec3::Zero();
     Stability stability = Stability::Saddle;
-    Eigen::Vector3cd eigenvalues;          // at the first point; the one nearest 0 is along the line
+    Eigen::Vector3cd eigenvalues = Eigen::Vector3cd::Zero();   // at the first point; the one nearest 0 is along the line
     double length = 0;                     // in (s_x, s_y, rho theta) [m]
 };
 

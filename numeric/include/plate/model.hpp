@@ -19,13 +19,22 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Value-initialisation ({}) does not zero Eigen's fixed-size vectors (their default constructor
+// leaves them uninitialised): arrays of them start from zeros<V>().
+template <class V, std::size_t N = 3>
+std::array<V, N> zeros() {
+    std::array<V, N> a;
+    a.fill(V::Zero());
+    return a;
+}
+
 // sigma = (m, J, c1, c2, c3, mu_k1, mu_k2, mu_k3).
 // A point part has only m and mu (one contact at the centre of mass, no rotation).
 struct Part {
     bool point = false;
     double m = 0;                 // mass [kg]
     Mat3 J = Mat3::Zero();        // rotational inertia about s, in S [kg m^2]
-    std::array<Vec3, 3> c{};      // contacts c_i in S [m]; all share one z (flat plate)
+    std::array<Vec3, 3> c = zeros<Vec3>();   // contacts c_i in S [m]; all share one z (flat plate)
     Vec3 mu = Vec3::Zero();       // kinetic friction coefficients mu_ki
 
     int contacts() const { return point ? 1 : 3; }

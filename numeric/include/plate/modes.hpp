@@ -69,7 +69,7 @@ std::string mode_name(const Mode& m);
 // point: f_i = gamma mu_i N_i G_i^T d/|G_i^T d|.
 struct FrictionGauge {
     double gamma = 0;               // 0 for w = 0; inf if no friction can supply w
-    std::array<Vec2, 3> f{};        // the optimal friction distribution [N], P frame
+    std::array<Vec2, 3> f = zeros<Vec2>();        // the optimal friction distribution [N], P frame
     int pivot = -1;                 // contact whose force lies inside its disk at the optimum, if any
     Vec3 direction = Vec3::Zero();  // d: the twist (s_x', s_y', theta') the needed friction opposes
     int iterations = 0;             // Newton iterations (0: closed form)
