@@ -3,7 +3,9 @@
 # elsewhere (relocatable), run the installed plate from / and check it finds its scenes beside
 # itself, then build a consumer project with find_package(plate CONFIG) against it and check it
 # computes the same twist as the installed program.
-#   check_install.sh BUILD_DIR SOURCE_DIR
+# With the Python module built, the installed module is imported from / with the documented
+# PYTHONPATH=PREFIX/lib/python3/dist-packages and must give the installed program's twist.
+#   check_install.sh BUILD_DIR SOURCE_DIR [PYTHON]
 set -euo pipefail
 build=$(cd "$1" && pwd); src=$(cd "$2" && pwd)
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
@@ -26,3 +28,16 @@ c = [float(x) for x in sys.argv[2:5]]
 assert t == c, f"installed plate {t} vs consumer {c}"
 print("consumer and installed plate agree:", c)
 PY
+python=${3:-}
+if [ -n "$python" ]; then
+  [ -f "$prefix/lib/python3/dist-packages/plate/__init__.py" ] || { echo "the Python module was not installed"; exit 1; }
+  PYTHONPATH="$prefix/lib/python3/dist-packages" "$python" - "$work/twist.json" "$prefix" <<'PY'
+import json, sys
+import plate
+assert plate.__file__.startswith(sys.argv[2]), plate.__file__
+t = json.load(open(sys.argv[1]))["twist"]
+c = plate.twist(plate.load_scene(sys.argv[2] + "/share/plate/scenes/fig4.json"), at=(0.02, 0.01, 0.5)).twist.tolist()
+assert t == c, f"installed plate {t} vs installed Python module {c}"
+print("installed Python module and installed plate agree:", c)
+PY
+fi

@@ -1,0 +1,40 @@
+"""plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch).
+
+Where does a part resting on a periodically shaken plate go?  The same library as the ``plate``
+program, from Python::
+
+    import plate
+    scene = plate.load_scene("scenes/fig4.json")          # or plate.scene_from_dict({...})
+    c = plate.twist(scene, at=(0.03, -0.02, 1.0))          # asymptotic twist (36) of the limit cycle
+    f = plate.field(scene, grid=9)                         # numpy arrays f.x, f.y, f.theta, f.twist
+    fp = plate.fixed_points(f)                             # fp.points: stable, unstable, saddle
+    tr = plate.simulate(scene, start=(0.03, -0.02, 1.0), time=5.0, dynamics="full")
+
+Results carry numpy arrays and ``summary``, the command line's JSON as a dict.  Errors raise
+``plate.InputError`` (a ValueError; bad scenes, with the file and field named as the command line
+names them), ValueError (bad options) or RuntimeError.  The GIL is released while the library works.
+"""
+import json as _json
+
+from ._plate import (Cycle, Field, FixedLine, FixedPoint, FixedPoints, InputError, Scene, Stop,
+                     Trajectory, field, fixed_points, load_scene, parse_scene, simulate, twist)
+from ._plate import __version__ as _compiled_version
+
+__version__ = _compiled_version
+__all__ = ["Cycle", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Scene", "Stop",
+           "Trajectory", "field", "fixed_points", "load_scene", "parse_scene", "scene_from_dict",
+           "scene_to_dict", "simulate", "twist"]
+
+
+def scene_from_dict(d, source="<dict>"):
+    """A scene from a dict in the scene file's form (see scenes/*.json); checked as a file is."""
+    return parse_scene(_json.dumps(d), source)
+
+
+def scene_to_dict(scene):
+    """The scene in the file form, as a dict (scene_from_dict(scene_to_dict(s)) gives s back)."""
+    return _json.loads(scene.to_json())
+
+
+Scene.to_dict = scene_to_dict
+Scene.from_dict = staticmethod(scene_from_dict)
