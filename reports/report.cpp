@@ -408,20 +408,21 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         }
         const std::string F = "'data/" + n + "_field.dat'", T = "'data/" + n + "_traj.dat'";
         const std::string arrows = " w vec head size 0.004,20 lc rgb '#777777' notitle";
+        const std::string kFieldSize = "800,640";   // field figures: large enough to read the arrows
         if (pt) {
             c.plot(n + "_xy", "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
                                   " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
-                   std::string(f.what) + ": s_x–s_y");
+                   std::string(f.what) + ": s_x–s_y", kFieldSize);
         } else {
             c.plot(n + "_3d", "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nsplot " + F + " u 1:2:3:4:5:6" + arrows +
                                   ", " + T + " u 1:2:3 w l lw 2 lc rgb '#c02020' notitle\n",
-                   std::string(f.what) + ": (s_x, s_y, θ)");
+                   std::string(f.what) + ": (s_x, s_y, θ)", kFieldSize);
             c.plot(n + "_xy", "set xlabel 's_x'\nset ylabel 's_y'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T + " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
-                   "s_x–s_y projection");
+                   "s_x–s_y projection", kFieldSize);
             c.plot(n + "_xt", "set xlabel 's_x'\nset ylabel 'θ'\nplot " + F + " u 1:3:4:6" + arrows + ", " + T + " u 1:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
-                   "s_x–θ projection");
+                   "s_x–θ projection", kFieldSize);
             c.plot(n + "_yt", "set xlabel 's_y'\nset ylabel 'θ'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T + " u 2:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
-                   "s_y–θ projection");
+                   "s_y–θ projection", kFieldSize);
         }
         int stuck = 0, lost = 0, sticks = 0, held_all = 0;
         for (const auto& p : field.points) {
@@ -440,7 +441,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                                       "plot " + SF + " u 1:2:7 w p pt 5 ps 2 palette notitle\n"
                                     : "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nset cblabel 'stick fraction'\n"
                                       "set cbrange [0:1]\nsplot " + SF + " u 1:2:3:7 w p pt 7 ps 1 palette notitle\n",
-                   std::string(f.what) + ": fraction of the cycle a contact is held (largest of the contacts)");
+                   std::string(f.what) + ": fraction of the cycle a contact is held (largest of the contacts)", kFieldSize);
         }
         c.html << "<table><tr><th>fixed point / line</th><th>at (from … to)</th><th>stability</th><th>eigenvalues (real parts)</th></tr>\n";
         for (const auto& p : fp.points) {
@@ -492,7 +493,7 @@ void write_report(const ReportOptions& opt) {
                 "function(){renderMathInElement(document.body,{delimiters:[{left:'$$',right:'$$',display:true}],throwOnError:false});});</script>\n";
     }
     std::ostringstream html;
-    html << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: verification report</title>\n" << kStyle << katex
+    html << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: verification report</title>\n" << kErrorTrap << kStyle << katex
          << "</head><body>\n<h1>Sliding manipulation on a 6-DoF plate: verification report</h1>\n";
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
          << "; machine: " << esc(machine_description()) << "; total "
@@ -505,7 +506,7 @@ void write_report(const ReportOptions& opt) {
     if (fs::exists(speed)) html << std::ifstream(speed).rdbuf();
     else html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
               << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
-    html << kSpeedEnd << "\n" << kImageCheck << "</body></html>\n";
+    html << kSpeedEnd << "\n" << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
 }
 

@@ -79,11 +79,12 @@ struct Ctx {
         o << std::setprecision(9);
         return o;
     }
-    // Runs a gnuplot script (cwd = dir) that must write `name`.svg; adds the <img>.
+    // Runs a gnuplot script (cwd = dir) that must write `name`.svg; adds the <img>. The SVG has a
+    // fixed size (shown at it, or the page's width if narrower; a click enlarges it to the window).
     void plot(const std::string& name, const std::string& script, const std::string& caption,
               const std::string& size = "640,480") {
         const fs::path gp = dir / "data" / (name + ".gp");
-        std::ofstream(gp) << "set terminal svg size " << size << " dynamic background rgb 'white' font 'sans,11'\n"
+        std::ofstream(gp) << "set terminal svg size " << size << " fixed background rgb 'white' font 'sans,11'\n"
                           << "set output '" << name << ".svg'\n" << script;
         if (!run_gnuplot(dir, "data/" + name + ".gp", dir / "data" / (name + ".log")) || !fs::exists(dir / (name + ".svg")))
             throw std::runtime_error("gnuplot failed on " + gp.string() + " (see data/" + name + ".log)");
@@ -94,10 +95,14 @@ struct Ctx {
 };
 
 inline const char* kStyle = R"(<style>
-body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+body{font-family:sans-serif;max-width:1700px;margin:2em auto;padding:0 1em;color:#222}
+p,ul,ol,table,.math{max-width:1100px}
 h1,h2,h3{color:#123}table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;font-size:90%}
 th{background:#eef}.pass{color:#080;font-weight:bold}.fail{color:#b00;font-weight:bold}figure{display:inline-block;margin:.5em}
-figure img{max-width:520px;border:1px solid #ddd}figcaption{font-size:85%;max-width:520px}code,pre{background:#f6f6f6}
+figure{max-width:calc(100% - 1em)}figure img{max-width:100%;height:auto;border:1px solid #ddd;cursor:zoom-in}
+figcaption{font-size:85%;max-width:640px}code,pre{background:#f6f6f6}
+#zoom{display:none;position:fixed;top:0;left:0;right:0;bottom:0;background:rgba(0,0,0,.75);z-index:9;cursor:zoom-out}
+#zoom img{display:block;margin:2vh auto;width:auto;height:96vh;max-width:96vw;object-fit:contain;background:#fff}
 pre{overflow-x:auto;padding:.5em}.math{overflow-x:auto}</style>
 )";
 
@@ -108,11 +113,31 @@ inline std::string verdict(bool ok) { return ok ? "<span class=\"pass\">pass</sp
 inline const char* kSpeedBegin = "<!-- speed-accuracy:begin -->";
 inline const char* kSpeedEnd = "<!-- speed-accuracy:end -->";
 
-// For scripts/check-report.sh: after loading, the body says whether every image rendered.
-inline const char* kImageCheck =
-    "<script>window.addEventListener('load',function(){var b=[].slice.call(document.images).filter("
-    "function(i){return !(i.complete&&i.naturalWidth>0);});document.body.setAttribute('data-images',"
-    "b.length?'missing:'+b.map(function(i){return i.getAttribute('src');}).join(','):'ok:'+document.images.length);});"
-    "</script>\n";
+// First in <head>: records every error the page meets (script errors, resources that fail to load,
+// console.error, rejected promises) for the browser check.
+inline const char* kErrorTrap =
+    "<script>window.__errors=[];window.addEventListener('error',function(e){var t=e.target;"
+    "window.__errors.push(t&&t!==window&&(t.src||t.href)?'failed to load '+(t.src||t.href):String(e.message));},true);"
+    "window.addEventListener('unhandledrejection',function(e){window.__errors.push('unhandled rejection: '+e.reason);});"
+    "(function(){var ce=console.error;console.error=function(){window.__errors.push([].join.call(arguments,' '));"
+    "ce.apply(console,arguments);};})();</script>\n";
+
+// Last in <body>: click a figure to see it as large as the window (click again to close); and, for
+// scripts/check-report.sh, once loaded the body states what a person would see: data-images (every
+// image decoded: ok:N, else missing:SRC,...), data-errors (none, else the errors), data-math (every
+// $$...$$ typeset by KaTeX: ok:N, else why not), data-figure-width (the narrowest figure as shown, px).
+inline const char* kPageCheck =
+    "<div id=\"zoom\"><img alt=\"enlarged figure\"></div>\n<script>(function(){var z=document.getElementById('zoom');"
+    "document.addEventListener('click',function(e){var t=e.target;if(t.closest&&t.closest('figure')&&t.tagName==='IMG'){"
+    "z.firstChild.src=t.src;z.style.display='block';}else if(t===z||t.parentNode===z){z.style.display='none';}});})();\n"
+    "window.addEventListener('load',function(){var b=document.body;var imgs=[].slice.call(document.querySelectorAll('figure img'));"
+    "var bad=imgs.filter(function(i){return !(i.complete&&i.naturalWidth>0);});"
+    "b.setAttribute('data-images',bad.length?'missing:'+bad.map(function(i){return i.getAttribute('src');}).join(','):'ok:'+imgs.length);"
+    "var w=imgs.map(function(i){return i.getBoundingClientRect().width;});"
+    "b.setAttribute('data-figure-width',w.length?Math.round(Math.min.apply(null,w)):0);"
+    "var k=document.querySelectorAll('.katex').length,ke=document.querySelectorAll('.katex-error').length;"
+    "var left=b.innerText.indexOf('$$')>=0;"
+    "b.setAttribute('data-math',ke?'errors:'+ke:left?(window.katex?'untypeset $$ left':'KaTeX not loaded'):'ok:'+k);"
+    "b.setAttribute('data-errors',window.__errors.length?window.__errors.join(' | '):'none');});</script>\n";
 
 }  // namespace plate::report::html

@@ -683,7 +683,7 @@ void write_speed_study(const SpeedOptions& opt) {
         page = page.substr(0, b + std::string(kSpeedBegin).size()) + c.html.str() + page.substr(e);
     } else {
         page = std::string("<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: speed and accuracy</title>\n") +
-               kStyle + "</head><body>\n" + kSpeedBegin + c.html.str() + kSpeedEnd + "\n" + kImageCheck + "</body></html>\n";
+               kErrorTrap + kStyle + "</head><body>\n" + kSpeedBegin + c.html.str() + kSpeedEnd + "\n" + kPageCheck + "</body></html>\n";
     }
     write_file_atomic(index.string(), [&](std::ostream& o) { o << page; });
 }

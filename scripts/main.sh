@@ -19,5 +19,5 @@ echo "== verification report (derivation, Theorem 1 on 10^4 thin and 10^3 thick 
 build/plate report --out "$out/report"
 echo "== speed-accuracy study (methods, limit-cycle solvers, failure maps, model hierarchy; a few minutes)" >&2
 build/plate bench --out "$out/report"
-if command -v chromium >/dev/null; then scripts/check-report.sh "$out/report"; fi
+scripts/check-report.sh "$out/report" --screenshot "$out/report/screenshot.png"
 echo "results in $out/ (open $out/report/index.html)" >&2

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The report as a person sees it (issue 17, point 6): `plate report --quick` opened in headless
+# Chromium by scripts/check-report.sh must show every figure at 600 px or more, typeset every
+# formula and meet no error; the screenshot is kept as the test's artefact (OUT/report_screenshot.png).
+# Then the check is shown to fail, with the right reason, on five doctored copies of the page.
+#   check_browser.sh PLATE_EXE SOURCE_DIR OUT_DIR
+set -euo pipefail
+exe=$1 src=$(cd "$2" && pwd) out=$3
+check="$src/scripts/check-report.sh"
+rm -rf "$out"; mkdir -p "$out"
+"$exe" report --quick --out "$out/report" 2> "$out/report.log"
+"$check" "$out/report" --screenshot "$out/report_screenshot.png"
+
+# Each doctored copy must fail, and say why.
+expect_fail() {   # NAME REASON EDIT...
+  local name=$1 reason=$2; shift 2
+  local d="$out/doctored_$name"
+  cp -r "$out/report" "$d"
+  (cd "$d" && eval "$@")
+  if "$check" "$d" > "$d.out" 2>&1; then
+    echo "check-report passed a page with $name"; cat "$d.out"; exit 1
+  fi
+  grep -q "$reason" "$d.out" || { echo "check-report failed $name for another reason:"; cat "$d.out"; exit 1; }
+  echo "doctored ($name): failed as it should: $(grep FAIL "$d.out" | head -1)"
+  rm -rf "$d" "$d.out"
+}
+first_svg=$(grep -o '<img src="[^"]*\.svg"' "$out/report/index.html" | head -1 | sed 's/<img src="//; s/"$//')
+expect_fail "a missing figure" "figures not shown" "rm '$first_svg'"
+expect_fail "a script error" "errors in the page" "sed -i 's|</body>|<script>no_such_function();</script></body>|' index.html"
+expect_fail "a formula KaTeX cannot parse" "formulas not typeset" "sed -i 's|</body>|<p>\$\$\\\\frac{1}{\$\$</p></body>|' index.html"
+expect_fail "KaTeX missing" "formulas not typeset" "rm -r katex"
+expect_fail "thumbnails" "below 600" "sed -i 's|</head>|<style>figure img{width:300px}</style></head>|' index.html"
