@@ -6,7 +6,7 @@
 #include "plate/modes.hpp"
 #include "plate/random_scene.hpp"
 
-#include "engine.hpp"   // dexp_inv, exp_so3, hat
+#include "so3.hpp"   // dexp_inv, exp_so3, hat
 
 #include <catch2/catch.hpp>
 

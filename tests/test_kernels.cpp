@@ -4,7 +4,7 @@
 #include "plate/dynamics.hpp"
 #include "plate/random_scene.hpp"
 
-#include "engine.hpp"   // exp_so3
+#include "so3.hpp"   // exp_so3
 
 #include <catch2/catch.hpp>
 

@@ -1,6 +1,9 @@
-// Internal: the adaptive stepping loop shared by trajectories and limit cycles, with stick-slip.
-// Dormand-Prince 5(4) (Boost.Odeint's FSAL stepper) on a scaled state, so that one scalar
-// tolerance is relative for every component, with a PI step-size controller (try_step).
+// Internal: the integration loop shared by trajectories and limit cycles, with stick-slip: the
+// mode logic (which guards a mode has, what an event means, which mode comes next, creep and
+// lingering slips) driving two parts that know nothing of contacts:
+//   stepper.hpp  one Dormand-Prince 5(4) step on a scaled state (one scalar tolerance relative for
+//                every component) under a PI step-size controller, and its dense output;
+//   events.hpp   the first root of a guard on a step's dense output (Illinois).
 //
 // The contact mode (modes.hpp: slide, pivot about a contact, stuck) is part of the state. Each mode
 // has guards that stay positive while it holds: the normal forces; in slide, each contact's slip
@@ -18,10 +21,11 @@
 // starting direction changes sign while the slip stays away from zero) is not an event.
 #pragma once
 
+#include "events.hpp"
 #include "plate/modes.hpp"
 #include "plate/simulate.hpp"
-
-#include <boost/numeric/odeint.hpp>
+#include "so3.hpp"
+#include "stepper.hpp"
 
 #include <algorithm>
 #include <array>
@@ -31,8 +35,6 @@
 #include <vector>
 
 namespace plate::detail {
-
-namespace odeint = boost::numeric::odeint;
 
 // Model concept: State, level, ws, mode; rhs(t, y, dy) in physical units, in the model's mode (fills
 // ws); q(y), qd(y), set_qd(y, qd); plate(t, y) -> PlateState; scale() -> State of characteristic
@@ -246,35 +248,8 @@ private:
         last_y_ = ys;
     }
 
-    // One Dormand-Prince step of size dt from (t_, ys_) into ys1_, fs1_. The error norm is
-    // max_i |err_i| / (rtol (1 + max(|y_i|, |y1_i|))). odeint's default checker divides by
-    // rtol (1 + |y_i| + dt |y'_i|) instead: a tolerance that grows with the step, so the error no
-    // longer scales as dt^5 and its controller overshoots (29% of fig4's field steps rejected).
-    // The step size follows the PI controller of Hairer & Wanner's DOPRI5 (Solving ODEs I, II.4;
-    // beta = 0.04, safety 0.9, factors in [0.2, 10]). On success t1 += dt and dt becomes the next
-    // step; on failure dt becomes the step to retry with.
-    bool try_step(double& t1, double& dt) {
-        stepper_.do_step(sysref(), ys_, fs_, t1, ys1_, fs1_, dt, err_);
-        double err = 0;
-        for (std::size_t i = 0; i < err_.size(); ++i)
-            err = std::max(err, std::abs(err_[i]) / (opt_.rtol * (1 + std::max(std::abs(ys_[i]), std::abs(ys1_[i])))));
-        if (!std::isfinite(err)) {
-            dt *= 0.2;
-            return false;
-        }
-        // err^expo / err_old^beta through logarithms: one log and one exp per step, not two pows.
-        constexpr double beta = 0.04, expo = 0.2 - 0.75 * beta;
-        const double log_err = std::log(std::max(err, 1e-16));
-        if (err > 1) {
-            dt /= std::min(5.0, std::exp(expo * log_err) / 0.9);
-            return false;
-        }
-        const double fac = std::clamp(std::exp(expo * log_err - beta * log_err_old_) / 0.9, 0.1, 5.0);
-        log_err_old_ = std::max(log_err, std::log(1e-4));
-        t1 += dt;
-        dt /= fac;
-        return true;
-    }
+    // One step of size dt from (t_, ys_) into ys1_, fs1_ (stepper.hpp); t1 and dt as there.
+    bool try_step(double& t1, double& dt) { return stepper_.try_step(sysref(), ys_, fs_, t1, ys1_, fs1_, dt, opt_.rtol); }
 
     double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
 
@@ -492,34 +467,24 @@ private:
     // The state at time t in the last step, scaled (dense output; constant while frozen).
     void dense(double t, double t1, State& out) {
         if (frozen_) { out = ys_; return; }
-        stepper_.calc_state(t, out, ys_, fs_, t_, ys1_, fs1_, t1);
+        stepper_.dense(t, ys_, fs_, t_, ys1_, fs1_, t1, out);
     }
 
-    // First root of guard i in (t_, t1] (Illinois on the dense output) to 1e-13 T; yr receives the
+    // First root of guard i in (t_, t1] on the dense output (events.hpp) to 1e-13 T; yr receives the
     // scaled state at the returned time, where the guard is already violated.
     double locate(int i, double t1, double g1, State& yr) {
-        double a = t_, b = t1, ga = g0_[i], gb = g1;
         yr = ys1_;
-        int side = 0;
         State ym, dym;
         Guards gm;
-        for (int it = 0; it < 200 && b - a > 1e-13 * scene_.plate.T; ++it) {
-            double m = gb != ga ? (a * gb - b * ga) / (gb - ga) : 0.5 * (a + b);
-            if (!(m > a && m < b) || it % 8 == 7) m = 0.5 * (a + b);   // a bisection now and then
-            dense(m, t1, ym);
-            sys(ym, dym, m);
-            guards(ym, gm);
-            if (crossed(i, ga, gm[i])) {
-                b = m; gb = gm[i]; yr = ym;
-                if (side == -1) ga *= 0.5;
-                side = -1;
-            } else {
-                a = m; ga = gm[i];
-                if (side == 1) gb *= 0.5;
-                side = 1;
-            }
-        }
-        return b;
+        return illinois_first_root(
+            t_, t1, g0_[i], g1, 1e-13 * scene_.plate.T,
+            [&](double m) {
+                dense(m, t1, ym);
+                sys(ym, dym, m);
+                guards(ym, gm);
+                return gm[i];
+            },
+            [&](double ga, double gm_i) { return crossed(i, ga, gm_i); }, [&] { yr = ym; });
     }
 
     // Did contact k's slip really reach zero at the root of its guard (rather than swing past zero)?
@@ -642,9 +607,7 @@ private:
     Model& model_;
     const Scene& scene_;
     IntegrationOptions opt_;
-    odeint::runge_kutta_dopri5<State> stepper_;
-    State err_{};
-    double log_err_old_ = std::log(1e-4);
+    Dopri5Controller<State> stepper_;
     State scale_{}, inv_scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, last_y_{};
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
     double v_ref_ = 0, h_min_ = 0, zero_abs_ = 0;
@@ -655,25 +618,5 @@ private:
     int burst_ = 0;
     double last_event_t_ = -std::numeric_limits<double>::infinity();
 };
-
-// Exponential coordinates of the plate orientation: R1 = exp(phi^). With the spatial angular
-// velocity omega1 (R1' = omega1^ R1, eq. 7), phi' = dexp_{phi}^{-1} omega1, which keeps R1 on
-// SO(3) exactly (R1 is never integrated as nine numbers). |phi| stays far below pi here.
-inline Mat3 hat(const Vec3& w) {
-    Mat3 W;
-    W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-    return W;
-}
-inline Mat3 exp_so3(const Vec3& phi) {
-    return Eigen::AngleAxisd(phi.norm(), phi.norm() > 0 ? Vec3(phi.normalized()) : Vec3::UnitZ())
-        .toRotationMatrix();
-}
-inline Vec3 dexp_inv(const Vec3& phi, const Vec3& w) {
-    const double a = phi.norm();
-    // 1/a^2 - (1 + cos a) / (2 a sin a), series 1/12 + a^2/720 + a^4/30240 near 0.
-    const double k = a < 1e-3 ? 1.0 / 12 + a * a / 720 + a * a * a * a / 30240
-                               : 1 / (a * a) - (1 + std::cos(a)) / (2 * a * std::sin(a));
-    return w - 0.5 * phi.cross(w) + k * phi.cross(phi.cross(w));
-}
 
 }  // namespace plate::detail
