@@ -1,0 +1,104 @@
+// Inverse design: the plate motion that makes the asymptotic twist field do what is wanted
+// (issue 16). Options in, summary out, like the rest of the library; every design is verified
+// before it is reported (the field's fixed points on a grid, and full-dynamics runs from seeded
+// random starts), and a design that fails verification says so.
+//
+// EXACT SYMMETRIES the search uses (checked in tests/test_design.cpp against fields computed both ways):
+//   rotate_motion(u, a)   the plate motion turned by a about z (x/y and rx/ry harmonics rotate, z and
+//                         rz stay): the field turns with it, xi'(R s, theta + a) = (R v, omega)
+//                         (friction disks are isotropic);
+//   shift_motion(u, D)    -alpha x D added to the linear acceleration (alpha: the angular one): the
+//                         plate point at D now moves as the centre did, so the field shifts by D,
+//                         xi'(s + D, theta) = xi(s, theta) (exact in the U-dynamics: the plate's
+//                         acceleration at r is p'' + alpha x r, its tilt the same everywhere).
+// So a design for a target at the centre moves exactly onto any other target, and the search only
+// shapes the field about the centre. And with only odd harmonics and no z or rz motion, turning the
+// motion by pi equals shifting it by half a period, so the field is odd about the centre
+// (xi(-s, theta + pi) = -xi(s, theta) for the translation part): a point part's centre is then a
+// fixed point by construction, and a rigid part's fixed points come in pairs (s, theta),
+// (-s, theta + pi) with the same stability -- a unique one cannot exist with such motions.
+#pragma once
+
+#include "plate/field.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace plate {
+
+PlateMotion rotate_motion(const PlateMotion& u, double angle);
+PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
+
+enum class DesignTargetKind { Sink };
+struct DesignTarget {
+    // Sink: every start in the region ends at position (x, y): for a point part the unique stable
+    // fixed point of its velocity field ("fixed-point X Y" is the same target).
+    DesignTargetKind kind = DesignTargetKind::Sink;
+    Vec2 at = Vec2::Zero();
+};
+
+struct DesignOptions {
+    double lin_limit = 20;     // largest amplitude of a linear-acceleration harmonic [m/s^2]
+    double ang_limit = 150;    // of an angular-acceleration harmonic [rad/s^2]
+    double period = 0;         // plate period T [s]; 0: the part scene's
+    double region = 0.05;      // the plate region |s_x|, |s_y| <= region [m]
+    // No flight: g + the vertical acceleration of every plate point in the region stays at or above
+    // this fraction of g, all period long (a constraint of the search, never a penalty).
+    double flight_margin = 0.2;
+    std::uint64_t seed = 1;
+    int starts = 16;           // multi-start: seeded feasible random motions, each refined locally
+    int local_evaluations = 400;   // per start (NLopt COBYLA)
+    int threads = 0;           // starts in parallel (0: all cores)
+    LimitCycleOptions cycle = cycle_defaults();
+    // Verification: the field's fixed points on a verify_grid^2 grid over the region, and the full
+    // dynamics from verify_starts seeded random starts in the region, which must end within
+    // verify_distance of the target.
+    int verify_grid = 7;
+    int verify_starts = 20;
+    double verify_distance = 0.005;   // [m]
+    double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
+    static LimitCycleOptions cycle_defaults() {
+        LimitCycleOptions o;
+        o.tol = 1e-6;
+        o.integration.rtol = 1e-7;
+        o.max_periods = 60;                    // a candidate cannot cost seconds
+        o.max_rhs_evaluations = 200'000;
+        return o;
+    }
+};
+
+struct DesignStartRun {
+    double x = 0, y = 0;        // the start [m]
+    double end_distance = 0;    // from the target after `seconds` of full dynamics [m]
+    double seconds = 0;
+    std::string stop;           // why the run stopped early, if it did
+};
+
+struct DesignSummary {
+    bool verified = false;      // the design passed every check below
+    bool unique = false;        // one stable fixed point on the grid, at the target
+    std::string failure;        // why not verified
+    Scene scene;                // the part with the designed plate motion
+    // The search, at the centre before the shift: the field's Jacobian there and its convergence
+    // rate (-max Re of the eigenvalues) [1/s].
+    double rate = 0;
+    Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();
+    long evaluations = 0;       // objective evaluations (each a few limit cycles)
+    long cycles = 0;            // limit cycles computed in the search
+    // Verification.
+    FixedPoints fixed_points;   // of the designed field on the grid
+    Vec3 fixed_point = Vec3::Zero();   // the stable one nearest the target
+    Eigen::Vector3cd fixed_point_eigenvalues = Eigen::Vector3cd::Zero();
+    std::vector<DesignStartRun> runs;   // full dynamics from random starts
+    double worst_end_distance = 0;
+    double min_vertical_margin = 0;     // min over the period and the region of (g + a_z) / g
+    double seconds = 0;
+    std::vector<std::string> notes;     // the symmetries used, and what they imply
+};
+
+// Designs a plate motion for the part of `part_scene` (its plate block is ignored but for its
+// period when opt.period is 0). Throws std::invalid_argument for a target the part cannot have.
+DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt = {});
+
+}  // namespace plate
