@@ -2,7 +2,7 @@
 """The layout shows the pipeline (issue 17, point 4): a file's folder tells its layer, and no file
 includes a header of a layer above its own.
 
-    symbolic  <  numeric  <  experiments, proofs (siblings: neither includes the other)
+    symbolic  <  numeric  <  experiments, proofs, design (siblings: none includes another)
               <  reports  <  apps, python, bench  (tests may include anything)
 
 Every quoted #include is resolved to the file it names (by the include folders of the layers) and
@@ -14,10 +14,10 @@ import re
 import sys
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
-RANK = {"symbolic": 0, "numeric": 1, "experiments": 2, "proofs": 2, "reports": 3, "apps": 4, "python": 4, "bench": 4}
+RANK = {"symbolic": 0, "numeric": 1, "experiments": 2, "proofs": 2, "design": 2, "reports": 3, "apps": 4, "python": 4, "bench": 4}
 # Where each layer's headers are found by their include names.
 INCLUDE_DIRS = {"symbolic": ["symbolic"], "numeric": ["numeric/include", "numeric/generated", "numeric/src"],
-                "experiments": ["experiments/include"], "proofs": ["proofs"], "reports": ["reports", "reports/generated"],
+                "experiments": ["experiments/include"], "proofs": ["proofs"], "design": ["design/include"], "reports": ["reports", "reports/generated"],
                 "apps": ["apps"], "python": [], "bench": []}
 include = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
