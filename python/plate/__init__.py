@@ -9,6 +9,7 @@ program, from Python::
     f = plate.field(scene, grid=9)                         # numpy arrays f.x, f.y, f.theta, f.twist
     fp = plate.fixed_points(f)                             # fp.points: stable, unstable, saddle
     tr = plate.simulate(scene, start=(0.03, -0.02, 1.0), time=5.0, dynamics="full")
+    d = plate.design(plate.load_scene("scenes/fig1_point.json"), sink=(0.02, -0.01))   # d.scene, d.verified
 
 Results carry numpy arrays and ``summary``, the command line's JSON as a dict.  Errors raise
 ``plate.InputError`` (a ValueError; bad scenes, with the file and field named as the command line
@@ -16,13 +17,13 @@ names them), ValueError (bad options) or RuntimeError.  The GIL is released whil
 """
 import json as _json
 
-from ._plate import (Cycle, Field, FixedLine, FixedPoint, FixedPoints, InputError, Scene, Stop,
-                     Trajectory, field, fixed_points, load_scene, parse_scene, simulate, twist)
+from ._plate import (Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Scene, Stop,
+                     Trajectory, design, field, fixed_points, load_scene, parse_scene, simulate, twist)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
-__all__ = ["Cycle", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Scene", "Stop",
-           "Trajectory", "field", "fixed_points", "load_scene", "parse_scene", "scene_from_dict",
+__all__ = ["Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Scene", "Stop",
+           "Trajectory", "design", "field", "fixed_points", "load_scene", "parse_scene", "scene_from_dict",
            "scene_to_dict", "simulate", "twist"]
 
 

@@ -7,6 +7,7 @@
 // The GIL is released while the library works (fields and long simulations take seconds), so other
 // Python threads run meanwhile. Errors are Python exceptions with the command line's messages:
 // plate.InputError (a ValueError) for a bad scene, ValueError for a bad option, RuntimeError else.
+#include "plate/design.hpp"
 #include "plate/field.hpp"
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
@@ -344,6 +345,56 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("field"), py::kw_only(), py::arg("ftol") = 1e-6, py::arg("max_rhs") = 20'000'000L,
           "Zeros of a field (from plate.field): candidate cells refined by Gauss-Newton, classified by the\n"
           "Jacobian's eigenvalues; curves of zeros as lines.");
+
+    // --- design --------------------------------------------------------------------------------
+    py::class_<DesignSummary>(m, "Design", "A designed plate motion and its verification (plate.design).")
+        .def_readonly("verified", &DesignSummary::verified)
+        .def_readonly("unique", &DesignSummary::unique)
+        .def_readonly("failure", &DesignSummary::failure)
+        .def_readonly("scene", &DesignSummary::scene)
+        .def_readonly("rate", &DesignSummary::rate, "convergence rate at the target, -max Re(eigenvalues) [1/s]")
+        .def_readonly("eigenvalues", &DesignSummary::eigenvalues)
+        .def_readonly("fixed_point", &DesignSummary::fixed_point)
+        .def_readonly("evaluations", &DesignSummary::evaluations)
+        .def_readonly("cycles", &DesignSummary::cycles)
+        .def_readonly("worst_end_distance", &DesignSummary::worst_end_distance,
+                      "of the full-dynamics runs from random starts [m]")
+        .def_readonly("min_vertical_margin", &DesignSummary::min_vertical_margin)
+        .def_readonly("seconds", &DesignSummary::seconds)
+        .def_readonly("notes", &DesignSummary::notes)
+        .def_property_readonly("runs", [](const DesignSummary& s) {
+            std::vector<std::tuple<double, double, double, double>> r;
+            for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
+            return r;
+        }, "(x, y, seconds, end distance) of each verification run");
+    m.def("design",
+          [](const Scene& part, std::pair<double, double> sink, double lin_limit, double ang_limit, double period,
+             std::uint64_t seed, int starts, int local_evaluations, int threads) {
+              DesignTarget t;
+              t.at = Vec2(sink.first, sink.second);
+              DesignOptions o;
+              require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
+              require(starts >= 1 && local_evaluations >= 1, "starts, local_evaluations: expected >= 1");
+              o.lin_limit = lin_limit;
+              o.ang_limit = ang_limit;
+              o.period = period;
+              o.seed = seed;
+              o.starts = starts;
+              o.local_evaluations = local_evaluations;
+              o.threads = threads;
+              py::gil_scoped_release free;
+              try {
+                  return design(part, t, o);
+              } catch (const std::invalid_argument& e) {
+                  py::gil_scoped_acquire hold;
+                  throw py::value_error(e.what());
+              }
+          },
+          py::arg("part"), py::kw_only(), py::arg("sink"), py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
+          py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 16, py::arg("local_evaluations") = 400,
+          py::arg("threads") = 0,
+          "Designs a plate motion that makes (x, y) = `sink` the unique stable fixed point of a point part's\n"
+          "field, within the amplitude limits and without flight, and verifies it (grid and full dynamics).");
 
     // --- simulate ------------------------------------------------------------------------------
     py::class_<PyTrajectory>(m, "Trajectory", "Samples of a simulation, with the contact mode on each step.")

@@ -273,3 +273,19 @@ def test_fig4_field_has_stable_fixed_points_at_the_centre_at_theta_0_and_pi():
     for p in fp.points:
         if p.stability == "stable":
             assert np.all(p.eigenvalues.real < 0)
+
+
+def test_a_designed_sink_gathers_parts_released_anywhere_on_the_plate():
+    # Checked here with the module's own full dynamics from starts of our choosing (not the design's).
+    part = plate.load_scene(scene_path("fig1_point"))
+    d = plate.design(part, sink=(0.02, -0.01), lin_limit=15, ang_limit=100, starts=8, local_evaluations=200)
+    assert d.verified, d.failure
+    sc = d.scene
+    for h in sc.to_dict()["plate"]["harmonics"]:
+        assert abs(h["amp"]) <= (15 if h["axis"] in ("x", "y", "z") else 100) * (1 + 1e-9)
+    T_end = 6 / d.rate                               # e^-6: from 7 cm to 0.2 mm in the linear picture
+    for start in [(-0.045, 0.045), (0.045, 0.045), (-0.045, -0.045), (0.0, 0.04)]:
+        tr = plate.simulate(sc, start=start, time=T_end, sample=T_end, dynamics="full")
+        assert not tr.stop
+        assert np.hypot(tr.q[-1, 0] - 0.02, tr.q[-1, 1] + 0.01) < 0.005
+    assert np.hypot(*(d.fixed_point[:2] - np.array([0.02, -0.01]))) < 0.002
