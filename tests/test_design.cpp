@@ -122,7 +122,7 @@ TEST_CASE("a point-part sink: designed within the limits, unique, verified in fu
     CHECK(limit_cycle(back, Vec3(0.01, 0.01, 0)).twist == limit_cycle(s.scene, Vec3(0.01, 0.01, 0)).twist);
 }
 
-TEST_CASE("designs are reproducible by seed, whatever the threads; other seeds search elsewhere", "[design]") {
+TEST_CASE("designs are reproducible by seed whatever the threads, and other seeds search elsewhere", "[design]") {
     const Scene part = scene("fig1_point");
     DesignTarget t;
     t.at = Vec2(-0.01, 0.015);
