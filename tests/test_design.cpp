@@ -183,3 +183,38 @@ TEST_CASE("an impossible target fails cleanly, never reported as done", "[design
         CHECK_THROWS_WITH(design(part, far, o), Catch::Contains("outside the plate region"));
     }
 }
+
+TEST_CASE("transport: a translating plate carries a point part at the target velocity, uniformly; too fast fails cleanly",
+          "[design]") {
+    const Scene part = scene("fig1_point");
+    DesignTarget t;
+    t.kind = DesignTargetKind::Transport;
+    t.velocity = Vec2(0.02, 0.01);
+    DesignOptions o;
+    o.lin_limit = 15;
+    o.starts = 8;
+    o.local_evaluations = 200;
+    o.verify_starts = 6;
+    const DesignSummary s = design(part, t, o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    CHECK((s.transport_mean - t.velocity).norm() <= 0.02 * t.velocity.norm());
+    // Uniform by construction: what remains is the cycles' tolerance (1e-6 v_ref).
+    CHECK(s.transport_spread < 1e-5 * s.scene.v_ref());
+    for (const Harmonic& h : s.scene.plate.harmonics) {
+        CHECK(static_cast<int>(h.axis) < 3);   // it only translates
+        CHECK(std::abs(h.amp) <= o.lin_limit * (1 + 1e-9));
+    }
+    CHECK(s.min_vertical_margin >= o.flight_margin - 1e-9);
+    // An independent look: the full dynamics from a corner moves it by v t (within 5 mm over ~2 s).
+    const double secs = 2.0;
+    const Trajectory tr = simulate(s.scene, Dynamics::Full, Vec3(-0.04, -0.04, 0), Vec3::Zero(), secs, secs);
+    REQUIRE(tr.stop.reason == StopReason::None);
+    CHECK((tr.samples.back().q.head<2>() - Vec2(-0.04, -0.04) - t.velocity * secs).norm() < 0.005);
+
+    // 2 m/s is far beyond what 15 m/s^2 at 20 Hz can drive through friction: reported, not done.
+    t.velocity = Vec2(2.0, 0);
+    const DesignSummary fast = design(part, t, o);
+    CHECK_FALSE(fast.verified);
+    CHECK(fast.failure.find("out of reach within the limits") != std::string::npos);
+}

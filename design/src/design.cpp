@@ -191,7 +191,212 @@ struct SinkProblem {
 
 }  // namespace
 
+namespace {
+
+// --- the point-part transport --------------------------------------------------------------------
+// Parameters: cosine and sine coefficients of harmonics n = 1, 2 on x, y and z (a plate that only
+// translates). The field is uniform; its value at the centre is driven onto the target.
+constexpr Axis kTransportAxes[3] = {Axis::x, Axis::y, Axis::z};
+constexpr int kTransportParams = 12;
+
+PlateMotion transport_motion(const std::vector<double>& p, double T) {
+    PlateMotion u;
+    u.T = T;
+    for (int a = 0; a < 3; ++a)
+        for (int n = 1; n <= 2; ++n) {
+            const double c = p[4 * a + 2 * (n - 1)], s = p[4 * a + 2 * (n - 1) + 1], amp = std::hypot(c, s);
+            if (amp > 0) u.harmonics.push_back({kTransportAxes[a], n, amp, std::atan2(c, s)});
+        }
+    return u;
+}
+
+struct TransportProblem {
+    TransportProblem(const Scene& part_, const Vec2& v_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
+        : part(part_), target(v_), opt(opt_), T(T_), cycles(cycles_) {}
+    const Scene& part;
+    Vec2 target;
+    const DesignOptions& opt;
+    double T;
+    std::atomic<long>* cycles;
+    long evaluations = 0;
+    std::vector<double> best_p;
+    double best_f = std::numeric_limits<double>::infinity();
+
+    static constexpr int kConstraints = 7;   // six harmonic amplitudes, the flight margin
+    void constraints(const std::vector<double>& p, double* c) const {
+        for (int k = 0; k < 6; ++k) c[k] = (std::hypot(p[2 * k], p[2 * k + 1]) - opt.lin_limit) / std::max(opt.lin_limit, 1e-12);
+        c[6] = opt.flight_margin - vertical_margin(transport_motion(p, T), part.g, opt.region);
+    }
+    bool feasible(const std::vector<double>& p) const {
+        double c[kConstraints];
+        constraints(p, c);
+        return std::all_of(c, c + kConstraints, [](double x) { return x <= 0; });
+    }
+    double evaluate(const std::vector<double>& p, Vec2* v_out = nullptr) {
+        ++evaluations;
+        Scene sc = part;
+        sc.plate = transport_motion(p, T);
+        const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), opt.cycle);
+        ++*cycles;
+        if (!lc.converged) return 1e3;
+        if (v_out) *v_out = lc.twist.head<2>();
+        return (lc.twist.head<2>() - target).norm() / target.norm();
+    }
+    double objective(const std::vector<double>& p) {
+        const double f = evaluate(p);
+        if (f < best_f && feasible(p)) {
+            best_f = f;
+            best_p = p;
+        }
+        return f;
+    }
+};
+
+// Runs `jobs` independent jobs on the option's threads.
+template <class Job>
+void run_parallel(int jobs, int threads, Job&& job) {
+    std::atomic<int> next{0};
+    auto worker = [&] {
+        for (int k; (k = next++) < jobs;) job(k);
+    };
+    const int nt = std::max(1, std::min(jobs, threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency())));
+    std::vector<std::thread> pool;
+    for (int i = 1; i < nt; ++i) pool.emplace_back(worker);
+    worker();
+    for (auto& th : pool) th.join();
+}
+
+DesignSummary design_transport(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
+    const auto t0 = Clock::now();
+    DesignSummary sum;
+    sum.notes.push_back("a plate that only translates (x, y, z): a point part's velocity field is the same everywhere");
+    std::atomic<long> cycles{0};
+    const int n_starts = std::max(1, opt.starts);
+    std::vector<std::vector<double>> best_p(n_starts);
+    std::vector<double> best_f(n_starts, std::numeric_limits<double>::infinity());
+    std::vector<long> evals(n_starts, 0);
+    run_parallel(n_starts, opt.threads, [&](int k) {
+        TransportProblem prob(part_scene, target.velocity, opt, T, &cycles);
+        Rng rng(opt.seed * 1000003 + static_cast<std::uint64_t>(k));
+        std::vector<double> p(kTransportParams);
+        bool ok = false;
+        for (int tries = 0; tries < 1000 && !ok; ++tries) {
+            for (double& x : p) x = rng.uniform(-opt.lin_limit, opt.lin_limit) / std::sqrt(2.0);
+            ok = prob.feasible(p);
+        }
+        if (!ok) return;
+        nlopt::opt local(nlopt::LN_COBYLA, kTransportParams);
+        local.set_lower_bounds(std::vector<double>(kTransportParams, -opt.lin_limit));
+        local.set_upper_bounds(std::vector<double>(kTransportParams, opt.lin_limit));
+        local.set_initial_step(std::vector<double>(kTransportParams, std::max(opt.lin_limit, 1e-6) / 4));
+        local.set_maxeval(opt.local_evaluations);
+        local.set_stopval(1e-4);   // within 0.01% of the target speed: done
+        local.set_min_objective(
+            [](const std::vector<double>& x, std::vector<double>&, void* d) { return static_cast<TransportProblem*>(d)->objective(x); },
+            &prob);
+        local.add_inequality_mconstraint(
+            [](unsigned, double* c, unsigned, const double* x, double*, void* d) {
+                static_cast<TransportProblem*>(d)->constraints(std::vector<double>(x, x + kTransportParams), c);
+            },
+            &prob, std::vector<double>(TransportProblem::kConstraints, 1e-9));
+        prob.objective(p);
+        double f = 0;
+        try {
+            local.optimize(p, f);
+        } catch (const std::exception&) {
+        }
+        best_p[k] = prob.best_p;
+        best_f[k] = prob.best_f;
+        evals[k] = prob.evaluations;
+    });
+    for (long e : evals) sum.evaluations += e;
+    const int best = static_cast<int>(std::min_element(best_f.begin(), best_f.end()) - best_f.begin());
+    sum.scene = part_scene;
+    sum.scene.name = part_scene.name + "_transport";
+    sum.scene.plate = PlateMotion{};
+    sum.scene.plate.T = T;
+    sum.cycles = cycles;
+    if (!std::isfinite(best_f[best])) {
+        sum.failure = "no motion within the limits keeps the part on the plate over the region";
+        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        return sum;
+    }
+    sum.scene.plate = combined(transport_motion(best_p[best], T));
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    // Verification: the field on the grid (mean and spread), then full dynamics from random starts.
+    GridSpec g;
+    g.nx = g.ny = opt.verify_grid;
+    g.nth = 1;
+    g.x0 = g.y0 = -opt.region;
+    g.x1 = g.y1 = opt.region;
+    FieldOptions fo;
+    fo.threads = opt.threads;
+    const Field f = compute_field(sum.scene, g, fo);
+    int undefined = 0;
+    for (const FieldPoint& p : f.points) {
+        if (!p.converged) ++undefined;
+        else sum.transport_mean += p.twist.head<2>();
+    }
+    if (undefined < static_cast<int>(f.points.size())) sum.transport_mean /= static_cast<double>(f.points.size() - undefined);
+    for (const FieldPoint& p : f.points)
+        if (p.converged) sum.transport_spread = std::max(sum.transport_spread, (p.twist.head<2>() - sum.transport_mean).norm());
+    sum.transport_tolerance = 0.02 * target.velocity.norm();
+    Rng rng(opt.seed ^ 0x5DEECE66DULL);
+    sum.runs.resize(opt.verify_starts);
+    for (DesignStartRun& r : sum.runs) {
+        r.x = rng.uniform(-opt.region, opt.region);
+        r.y = rng.uniform(-opt.region, opt.region);
+        r.seconds = std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0);   // about a region's width of travel
+    }
+    run_parallel(static_cast<int>(sum.runs.size()), opt.threads, [&](int k) {
+        DesignStartRun& r = sum.runs[k];
+        IntegrationOptions io;
+        io.rtol = 1e-7;
+        const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, 0), Vec3::Zero(), r.seconds, r.seconds, io);
+        // The distance from where the target velocity would have taken it.
+        r.end_distance = tr.samples.empty() ? std::numeric_limits<double>::infinity()
+                                            : (tr.samples.back().q.head<2>() - Vec2(r.x, r.y) - target.velocity * r.seconds).norm();
+        if (tr.stop.reason != StopReason::None) r.stop = tr.stop.describe();
+    });
+    int stopped = 0;
+    for (const DesignStartRun& r : sum.runs) {
+        sum.worst_end_distance = std::max(sum.worst_end_distance, r.end_distance);
+        stopped += !r.stop.empty();
+    }
+    sum.unique = true;   // (no fixed point is sought)
+    if (undefined) sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
+    else if (!((sum.transport_mean - target.velocity).norm() <= sum.transport_tolerance))
+        sum.failure = "the field's mean velocity (" + std::to_string(sum.transport_mean.x()) + ", " +
+                      std::to_string(sum.transport_mean.y()) + ") m/s misses the target by more than 2%: out of reach within the limits";
+    else if (!(sum.transport_spread <= sum.transport_tolerance))
+        sum.failure = "the field is not uniform over the region";
+    else if (stopped)
+        sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
+    else if (!(sum.worst_end_distance <= opt.verify_distance))
+        sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) +
+                      " m from where the target velocity takes it";
+    sum.verified = sum.failure.empty();
+    sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return sum;
+}
+
+}  // namespace
+
+static DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt);
+
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
+    const double T = opt.period > 0 ? opt.period : part_scene.plate.T;
+    if (!(T > 0)) throw std::invalid_argument("design: no plate period (give one)");
+    if (target.kind == DesignTargetKind::Transport) {
+        if (!part_scene.part.point)
+            throw std::invalid_argument("design: this version designs transport for point parts only");
+        if (!(target.velocity.norm() > 0)) throw std::invalid_argument("design: a transport target needs a velocity");
+        return design_transport(part_scene, target, opt, T);
+    }
+    return design_sink(part_scene, target, opt);
+}
+
+static DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
     const auto t0 = Clock::now();
     if (!part_scene.part.point)
         throw std::invalid_argument("design: this version designs sinks for point parts; a rigid part's fixed point, "

@@ -362,16 +362,24 @@ PYBIND11_MODULE(_plate, m) {
         .def_readonly("min_vertical_margin", &DesignSummary::min_vertical_margin)
         .def_readonly("seconds", &DesignSummary::seconds)
         .def_readonly("notes", &DesignSummary::notes)
+        .def_readonly("transport_mean", &DesignSummary::transport_mean)
+        .def_readonly("transport_spread", &DesignSummary::transport_spread)
         .def_property_readonly("runs", [](const DesignSummary& s) {
             std::vector<std::tuple<double, double, double, double>> r;
             for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
             return r;
         }, "(x, y, seconds, end distance) of each verification run");
     m.def("design",
-          [](const Scene& part, std::pair<double, double> sink, double lin_limit, double ang_limit, double period,
+          [](const Scene& part, std::optional<std::pair<double, double>> sink,
+             std::optional<std::pair<double, double>> transport, double lin_limit, double ang_limit, double period,
              std::uint64_t seed, int starts, int local_evaluations, int threads) {
+              require(sink.has_value() != transport.has_value(), "design: give one target, sink=(x, y) or transport=(vx, vy)");
               DesignTarget t;
-              t.at = Vec2(sink.first, sink.second);
+              if (sink) t.at = Vec2(sink->first, sink->second);
+              if (transport) {
+                  t.kind = DesignTargetKind::Transport;
+                  t.velocity = Vec2(transport->first, transport->second);
+              }
               DesignOptions o;
               require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
               require(starts >= 1 && local_evaluations >= 1, "starts, local_evaluations: expected >= 1");
@@ -390,11 +398,13 @@ PYBIND11_MODULE(_plate, m) {
                   throw py::value_error(e.what());
               }
           },
-          py::arg("part"), py::kw_only(), py::arg("sink"), py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
+          py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
+          py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 16, py::arg("local_evaluations") = 400,
           py::arg("threads") = 0,
-          "Designs a plate motion that makes (x, y) = `sink` the unique stable fixed point of a point part's\n"
-          "field, within the amplitude limits and without flight, and verifies it (grid and full dynamics).");
+          "Designs a plate motion for a point part, within the amplitude limits and without flight, and verifies\n"
+          "it (grid and full dynamics): sink=(x, y) the unique stable fixed point of its field, or\n"
+          "transport=(vx, vy) a uniform velocity over the plate.");
 
     // --- simulate ------------------------------------------------------------------------------
     py::class_<PyTrajectory>(m, "Trajectory", "Samples of a simulation, with the contact mode on each step.")

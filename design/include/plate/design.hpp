@@ -30,12 +30,17 @@ namespace plate {
 PlateMotion rotate_motion(const PlateMotion& u, double angle);
 PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 
-enum class DesignTargetKind { Sink };
+enum class DesignTargetKind { Sink, Transport };
 struct DesignTarget {
-    // Sink: every start in the region ends at position (x, y): for a point part the unique stable
+    // Sink: every start in the region ends at position `at`: for a point part the unique stable
     // fixed point of its velocity field ("fixed-point X Y" is the same target).
+    // Transport: the part moves at the uniform velocity `velocity` everywhere in the region. A plate
+    // that only translates (x, y, z harmonics n = 1, 2) gives a point part the same velocity at every
+    // position (nothing in its dynamics depends on where it is), so the field is uniform by
+    // construction and the search only sets its value.
     DesignTargetKind kind = DesignTargetKind::Sink;
     Vec2 at = Vec2::Zero();
+    Vec2 velocity = Vec2::Zero();   // [m/s]
 };
 
 struct DesignOptions {
@@ -93,6 +98,10 @@ struct DesignSummary {
     std::vector<DesignStartRun> runs;   // full dynamics from random starts
     double worst_end_distance = 0;
     double min_vertical_margin = 0;     // min over the period and the region of (g + a_z) / g
+    // Transport: the field's mean velocity over the verification grid and its largest deviation from it.
+    Vec2 transport_mean = Vec2::Zero();
+    double transport_spread = 0;       // [m/s]
+    double transport_tolerance = 0;    // accepted |mean - target| [m/s]
     double seconds = 0;
     std::vector<std::string> notes;     // the symmetries used, and what they imply
 };
