@@ -184,7 +184,7 @@ TEST_CASE("an impossible target fails cleanly, never reported as done", "[design
     }
 }
 
-TEST_CASE("transport: a translating plate carries a point part at the target velocity, uniformly; too fast fails cleanly",
+TEST_CASE("transport: a translating plate carries a point part at the target velocity uniformly, and too fast fails cleanly",
           "[design]") {
     const Scene part = scene("fig1_point");
     DesignTarget t;
