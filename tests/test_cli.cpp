@@ -22,13 +22,22 @@ struct Run {
     std::string out, err;
 };
 
+// A folder of this test process's own, removed when the process ends (ctest runs each test case
+// as a process: without it, every run left one behind in /tmp).
+struct OwnTmpDir {
+    fs::path p;
+    ~OwnTmpDir() {
+        std::error_code ec;
+        fs::remove_all(p, ec);
+    }
+};
 fs::path tmpdir() {
-    static const fs::path d = [] {
+    static const OwnTmpDir d{[] {
         fs::path p = fs::temp_directory_path() / ("plate_cli_" + std::to_string(::getpid()));
         fs::create_directories(p);
         return p;
-    }();
-    return d;
+    }()};
+    return d.p;
 }
 
 std::string slurp(const fs::path& p) {
