@@ -1,9 +1,10 @@
 // plate: the command-line program (apps/main.cpp runs it). See `plate --help`.
 // Exit codes: 0 success; 2 bad input (usage, scene file); 3 a simulation left the model's
 // assumptions (contact lost, sticking, step collapse) -- its output up to that time is kept;
-// 1 any other failure.
+// 4 a design that failed verification (nothing written); 1 any other failure.
 #include "cli.hpp"
 
+#include "plate/design.hpp"
 #include "plate/field.hpp"
 #include "plate/hierarchy.hpp"
 #include "plate/output.hpp"
@@ -69,6 +70,7 @@ const char* kUsage =
     "  proofs        the numerical checks of Theorem 1 (contraction, Floquet, limit surfaces, A), JSON\n"
     "  report        the verification report: DIR/index.html with SVG figures (gnuplot)\n"
     "  bench         the speed-accuracy study, written into the report in DIR (--full: the long campaign)\n"
+    "  design        the plate motion that sends a (point) part where wanted: a sink or a transport, verified\n"
     "\n"
     "SCENE is a JSON scene file (see scenes/). Units are SI. Exit codes: 0 ok, 2 bad input,\n"
     "3 a simulation left the model (a normal force reached zero: the part would fly), 1 other failure.\n";
@@ -566,6 +568,100 @@ int cmd_proofs(int argc, char** argv, Io& cio) {
     return 0;
 }
 
+nlohmann::json complex_json(const std::complex<double>& z) { return {z.real(), z.imag()}; }
+
+int cmd_design(int argc, char** argv, Io& cio) {
+    Args a(argc, argv, {{"--target", 3}, {"--out", 1}, {"--limits", 2}, {"--period", 1}, {"--seed", 1},
+                        {"--threads", 1}, {"--starts", 1}, {"--evaluations", 1}});
+    if (a.help) {
+        cio.out << "usage: plate design PART_SCENE --target KIND A B --out SCENE.json [--limits LIN ANG] [--period T]\n"
+                     "                    [--seed S] [--threads K] [--starts N] [--evaluations M]\n"
+                     "Designs a plate motion for the part of PART_SCENE (its plate block is ignored but for its period)\n"
+                     "and verifies it before reporting. Targets (point parts in this version):\n"
+                     "  sink X Y          (or fixed-point X Y) the unique stable fixed point of the velocity field at (X, Y)\n"
+                     "  transport VX VY   a uniform velocity (VX, VY) [m/s] over the plate\n"
+                     "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
+                     "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
+                     "seeded feasible motions (default 16), --evaluations each (default 400). Verification: the field's\n"
+                     "fixed points on a 7x7 grid and full dynamics from 20 seeded random starts. Writes the designed\n"
+                     "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n";
+        return 0;
+    }
+    const Scene part = scene_arg(a, cio);
+    if (!a.has("--target")) throw UsageError("missing --target KIND A B");
+    if (!a.has("--out")) throw UsageError("missing --out SCENE.json");
+    const std::string kind = a.opt.at("--target")[0];
+    DesignTarget t;
+    const Vec2 ab(Args::parse_num("--target", a.opt.at("--target")[1]), Args::parse_num("--target", a.opt.at("--target")[2]));
+    if (kind == "sink" || kind == "fixed-point") t.at = ab;
+    else if (kind == "transport") {
+        t.kind = DesignTargetKind::Transport;
+        t.velocity = ab;
+    } else {
+        throw UsageError("--target: expected sink X Y, fixed-point X Y or transport VX VY, got '" + kind + "'");
+    }
+    DesignOptions o;
+    o.lin_limit = a.num("--limits", 0, o.lin_limit);
+    o.ang_limit = a.num("--limits", 1, o.ang_limit);
+    if (!(o.lin_limit >= 0 && o.ang_limit >= 0 && o.lin_limit <= kMaxAmplitude && o.ang_limit <= kMaxAmplitude))
+        throw UsageError("--limits: expected amplitudes from 0 to " + fmt(kMaxAmplitude));
+    o.period = a.num("--period", 0, 0);
+    if (a.has("--period") && !(o.period >= kPeriodRange[0] && o.period <= kPeriodRange[1]))
+        throw UsageError("--period: expected " + fmt(kPeriodRange[0]) + " to " + fmt(kPeriodRange[1]) + " s");
+    o.seed = static_cast<std::uint64_t>(a.integer("--seed", 1, 0, 1L << 40));
+    o.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+    o.starts = static_cast<int>(a.integer("--starts", o.starts, 1, 10000));
+    o.local_evaluations = static_cast<int>(a.integer("--evaluations", o.local_evaluations, 1, 1'000'000));
+    DesignSummary d;
+    try {
+        d = design(part, t, o);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
+    const bool sink = t.kind == DesignTargetKind::Sink;
+    nlohmann::json j;
+    j["target"] = {{"kind", sink ? "sink" : "transport"}, {sink ? "at" : "velocity", {ab.x(), ab.y()}}};
+    j["verified"] = d.verified;
+    if (!d.verified) j["failure"] = d.failure;
+    j["scene"] = a.str("--out", "");
+    if (sink) {
+        j["unique"] = d.unique;
+        j["convergence_rate_per_s"] = d.rate;
+        j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1]};
+        j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]), complex_json(d.fixed_point_eigenvalues[1])};
+        j["fixed_points_on_grid"] = fixed_points_sentence(d.fixed_points);
+    } else {
+        j["mean_velocity"] = {d.transport_mean.x(), d.transport_mean.y()};
+        j["spread"] = d.transport_spread;
+        j["tolerance"] = d.transport_tolerance;
+    }
+    nlohmann::json runs = nlohmann::json::array();
+    for (const DesignStartRun& r : d.runs) {
+        nlohmann::json x = {{"start", {r.x, r.y}}, {"seconds", r.seconds}, {"end_distance", r.end_distance}};
+        if (!r.stop.empty()) x["stop"] = r.stop;
+        runs.push_back(x);
+    }
+    j["full_dynamics_runs"] = runs;
+    j["worst_end_distance"] = d.worst_end_distance;
+    j["min_vertical_acceleration_margin_over_g"] = d.min_vertical_margin;
+    j["limits"] = {o.lin_limit, o.ang_limit};
+    j["evaluations"] = d.evaluations;
+    j["limit_cycles"] = d.cycles;
+    j["seconds"] = d.seconds;
+    j["notes"] = d.notes;
+    if (d.verified) {
+        write_file_atomic(a.str("--out", ""), [&](std::ostream& out) { out << scene_to_json(d.scene).dump(2) << "\n"; });
+        for (const std::string& w : scene_warnings(d.scene)) cio.err << "warning: designed scene: " << w << "\n";
+    }
+    cio.out << j.dump(2) << std::endl;
+    if (!d.verified) {
+        cio.err << "plate design: " << a.pos[0] << ": the design failed verification: " << d.failure << " (no scene written)"
+                << std::endl;
+        return 4;
+    }
+    return 0;
+}
+
 // The output folder of report and bench, which take no SCENE.
 std::string out_dir_arg(const Args& a, const std::string& cmd) {
     if (!a.pos.empty()) throw UsageError(cmd + " takes no SCENE argument");
@@ -637,6 +733,7 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
         if (cmd == "proofs") return cmd_proofs(argc - 2, argv + 2, cio);
         if (cmd == "report") return cmd_report(argc - 2, argv + 2, cio);
         if (cmd == "bench") return cmd_bench(argc - 2, argv + 2, cio);
+        if (cmd == "design") return cmd_design(argc - 2, argv + 2, cio);
         cio.err << "plate: unknown command '" << cmd << "'\n" << kUsage;
         return 2;
     } catch (const InputError& e) {

@@ -132,7 +132,7 @@ TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twi
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    for (const char* c : {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench "}) {
+    for (const char* c : {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench ", "design ", "proofs ", "report "}) {
         const Run r = run(std::string(c) + "--help");
         CHECK(r.code == 0);
         CHECK(r.out.find("usage") != std::string::npos);
@@ -401,4 +401,40 @@ TEST_CASE("progress lines only for a person watching: quiet when stderr is not a
     const std::string forced = "PLATE_PROGRESS=1 " + std::string(PLATE_EXE) + " " + cmd + " > " + o.string() + " 2> " + e.string();
     REQUIRE(std::system(forced.c_str()) == 0);
     CHECK(slurp(e).find("field: ") != std::string::npos);
+}
+
+TEST_CASE("plate design: a verified sink is a scene whose own field has its one stable fixed point at the target, "
+          "and a failed design exits 4 and writes nothing", "[cli][design]") {
+    const fs::path d = tmpdir() / "design";
+    fs::create_directories(d);
+    const Run r = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
+                      "--starts 8 --evaluations 200 --out " + (d / "sink.json").string());
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["verified"] == true);
+    CHECK(j["unique"] == true);
+    CHECK(j["convergence_rate_per_s"].get<double>() > 0.5);
+    // The designed scene through the program's own fixed-point search (not the design's verification).
+    const Run fp = run("fixed-points " + (d / "sink.json").string() + " --grid 9");
+    REQUIRE(fp.code == 0);
+    const auto p = nlohmann::json::parse(fp.out)["points"];
+    int stable = 0;
+    for (const auto& x : p)
+        if (x["stability"] == "stable") {
+            ++stable;
+            CHECK(std::hypot(x["at"][0].get<double>() - 0.02, x["at"][1].get<double>() + 0.01) < 2e-3);
+        }
+    CHECK(stable == 1);
+
+    const Run fast = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target transport 2 0 --limits 15 100 "
+                         "--starts 4 --evaluations 100 --out " + (d / "fast.json").string());
+    CHECK(fast.code == 4);
+    CHECK(fast.err.find("failed verification") != std::string::npos);
+    CHECK(nlohmann::json::parse(fast.out)["verified"] == false);
+    CHECK_FALSE(fs::exists(d / "fast.json"));
+
+    const Run bad = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target wobble 0 0 --out " + (d / "x.json").string());
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--target") != std::string::npos);
 }

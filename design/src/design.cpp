@@ -386,11 +386,11 @@ static DesignSummary design_sink(const Scene& part_scene, const DesignTarget& ta
 
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
     const double T = opt.period > 0 ? opt.period : part_scene.plate.T;
-    if (!(T > 0)) throw std::invalid_argument("design: no plate period (give one)");
+    if (!(T > 0)) throw std::invalid_argument("no plate period (give one)");
     if (target.kind == DesignTargetKind::Transport) {
         if (!part_scene.part.point)
-            throw std::invalid_argument("design: this version designs transport for point parts only");
-        if (!(target.velocity.norm() > 0)) throw std::invalid_argument("design: a transport target needs a velocity");
+            throw std::invalid_argument("this version designs transport for point parts only");
+        if (!(target.velocity.norm() > 0)) throw std::invalid_argument("a transport target needs a velocity");
         return design_transport(part_scene, target, opt, T);
     }
     return design_sink(part_scene, target, opt);
@@ -399,12 +399,12 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
 static DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
     const auto t0 = Clock::now();
     if (!part_scene.part.point)
-        throw std::invalid_argument("design: this version designs sinks for point parts; a rigid part's fixed point, "
+        throw std::invalid_argument("this version designs sinks for point parts; a rigid part's fixed point, "
                                     "transport and orientation targets are not built yet");
     if (!(std::abs(target.at.x()) <= opt.region && std::abs(target.at.y()) <= opt.region))
-        throw std::invalid_argument("design: the target lies outside the plate region");
+        throw std::invalid_argument("the target lies outside the plate region");
     const double T = opt.period > 0 ? opt.period : part_scene.plate.T;
-    if (!(T > 0)) throw std::invalid_argument("design: no plate period (give one)");
+    if (!(T > 0)) throw std::invalid_argument("no plate period (give one)");
 
     DesignSummary sum;
     sum.notes.push_back("odd harmonics on x, y, rx, ry only: the field is odd about the design's centre, so the "
