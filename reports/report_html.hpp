@@ -123,14 +123,15 @@ inline const char* kErrorTrap =
     "ce.apply(console,arguments);};})();</script>\n";
 
 // Last in <body>: click a figure to see it as large as the window (click again to close); and, for
-// scripts/check-report.sh, once loaded the body states what a person would see: data-images (every
+// scripts/check-report.sh, a second after loading (errors thrown by late scripts count) the body
+// states what a person would see: data-images (every
 // image decoded: ok:N, else missing:SRC,...), data-errors (none, else the errors), data-math (every
 // $$...$$ typeset by KaTeX: ok:N, else why not), data-figure-width (the narrowest figure as shown, px).
 inline const char* kPageCheck =
     "<div id=\"zoom\"><img alt=\"enlarged figure\"></div>\n<script>(function(){var z=document.getElementById('zoom');"
     "document.addEventListener('click',function(e){var t=e.target;if(t.closest&&t.closest('figure')&&t.tagName==='IMG'){"
     "z.firstChild.src=t.src;z.style.display='block';}else if(t===z||t.parentNode===z){z.style.display='none';}});})();\n"
-    "window.addEventListener('load',function(){var b=document.body;var imgs=[].slice.call(document.querySelectorAll('figure img'));"
+    "window.addEventListener('load',function(){setTimeout(function(){var b=document.body;var imgs=[].slice.call(document.querySelectorAll('figure img'));"
     "var bad=imgs.filter(function(i){return !(i.complete&&i.naturalWidth>0);});"
     "b.setAttribute('data-images',bad.length?'missing:'+bad.map(function(i){return i.getAttribute('src');}).join(','):'ok:'+imgs.length);"
     "var w=imgs.map(function(i){return i.getBoundingClientRect().width;});"
@@ -138,6 +139,6 @@ inline const char* kPageCheck =
     "var k=document.querySelectorAll('.katex').length,ke=document.querySelectorAll('.katex-error').length;"
     "var left=b.innerText.indexOf('$$')>=0;"
     "b.setAttribute('data-math',ke?'errors:'+ke:left?(window.katex?'untypeset $$ left':'KaTeX not loaded'):'ok:'+k);"
-    "b.setAttribute('data-errors',window.__errors.length?window.__errors.join(' | '):'none');});</script>\n";
+    "b.setAttribute('data-errors',window.__errors.length?window.__errors.join(' | '):'none');},1000);});</script>\n";
 
 }  // namespace plate::report::html

@@ -43,8 +43,8 @@ TEST_CASE("turning the plate motion about z turns the field with it", "[design][
                 const Vec3 v = xi(sc, q);
                 const Vec2 s = R * q.head<2>();
                 const Vec3 w = xi(rot, Vec3(s.x(), s.y(), q[2] + a));
-                CHECK((w.head<2>() - R * v.head<2>()).norm() < 1e-7 * sc.v_ref());
-                CHECK(std::abs(w[2] - v[2]) < 1e-7 * sc.v_ref() / sc.part.rho());
+                CHECK((w.head<2>() - R * v.head<2>()).norm() < 1e-8 * sc.v_ref());
+                CHECK(std::abs(w[2] - v[2]) < 1e-8 * sc.v_ref() / sc.part.rho());
                 // (not vacuous: the unturned twist differs)
                 CHECK((w.head<2>() - v.head<2>()).norm() > 1e-3 * sc.v_ref());
             }
@@ -70,8 +70,8 @@ TEST_CASE("adding -alpha x D to the linear acceleration shifts the field by D", 
             const Vec3 v = xi(sc, q);
             const Vec3 at = Vec3(q[0] + D.x(), q[1] + D.y(), q[2]);
             const Vec3 w = xi(shifted, at);
-            CHECK((w - v).head<2>().norm() < 1e-7 * sc.v_ref());
-            CHECK(std::abs(w[2] - v[2]) < 1e-7 * sc.v_ref() / sc.part.rho());
+            CHECK((w - v).head<2>().norm() < 1e-8 * sc.v_ref());
+            CHECK(std::abs(w[2] - v[2]) < 1e-8 * sc.v_ref() / sc.part.rho());
             CHECK((xi(sc, at) - v).norm() > 1e-3 * sc.v_ref());   // the field does vary over D
             if (has_vertical) CHECK((xi(wrong, at) - v).head<2>().norm() > 1e-4 * sc.v_ref());
         }
@@ -84,8 +84,8 @@ TEST_CASE("odd harmonics without z or rz: the field is odd, (s, theta) and (-s, 
     const Scene sc = scene("fig4");
     for (const Vec3& q : {Vec3(0.03, -0.02, 1.0), Vec3(-0.01, 0.04, -2.0)}) {
         const Vec3 v = xi(sc, q), w = xi(sc, Vec3(-q[0], -q[1], q[2] + kPi));
-        CHECK((w.head<2>() + v.head<2>()).norm() < 1e-7 * sc.v_ref());
-        CHECK(std::abs(w[2] - v[2]) < 1e-7 * sc.v_ref() / sc.part.rho());
+        CHECK((w.head<2>() + v.head<2>()).norm() < 1e-8 * sc.v_ref());
+        CHECK(std::abs(w[2] - v[2]) < 1e-8 * sc.v_ref() / sc.part.rho());
     }
     // A z harmonic breaks it (the half-period shift flips z, the turn does not).
     Scene heave = sc;

@@ -4,7 +4,8 @@ Closed forms (a block's deceleration, a circular translation's steady circle, a 
 integrated piecewise in closed form below), exact symmetries of the model (isotropic friction disks:
 a rotated plate motion rotates the field; a shifted rotation centre shifts it), and the paper's
 published claims (Fig. 4's fixed points). Tolerances follow from the method's settings: a cycle at
-tol/rtol 1e-9/1e-10 is within ~1e-8 v_ref of the exact one (the C++ tests measure 60 rtol v_ref).
+tol/rtol 1e-9/1e-10 is within ~6e-9 v_ref of the exact one (the C++ tests measure 60 rtol v_ref), one
+at 1e-10/1e-11 within ~6e-10 v_ref: the symmetry identities are asked to 1e-8 v_ref.
 """
 import math
 import os
@@ -156,7 +157,7 @@ def test_a_point_part_shaken_above_mu_g_follows_the_piecewise_closed_form_stick_
     c = plate.twist(sc, at=(0, 0), tol=1e-9, rtol=1e-10)
     assert c.converged
     assert stuck > 0.05 * T                                  # it really sticks for part of the period
-    assert abs(c.twist[0] - mean_v) < 1e-7 * sc.v_ref
+    assert abs(c.twist[0] - mean_v) < 2e-8 * sc.v_ref   # the cycle's error ~60 rtol v_ref = 6e-9 v_ref
     assert abs(c.twist[1]) < 1e-12
     assert c.stick_fraction[0] == pytest.approx(stuck / T, abs=1e-7)
     assert "stuck" in [m for _, m in c.mode_sequence] and "slide" in [m for _, m in c.mode_sequence]
@@ -234,20 +235,21 @@ def test_rotating_the_plate_motion_about_z_rotates_the_twist_field():
         xi = plate.twist(sc, at=q, tol=1e-9, rtol=1e-10).twist
         s = R @ np.array(q[:2])
         xi_rot = plate.twist(rot, at=(s[0], s[1], q[2] + a), tol=1e-9, rtol=1e-10).twist
-        np.testing.assert_allclose(xi_rot[:2], R @ xi[:2], atol=1e-7 * sc.v_ref)
-        assert abs(xi_rot[2] - xi[2]) < 1e-7 * sc.v_ref / sc.rho
+        np.testing.assert_allclose(xi_rot[:2], R @ xi[:2], atol=1e-8 * sc.v_ref)
+        assert abs(xi_rot[2] - xi[2]) < 1e-8 * sc.v_ref / sc.rho
         assert np.linalg.norm(xi[:2] - xi_rot[:2]) > 1e-3 * sc.v_ref   # (the check is not vacuous)
 
 
-def test_adding_minus_alpha_cross_D_to_the_linear_acceleration_shifts_the_field_by_D():
-    d = plate.load_scene(scene_path("fig4")).to_dict()
+@pytest.mark.parametrize("name", ["fig4", "heave_yaw"])   # (heave_yaw has rz: the shift's x, y parts too)
+def test_adding_minus_alpha_cross_D_to_the_linear_acceleration_shifts_the_field_by_D(name):
+    d = plate.load_scene(scene_path(name)).to_dict()
     D = np.array([0.02, -0.01, 0.0])
     sc, shifted = plate.scene_from_dict(d), plate.scene_from_dict(shift_centre(d, D))
     for q in [(0.03, -0.02, 1.0), (0.0, 0.0, 0.3)]:
         xi = plate.twist(sc, at=q, tol=1e-9, rtol=1e-10).twist
         moved = plate.twist(shifted, at=(q[0] + D[0], q[1] + D[1], q[2]), tol=1e-9, rtol=1e-10).twist
-        np.testing.assert_allclose(moved[:2], xi[:2], atol=1e-7 * sc.v_ref)
-        assert abs(moved[2] - xi[2]) < 1e-7 * sc.v_ref / sc.rho
+        np.testing.assert_allclose(moved[:2], xi[:2], atol=1e-8 * sc.v_ref)
+        assert abs(moved[2] - xi[2]) < 1e-8 * sc.v_ref / sc.rho
         unmoved = plate.twist(sc, at=(q[0] + D[0], q[1] + D[1], q[2]), tol=1e-9, rtol=1e-10).twist
         assert np.linalg.norm(unmoved - xi) > 1e-3 * sc.v_ref      # the field really varies over D
 

@@ -9,7 +9,8 @@ exe=$1 src=$(cd "$2" && pwd) out=$3
 check="$src/scripts/check-report.sh"
 rm -rf "$out"; mkdir -p "$out"
 "$exe" report --quick --out "$out/report" 2> "$out/report.log"
-"$check" "$out/report" --screenshot "$out/report_screenshot.png"
+# (the quick report has 29 figures and 8 display formulas: at least 25 and 8 must show)
+"$check" "$out/report" --screenshot "$out/report_screenshot.png" --min-images 25 --min-formulas 8
 
 # Each doctored copy must fail, and say why.
 expect_fail() {   # NAME REASON EDIT...
@@ -17,7 +18,7 @@ expect_fail() {   # NAME REASON EDIT...
   local d="$out/doctored_$name"
   cp -r "$out/report" "$d"
   (cd "$d" && eval "$@")
-  if "$check" "$d" > "$d.out" 2>&1; then
+  if "$check" "$d" --min-images 25 --min-formulas 8 > "$d.out" 2>&1; then
     echo "check-report passed a page with $name"; cat "$d.out"; exit 1
   fi
   grep -q "$reason" "$d.out" || { echo "check-report failed $name for another reason:"; cat "$d.out"; exit 1; }
@@ -30,3 +31,5 @@ expect_fail "a script error" "errors in the page" "sed -i 's|</body>|<script>no_
 expect_fail "a formula KaTeX cannot parse" "formulas not typeset" "sed -i 's|</body>|<p>\$\$\\\\frac{1}{\$\$</p></body>|' index.html"
 expect_fail "KaTeX missing" "formulas not typeset" "rm -r katex"
 expect_fail "thumbnails" "below 600" "sed -i 's|</head>|<style>figure img{width:300px}</style></head>|' index.html"
+expect_fail "a late script error" "errors in the page" "sed -i 's|</body>|<script>setTimeout(function(){no_such_function();},200);</script></body>|' index.html"
+expect_fail "most figures dropped from the page" "fewer than 25" "sed -i 's|<figure>.*</figure>||' index.html"
