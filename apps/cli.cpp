@@ -13,17 +13,19 @@
 #include "report.hpp"
 #include "theorem1.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <chrono>
 #include <cmath>
-#include <filesystem>
+#include <cstdint>
 #include <cstdlib>
-#include <cstring>
-#include <iomanip>
+#include <filesystem>
+#include <functional>
 #include <iostream>
-#include <map>
-#include <optional>
+#include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace plate::cli {
@@ -56,134 +58,190 @@ std::string fmt(double x) {
     return s.str();
 }
 
-const char* kUsage =
-    "plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch)\n"
-    "\n"
-    "usage: plate COMMAND SCENE [options]      plate COMMAND --help for its options; plate --version\n"
-    "\n"
-    "commands:\n"
-    "  twist         asymptotic twist (36) at one configuration, as JSON\n"
-    "  field         asymptotic twist field on a grid over (s_x, s_y, theta), JSON or CSV\n"
-    "  fixed-points  zeros of the field, refined and classified (stable, unstable, saddle; lines)\n"
-    "  simulate      U-dynamics, full-dynamics or field-integral-curve trajectory, CSV\n"
-    "  random-scene  a seeded random part and plate motion (like Fig. 3), as a scene file\n"
-    "  proofs        the numerical checks of Theorem 1 (contraction, Floquet, limit surfaces, A), JSON\n"
-    "  report        the verification report: DIR/index.html with SVG figures (gnuplot)\n"
-    "  bench         the speed-accuracy study, written into the report in DIR (--full: the long campaign)\n"
-    "  design        the plate motion that sends a (point) part where wanted: a sink or a transport, verified\n"
+const char* kAbout = "plate: sliding manipulation on a vibrating 6-DoF plate (Vose, Umbanhowar & Lynch)\n";
+const char* kFooter =
+    "plate COMMAND --help for its options; plate --version\n"
     "\n"
     "SCENE is a JSON scene file (see scenes/). Units are SI. Exit codes: 0 ok, 2 bad input,\n"
-    "3 a simulation left the model (a normal force reached zero: the part would fly), 1 other failure.\n";
+    "3 a simulation left the model (a normal force reached zero: the part would fly), 4 a design that\n"
+    "failed its verification, 1 other failure.\n";
+
+// ---- the command line ----------------------------------------------------------------------
+// CLI11 splits the arguments into a command, its options and their values, finds unknown
+// options and writes the help. The rules for values are ours, and every message names the option.
 
 struct UsageError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Minimal option parser: --name values...; positional arguments in order.
-struct Args {
-    std::vector<std::string> pos;
-    std::map<std::string, std::vector<std::string>> opt;
-    bool help = false;
+// A finite number, all of the text ("nan", "inf", "1e999", "" and "3x" are refused).
+double parse_num(const std::string& k, const std::string& s) {
+    char* end = nullptr;
+    const double x = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !std::isfinite(x))
+        throw UsageError("option " + k + ": expected a finite number, got '" + s + "'");
+    return x;
+}
 
-    Args(int argc, char** argv, const std::map<std::string, int>& arity) {
-        for (int i = 0; i < argc; ++i) {
-            std::string a = argv[i];
-            if (a == "--help" || a == "-h") { help = true; continue; }
-            if (a.rfind("--", 0) == 0) {
-                auto it = arity.find(a);
-                if (it == arity.end()) throw UsageError("unknown option " + a);
-                if (opt.count(a)) throw UsageError("option " + a + " given twice");
-                std::vector<std::string> vals;
-                for (int k = 0; k < it->second; ++k) {
-                    if (i + 1 >= argc) throw UsageError("option " + a + " expects " + std::to_string(it->second) + " value(s)");
-                    vals.push_back(argv[++i]);
-                }
-                opt[a] = vals;
-            } else {
-                pos.push_back(a);
-            }
+// A whole number from lo to hi, all of the text, base 10.
+long parse_whole(const std::string& k, const std::string& s, long lo, long hi) {
+    char* end = nullptr;
+    const long x = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || *end != '\0' || x < lo || x > hi)
+        throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " +
+                         std::to_string(hi) + ", got '" + s + "'");
+    return x;
+}
+
+// The options of one command, declared on its CLI11 subcommand into the command's variables
+// (which hold the defaults). Each option reaches its callback once per occurrence, as it is
+// parsed (trigger_on_parse): a second occurrence is refused there (CLI11's Throw policy counts
+// values, not occurrences, so `--at 0 0 --at 1` would pass as three numbers), and the text is
+// converted by the rules above.
+class Options {
+public:
+    Options(CLI::App* cmd, const std::string& footer) : cmd_(cmd) { cmd_->group("commands")->footer(footer); }
+    Options(const Options&) = delete;   // the callbacks hold `this`
+    Options& operator=(const Options&) = delete;
+
+    bool given() const { return cmd_->parsed(); }   // this is the command run
+    bool has(const std::string& name) const { return seen_.count(name) > 0; }
+
+    // What CLI11 could not place (the app allows extras so that the messages are ours): an
+    // unknown option, or an argument beyond SCENE.
+    void reject(const std::vector<std::string>& leftovers) const {
+        for (const std::string& s : leftovers) {
+            char* end = nullptr;
+            std::strtod(s.c_str(), &end);
+            if (s.size() > 1 && s[0] == '-' && *end != '\0') throw UsageError("unknown option " + s);
         }
+        if (leftovers.empty()) return;
+        throw UsageError(takes_scene_ ? "expected exactly one SCENE file" : cmd_->get_name() + " takes no SCENE argument");
     }
-    bool has(const std::string& k) const { return opt.count(k) > 0; }
-    double num(const std::string& k, int i, double def) const {
-        if (!has(k)) return def;
-        return parse_num(k, opt.at(k)[i]);
+
+    void scene_file(std::string& file, const std::string& name = "SCENE") {
+        takes_scene_ = true;
+        cmd_->add_option(name, file, "the scene file (JSON, see scenes/)")->required()->option_text(" ");
     }
-    static double parse_num(const std::string& k, const std::string& s) {
-        char* end = nullptr;
-        const double x = std::strtod(s.c_str(), &end);
-        if (s.empty() || *end != '\0' || !std::isfinite(x))
-            throw UsageError("option " + k + ": expected a finite number, got '" + s + "'");
-        return x;
+    // The help shows the default: `def`, or else x's value; none if def is "".
+    void number(const std::string& name, double& x, const std::string& help, const char* def = nullptr) {
+        std::ostringstream value;
+        value << x;
+        add<std::string>(name, 1, "X", help + in_parentheses("", def ? def : value.str()),
+                         [name, &x](const std::string& s) { x = parse_num(name, s); });
     }
-    long integer(const std::string& k, long def, long lo, long hi) const {
-        if (!has(k)) return def;
-        const std::string& s = opt.at(k)[0];
-        char* end = nullptr;
-        const long x = std::strtol(s.c_str(), &end, 10);
-        if (s.empty() || *end != '\0' || x < lo || x > hi)
-            throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " +
-                             std::to_string(hi) + ", got '" + s + "'");
-        return x;
+    template <class Int>
+    void whole(const std::string& name, Int& x, long lo, long hi, const std::string& help, const char* def = nullptr) {
+        const std::string range = std::to_string(lo) + " to " + std::to_string(hi);
+        add<std::string>(name, 1, "N", help + in_parentheses(range, def ? def : std::to_string(x)),
+                         [name, &x, lo, hi](const std::string& s) {
+                             x = static_cast<Int>(parse_whole(name, s, lo, hi));
+                         });
     }
-    std::string str(const std::string& k, const std::string& def) const { return has(k) ? opt.at(k)[0] : def; }
+    // lo to hi numbers (`names` in the help); how many a part takes is checked where that is known (config_arg).
+    void numbers(const std::string& name, std::vector<double>& v, std::size_t lo, std::size_t hi,
+                 const std::string& names, const std::string& help) {
+        const std::string count = std::to_string(lo) + (lo < hi ? " or " + std::to_string(hi) : "");
+        add<std::vector<std::string>>(name, static_cast<int>(hi), names, help,
+                                      [name, &v, lo, hi, count](const std::vector<std::string>& s) {
+                                          if (s.size() < lo || s.size() > hi)
+                                              throw UsageError(name + ": expected " + count + " numbers");
+                                          v.clear();
+                                          for (const std::string& x : s) v.push_back(parse_num(name, x));
+                                      });
+    }
+    void words(const std::string& name, std::vector<std::string>& v, std::size_t n, const std::string& names,
+               const std::string& help) {
+        add<std::vector<std::string>>(name, static_cast<int>(n), names, help,
+                                      [name, &v, n](const std::vector<std::string>& s) {
+                                          if (s.size() != n)
+                                              throw UsageError("option " + name + " expects " + std::to_string(n) +
+                                                               " value(s)");
+                                          v = s;
+                                      });
+    }
+    void text(const std::string& name, std::string& s, const std::string& value, const std::string& help) {
+        add<std::string>(name, 1, value, help, [&s](const std::string& t) { s = t; });
+    }
+    void flag(const std::string& name, bool& b, const std::string& help) {
+        cmd_->add_flag_function(name, [this, name, &b](std::int64_t) { once(name); b = true; }, help)
+            ->disable_flag_override()
+            ->trigger_on_parse();
+    }
+
+private:
+    template <class T>
+    void add(const std::string& name, int max_values, const std::string& names, const std::string& help,
+             std::function<void(const T&)> store) {
+        cmd_->add_option_function<T>(name, [this, name, store](const T& v) { once(name); store(v); }, help)
+            ->expected(1, max_values)
+            ->allow_extra_args(false)                   // (a vector's default: eat every value that follows)
+            ->option_text(names)
+            ->type_name(names.substr(0, names.find(' ')))   // "--at: 1 required SX missing"
+            ->trigger_on_parse();
+    }
+    void once(const std::string& name) {
+        if (!seen_.insert(name).second) throw UsageError("option " + name + " given twice");
+    }
+    // " (RANGE; default DEF)", without what is empty.
+    static std::string in_parentheses(const std::string& range, const std::string& def) {
+        std::string s = range;
+        if (!def.empty()) s += (s.empty() ? "default " : "; default ") + def;
+        return s.empty() ? s : " (" + s + ")";
+    }
+
+    CLI::App* cmd_;
+    std::set<std::string> seen_;
+    bool takes_scene_ = false;
 };
 
 // The scene file; its warnings (scene_warnings: admissible, outside the intended regime) to err.
-Scene scene_arg(const Args& a, Io& cio) {
-    if (a.pos.size() != 1) throw UsageError("expected exactly one SCENE file");
-    Scene sc = load_scene(a.pos[0]);
+Scene scene_arg(const std::string& file, Io& cio) {
+    Scene sc = load_scene(file);
     for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
     return sc;
 }
 
-// Reads --NAME with 3 numbers (rigid) or 2 (point part; a third is rejected).
-Vec3 config_arg(const Args& a, const std::string& k, const Scene& sc, bool required, const Vec3& def = Vec3::Zero()) {
+// --NAME's numbers (`v`, given or not): 3 for a rigid part, 2 for a point part.
+Vec3 config_arg(const Options& a, const std::string& k, const std::vector<double>& v, const Scene& sc, bool required) {
     if (!a.has(k)) {
         if (required) throw UsageError("missing " + k + (sc.part.point ? " SX SY" : " SX SY THETA"));
-        return def;
+        return Vec3::Zero();
     }
-    const auto& v = a.opt.at(k);
     Vec3 q = Vec3::Zero();
     const std::size_t need = sc.part.point ? 2 : 3;
-    std::vector<std::string> vals = v;
-    if (vals.size() != need) throw UsageError(k + ": expected " + std::to_string(need) + " numbers");
-    for (std::size_t i = 0; i < need; ++i) q[i] = Args::parse_num(k, vals[i]);
+    if (v.size() != need) throw UsageError(k + ": expected " + std::to_string(need) + " numbers");
+    for (std::size_t i = 0; i < need; ++i) q[i] = v[i];
     return q;
 }
 
-// Options taking 2 or 3 values depending on the part are parsed from the raw argv.
-std::map<std::string, int> with_config(std::map<std::string, int> m, const std::vector<std::string>& keys, int n) {
-    for (const auto& k : keys) m[k] = n;
-    return m;
+// ---- the limit cycle's and the grid's options (twist, field, fixed-points) ------------------
+
+struct CycleArgs {
+    LimitCycleOptions o = [] {
+        LimitCycleOptions o;
+        // The command line's budget per cycle is tighter than the library's (2e7, for tight references):
+        // 2e6, about 0.3 s; the shipped scenes' field cycles take at most ~6e4 at the default tolerances.
+        o.max_rhs_evaluations = kCliCycleBudget;
+        return o;
+    }();
+    std::string solver;
+};
+
+void add_cycle_options(Options& p, CycleArgs& c) {
+    p.number("--tol", c.o.tol, "accepted distance to the cycle, relative to the slip-speed scale");
+    p.number("--rtol", c.o.integration.rtol, "integrator tolerance, in (0, 1e-2)");
+    p.whole("--max-periods", c.o.max_periods, 2, 100000, "periods before the cycle counts as not converged");
+    p.whole("--max-rhs", c.o.max_rhs_evaluations, 1000, 1'000'000'000'000L,
+            "work budget of one cycle, right-hand sides");
+    p.text("--cycle-solver", c.solver, "NAME", "period-by-period, anderson, newton or shooting (default shooting)");
 }
 
-// For a point part, --at/--from take two values: peek at the scene before parsing.
-int config_arity(int argc, char** argv) {
-    for (int i = 0; i < argc; ++i) {
-        std::string s = argv[i];
-        if (s.rfind("--", 0) == 0 || s == "-h") continue;
-        try {
-            return load_scene(s).part.point ? 2 : 3;
-        } catch (const InputError&) {
-            throw;
-        }
-    }
-    return 3;
-}
-
-
-LimitCycleOptions cycle_opts(const Args& a) {
-    LimitCycleOptions o;
-    o.tol = a.num("--tol", 0, o.tol);
-    o.integration.rtol = a.num("--rtol", 0, o.integration.rtol);
-    o.max_periods = static_cast<int>(a.integer("--max-periods", o.max_periods, 2, 100000));
-    // The command line's budget per cycle is tighter than the library's (2e7, for tight references):
-    // 2e6, about 0.3 s; the shipped scenes' field cycles take at most ~6e4 at the default tolerances.
-    o.max_rhs_evaluations = a.integer("--max-rhs", kCliCycleBudget, 1000, 1'000'000'000'000L);
+LimitCycleOptions cycle_opts(const Options& a, const CycleArgs& c) {
+    LimitCycleOptions o = c.o;
     if (a.has("--cycle-solver")) {
         try {
-            o.solver = parse_cycle_solver(a.str("--cycle-solver", ""));
+            o.solver = parse_cycle_solver(c.solver);
         } catch (const std::invalid_argument& e) {
             throw UsageError(std::string("--cycle-solver: ") + e.what());
         }
@@ -193,48 +251,65 @@ LimitCycleOptions cycle_opts(const Args& a) {
     return o;
 }
 
-const std::map<std::string, int> kCycleOpts = {{"--tol", 1}, {"--rtol", 1}, {"--max-periods", 1}, {"--cycle-solver", 1},
-                                               {"--max-rhs", 1}};
-const std::map<std::string, int> kGridOpts = {{"--grid", 1}, {"--nx", 1}, {"--ny", 1}, {"--ntheta", 1}, {"--x", 2},
-                                              {"--y", 2}, {"--theta0", 1}, {"--threads", 1}};
+struct GridArgs {
+    int n = 7;
+    GridSpec g;
+    std::vector<double> x, y;
+    int threads = 0;
+};
 
-std::map<std::string, int> merge(std::map<std::string, int> a, const std::map<std::string, int>& b) {
-    a.insert(b.begin(), b.end());
-    return a;
+void add_grid_options(Options& p, GridArgs& a) {
+    p.whole("--grid", a.n, 1, 201, "grid points on each axis");
+    p.whole("--nx", a.g.nx, 1, 201, "points along s_x", "--grid");
+    p.whole("--ny", a.g.ny, 1, 201, "points along s_y", "--grid");
+    p.whole("--ntheta", a.g.nth, 1, 720, "points along theta", "--grid");
+    p.numbers("--x", a.x, 2, 2, "MIN MAX", "the range of s_x [m] (default -0.05 0.05)");
+    p.numbers("--y", a.y, 2, 2, "MIN MAX", "the range of s_y [m] (default -0.05 0.05)");
+    p.number("--theta0", a.g.th0, "the first theta of the full turn");
+    p.whole("--threads", a.threads, 0, 256, "threads (0: all cores)");
 }
 
-GridSpec grid_opts(const Args& a) {
-    GridSpec g;
-    const int n = static_cast<int>(a.integer("--grid", 7, 1, 201));
-    g.nx = static_cast<int>(a.integer("--nx", n, 1, 201));
-    g.ny = static_cast<int>(a.integer("--ny", n, 1, 201));
-    g.nth = static_cast<int>(a.integer("--ntheta", n, 1, 720));
-    g.x0 = a.num("--x", 0, g.x0);
-    g.x1 = a.num("--x", 1, g.x1);
-    g.y0 = a.num("--y", 0, g.y0);
-    g.y1 = a.num("--y", 1, g.y1);
-    g.th0 = a.num("--theta0", 0, g.th0);
+GridSpec grid_opts(const Options& a, const GridArgs& ga) {
+    GridSpec g = ga.g;
+    if (!a.has("--nx")) g.nx = ga.n;
+    if (!a.has("--ny")) g.ny = ga.n;
+    if (!a.has("--ntheta")) g.nth = ga.n;
+    if (a.has("--x")) {
+        g.x0 = ga.x[0];
+        g.x1 = ga.x[1];
+    }
+    if (a.has("--y")) {
+        g.y0 = ga.y[0];
+        g.y1 = ga.y[1];
+    }
     if (!(g.x1 >= g.x0) || !(g.y1 >= g.y0)) throw UsageError("--x and --y take MIN MAX with MIN <= MAX");
     return g;
 }
 
-int cmd_twist(int argc, char** argv, Io& cio) {
-    const int d = config_arity(argc, argv);
-    Args a(argc, argv, merge(with_config({}, {"--at", "--from"}, d), kCycleOpts));
-    if (a.help) {
-        cio.out << "usage: plate twist SCENE --at SX SY THETA [--from VX VY OMEGA] [--tol X] [--rtol X]\n"
-                     "                   [--max-periods N]\n"
-                     "Asymptotic twist (36) of the reduced U-dynamics limit cycle at (SX, SY, THETA), starting\n"
-                     "from the part twist --from (default: at rest relative to the plate). Point parts: --at SX SY.\n"
-                     "--tol: accepted distance to the cycle relative to the slip-speed scale (default 1e-7);\n"
-                     "--rtol: integrator tolerance (default 1e-8); --max-periods (default 400); --max-rhs: the work\n"
-                     "budget of the cycle in right-hand sides (default 2e6, about 0.3 s; then stop: step_limit).\n";
-        return 0;
+// ---- plate twist ---------------------------------------------------------------------------
+
+struct TwistArgs : Options {
+    std::string scene;
+    std::vector<double> at, from;
+    CycleArgs cycle;
+    explicit TwistArgs(CLI::App* cmd)
+        : Options(cmd, "Asymptotic twist (36) of the reduced U-dynamics limit cycle at (SX, SY, THETA), starting\n"
+                       "from the part twist --from (default: at rest relative to the plate). Point parts: --at SX SY.\n"
+                       "--tol: accepted distance to the cycle relative to the slip-speed scale (default 1e-7);\n"
+                       "--rtol: integrator tolerance (default 1e-8); --max-periods (default 400); --max-rhs: the work\n"
+                       "budget of the cycle in right-hand sides (default 2e6, about 0.3 s; then stop: step_limit).\n") {
+        scene_file(scene);
+        numbers("--at", at, 2, 3, "SX SY THETA", "the configuration (point parts: SX SY); required");
+        numbers("--from", from, 2, 3, "VX VY OMEGA", "the part's twist relative to the plate at the start");
+        add_cycle_options(*this, cycle);
     }
-    const Scene sc = scene_arg(a, cio);
-    const Vec3 q = config_arg(a, "--at", sc, true);
-    const Vec3 qd = config_arg(a, "--from", sc, false);
-    const LimitCycleSummary lc = limit_cycle(sc, q, cycle_opts(a), qd);
+};
+
+int cmd_twist(const TwistArgs& a, Io& cio) {
+    const Scene sc = scene_arg(a.scene, cio);
+    const Vec3 q = config_arg(a, "--at", a.at, sc, true);
+    const Vec3 qd = config_arg(a, "--from", a.from, sc, false);
+    const LimitCycleSummary lc = limit_cycle(sc, q, cycle_opts(a, a.cycle), qd);
     cio.out << to_json(sc, q, lc).dump(2) << std::endl;
     return 0;
 }
@@ -244,8 +319,7 @@ int cmd_twist(int argc, char** argv, Io& cio) {
 // shipped scenes' 9x9x9 fields: 0.2-3.4x of it; warm starts save, sticking cycles cost more), and a
 // field estimated over the budget --max-work (right-hand sides, default 2e9: minutes on two cores)
 // is refused with the estimate. The budget also holds while the field runs (require_within_budget).
-long check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, const Args& a) {
-    const long budget = a.integer("--max-work", 2'000'000'000L, 1000, 1'000'000'000'000'000L);
+long check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, long budget) {
     const auto t0 = std::chrono::steady_clock::now();
     const double dth = 2 * kPi / 5;
     const Vec3 samples[] = {{(g.x0 + g.x1) / 2, (g.y0 + g.y1) / 2, g.th0},
@@ -276,56 +350,78 @@ void require_within_budget(const Field& f, long budget) {
                              " configurations not started (the up-front estimate was low): raise --max-work");
 }
 
-int cmd_field(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--format", 1}, {"--out", 1}, {"--max-work", 1}}));
-    if (a.help) {
-        cio.out << "usage: plate field SCENE [--grid N] [--nx N] [--ny N] [--ntheta N] [--x MIN MAX]\n"
-                     "                   [--y MIN MAX] [--theta0 T] [--format json|csv] [--out FILE]\n"
-                     "                   [--threads N] [--tol X] [--rtol X] [--max-periods N]\n"
-                     "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.05,0.05]^2 m x [0, 2pi)),\n"
-                     "theta covering a full turn. Point parts: asymptotic velocity field on (s_x, s_y).\n"
-                     "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n"
-                     "--max-work N: the budget in right-hand sides (default 2e9); the work is estimated up front\n"
-                     "from one cycle and a larger field is refused with the estimate (exit 2); a field that spends\n"
-                     "it anyway stops there (exit 1, no output).\n";
-        return 0;
+
+// ---- plate field, plate fixed-points ---------------------------------------------------------
+
+constexpr long kMaxWorkLimit = 1'000'000'000'000'000L;
+
+struct FieldArgs : Options {
+    std::string scene, format = "json", out = "-";
+    GridArgs grid;
+    CycleArgs cycle;
+    long max_work = 2'000'000'000L;
+    explicit FieldArgs(CLI::App* cmd)
+        : Options(cmd, "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.05,0.05]^2 m x [0, 2pi)),\n"
+                       "theta covering a full turn. Point parts: asymptotic velocity field on (s_x, s_y).\n"
+                       "Configurations run in parallel on all cores (--threads). Output to stdout or --out FILE.\n"
+                       "--max-work N: the budget in right-hand sides (default 2e9); the work is estimated up front\n"
+                       "from one cycle and a larger field is refused with the estimate (exit 2); a field that spends\n"
+                       "it anyway stops there (exit 1, no output).\n") {
+        scene_file(scene);
+        add_grid_options(*this, grid);
+        text("--format", format, "json|csv", "the output's format (default json)");
+        text("--out", out, "FILE", "the output file (default: standard output)");
+        whole("--max-work", max_work, 1000, kMaxWorkLimit, "work budget of the field, right-hand sides");
+        add_cycle_options(*this, cycle);
     }
-    const Scene sc = scene_arg(a, cio);
-    const GridSpec g = grid_opts(a);
-    const std::string format = a.str("--format", "json");
+};
+
+int cmd_field(const FieldArgs& a, Io& cio) {
+    const Scene sc = scene_arg(a.scene, cio);
+    const GridSpec g = grid_opts(a, a.grid);
+    const std::string format = a.format;
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
     FieldOptions fo;
-    fo.cycle = cycle_opts(a);
-    fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
-    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a);
+    fo.cycle = cycle_opts(a, a.cycle);
+    fo.threads = a.grid.threads;
+    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a.max_work);
     ProgressPrinter prog{"field"};
     prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
     fo.progress = std::ref(prog);
     const Field f = compute_field(sc, g, fo);
     require_within_budget(f, fo.max_rhs_evaluations);
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) {
+    write_file_atomic(a.out, [&](std::ostream& out) {
         if (format == "csv") write_field_csv(out, f);
         else out << to_json(sc, f).dump(1) << "\n";
     }, cio.out);
     return 0;
 }
 
-int cmd_fixed_points(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, merge(merge(kGridOpts, kCycleOpts), {{"--out", 1}, {"--max-work", 1}}));
-    if (a.help) {
-        cio.out << "usage: plate fixed-points SCENE [grid options as for field] [--out FILE]\n"
-                     "Computes the field, finds cells where every component changes sign, refines the zeros\n"
-                     "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
-                     "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field;\n"
-                     "the refinement's own budget is the smaller of it and 2e7 right-hand sides.\n";
-        return 0;
+struct FixedPointsArgs : Options {
+    std::string scene, out = "-";
+    GridArgs grid;
+    CycleArgs cycle;
+    long max_work = 2'000'000'000L;
+    explicit FixedPointsArgs(CLI::App* cmd)
+        : Options(cmd, "Computes the field, finds cells where every component changes sign, refines the zeros\n"
+                       "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
+                       "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field;\n"
+                       "the refinement's own budget is the smaller of it and 2e7 right-hand sides.\n") {
+        scene_file(scene);
+        add_grid_options(*this, grid);
+        text("--out", out, "FILE", "the output file (default: standard output)");
+        whole("--max-work", max_work, 1000, kMaxWorkLimit, "work budget of the field, right-hand sides");
+        add_cycle_options(*this, cycle);
     }
-    const Scene sc = scene_arg(a, cio);
+};
+
+int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
+    const Scene sc = scene_arg(a.scene, cio);
     FieldOptions fo;
-    fo.cycle = cycle_opts(a);
-    fo.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
-    const GridSpec g = grid_opts(a);
-    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a);   // (the refinement has its own budget)
+    fo.cycle = cycle_opts(a, a.cycle);
+    fo.threads = a.grid.threads;
+    const GridSpec g = grid_opts(a, a.grid);
+    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a.max_work);   // (the refinement has its own budget)
     ProgressPrinter prog{"field"};
     prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
     fo.progress = std::ref(prog);
@@ -333,50 +429,67 @@ int cmd_fixed_points(int argc, char** argv, Io& cio) {
     require_within_budget(f, fo.max_rhs_evaluations);
     FixedPointOptions fpo;
     fpo.cycle = fo.cycle;
-    if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.integer("--max-work", 0, 1000, 1'000'000'000'000'000L));
+    if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.max_work);
     const FixedPoints fp = find_fixed_points(sc, f, fpo);
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
+    write_file_atomic(a.out, [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
-int cmd_simulate(int argc, char** argv, Io& cio) {
-    const int d = config_arity(argc, argv);
-    Args a(argc, argv, merge(with_config({{"--dynamics", 1}, {"--time", 1}, {"--sample", 1}, {"--out", 1},
-                                          {"--rtol", 1}},
-                                         {"--from", "--twist"}, d),
-                             {{"--tol", 1}, {"--max-periods", 1}, {"--model-tol", 1}, {"--verify", 0}, {"--max-steps", 1}}));
-    if (a.help) {
-        cio.out << "usage: plate simulate SCENE --dynamics full|u|field|auto --from SX SY THETA --time T\n"
-                     "                      [--twist VX VY OMEGA] [--sample DT] [--out FILE] [--rtol X]\n"
-                     "Trajectory from configuration --from with part twist --twist relative to the plate\n"
-                     "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
-                     "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps).\n"
-                     "auto: the cheapest of point/thin/thick part x field/u/full dynamics whose final configuration\n"
-                     "is predicted within --model-tol E (default 1e-2; of rho and radians) of the scene's part\n"
-                     "under full dynamics, decided up front from a few limit cycles at --from and the scene's\n"
-                     "dimensionless numbers (hierarchy.hpp); --verify also runs the full model and reports the\n"
-                     "measured error. The choice and its estimates go to stderr.\n"
-                     "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
-                     "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05), and the contact mode on the\n"
-                     "step that ended there (slide, pivot1-3, stuck: stick-slip is simulated through). Exit code 3\n"
-                     "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n"
-                     "--max-steps N: the work budget (integrator steps; for field, RK4 steps of the curve; default\n"
-                     "2e7, field 1e4). The work is estimated up front from one plate period (or one RK4 step) and a\n"
-                     "run that would exceed the budget is refused with the estimate (exit 2); at most 10^7 rows.\n";
-        return 0;
+// ---- plate simulate ------------------------------------------------------------------------
+
+struct SimulateArgs : Options {
+    std::string scene, dynamics, out = "-";
+    std::vector<double> from, twist;
+    double time = 0, sample = 0, model_tol = 1e-2;
+    double rtol = IntegrationOptions{}.rtol, tol = LimitCycleOptions{}.tol;
+    std::string max_periods;   // (accepted as always, any value: no simulation reads it)
+    long max_steps = 0;
+    bool verify = false;
+    explicit SimulateArgs(CLI::App* cmd)
+        : Options(cmd, "Trajectory from configuration --from with part twist --twist relative to the plate\n"
+                       "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
+                       "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps).\n"
+                       "auto: the cheapest of point/thin/thick part x field/u/full dynamics whose final configuration\n"
+                       "is predicted within --model-tol E (default 1e-2; of rho and radians) of the scene's part\n"
+                       "under full dynamics, decided up front from a few limit cycles at --from and the scene's\n"
+                       "dimensionless numbers (hierarchy.hpp); --verify also runs the full model and reports the\n"
+                       "measured error. The choice and its estimates go to stderr.\n"
+                       "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
+                       "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05), and the contact mode on the\n"
+                       "step that ended there (slide, pivot1-3, stuck: stick-slip is simulated through). Exit code 3\n"
+                       "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n"
+                       "--max-steps N: the work budget (integrator steps; for field, RK4 steps of the curve; default\n"
+                       "2e7, field 1e4). The work is estimated up front from one plate period (or one RK4 step) and a\n"
+                       "run that would exceed the budget is refused with the estimate (exit 2); at most 10^7 rows.\n") {
+        scene_file(scene);
+        text("--dynamics", dynamics, "full|u|field|auto", "the model; required");
+        numbers("--from", from, 2, 3, "SX SY THETA", "the start (point parts: SX SY); required");
+        number("--time", time, "the duration T [s]; required", "");
+        numbers("--twist", twist, 2, 3, "VX VY OMEGA", "the part's twist relative to the plate at the start");
+        number("--sample", sample, "seconds between rows", "a quarter of the plate's period");
+        text("--out", out, "FILE", "the CSV file (default: standard output)");
+        number("--rtol", rtol, "integrator tolerance");
+        number("--tol", tol, "limit-cycle tolerance of the field curve");
+        text("--max-periods", max_periods, "N", "(not used by simulate)");
+        number("--model-tol", model_tol, "auto: the error allowed");
+        flag("--verify", verify, "auto: also run the full model and report the measured error");
+        whole("--max-steps", max_steps, 1, 1'000'000'000'000L, "work budget, integrator steps", "2e7, field 1e4");
     }
-    const Scene sc = scene_arg(a, cio);
-    std::string dyn = a.str("--dynamics", "");
+};
+
+int cmd_simulate(const SimulateArgs& a, Io& cio) {
+    const Scene sc = scene_arg(a.scene, cio);
+    std::string dyn = a.dynamics;
     if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "auto")
         throw UsageError("--dynamics: expected full, u, field or auto");
-    const Vec3 q0 = config_arg(a, "--from", sc, true);
-    const Vec3 qd0 = config_arg(a, "--twist", sc, false);
+    const Vec3 q0 = config_arg(a, "--from", a.from, sc, true);
+    const Vec3 qd0 = config_arg(a, "--twist", a.twist, sc, false);
     if (!a.has("--time")) throw UsageError("missing --time T");
-    const double T = a.num("--time", 0, 0);
-    const double dt = a.num("--sample", 0, sc.plate.T / 4);
+    const double T = a.time;
+    const double dt = a.has("--sample") ? a.sample : sc.plate.T / 4;
     if (!(T > 0) || !(dt > 0)) throw UsageError("--time and --sample must be > 0");
     IntegrationOptions io;
-    io.rtol = a.num("--rtol", 0, io.rtol);
+    io.rtol = a.rtol;
     Trajectory tr;
     ProgressPrinter prog{"simulate"};
     prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
@@ -384,7 +497,7 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
     bool verify_auto = false;
     if (dyn == "auto") {
         if (!qd0.isZero()) throw UsageError("--dynamics auto answers from rest: drop --twist");
-        const double tol = a.num("--model-tol", 0, 1e-2);
+        const double tol = a.model_tol;
         if (!(tol > 0)) throw UsageError("--model-tol must be > 0");
         const ModelEstimate est = estimate_model_errors(sc, q0, T);
         PartModel part;
@@ -399,8 +512,8 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
                   << ", growth " << est.growth() << (est.ok ? "" : " (" + est.note + ")") << "\n";
         used = simplified(sc, part);
         dyn = d == Dynamics::Full ? "full" : d == Dynamics::U ? "u" : "field";
-        verify_auto = a.has("--verify") && picked.name() != Rung{}.name();
-    } else if (a.has("--verify")) {
+        verify_auto = a.verify && picked.name() != Rung{}.name();
+    } else if (a.verify) {
         throw UsageError("--verify goes with --dynamics auto");
     }
     const Scene& sc_run = used;
@@ -411,7 +524,7 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
         throw UsageError("--time / --sample give " + fmt(rows) + " rows, above the limit of " + fmt(kMaxRows) +
                          ": sample less often");
     const bool field_dyn = dyn == "field";
-    const long budget = a.integer("--max-steps", field_dyn ? 10'000 : io.max_steps, 1, 1'000'000'000'000L);
+    const long budget = a.has("--max-steps") ? a.max_steps : field_dyn ? 10'000 : io.max_steps;
     io.max_steps = budget;
     {
         const auto t0 = std::chrono::steady_clock::now();
@@ -420,7 +533,7 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
         if (field_dyn) {
             // RK4 steps of 0.05 s, and at least one per sample.
             LimitCycleOptions lo;
-            lo.tol = a.num("--tol", 0, lo.tol);
+            lo.tol = a.tol;
             const double h = std::min(0.05, dt), span = std::min(T, h);
             const Trajectory pilot = field_curve(sc_run, q0, span, span, lo);
             pilot_steps = 1;
@@ -444,7 +557,7 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
     if (dyn == "field") {
         if (!qd0.isZero()) throw UsageError("--twist has no meaning for --dynamics field");
         LimitCycleOptions lo;
-        lo.tol = a.num("--tol", 0, lo.tol);
+        lo.tol = a.tol;
         tr = field_curve(sc_run, q0, T, dt, lo);
     } else {
         tr = simulate(sc_run, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, dt, io);
@@ -461,31 +574,39 @@ int cmd_simulate(int argc, char** argv, Io& cio) {
         }
     }
     if (tr.stop.reason == StopReason::StepLimit)   // the estimate was low: a cut-off run is not a result
-        throw std::runtime_error(a.pos[0] + ": stopped: " + tr.stop.describe() + " (the up-front estimate was low: raise --max-steps); nothing written");
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio.out);
+        throw std::runtime_error(a.scene + ": stopped: " + tr.stop.describe() + " (the up-front estimate was low: raise --max-steps); nothing written");
+    write_file_atomic(a.out, [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio.out);
     if (tr.stop.reason != StopReason::None) {
-        cio.err << "plate simulate: " << a.pos[0] << ": stopped: " << tr.stop.describe() << std::endl;
+        cio.err << "plate simulate: " << a.scene << ": stopped: " << tr.stop.describe() << std::endl;
         return tr.stop.reason == StopReason::ContactLost ? 3 : 1;
     }
     return 0;
 }
 
-int cmd_random_scene(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, {{"--seed", 1}, {"--thin", 0}, {"--point", 0}, {"--out", 1}});
-    if (a.help) {
-        cio.out << "usage: plate random-scene --seed N [--thin | --point] [--out FILE]\n"
-                     "A random part (thick by default) and a random plate motion (harmonics 1-2 on every axis,\n"
-                     "vertical acceleration kept below 0.6 g within 3 cm of the centre), reproducible by seed.\n";
-        return 0;
+// ---- plate random-scene --------------------------------------------------------------------
+
+struct RandomSceneArgs : Options {
+    std::uint64_t seed = 0;
+    bool thin = false, point = false;
+    std::string out = "-";
+    explicit RandomSceneArgs(CLI::App* cmd)
+        : Options(cmd, "A random part (thick by default) and a random plate motion (harmonics 1-2 on every axis,\n"
+                       "vertical acceleration kept below 0.6 g within 3 cm of the centre), reproducible by seed.\n") {
+        whole("--seed", seed, 0, 1L << 62, "the seed; required", "");
+        flag("--thin", thin, "a thin part (contacts in the plane of the centre of mass: Theorem 1)");
+        flag("--point", point, "a point part");
+        text("--out", out, "FILE", "the scene file (default: standard output)");
     }
-    if (!a.pos.empty()) throw UsageError("random-scene takes no SCENE argument");
+};
+
+int cmd_random_scene(const RandomSceneArgs& a, Io& cio) {
     if (!a.has("--seed")) throw UsageError("missing --seed N");
     RandomSceneOptions ro;
-    ro.thin = a.has("--thin");
-    ro.point = a.has("--point");
+    ro.thin = a.thin;
+    ro.point = a.point;
     if (ro.thin && ro.point) throw UsageError("--thin and --point exclude each other");
-    const Scene sc = random_scene(static_cast<std::uint64_t>(a.integer("--seed", 0, 0, 1L << 62)), ro);
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << scene_to_json(sc).dump(2) << "\n"; }, cio.out);
+    const Scene sc = random_scene(a.seed, ro);
+    write_file_atomic(a.out, [&](std::ostream& out) { out << scene_to_json(sc).dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
@@ -519,21 +640,31 @@ nlohmann::json contraction_json(const proofs::ContractionSummary& s) {
     return j;
 }
 
-int cmd_proofs(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, {{"--thin", 1}, {"--thick", 1}, {"--surfaces", 1}, {"--seed", 1}, {"--threads", 1}, {"--out", 1}});
-    if (a.help) {
-        cio.out << "usage: plate proofs [--thin N] [--thick M] [--surfaces K] [--seed S] [--threads T] [--out FILE]\n"
-                     "Numerical checks of Theorem 1 on seeded random parts and plate motions: Lyapunov contraction\n"
-                     "of the relative twist against its integration-error bound, convergence, uniqueness of the\n"
-                     "cycle from further initial twists, Floquet multipliers (N thin parts, default 10000; M thick\n"
-                     "parts beyond the theorem, default 1000); limit surfaces of K thin parts (default 200); the\n"
-                     "conditioning of A as a contact approaches the line of the other two (e/L = 1 ... 0).\n"
-                     "JSON to stdout or --out FILE; exit code 0 even when a check fails.\n";
-        return 0;
+// ---- plate proofs --------------------------------------------------------------------------
+
+struct ProofsArgs : Options {
+    int thin = 10000, thick = 1000, surfaces = 200, threads = 0;
+    std::uint64_t seed = 1;
+    std::string out = "-";
+    explicit ProofsArgs(CLI::App* cmd)
+        : Options(cmd, "Numerical checks of Theorem 1 on seeded random parts and plate motions: Lyapunov contraction\n"
+                       "of the relative twist against its integration-error bound, convergence, uniqueness of the\n"
+                       "cycle from further initial twists, Floquet multipliers (N thin parts, default 10000; M thick\n"
+                       "parts beyond the theorem, default 1000); limit surfaces of K thin parts (default 200); the\n"
+                       "conditioning of A as a contact approaches the line of the other two (e/L = 1 ... 0).\n"
+                       "JSON to stdout or --out FILE; exit code 0 even when a check fails.\n") {
+        whole("--thin", thin, 0, 1000000, "thin parts");
+        whole("--thick", thick, 0, 100000, "thick parts");
+        whole("--surfaces", surfaces, 0, 20000, "limit surfaces");
+        whole("--seed", seed, 0, 1L << 40, "the first seed");
+        whole("--threads", threads, 0, 256, "threads (0: all cores)");
+        text("--out", out, "FILE", "the JSON file (default: standard output)");
     }
-    if (!a.pos.empty()) throw UsageError("proofs takes no SCENE argument");
-    const auto seed = static_cast<std::uint64_t>(a.integer("--seed", 1, 0, 1L << 40));
-    const int threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+};
+
+int cmd_proofs(const ProofsArgs& a, Io& cio) {
+    const std::uint64_t seed = a.seed;
+    const int threads = a.threads;
     nlohmann::json j;
     j["seed"] = seed;
     auto campaign = [&](bool thin, int n, std::uint64_t s0) {
@@ -545,11 +676,11 @@ int cmd_proofs(int argc, char** argv, Io& cio) {
         o.progress = ProgressPrinter{thin ? "proofs, thin parts" : "proofs, thick parts", 10.0};
         return contraction_json(proofs::check_contraction(o));
     };
-    j["thin"] = campaign(true, static_cast<int>(a.integer("--thin", 10000, 0, 1000000)), seed);
-    j["thick"] = campaign(false, static_cast<int>(a.integer("--thick", 1000, 0, 100000)), seed + 50'000'000);
+    j["thin"] = campaign(true, a.thin, seed);
+    j["thick"] = campaign(false, a.thick, seed + 50'000'000);
     // Limit surfaces of random thin parts at random plate times.
     const proofs::LimitSurfaceCampaign ls =
-        proofs::check_limit_surfaces(static_cast<int>(a.integer("--surfaces", 200, 0, 20000)), seed);
+        proofs::check_limit_surfaces(a.surfaces, seed);
     j["limit_surfaces"] = {{"parts", ls.parts}, {"directions", 300}, {"convex_and_normal", ls.convex},
                            {"strictly_convex", ls.strict}, {"worst_max_work_violation", ls.worst_max_work},
                            {"worst_monotonicity_violation", ls.worst_monotonicity},
@@ -564,35 +695,50 @@ int cmd_proofs(int argc, char** argv, Io& cio) {
         j["conditioning_of_A"].push_back({{"e_over_L", cs.e_over_L}, {"max_condition", c.max_condition},
                                           {"min_singular_over_max", c.min_singular}});
     }
-    write_file_atomic(a.str("--out", "-"), [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
+    write_file_atomic(a.out, [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
+// ---- plate design --------------------------------------------------------------------------
+
 nlohmann::json complex_json(const std::complex<double>& z) { return {z.real(), z.imag()}; }
 
-int cmd_design(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, {{"--target", 3}, {"--out", 1}, {"--limits", 2}, {"--period", 1}, {"--seed", 1},
-                        {"--threads", 1}, {"--starts", 1}, {"--evaluations", 1}});
-    if (a.help) {
-        cio.out << "usage: plate design PART_SCENE --target KIND A B --out SCENE.json [--limits LIN ANG] [--period T]\n"
-                     "                    [--seed S] [--threads K] [--starts N] [--evaluations M]\n"
-                     "Designs a plate motion for the part of PART_SCENE (its plate block is ignored but for its period)\n"
-                     "and verifies it before reporting. Targets (point parts in this version):\n"
-                     "  sink X Y          (or fixed-point X Y) the unique stable fixed point of the velocity field at (X, Y)\n"
-                     "  transport VX VY   a uniform velocity (VX, VY) [m/s] over the plate\n"
-                     "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
-                     "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
-                     "seeded feasible motions (default 16), --evaluations each (default 400). Verification: the field's\n"
-                     "fixed points on a 7x7 grid and full dynamics from 20 seeded random starts. Writes the designed\n"
-                     "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n";
-        return 0;
+struct DesignArgs : Options {
+    std::string scene, out;
+    std::vector<std::string> target;
+    std::vector<double> limits;
+    double period = 0;
+    std::uint64_t seed = 1;
+    int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations;
+    explicit DesignArgs(CLI::App* cmd)
+        : Options(cmd, "Designs a plate motion for the part of PART_SCENE (its plate block is ignored but for its period)\n"
+                       "and verifies it before reporting. Targets (point parts in this version):\n"
+                       "  sink X Y          (or fixed-point X Y) the unique stable fixed point of the velocity field at (X, Y)\n"
+                       "  transport VX VY   a uniform velocity (VX, VY) [m/s] over the plate\n"
+                       "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
+                       "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
+                       "seeded feasible motions (default 16), --evaluations each (default 400). Verification: the field's\n"
+                       "fixed points on a 7x7 grid and full dynamics from 20 seeded random starts. Writes the designed\n"
+                       "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
+        scene_file(scene, "PART_SCENE");
+        words("--target", target, 3, "KIND A B", "sink X Y, fixed-point X Y or transport VX VY; required");
+        text("--out", out, "SCENE.json", "the designed scene; required");
+        numbers("--limits", limits, 2, 2, "LIN ANG", "the largest harmonic amplitudes (default 20 m/s^2, 150 rad/s^2)");
+        number("--period", period, "the plate's period [s]", "the part scene's");
+        whole("--seed", seed, 0, 1L << 40, "the seed");
+        whole("--threads", threads, 0, 256, "threads (0: all cores)");
+        whole("--starts", starts, 1, 10000, "seeded starts of the search");
+        whole("--evaluations", evaluations, 1, 1'000'000, "evaluations per start");
     }
-    const Scene part = scene_arg(a, cio);
+};
+
+int cmd_design(const DesignArgs& a, Io& cio) {
+    const Scene part = scene_arg(a.scene, cio);
     if (!a.has("--target")) throw UsageError("missing --target KIND A B");
     if (!a.has("--out")) throw UsageError("missing --out SCENE.json");
-    const std::string kind = a.opt.at("--target")[0];
+    const std::string kind = a.target[0];
     DesignTarget t;
-    const Vec2 ab(Args::parse_num("--target", a.opt.at("--target")[1]), Args::parse_num("--target", a.opt.at("--target")[2]));
+    const Vec2 ab(parse_num("--target", a.target[1]), parse_num("--target", a.target[2]));
     if (kind == "sink" || kind == "fixed-point") t.at = ab;
     else if (kind == "transport") {
         t.kind = DesignTargetKind::Transport;
@@ -601,17 +747,19 @@ int cmd_design(int argc, char** argv, Io& cio) {
         throw UsageError("--target: expected sink X Y, fixed-point X Y or transport VX VY, got '" + kind + "'");
     }
     DesignOptions o;
-    o.lin_limit = a.num("--limits", 0, o.lin_limit);
-    o.ang_limit = a.num("--limits", 1, o.ang_limit);
+    if (a.has("--limits")) {
+        o.lin_limit = a.limits[0];
+        o.ang_limit = a.limits[1];
+    }
     if (!(o.lin_limit >= 0 && o.ang_limit >= 0 && o.lin_limit <= kMaxAmplitude && o.ang_limit <= kMaxAmplitude))
         throw UsageError("--limits: expected amplitudes from 0 to " + fmt(kMaxAmplitude));
-    o.period = a.num("--period", 0, 0);
+    o.period = a.period;
     if (a.has("--period") && !(o.period >= kPeriodRange[0] && o.period <= kPeriodRange[1]))
         throw UsageError("--period: expected " + fmt(kPeriodRange[0]) + " to " + fmt(kPeriodRange[1]) + " s");
-    o.seed = static_cast<std::uint64_t>(a.integer("--seed", 1, 0, 1L << 40));
-    o.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
-    o.starts = static_cast<int>(a.integer("--starts", o.starts, 1, 10000));
-    o.local_evaluations = static_cast<int>(a.integer("--evaluations", o.local_evaluations, 1, 1'000'000));
+    o.seed = a.seed;
+    o.threads = a.threads;
+    o.starts = a.starts;
+    o.local_evaluations = a.evaluations;
     DesignSummary d;
     try {
         d = design(part, t, o);
@@ -623,7 +771,7 @@ int cmd_design(int argc, char** argv, Io& cio) {
     j["target"] = {{"kind", sink ? "sink" : "transport"}, {sink ? "at" : "velocity", {ab.x(), ab.y()}}};
     j["verified"] = d.verified;
     if (!d.verified) j["failure"] = d.failure;
-    j["scene"] = a.str("--out", "");
+    j["scene"] = a.out;
     if (sink) {
         j["unique"] = d.unique;
         j["convergence_rate_per_s"] = d.rate;
@@ -650,62 +798,74 @@ int cmd_design(int argc, char** argv, Io& cio) {
     j["seconds"] = d.seconds;
     j["notes"] = d.notes;
     if (d.verified) {
-        write_file_atomic(a.str("--out", ""), [&](std::ostream& out) { out << scene_to_json(d.scene).dump(2) << "\n"; });
+        write_file_atomic(a.out, [&](std::ostream& out) { out << scene_to_json(d.scene).dump(2) << "\n"; });
         for (const std::string& w : scene_warnings(d.scene)) cio.err << "warning: designed scene: " << w << "\n";
     }
     cio.out << j.dump(2) << std::endl;
     if (!d.verified) {
-        cio.err << "plate design: " << a.pos[0] << ": the design failed verification: " << d.failure << " (no scene written)"
+        cio.err << "plate design: " << a.scene << ": the design failed verification: " << d.failure << " (no scene written)"
                 << std::endl;
         return 4;
     }
     return 0;
 }
 
-// The output folder of report and bench, which take no SCENE.
-std::string out_dir_arg(const Args& a, const std::string& cmd) {
-    if (!a.pos.empty()) throw UsageError(cmd + " takes no SCENE argument");
-    if (!a.has("--out")) throw UsageError("missing --out DIR");
-    return a.str("--out", "");
-}
 
-int cmd_report(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, {{"--out", 1}, {"--seed", 1}, {"--quick", 0}, {"--threads", 1}, {"--source", 1}});
-    if (a.help) {
-        cio.out << "usage: plate report --out DIR [--quick] [--seed S] [--threads T] [--source ROOT]\n"
-                     "Writes DIR/index.html and its figures: the derivation and its findings, kernel equivalence,\n"
-                     "Theorem 1 checks (10^4 thin, 10^3 thick parts; --quick: a few), limit surfaces, Fig. 3, and the\n"
-                     "paper's fields with full-dynamics trajectories and fixed-point tables. ROOT: the project folder\n"
-                     "(scenes/, reports/generated/), default the one this program was built from.\n";
-        return 0;
+// ---- plate report, plate bench -------------------------------------------------------------
+
+struct ReportArgs : Options {
+    std::string out, source;
+    std::uint64_t seed = 1;
+    int threads = 0;
+    bool quick = false;
+    explicit ReportArgs(CLI::App* cmd)
+        : Options(cmd, "Writes DIR/index.html and its figures: the derivation and its findings, kernel equivalence,\n"
+                       "Theorem 1 checks (10^4 thin, 10^3 thick parts; --quick: a few), limit surfaces, Fig. 3, and the\n"
+                       "paper's fields with full-dynamics trajectories and fixed-point tables. ROOT: the project folder\n"
+                       "(scenes/, reports/generated/), default the one this program was built from.\n") {
+        text("--out", out, "DIR", "the report's folder; required");
+        flag("--quick", quick, "small campaigns and grids");
+        whole("--seed", seed, 0, 1L << 40, "the seed");
+        whole("--threads", threads, 0, 256, "threads (0: all cores)");
+        text("--source", source, "ROOT", "the project folder");
     }
+};
+
+int cmd_report(const ReportArgs& a, Io& cio) {
+    if (!a.has("--out")) throw UsageError("missing --out DIR");
     report::ReportOptions o;
-    o.out = out_dir_arg(a, "report");
-    o.source_dir = a.str("--source", data_root());
-    o.seed = static_cast<std::uint64_t>(a.integer("--seed", 1, 0, 1L << 40));
-    o.quick = a.has("--quick");
-    o.threads = static_cast<int>(a.integer("--threads", 0, 0, 256));
+    o.out = a.out;
+    o.source_dir = a.has("--source") ? a.source : data_root();
+    o.seed = a.seed;
+    o.quick = a.quick;
+    o.threads = a.threads;
     report::write_report(o);
     cio.err << "report: " << o.out << "/index.html" << std::endl;
     return 0;
 }
 
-int cmd_bench(int argc, char** argv, Io& cio) {
-    Args a(argc, argv, {{"--out", 1}, {"--full", 0}, {"--source", 1}});
-    if (a.help) {
-        cio.out << "usage: plate bench --out DIR [--full] [--source ROOT]\n"
-                     "The speed-accuracy study: work-precision charts (every method and friction treatment on (a) an\n"
-                     "asymptotic twist of fig4, (b) fig4's 20 s full-dynamics trajectory, (c) a near-sticking twist of\n"
-                     "fig6) against reference solutions; the limit-cycle solvers on fig4's field against period-by-\n"
-                     "period RK4; failure maps; the model hierarchy. Writes the charts into DIR and the section into\n"
-                     "DIR/index.html (the report's page if `plate report --out DIR` wrote one). Quick by default\n"
-                     "(minutes); --full sweeps more settings.\n";
-        return 0;
+struct BenchArgs : Options {
+    std::string out, source;
+    bool full = false;
+    explicit BenchArgs(CLI::App* cmd)
+        : Options(cmd, "The speed-accuracy study: work-precision charts (every method and friction treatment on (a) an\n"
+                       "asymptotic twist of fig4, (b) fig4's 20 s full-dynamics trajectory, (c) a near-sticking twist of\n"
+                       "fig6) against reference solutions; the limit-cycle solvers on fig4's field against period-by-\n"
+                       "period RK4; failure maps; the model hierarchy. Writes the charts into DIR and the section into\n"
+                       "DIR/index.html (the report's page if `plate report --out DIR` wrote one). Quick by default\n"
+                       "(minutes); --full sweeps more settings.\n") {
+        text("--out", out, "DIR", "the report's folder; required");
+        flag("--full", full, "the long campaign");
+        text("--source", source, "ROOT", "the project folder (default: the one this program was built from)");
     }
+};
+
+int cmd_bench(const BenchArgs& a, Io& cio) {
+    if (!a.has("--out")) throw UsageError("missing --out DIR");
     report::SpeedOptions o;
-    o.out = out_dir_arg(a, "bench");
-    o.source_dir = a.str("--source", data_root());
-    o.full = a.has("--full");
+    o.out = a.out;
+    o.source_dir = a.has("--source") ? a.source : data_root();
+    o.full = a.full;
     report::write_speed_study(o);
     cio.err << "bench: " << o.out << "/index.html" << std::endl;
     return 0;
@@ -715,26 +875,64 @@ int cmd_bench(int argc, char** argv, Io& cio) {
 
 int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
     Io cio{out, err};
-    if (argc >= 2 && !std::strcmp(argv[1], "--version")) {
-        cio.out << "plate " << PLATE_VERSION << " (scenes and report inputs: " << data_root() << ")\n";
-        return 0;
-    }
-    if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-        cio.out << kUsage;
-        return argc < 2 ? 2 : 0;
+    CLI::App app{kAbout, "plate"};
+    app.get_formatter()->label("Usage", "usage");   // (as before: the help says "usage: plate ...")
+    app.get_formatter()->label("SUBCOMMAND", "COMMAND");
+    app.footer(kFooter);
+    app.set_version_flag("--version", [] {
+        return "plate " PLATE_VERSION " (scenes and report inputs: " + data_root() + ")";
+    });
+    app.require_subcommand(1);
+    app.allow_extras();   // (and so every command) what is left over is judged by Options::reject
+    auto command = [&app](const char* name, const char* about) { return app.add_subcommand(name, about); };
+    TwistArgs twist(command("twist", "asymptotic twist (36) at one configuration, as JSON"));
+    FieldArgs field(command("field", "asymptotic twist field on a grid over (s_x, s_y, theta), JSON or CSV"));
+    FixedPointsArgs fixed_points(
+        command("fixed-points", "zeros of the field, refined and classified (stable, unstable, saddle; lines)"));
+    SimulateArgs simulate(command("simulate", "U-dynamics, full-dynamics or field-integral-curve trajectory, CSV"));
+    RandomSceneArgs random_scene(
+        command("random-scene", "a seeded random part and plate motion (like Fig. 3), as a scene file"));
+    ProofsArgs proofs(
+        command("proofs", "the numerical checks of Theorem 1 (contraction, Floquet, limit surfaces, A), JSON"));
+    ReportArgs report(command("report", "the verification report: DIR/index.html with SVG figures (gnuplot)"));
+    BenchArgs bench(
+        command("bench", "the speed-accuracy study, written into the report in DIR (--full: the long campaign)"));
+    DesignArgs design(
+        command("design", "the plate motion that sends a (point) part where wanted: a sink or a transport, verified"));
+    const std::pair<const Options*, std::function<int()>> commands[] = {
+        {&twist, [&] { return cmd_twist(twist, cio); }},
+        {&field, [&] { return cmd_field(field, cio); }},
+        {&fixed_points, [&] { return cmd_fixed_points(fixed_points, cio); }},
+        {&simulate, [&] { return cmd_simulate(simulate, cio); }},
+        {&random_scene, [&] { return cmd_random_scene(random_scene, cio); }},
+        {&proofs, [&] { return cmd_proofs(proofs, cio); }},
+        {&report, [&] { return cmd_report(report, cio); }},
+        {&bench, [&] { return cmd_bench(bench, cio); }},
+        {&design, [&] { return cmd_design(design, cio); }},
+    };
+
+    if (argc < 2) {
+        cio.out << app.help();
+        return 2;
     }
     const std::string cmd = argv[1];
+    const bool known = !app.get_subcommands([&](const CLI::App* c) { return c->get_name() == cmd; }).empty();
+    if (!known && cmd != "--help" && cmd != "-h" && cmd != "--version") {
+        cio.err << "plate: unknown command '" << cmd << "'\n" << app.help();
+        return 2;
+    }
     try {
-        if (cmd == "twist") return cmd_twist(argc - 2, argv + 2, cio);
-        if (cmd == "field") return cmd_field(argc - 2, argv + 2, cio);
-        if (cmd == "fixed-points") return cmd_fixed_points(argc - 2, argv + 2, cio);
-        if (cmd == "simulate") return cmd_simulate(argc - 2, argv + 2, cio);
-        if (cmd == "random-scene") return cmd_random_scene(argc - 2, argv + 2, cio);
-        if (cmd == "proofs") return cmd_proofs(argc - 2, argv + 2, cio);
-        if (cmd == "report") return cmd_report(argc - 2, argv + 2, cio);
-        if (cmd == "bench") return cmd_bench(argc - 2, argv + 2, cio);
-        if (cmd == "design") return cmd_design(argc - 2, argv + 2, cio);
-        cio.err << "plate: unknown command '" << cmd << "'\n" << kUsage;
+        app.parse(argc, argv);
+        for (const auto& [options, run_command] : commands) {
+            if (!options->given()) continue;
+            options->reject(app.remaining(true));
+            return run_command();
+        }
+        return 0;   // (not reached: a command is required)
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success))   // --help, --version
+            return app.exit(e, cio.out, cio.err);
+        cio.err << "plate " << cmd << ": " << e.what() << " (see plate " << cmd << " --help)" << std::endl;
         return 2;
     } catch (const InputError& e) {
         cio.err << "plate " << cmd << ": " << e.what() << std::endl;

@@ -2,7 +2,7 @@
 # Installs the Debian packages the project needs, those that are missing only.
 set -euo pipefail
 pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-dev libcln-dev
-      catch2 nlohmann-json3-dev gnuplot-nox libjs-katex valgrind chromium
+      catch2 nlohmann-json3-dev libcli11-dev gnuplot-nox libjs-katex valgrind chromium
       python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev)
 missing=()
 for p in "${pkgs[@]}"; do
