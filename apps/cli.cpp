@@ -353,6 +353,21 @@ void require_within_budget(const Field& f, long budget) {
 
 // ---- plate field, plate fixed-points ---------------------------------------------------------
 
+// The field of `field` and `fixed-points`: its work estimated up front against `max_work`, progress
+// on a terminal, and refused if the budget was spent anyway.
+Field bounded_field(const Scene& sc, const GridSpec& g, const LimitCycleOptions& cycle, int threads, long max_work, Io& cio) {
+    FieldOptions fo;
+    fo.cycle = cycle;
+    fo.threads = threads;
+    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, max_work);
+    ProgressPrinter prog{"field"};
+    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
+    fo.progress = std::ref(prog);
+    Field f = compute_field(sc, g, fo);
+    require_within_budget(f, fo.max_rhs_evaluations);
+    return f;
+}
+
 constexpr long kMaxWorkLimit = 1'000'000'000'000'000L;
 
 struct FieldArgs : Options {
@@ -381,15 +396,7 @@ int cmd_field(const FieldArgs& a, Io& cio) {
     const GridSpec g = grid_opts(a, a.grid);
     const std::string format = a.format;
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
-    FieldOptions fo;
-    fo.cycle = cycle_opts(a, a.cycle);
-    fo.threads = a.grid.threads;
-    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a.max_work);
-    ProgressPrinter prog{"field"};
-    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
-    fo.progress = std::ref(prog);
-    const Field f = compute_field(sc, g, fo);
-    require_within_budget(f, fo.max_rhs_evaluations);
+    const Field f = bounded_field(sc, g, cycle_opts(a, a.cycle), a.grid.threads, a.max_work, cio);
     write_file_atomic(a.out, [&](std::ostream& out) {
         if (format == "csv") write_field_csv(out, f);
         else out << to_json(sc, f).dump(1) << "\n";
@@ -417,18 +424,10 @@ struct FixedPointsArgs : Options {
 
 int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
     const Scene sc = scene_arg(a.scene, cio);
-    FieldOptions fo;
-    fo.cycle = cycle_opts(a, a.cycle);
-    fo.threads = a.grid.threads;
-    const GridSpec g = grid_opts(a, a.grid);
-    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, a.max_work);   // (the refinement has its own budget)
-    ProgressPrinter prog{"field"};
-    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
-    fo.progress = std::ref(prog);
-    const Field f = compute_field(sc, g, fo);
-    require_within_budget(f, fo.max_rhs_evaluations);
-    FixedPointOptions fpo;
-    fpo.cycle = fo.cycle;
+    const LimitCycleOptions cycle = cycle_opts(a, a.cycle);
+    const Field f = bounded_field(sc, grid_opts(a, a.grid), cycle, a.grid.threads, a.max_work, cio);
+    FixedPointOptions fpo;   // (the refinement has its own budget)
+    fpo.cycle = cycle;
     if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.max_work);
     const FixedPoints fp = find_fixed_points(sc, f, fpo);
     write_file_atomic(a.out, [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
