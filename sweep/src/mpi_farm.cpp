@@ -1,0 +1,235 @@
+// The MPI farm (built when Open MPI is found). Rank 0 hands out tasks one at a time (self-
+// scheduling) to its own threads and to the other ranks' threads, and collects the results; only
+// each rank's main thread calls MPI (MPI_THREAD_FUNNELED).
+//
+// Protocol (tags): a worker rank first sends HELLO with its thread count T; rank 0 answers with T
+// ASSIGN messages (a task index, or -1: no more). Each finished task returns as RESULT ("index\n"
+// + text), which rank 0 answers with the next ASSIGN. A worker rank ends after T stops; rank 0 once
+// every slot of every rank has had its stop and its own threads are done. Per task the wire carries
+// one 4-byte index out and the result text back (~1 kB for a fixed-point row).
+//
+// The main threads poll (MPI_Iprobe, then a 200 us sleep when idle) rather than block in MPI_Recv:
+// Open MPI's blocking receive spins, which would take a core from the threads computing beside it.
+#include "plate/farm.hpp"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace plate::sweep {
+namespace {
+
+constexpr int kHello = 11, kAssign = 12, kResult = 13;
+
+void nap() { std::this_thread::sleep_for(std::chrono::microseconds(200)); }
+
+// A thread-safe queue of tasks for the rank's threads, and of their results for the main thread.
+struct Local {
+    std::mutex m;
+    std::condition_variable cv;
+    std::deque<int> tasks;
+    std::deque<std::pair<int, std::string>> results;
+    bool closed = false;
+
+    void push(int i) {
+        {
+            std::lock_guard<std::mutex> l(m);
+            tasks.push_back(i);
+        }
+        cv.notify_one();
+    }
+    void close() {
+        {
+            std::lock_guard<std::mutex> l(m);
+            closed = true;
+        }
+        cv.notify_all();
+    }
+    bool pop(int& i) {
+        std::unique_lock<std::mutex> l(m);
+        cv.wait(l, [&] { return closed || !tasks.empty(); });
+        if (tasks.empty()) return false;
+        i = tasks.front();
+        tasks.pop_front();
+        return true;
+    }
+    void finish(int i, std::string r) {
+        std::lock_guard<std::mutex> l(m);
+        results.emplace_back(i, std::move(r));
+    }
+    bool take(std::pair<int, std::string>& r) {
+        std::lock_guard<std::mutex> l(m);
+        if (results.empty()) return false;
+        r = std::move(results.front());
+        results.pop_front();
+        return true;
+    }
+};
+
+class MpiFarm : public Farm {
+public:
+    explicit MpiFarm(int threads) {
+        int provided = 0;
+        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+        if (provided < MPI_THREAD_FUNNELED) {
+            MPI_Finalize();
+            throw std::runtime_error("the MPI library does not provide MPI_THREAD_FUNNELED");
+        }
+        MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+        MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
+        if (threads <= 0) {
+            const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+            const int on_node = local ? std::max(1, std::atoi(local)) : 1;
+            threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / on_node);
+        }
+        threads_ = threads;
+        workers_ = threads;
+    }
+    ~MpiFarm() override { MPI_Finalize(); }
+    MpiFarm(const MpiFarm&) = delete;
+    MpiFarm& operator=(const MpiFarm&) = delete;
+
+    int rank() const override { return rank_; }
+    int ranks() const override { return ranks_; }
+    int workers() const override { return workers_; }
+    std::string describe() const override {
+        return std::to_string(ranks_) + " MPI ranks x " + std::to_string(threads_) + (threads_ == 1 ? " thread" : " threads") +
+               " (rank 0's)";
+    }
+    void broadcast(std::string& text) override {
+        unsigned long n = text.size();
+        MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG, 0, MPI_COMM_WORLD);
+        text.resize(n);
+        MPI_Bcast(text.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
+    }
+    void abort(int code) override { MPI_Abort(MPI_COMM_WORLD, code); }
+
+    void run(const std::vector<int>& todo, const std::function<std::string(int)>& work,
+             const std::function<void(int, const std::string&)>& done) override {
+        Local local;
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads_; ++t)
+            pool.emplace_back([&] {
+                for (int i; local.pop(i);) local.finish(i, work(i));
+            });
+        std::exception_ptr failure;   // rank 0's done() threw (a journal that cannot be written):
+        try {                         // the caller reports it and aborts every rank
+            if (rank_ == 0) root(todo, done, local);
+            else worker(local);
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        {
+            std::lock_guard<std::mutex> l(local.m);
+            local.tasks.clear();
+        }
+        local.close();
+        for (auto& t : pool) t.join();
+        if (failure) std::rethrow_exception(failure);
+        MPI_Barrier(MPI_COMM_WORLD);
+    }
+
+private:
+    void root(const std::vector<int>& todo, const std::function<void(int, const std::string&)>& done, Local& local) {
+        std::size_t next = 0;
+        auto take = [&] { return next < todo.size() ? todo[next++] : -1; };
+        // Own threads: one task each, topped up as they finish.
+        int local_busy = 0;
+        for (int t = 0; t < threads_; ++t) {
+            const int i = take();
+            if (i < 0) break;
+            local.push(i);
+            ++local_busy;
+        }
+        int slots = 0, stops = 0, hellos = 0;   // remote threads; stops sent; ranks heard from
+        workers_ = threads_;
+        std::string buf;
+        while (hellos < ranks_ - 1 || stops < slots || local_busy > 0) {
+            bool idle = true;
+            std::pair<int, std::string> r;
+            while (local.take(r)) {
+                idle = false;
+                --local_busy;
+                done(r.first, r.second);
+                const int i = take();
+                if (i >= 0) {
+                    local.push(i);
+                    ++local_busy;
+                }
+            }
+            int flag = 0;
+            MPI_Status st;
+            MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &st);
+            if (flag) {
+                idle = false;
+                int n = 0;
+                MPI_Get_count(&st, MPI_CHAR, &n);
+                buf.resize(static_cast<std::size_t>(n));
+                MPI_Recv(buf.data(), n, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                int answers = 1;
+                if (st.MPI_TAG == kHello) {
+                    answers = std::atoi(buf.c_str());
+                    slots += answers;
+                    workers_ += answers;
+                    ++hellos;
+                } else {   // kResult
+                    const std::size_t nl = buf.find('\n');
+                    done(std::atoi(buf.c_str()), buf.substr(nl + 1));
+                }
+                for (int a = 0; a < answers; ++a) {
+                    const int i = take();
+                    if (i < 0) ++stops;
+                    MPI_Send(&i, 1, MPI_INT, st.MPI_SOURCE, kAssign, MPI_COMM_WORLD);
+                }
+            }
+            if (idle) nap();
+        }
+    }
+
+    void worker(Local& local) {
+        const std::string hello = std::to_string(threads_);
+        MPI_Send(hello.data(), static_cast<int>(hello.size()), MPI_CHAR, 0, kHello, MPI_COMM_WORLD);
+        int stops = 0, busy = 0;
+        while (stops < threads_ || busy > 0) {
+            bool idle = true;
+            int flag = 0;
+            MPI_Status st;
+            MPI_Iprobe(0, kAssign, MPI_COMM_WORLD, &flag, &st);
+            if (flag) {
+                idle = false;
+                int i = -1;
+                MPI_Recv(&i, 1, MPI_INT, 0, kAssign, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                if (i < 0) ++stops;
+                else {
+                    local.push(i);
+                    ++busy;
+                }
+            }
+            std::pair<int, std::string> r;
+            while (local.take(r)) {
+                idle = false;
+                --busy;
+                const std::string msg = std::to_string(r.first) + "\n" + r.second;
+                MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, 0, kResult, MPI_COMM_WORLD);
+            }
+            if (idle) nap();
+        }
+    }
+
+    int rank_ = 0, ranks_ = 1, threads_ = 1, workers_ = 1;
+};
+
+}  // namespace
+
+bool mpi_built() { return true; }
+std::unique_ptr<Farm> mpi_farm(int threads) { return std::make_unique<MpiFarm>(threads); }
+
+}  // namespace plate::sweep
