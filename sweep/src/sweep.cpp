@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -118,7 +120,11 @@ Campaign campaign_from_json(const json& file, const std::string& source) {
         fs::path p = r.text(scene, "scene");
         if (p.is_relative()) p = fs::path(source).parent_path() / p;
         scene_source = p.string();
-        c.base = read_json_file(p.string(), "scene file (campaign field 'scene')");
+        try {
+            c.base = read_json_file(p.string(), "the scene file");
+        } catch (const InputError& e) {
+            r.fail("scene", e.what());
+        }
     } else if (scene.is_object()) {
         c.base = scene;
     } else {
@@ -507,16 +513,24 @@ json journal_header(const Campaign& c) {
 }  // namespace
 
 Journal::Journal(const std::string& dir, const Campaign& c) : done_(static_cast<std::size_t>(c.cases()), 0) {
+    try {
+        open(dir, c);
+    } catch (...) {   // (the destructor does not run for a constructor that throws: release the lock here)
+        if (fd_ >= 0) ::close(fd_);
+        if (lock_ >= 0) ::close(lock_);
+        throw;
+    }
+}
+
+void Journal::open(const std::string& dir, const Campaign& c) {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (!fs::is_directory(dir)) throw InputError(dir + ": cannot create the output folder");
     const std::string lock = (fs::path(dir) / "journal.lock").string();
     lock_ = ::open(lock.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
     if (lock_ < 0) throw InputError(lock + ": cannot open: " + std::strerror(errno));
-    if (::flock(lock_, LOCK_EX | LOCK_NB) != 0) {
-        ::close(lock_);
+    if (::flock(lock_, LOCK_EX | LOCK_NB) != 0)
         throw InputError(dir + ": another plate sweep is writing this folder (" + lock + " is locked)");
-    }
     path_ = (fs::path(dir) / "journal.jsonl").string();
     const std::string header = journal_header(c).dump();
     std::string text;
@@ -535,11 +549,11 @@ Journal::Journal(const std::string& dir, const Campaign& c) : done_(static_cast<
         const bool last = nl == std::string::npos || nl + 1 == text.size();
         const std::string line = text.substr(pos, nl == std::string::npos ? std::string::npos : nl - pos);
         ++line_no;
-        json e;
+        Row e;
         bool ok = nl != std::string::npos;
         if (ok) {
             try {
-                e = json::parse(line);
+                e = Row::parse(line);
             } catch (const json::exception&) {
                 ok = false;
             }
@@ -562,7 +576,7 @@ Journal::Journal(const std::string& dir, const Campaign& c) : done_(static_cast<
                 en.index = e.at("case").get<int>();
                 en.rank = e.at("rank").get<int>();
                 en.seconds = e.at("seconds").get<double>();
-                en.row = Row::parse(e.at("row").dump());
+                en.row = e.at("row");
             } catch (const json::exception&) {
                 throw InputError(path_ + ":" + std::to_string(line_no) + ": a journal line without case, rank, seconds or row");
             }
@@ -596,11 +610,11 @@ Journal::~Journal() {
 
 void Journal::append(const std::string& line) {
     Entry en;
-    const json e = json::parse(line);
+    const Row e = Row::parse(line);
     en.index = e.at("case").get<int>();
     en.rank = e.at("rank").get<int>();
     en.seconds = e.at("seconds").get<double>();
-    en.row = Row::parse(e.at("row").dump());
+    en.row = e.at("row");
     if (done(en.index)) return;   // (never sent twice; kept idempotent)
     write_all(fd_, line + "\n", path_);
     if (::fdatasync(fd_) != 0) throw std::runtime_error(path_ + ": fdatasync failed: " + std::strerror(errno));
@@ -673,10 +687,8 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
     std::vector<Panel> panels;
     if (c.fixed_points) {
         panels.push_back({"stable fixed points found", [=](const Row& r) { return get(r, "fp_stable"); }});
-        panels.push_back({"the stable point's distance from the centre [mm]", [=](const Row& r) {
-                              return 1e3 * std::hypot(get(r, "stable_x") - (c.grid.x0 + c.grid.x1) / 2,
-                                                      get(r, "stable_y") - (c.grid.y0 + c.grid.y1) / 2);
-                          }});
+        panels.push_back({"convergence rate of the stable point nearest the centre [1/s]",
+                          [=](const Row& r) { return get(r, "stable_rate"); }});
     } else if (c.field) {
         panels.push_back({"mean speed over the field [mm/s]", [=](const Row& r) { return 1e3 * get(r, "field_mean_speed"); }});
         panels.push_back({"mean stick fraction over the field", [=](const Row& r) { return get(r, "field_mean_stick"); }});
@@ -691,7 +703,7 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
                           }});
         panels.push_back({"design's convergence rate [1/s]", [=](const Row& r) { return get(r, "design_rate"); }});
     }
-    const int W = 1040, H = 520, pw = 400, ph = 360, top = 70, left0 = 90;
+    const int W = 1120, H = 520, pw = 400, ph = 360, top = 70, left0 = 90;
     const bool two = c.parameters.size() >= 2;
     std::ostringstream s;
     s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W << " " << H
@@ -843,9 +855,14 @@ SweepSummary run_sweep(const std::string& campaign_file, const SweepOptions& opt
             if (!journal->done(i)) todo.push_back(i);
     }
     std::atomic<int> finished{0};
+    // Test hook (tests/sweep/check_sweep.py): each case takes at least this long [s], so that a test
+    // can kill a run in the middle, whatever the machine's speed.
+    const char* delay_env = std::getenv("PLATE_TEST_SWEEP_CASE_DELAY");
+    const double delay = delay_env ? std::atof(delay_env) : 0.0;
     auto work = [&](int i) {
         const auto a = std::chrono::steady_clock::now();
         const Row row = run_case(c, i);
+        if (delay > 0) std::this_thread::sleep_for(std::chrono::duration<double>(delay));
         const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
         return journal_line(i, farm.rank(), sec, row);
     };

@@ -115,6 +115,7 @@ public:
     void append(const std::string& line);
 
 private:
+    void open(const std::string& dir, const Campaign& c);
     std::string path_;
     int fd_ = -1, lock_ = -1;
     std::vector<Entry> entries_;
