@@ -159,8 +159,10 @@ Campaign campaign_from_json(const json& file, const std::string& source) {
         q.pointer = r.text(r.need(p, f, "pointer"), f + ".pointer");
         try {
             const json::json_pointer ptr(q.pointer);
-            if (!c.base.contains(ptr) || !c.base.at(ptr).is_number())
-                r.fail(f + ".pointer", "'" + q.pointer + "' addresses no number of the base scene " + scene_source);
+            const bool numbers = c.base.contains(ptr) && c.base.at(ptr).is_array() && !c.base.at(ptr).empty() &&
+                                 std::all_of(c.base.at(ptr).begin(), c.base.at(ptr).end(), [](const json& x) { return x.is_number(); });
+            if (!c.base.contains(ptr) || !(c.base.at(ptr).is_number() || numbers))
+                r.fail(f + ".pointer", "'" + q.pointer + "' addresses no number (or array of numbers) of the base scene " + scene_source);
         } catch (const json::exception&) {
             r.fail(f + ".pointer", "'" + q.pointer + "' is no JSON pointer (RFC 6901, e.g. /plate/harmonics/0/amp)");
         }
@@ -318,7 +320,13 @@ std::vector<double> case_values(const Campaign& c, int index) {
 Scene case_scene(const Campaign& c, int index) {
     json s = c.base;
     const std::vector<double> v = case_values(c, index);
-    for (std::size_t p = 0; p < v.size(); ++p) s[json::json_pointer(c.parameters[p].pointer)] = v[p];
+    for (std::size_t p = 0; p < v.size(); ++p) {
+        json& x = s[json::json_pointer(c.parameters[p].pointer)];
+        if (x.is_array())   // every element (e.g. /part/friction: every contact's)
+            for (json& e : x) e = v[p];
+        else
+            x = v[p];
+    }
     return parse_scene(s.dump(), c.name + " case " + std::to_string(index));
 }
 

@@ -20,7 +20,9 @@
 //                  "fixed_points": true,                    // on the field's grid
 //                  "design": {"target": ["sink", X, Y], "starts": 4, "evaluations": 200},
 //                  "cycle": {"tol": 1e-7, "rtol": 1e-8, "max_rhs": 2e6} } }
-// Unknown or missing fields are errors naming the file and the field (InputError).
+// A pointer addresses a number of the scene, or an array of numbers, every element of which takes
+// the value (/part/friction: every contact's friction). Unknown or missing fields are errors naming
+// the file and the field (InputError).
 #pragma once
 
 #include "plate/design.hpp"

@@ -1,0 +1,193 @@
+#!/usr/bin/env python3
+"""`plate sweep` end to end (issue 20, point 4): the same table, byte for byte, from one thread, two
+threads and `mpirun -np 2`; a run killed mid-way (SIGKILL of the process, SIGKILL of one MPI rank,
+SIGINT of the launcher) leaves no table, and the same command resumes it to the uninterrupted table,
+skipping the finished cases and cutting a torn journal line; bad input exits 2 naming file and field.
+
+    check_sweep.py PLATE SOURCE_DIR WORKDIR [MPIRUN]
+
+Each case is slowed to >= 0.15 s (0.6 s) by the test hook PLATE_TEST_SWEEP_CASE_DELAY where a run is to be
+killed in the middle, so that the kill lands mid-run on any machine. Exit 1 with what failed.
+"""
+import json
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+plate, source, work = sys.argv[1], pathlib.Path(sys.argv[2]).resolve(), pathlib.Path(sys.argv[3]).resolve()
+mpirun = sys.argv[4] if len(sys.argv) > 4 and sys.argv[4] else None
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what, flush=True)
+    if not ok:
+        failures.append(what)
+
+
+shutil.rmtree(work, ignore_errors=True)
+work.mkdir(parents=True)
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", PLATE_PROGRESS="0",
+           OMPI_MCA_rmaps_base_oversubscribe="1")
+campaign = work / "campaign.json"
+campaign.write_text(json.dumps({
+    "name": "check_sweep",
+    "scene": str(source / "scenes" / "fig4.json"),
+    "parameters": [
+        {"name": "x_amp", "pointer": "/plate/harmonics/0/amp", "values": [10, 25]},
+        {"name": "mu", "pointer": "/part/friction", "values": [0.3, -0.2]},   # -0.2: a failed row each
+        {"name": "rx_phase", "pointer": "/plate/harmonics/2/phase", "from": 0, "to": 4.71238898038469, "count": 4},
+    ],
+    "compute": {"twist_at": [[0.01, 0, 0.5]], "field": {"grid": [5, 5, 5]}, "fixed_points": True},
+}))
+CASES = 16
+
+
+def sweep(out, *extra, launcher=(), delay=None):
+    e = dict(env)
+    if delay:
+        e["PLATE_TEST_SWEEP_CASE_DELAY"] = str(delay)
+    return [*launcher, plate, "sweep", str(campaign), "--out", str(out), *extra], e
+
+
+def run(out, *extra, launcher=(), delay=None):
+    cmd, e = sweep(out, *extra, launcher=launcher, delay=delay)
+    p = subprocess.run(cmd, env=e, capture_output=True, text=True, timeout=600)
+    summary = json.loads(p.stdout) if p.returncode == 0 and p.stdout.strip() else None
+    return p, summary
+
+
+def table(out):
+    return (out / "table.csv").read_bytes() + b"\n--\n" + (out / "table.jsonl").read_bytes()
+
+
+def journal_cases(out):
+    j = out / "journal.jsonl"
+    return max(0, j.read_text().count("\n") - 1) if j.exists() else 0
+
+
+def start_and_wait(out, cases, launcher=(), threads="1", delay=0.15):
+    if launcher:
+        launcher = [*launcher, "-x", "PLATE_TEST_SWEEP_CASE_DELAY"]
+    cmd, e = sweep(out, "--threads", threads, launcher=launcher, delay=delay)
+    p = subprocess.Popen(cmd, env=e, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    t0 = time.time()
+    while journal_cases(out) < cases and p.poll() is None and time.time() - t0 < 300:
+        time.sleep(0.01)
+    return p
+
+
+MPI = [mpirun, "-np", "2", "--oversubscribe"] if mpirun else None
+
+# --- the reference and its copies -------------------------------------------------------------------
+ref = work / "ref"
+p, s = run(ref, "--threads", "1")
+check(p.returncode == 0 and s and s["cases"] == CASES and s["computed"] == CASES, f"one thread: {CASES} cases ({p.stderr.strip()[:300]})")
+rows = [json.loads(l) for l in (ref / "table.jsonl").read_text().splitlines()]
+failed = [r for r in rows if r["status"] == "failed"]
+check(len(rows) == CASES and [r["case"] for r in rows] == list(range(CASES)), "one row per case, in case order")
+check(len(failed) == CASES // 2 and all(r["mu"] == -0.2 and "friction" in r["reason"] for r in failed),
+      "the 8 cases with friction -0.2 failed with a reason naming the friction; the others are ok")
+check(all(r["fp_stable"] is not None and r["stable_rate"] is None or r["stable_rate"] > 0 for r in rows if r["status"] == "ok"),
+      "every ok row has its fixed points classified (a stable one converges: rate > 0)")
+check(s and s["failed"] == CASES // 2, "the summary counts the failed rows")
+
+p, s = run(work / "two_threads", "--threads", "2")
+check(p.returncode == 0 and table(work / "two_threads") == table(ref), "two threads: the same table, byte for byte")
+
+if MPI:
+    out = work / "mpi"
+    p, s = run(out, "--threads", "1", launcher=MPI)
+    check(p.returncode == 0 and s and "2 MPI ranks" in s["farm"], f"mpirun -np 2 runs ({p.stderr.strip()[:300]})")
+    check(p.returncode == 0 and table(out) == table(ref), "mpirun -np 2: the same table, byte for byte")
+    ranks = {l.split(",")[1] for l in (out / "timing.csv").read_text().splitlines()[1:]} if p.returncode == 0 else set()
+    check(ranks == {"0", "1"}, f"both ranks computed cases (ranks seen: {sorted(ranks)})")
+else:
+    print("skip mpirun: no MPI launcher given (Open MPI not installed or the program built without it)")
+
+# --- killed and resumed -------------------------------------------------------------------------------
+def resumed_equals_ref(out, label, launcher=()):
+    before = journal_cases(out)
+    check(not (out / "table.csv").exists(), f"{label}: no table after the kill ({before} cases in the journal)")
+    check(0 < before < CASES, f"{label}: the kill landed mid-run ({before} of {CASES} cases journaled)")
+    # A write cut short by the kill: half a line at the end of the journal.
+    with open(out / "journal.jsonl", "a") as j:
+        j.write('{"case": 15, "rank": 0, "seconds": 0.2, "row": {"case": 15, "x_a')
+    p, s = run(out, "--threads", "2" if not launcher else "1", launcher=launcher)
+    check(p.returncode == 0 and s and s["resumed"] == before and s["computed"] == CASES - before
+          and s["torn_journal_lines_dropped"] == 1,
+          f"{label}: resumed {before} cases, computed the other {CASES - before}, cut the torn line "
+          f"({s and {k: s[k] for k in ('resumed', 'computed', 'torn_journal_lines_dropped')}} {p.stderr.strip()[:200]})")
+    check(p.returncode == 0 and table(out) == table(ref), f"{label}: the resumed table equals the uninterrupted one")
+
+
+out = work / "killed"
+proc = start_and_wait(out, 3)
+proc.kill()
+proc.wait()
+resumed_equals_ref(out, "SIGKILL of the process")
+
+if MPI:
+    out = work / "killed_rank"
+    proc = start_and_wait(out, 3, launcher=MPI)
+    victim = None
+    for d in pathlib.Path("/proc").iterdir():   # the rank-1 plate process of this run
+        try:
+            environ = (d / "environ").read_bytes().split(b"\0")
+            cmdline = (d / "cmdline").read_bytes()
+        except (OSError, ValueError):
+            continue
+        if b"OMPI_COMM_WORLD_RANK=1" in environ and str(out).encode() in cmdline:
+            victim = int(d.name)
+    check(victim is not None, "found rank 1's process")
+    if victim:
+        os.kill(victim, signal.SIGKILL)
+    try:
+        rc = proc.wait(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        rc = "hung"
+    check(rc != 0, f"mpirun ends when a rank is killed (exit {rc})")
+    resumed_equals_ref(out, "SIGKILL of MPI rank 1", launcher=MPI)
+
+    # (Open MPI's launcher lets its ranks run on for about a second after SIGINT: slower cases here.)
+    out = work / "interrupted"
+    proc = start_and_wait(out, 3, launcher=MPI, delay=0.6)
+    proc.send_signal(signal.SIGINT)
+    try:
+        rc = proc.wait(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        rc = "hung"
+    check(rc != 0, f"SIGINT ends mpirun (exit {rc})")
+    resumed_equals_ref(out, "SIGINT of the launcher", launcher=MPI)
+
+# --- bad input --------------------------------------------------------------------------------------
+other = work / "other.json"
+spec = json.loads(campaign.read_text())
+spec["parameters"][0]["values"] = [10, 26]
+other.write_text(json.dumps(spec))
+before = table(ref)
+p = subprocess.run([plate, "sweep", str(other), "--out", str(ref)], env=env, capture_output=True, text=True)
+check(p.returncode == 2 and "journal of another campaign" in p.stderr and table(ref) == before,
+      f"another campaign into the same folder: exit 2, the table untouched ({p.returncode}: {p.stderr.strip()[:200]})")
+spec["parameters"][0]["pointer"] = "/plate/harmonics/7/amp"
+other.write_text(json.dumps(spec))
+p = subprocess.run([plate, "sweep", str(other), "--out", str(work / "never")], env=env, capture_output=True, text=True)
+check(p.returncode == 2 and str(other) in p.stderr and "parameters[0].pointer" in p.stderr and not (work / "never").exists(),
+      f"a pointer to no field: exit 2 naming file and field, no folder ({p.returncode}: {p.stderr.strip()[:200]})")
+if MPI:
+    p = subprocess.run([*MPI, plate, "sweep", str(other), "--out", str(work / "never")], env=env, capture_output=True, text=True, timeout=120)
+    check(p.returncode == 2 and p.stderr.count("parameters[0].pointer") == 1 and not (work / "never").exists(),
+          f"the same under mpirun: exit 2, said once (by rank 0), no folder ({p.returncode}: {p.stderr.strip()[:300]})")
+
+if failures:
+    print(f"{len(failures)} check(s) failed", file=sys.stderr)
+    sys.exit(1)
+shutil.rmtree(work, ignore_errors=True)
+print("all sweep checks passed")
