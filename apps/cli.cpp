@@ -852,10 +852,13 @@ int cmd_sweep(const SweepArgs& a, Io& cio) {
     sweep::SweepSummary s;
     try {
         s = sweep::run_sweep(a.campaign, o, *farm);
-    } catch (const sweep::Reported&) {
-        return 2;   // (rank 0 said what)
-    } catch (const InputError&) {
-        throw;      // (every rank returns; rank 0 says what)
+    } catch (const sweep::Reported&) {   // bad input, which rank 0 reports; every rank returns 2, rank 0
+        farm->barrier();                  // first (the launcher ends the job at the first failed rank)
+        return 2;
+    } catch (const InputError& e) {
+        cio.err << "plate sweep: " << e.what() << std::endl;
+        farm->barrier();
+        return 2;
     } catch (const std::exception& e) {
         cio.err << "plate sweep: error on rank " << farm->rank() << ": " << e.what() << std::endl;
         farm->abort(1);

@@ -611,7 +611,15 @@ void write_report(const ReportOptions& opt) {
     if (fs::exists(speed)) html << std::ifstream(speed).rdbuf();
     else html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
               << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
-    html << kSpeedEnd << "\n" << kPageCheck << "</body></html>\n";
+    html << kSpeedEnd << "\n";
+    // The campaigns' scaling study (bench/scaling.py) keeps its section between these.
+    html << kCampaignsBegin;
+    const fs::path campaigns = c.dir / "data" / "campaigns_section.html";
+    if (fs::exists(campaigns)) html << std::ifstream(campaigns).rdbuf();
+    else html << "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " << esc(opt.out)
+              << "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
+                 "load balance, the cost of a 1 000-core campaign).</p>\n";
+    html << kCampaignsEnd << "\n" << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
 }
 

@@ -112,6 +112,9 @@ inline std::string verdict(bool ok) { return ok ? "<span class=\"pass\">pass</sp
 // The report's page keeps the speed-accuracy section (written by `plate bench`) between these.
 inline const char* kSpeedBegin = "<!-- speed-accuracy:begin -->";
 inline const char* kSpeedEnd = "<!-- speed-accuracy:end -->";
+// ... and the campaigns' scaling study (bench/scaling.py) between these.
+inline const char* kCampaignsBegin = "<!-- campaigns:begin -->";
+inline const char* kCampaignsEnd = "<!-- campaigns:end -->";
 
 // First in <head>: records every error the page meets (script errors, resources that fail to load,
 // console.error, rejected promises) for the browser check.

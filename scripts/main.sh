@@ -15,9 +15,16 @@ for scene in scenes/*.json; do
   build/plate field "$scene" --format csv --out "$out/$name.field.csv"
   build/plate fixed-points "$scene" --out "$out/$name.fixed-points.json"
 done
+for campaign in campaigns/*.json; do
+  name=$(basename "$campaign" .json)
+  echo "== campaign $name" >&2
+  build/plate sweep "$campaign" --out "$out/campaigns/$name"
+done
 echo "== verification report (derivation, Theorem 1 on 10^4 thin and 10^3 thick parts, fields; several minutes)" >&2
 build/plate report --out "$out/report"
 echo "== speed-accuracy study (methods, limit-cycle solvers, failure maps, model hierarchy; a few minutes)" >&2
 build/plate bench --out "$out/report"
+echo "== campaigns' scaling study (threads and MPI ranks; about a minute)" >&2
+/usr/bin/python3 bench/scaling.py --out "$out/report"
 scripts/check-report.sh "$out/report" --screenshot "$out/report/screenshot.png"
 echo "results in $out/ (open $out/report/index.html)" >&2

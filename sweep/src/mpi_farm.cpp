@@ -116,6 +116,7 @@ public:
         MPI_Bcast(text.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
     }
     void abort(int code) override { MPI_Abort(MPI_COMM_WORLD, code); }
+    void barrier() override { MPI_Barrier(MPI_COMM_WORLD); }
 
     void run(const std::vector<int>& todo, const std::function<std::string(int)>& work,
              const std::function<void(int, const std::string&)>& done) override {

@@ -29,6 +29,8 @@ public:
     // when every task is done. `work` must not throw (a failure is a result).
     virtual void run(const std::vector<int>& todo, const std::function<std::string(int)>& work,
                      const std::function<void(int, const std::string&)>& done) = 0;
+    // Waits for every rank (collective); threads: returns at once.
+    virtual void barrier() {}
     // Ends every rank at once with exit code `code` (after an error on one of them); threads: no-op.
     virtual void abort(int /*code*/) {}
 };
