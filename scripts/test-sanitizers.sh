@@ -2,7 +2,7 @@
 # The C++ tests under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/), a named
 # representative subset so that CI stays well under its budget: the stick-slip engine and its
 # modes, the Theorem 1 checks, the generated kernels, limit cycles, the a-priori model choice and
-# the fields; then the fuzz target's replay. Any sanitizer report fails the run (halt_on_error; UBSan
+# the fields, the campaigns (journal, farm); then the fuzz target's replay. Any sanitizer report fails the run (halt_on_error; UBSan
 # made fatal).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +11,7 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" -DP
 cmake --build build-asan -j"$(nproc)" --target plate_tests plate plate_fuzz_replay
 export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
-for tags in "[stick]" "[proofs]" "[kernels]" "[limit_cycle]" "[auto]" "[field]"; do
+for tags in "[stick]" "[proofs]" "[kernels]" "[limit_cycle]" "[auto]" "[field]" "[sweep]"; do
   echo "sanitizers: $tags" >&2
   build-asan/tests/plate_tests "$tags"
 done
