@@ -664,9 +664,58 @@ struct ProofsArgs : Options {
     }
 };
 
+// A contraction case as the MPI ranks send it: what summarize_contraction reads, doubles exact
+// (nlohmann writes 17 digits; NaN and infinities as text).
+nlohmann::json exact(double x) {
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    return x;
+}
+double exact(const nlohmann::json& j) {
+    if (j.is_number()) return j.get<double>();
+    const std::string s = j.get<std::string>();
+    return s == "nan" ? std::nan("") : s == "inf" ? HUGE_VAL : -HUGE_VAL;
+}
+std::string case_text(const proofs::ContractionCase& c) {
+    return nlohmann::json{{"seed", c.seed}, {"valid", c.valid}, {"why_invalid", c.why_invalid},
+                          {"monotone", c.monotone}, {"converged", c.converged}, {"unique", c.unique},
+                          {"spectral_radius", exact(c.spectral_radius)}, {"worst_increase", exact(c.worst_increase)},
+                          {"rate", exact(c.rate)}, {"tie_samples", c.tie.samples}, {"tie_statics", exact(c.tie.worst_statics)},
+                          {"tie_wrench", exact(c.tie.worst_wrench)}, {"tie_failure", c.tie.failure}}
+        .dump();
+}
+proofs::ContractionCase case_from_text(const std::string& text) {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    proofs::ContractionCase c;
+    c.seed = j["seed"].get<std::uint64_t>();
+    c.valid = j["valid"].get<bool>();
+    c.why_invalid = j["why_invalid"].get<std::string>();
+    c.monotone = j["monotone"].get<bool>();
+    c.converged = j["converged"].get<bool>();
+    c.unique = j["unique"].get<bool>();
+    c.spectral_radius = exact(j["spectral_radius"]);
+    c.worst_increase = exact(j["worst_increase"]);
+    c.rate = exact(j["rate"]);
+    c.tie.samples = j["tie_samples"].get<int>();
+    c.tie.worst_statics = exact(j["tie_statics"]);
+    c.tie.worst_wrench = exact(j["tie_wrench"]);
+    c.tie.failure = j["tie_failure"].get<std::string>();
+    return c;
+}
+
 int cmd_proofs(const ProofsArgs& a, Io& cio) {
     const std::uint64_t seed = a.seed;
     const int threads = a.threads;
+    // Under mpirun the contraction cases (the bulk of the work) are shared over the ranks, one at a
+    // time; the summary is the single-process one to the bit (but for its wall time). Rank 0 alone
+    // checks the limit surfaces and A and writes the output.
+    std::unique_ptr<sweep::Farm> farm;
+    if (sweep::mpi_launched()) {
+        if (!sweep::mpi_built())
+            throw UsageError("started by an MPI launcher with several ranks, but this plate was built without MPI");
+        farm = sweep::mpi_farm(threads);
+    }
+    const bool root = !farm || farm->root();
     nlohmann::json j;
     j["seed"] = seed;
     auto campaign = [&](bool thin, int n, std::uint64_t s0) {
@@ -675,11 +724,28 @@ int cmd_proofs(const ProofsArgs& a, Io& cio) {
         o.seed = s0;
         o.thin = thin;
         o.threads = threads;
-        o.progress = ProgressPrinter{thin ? "proofs, thin parts" : "proofs, thick parts", 10.0};
-        return contraction_json(proofs::check_contraction(o));
+        ProgressPrinter prog{thin ? "proofs, thin parts" : "proofs, thick parts", 10.0};
+        if (!root) prog.to = nullptr;
+        o.progress = prog;
+        if (!farm) return contraction_json(proofs::check_contraction(o));
+        const auto t0 = std::chrono::steady_clock::now();
+        std::vector<proofs::ContractionCase> cases(static_cast<std::size_t>(n));
+        std::vector<int> todo;
+        for (int k = 0; root && k < n; ++k) todo.push_back(k);
+        int done = 0;
+        farm->run(todo, [&](int k) { return case_text(proofs::contraction_random_case(o, k)); },
+                  [&](int k, const std::string& text) {
+                      cases[static_cast<std::size_t>(k)] = case_from_text(text);
+                      prog(++done, n);
+                  });
+        if (!root) return nlohmann::json();
+        return contraction_json(proofs::summarize_contraction(
+            o, std::move(cases), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
     };
     j["thin"] = campaign(true, a.thin, seed);
     j["thick"] = campaign(false, a.thick, seed + 50'000'000);
+    if (!root) return 0;
+    if (farm) j["mpi"] = farm->describe();
     // Limit surfaces of random thin parts at random plate times.
     const proofs::LimitSurfaceCampaign ls =
         proofs::check_limit_surfaces(a.surfaces, seed);

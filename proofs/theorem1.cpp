@@ -237,9 +237,8 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
     return t;
 }
 
-namespace {
-
-ContractionCase run_case(const ContractionOptions& opt, std::uint64_t seed) {
+ContractionCase contraction_random_case(const ContractionOptions& opt, int k) {
+    const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(k);
     RandomSceneOptions ro;
     ro.thin = opt.thin;
     Scene sc = random_scene(seed, ro);
@@ -290,17 +289,14 @@ ContractionCase run_case(const ContractionOptions& opt, std::uint64_t seed) {
     return c;
 }
 
-}  // namespace
-
 ContractionSummary check_contraction(const ContractionOptions& opt) {
-    ContractionSummary s;
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<ContractionCase> cases(opt.cases);
     std::atomic<int> next{0}, done{0};
     std::mutex progress_mutex;
     auto worker = [&] {
         for (int k; (k = next.fetch_add(1)) < opt.cases;) {
-            cases[k] = run_case(opt, opt.seed + static_cast<std::uint64_t>(k));
+            cases[k] = contraction_random_case(opt, k);
             const int d = ++done;
             if (opt.progress) {
                 std::lock_guard<std::mutex> lock(progress_mutex);
@@ -314,7 +310,12 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
     for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
     worker();
     for (auto& t : pool) t.join();
+    return summarize_contraction(opt, std::move(cases),
+                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
 
+ContractionSummary summarize_contraction(const ContractionOptions& opt, std::vector<ContractionCase> cases, double seconds) {
+    ContractionSummary s;
     std::vector<double> rates;
     for (auto& c : cases) {
         ++s.cases;
@@ -341,7 +342,7 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
         std::sort(rates.begin(), rates.end());
         s.median_rate = rates[rates.size() / 2];
     }
-    s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    s.seconds = seconds;
     return s;
 }
 

@@ -103,6 +103,11 @@ struct ContractionSummary {
 ContractionCase contraction_case(const Scene& scene, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b,
                                  int periods, double rtol);
 ContractionSummary check_contraction(const ContractionOptions& opt);
+// check_contraction in pieces, for cases computed elsewhere (MPI ranks: plate proofs): case k of the
+// campaign (seed opt.seed + k; opt.threads and opt.progress unused), and the summary of cases 0..n-1
+// in order (what check_contraction returns for them, `seconds` its wall time).
+ContractionCase contraction_random_case(const ContractionOptions& opt, int k);
+ContractionSummary summarize_contraction(const ContractionOptions& opt, std::vector<ContractionCase> cases, double seconds);
 
 // Jacobian of the period map at the cycle start (central differences) and its spectral radius.
 double floquet_radius(const Scene& scene, const Vec3& q0, const Vec3& cycle_start, double rtol);

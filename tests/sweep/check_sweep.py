@@ -3,6 +3,7 @@
 threads and `mpirun -np 2`; a run killed mid-way (SIGKILL of the process, SIGKILL of one MPI rank,
 SIGINT of the launcher) leaves no table, and the same command resumes it to the uninterrupted table,
 skipping the finished cases and cutting a torn journal line; bad input exits 2 naming file and field.
+And `plate proofs` under `mpirun -np 2` gives the single-process summary to the last digit.
 
     check_sweep.py PLATE SOURCE_DIR WORKDIR [MPIRUN]
 
@@ -185,6 +186,22 @@ if MPI:
     p = subprocess.run([*MPI, plate, "sweep", str(other), "--out", str(work / "never")], env=env, capture_output=True, text=True, timeout=120)
     check(p.returncode == 2 and p.stderr.count("parameters[0].pointer") == 1 and not (work / "never").exists(),
           f"the same under mpirun: exit 2, said once (by rank 0), no folder ({p.returncode}: {p.stderr.strip()[:300]})")
+
+# --- plate proofs under mpirun: the contraction cases shared over the ranks, the same summary ----------
+if MPI:
+    outs = []
+    for launcher in ((), MPI):
+        f = work / f"proofs{len(outs)}.json"
+        p = subprocess.run([*launcher, plate, "proofs", "--thin", "24", "--thick", "6", "--surfaces", "2", "--threads", "1",
+                            "--out", str(f)], env=env, capture_output=True, text=True, timeout=600)
+        outs.append(json.loads(f.read_text()) if p.returncode == 0 else None)
+    if all(outs):
+        mpi_said = outs[1].pop("mpi", "")
+        for o in outs:
+            for k in ("thin", "thick"):
+                o[k].pop("seconds")   # (wall time)
+    check(all(outs) and "2 MPI ranks" in mpi_said and outs[0] == outs[1] and outs[0]["thin"]["valid"] > 0,
+          "plate proofs under mpirun -np 2: the same summary as one process, to the last digit (but its wall time)")
 
 if failures:
     print(f"{len(failures)} check(s) failed", file=sys.stderr)
