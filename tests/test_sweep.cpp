@@ -224,7 +224,7 @@ TEST_CASE("the journal: entries survive, a torn last line is cut, a damaged one 
     }
 }
 
-TEST_CASE("the table: full precision, missing values empty, text quoted; written only when every case is done", "[sweep][journal]") {
+TEST_CASE("the table: full precision, missing values empty, text quoted, written only when every case is done", "[sweep][journal]") {
     TempDir d;
     const Campaign c = load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.1, -1]}])"));
     const std::string dir = d / "out";
