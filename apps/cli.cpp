@@ -37,7 +37,11 @@ namespace {
 struct Io {
     std::ostream& out;
     std::ostream& err;
+    // The MPI ranks of a command started under mpirun (plate field, fixed-points, design, proofs):
+    // held here so that it outlives an exception from the command, whose report run() coordinates.
+    std::unique_ptr<sweep::Farm> farm;
 };
+
 
 constexpr double kMaxRows = 1e7;   // rows of a trajectory CSV
 
@@ -358,13 +362,26 @@ void require_within_budget(const Field& f, long budget) {
 
 // The field of `field` and `fixed-points`: its work estimated up front against `max_work`, progress
 // on a terminal, and refused if the budget was spent anyway.
+// The field within its work budget; under mpirun (cio.farm) its planes are shared over the ranks and
+// Under an MPI launcher with several ranks: the ranks (threads each), else null (one process).
+sweep::Farm* launched_farm(Io& cio, int threads) {
+    if (!sweep::mpi_launched()) return nullptr;
+    if (!sweep::mpi_built())
+        throw UsageError("started by an MPI launcher with several ranks, but this plate was built without MPI: "
+                         "every process would do the whole job (rebuild with libopenmpi-dev, or run it alone)");
+    cio.farm = sweep::mpi_farm(threads);
+    return cio.farm.get();
+}
+
+// every rank returns the whole field, the same as one process computes.
 Field bounded_field(const Scene& sc, const GridSpec& g, const LimitCycleOptions& cycle, int threads, long max_work, Io& cio) {
     FieldOptions fo;
     fo.cycle = cycle;
     fo.threads = threads;
+    if (cio.farm) fo.tasks = sweep::farm_tasks(*cio.farm);
     fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, max_work);
     ProgressPrinter prog{"field"};
-    prog.to = &cio.err == &std::cerr && progress_wanted() ? &cio.err : nullptr;
+    prog.to = &cio.err == &std::cerr && progress_wanted() && (!cio.farm || cio.farm->root()) ? &cio.err : nullptr;
     fo.progress = std::ref(prog);
     Field f = compute_field(sc, g, fo);
     require_within_budget(f, fo.max_rhs_evaluations);
@@ -399,10 +416,17 @@ int cmd_field(const FieldArgs& a, Io& cio) {
     const GridSpec g = grid_opts(a, a.grid);
     const std::string format = a.format;
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
+    launched_farm(cio, a.grid.threads);
     const Field f = bounded_field(sc, g, cycle_opts(a, a.cycle), a.grid.threads, a.max_work, cio);
+    if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 writes)
     write_file_atomic(a.out, [&](std::ostream& out) {
-        if (format == "csv") write_field_csv(out, f);
-        else out << to_json(sc, f).dump(1) << "\n";
+        if (format == "csv") {
+            write_field_csv(out, f);
+        } else {
+            nlohmann::json j = to_json(sc, f);
+            if (cio.farm) j["mpi"] = cio.farm->describe();
+            out << j.dump(1) << "\n";
+        }
     }, cio.out);
     return 0;
 }
@@ -428,7 +452,10 @@ struct FixedPointsArgs : Options {
 int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
     const Scene sc = scene_arg(a.scene, cio);
     const LimitCycleOptions cycle = cycle_opts(a, a.cycle);
-    const Field f = bounded_field(sc, grid_opts(a, a.grid), cycle, a.grid.threads, a.max_work, cio);
+    const GridSpec g = grid_opts(a, a.grid);
+    launched_farm(cio, a.grid.threads);
+    const Field f = bounded_field(sc, g, cycle, a.grid.threads, a.max_work, cio);
+    if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 refines the zeros and writes)
     FixedPointOptions fpo;   // (the refinement has its own budget)
     fpo.cycle = cycle;
     if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.max_work);
@@ -709,12 +736,7 @@ int cmd_proofs(const ProofsArgs& a, Io& cio) {
     // Under mpirun the contraction cases (the bulk of the work) are shared over the ranks, one at a
     // time; the summary is the single-process one to the bit (but for its wall time). Rank 0 alone
     // checks the limit surfaces and A and writes the output.
-    std::unique_ptr<sweep::Farm> farm;
-    if (sweep::mpi_launched()) {
-        if (!sweep::mpi_built())
-            throw UsageError("started by an MPI launcher with several ranks, but this plate was built without MPI");
-        farm = sweep::mpi_farm(threads);
-    }
+    sweep::Farm* const farm = launched_farm(cio, threads);
     const bool root = !farm || farm->root();
     nlohmann::json j;
     j["seed"] = seed;
@@ -828,12 +850,16 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     o.threads = a.threads;
     o.starts = a.starts;
     o.local_evaluations = a.evaluations;
+    // Under mpirun the starts, the verification field's planes and the verification runs are shared
+    // over the ranks; every rank follows the same path, rank 0 writes.
+    if (sweep::Farm* farm = launched_farm(cio, a.threads)) o.tasks = sweep::farm_tasks(*farm);
     DesignSummary d;
     try {
         d = design(part, t, o);
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
+    if (cio.farm && !cio.farm->root()) return d.verified ? 0 : 4;
     const bool sink = t.kind == DesignTargetKind::Sink;
     nlohmann::json j;
     j["target"] = {{"kind", sink ? "sink" : "transport"}, {sink ? "at" : "velocity", {ab.x(), ab.y()}}};
@@ -1011,7 +1037,7 @@ int cmd_bench(const BenchArgs& a, Io& cio) {
 }  // namespace
 
 int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
-    Io cio{out, err};
+    Io cio{out, err, nullptr};
     CLI::App app{kAbout, "plate"};
     app.get_formatter()->label("Usage", "usage");   // (as before: the help says "usage: plate ...")
     app.get_formatter()->label("SUBCOMMAND", "COMMAND");
@@ -1060,6 +1086,29 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
         cio.err << "plate: unknown command '" << cmd << "'\n" << app.help();
         return 2;
     }
+    // An error's exit code (2: bad input or usage, 1: anything else), reported on stderr if `print`.
+    auto fail = [&](const std::exception_ptr& ep, bool print) -> int {
+        std::ostringstream msg;
+        int code = 1;
+        try {
+            std::rethrow_exception(ep);
+        } catch (const CLI::ParseError& e) {
+            if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success))   // --help, --version
+                return app.exit(e, cio.out, cio.err);
+            msg << e.what() << " (see plate " << cmd << " --help)";
+            code = 2;
+        } catch (const InputError& e) {
+            msg << e.what();
+            code = 2;
+        } catch (const UsageError& e) {
+            msg << e.what() << " (see plate " << cmd << " --help)";
+            code = 2;
+        } catch (const std::exception& e) {
+            msg << "error: " << e.what();
+        }
+        if (print) cio.err << "plate " << cmd << ": " << msg.str() << std::endl;
+        return code;
+    };
     try {
         app.parse(argc, argv);
         for (const auto& [options, run_command] : commands) {
@@ -1068,19 +1117,23 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
             return run_command();
         }
         return 0;   // (not reached: a command is required)
-    } catch (const CLI::ParseError& e) {
-        if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success))   // --help, --version
-            return app.exit(e, cio.out, cio.err);
-        cio.err << "plate " << cmd << ": " << e.what() << " (see plate " << cmd << " --help)" << std::endl;
-        return 2;
-    } catch (const InputError& e) {
-        cio.err << "plate " << cmd << ": " << e.what() << std::endl;
-        return 2;
-    } catch (const UsageError& e) {
-        cio.err << "plate " << cmd << ": " << e.what() << " (see plate " << cmd << " --help)" << std::endl;
-        return 2;
-    } catch (const std::exception& e) {
-        cio.err << "plate " << cmd << ": error: " << e.what() << std::endl;
+    } catch (...) {
+        const std::exception_ptr ep = std::current_exception();
+        // (an error before the command joined its ranks, e.g. in its scene, meets every rank alike:
+        // they join now to report it once)
+        if (!cio.farm && sweep::mpi_launched() && sweep::mpi_built() && fail(ep, false) == 2) cio.farm = sweep::mpi_farm(1);
+        if (!cio.farm || cio.farm->ranks() == 1) return fail(ep, true);
+        // Under mpirun every rank meets the same bad input: rank 0 reports it, and every rank waits
+        // for that before returning 2 (the launcher ends the job at the first rank that fails). Any
+        // other error is one rank's: it says which, and ends every rank.
+        if (fail(ep, false) == 2) {
+            if (cio.farm->root()) fail(ep, true);
+            cio.farm->barrier();
+            return 2;
+        }
+        cio.err << "plate " << cmd << ": error on rank " << cio.farm->rank() << ": ";
+        fail(ep, true);
+        cio.farm->abort(1);
         return 1;
     }
 }

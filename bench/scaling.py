@@ -10,6 +10,7 @@ On this machine's cores, `plate sweep` runs
   * load balance: campaigns/heave_yaw_stick_slip.json, sliding and sticking cases whose times differ
     ~10x, on 2 workers: busy time over wall time x workers, against the makespan a static split into
     contiguous blocks would have had with the same measured case times;
+  * one large field (fig4, 40^3) and one design (a point-part sink) under the same configurations;
   * the journal's cost: fdatasync of a case-sized line in DIR, the bytes sent per case;
 and writes DIR/campaigns_scaling.svg, DIR/data/scaling.json and the report's "Campaigns" section
 (DIR/data/campaigns_section.html, spliced into DIR/index.html when the report is there), including
@@ -106,6 +107,35 @@ mixed_camp = src / "campaigns" / "heave_yaw_stick_slip.json"
 lb = [sweep(mixed_camp, r, t, f"mixed_{r}x{t}") for r, t in configs if r * t == 2]
 
 
+# One large field and one design, shared the same ways (plate field / plate design under mpirun).
+def timed(args, ranks, threads, tag):
+    f = work / tag
+    cmd = [plate, *args, "--threads", str(threads), "--out", str(f)]
+    if ranks > 1:
+        cmd = [a.mpirun, "-np", str(ranks), "--oversubscribe", *cmd]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        sys.exit(f"scaling: {' '.join(cmd)} failed ({p.returncode}): {p.stderr[-800:]}")
+    return {"ranks": ranks, "threads": threads, "wall": wall, "output": f.read_bytes(), "stdout": p.stdout}
+
+
+G = 40 // scale if not a.quick else 16
+field_args = ["field", str(src / "scenes" / "fig4.json"), "--grid", str(G), "--format", "csv"]
+fields = [timed(field_args, r, t, f"field_{r}x{t}.csv") for r, t in configs]
+design_args = ["design", str(src / "scenes" / "fig1_point.json"), "--target", "sink", "0.02", "-0.01", "--limits", "15", "100"]
+if a.quick:
+    design_args += ["--starts", "4"]
+designs = [timed(design_args, r, t, f"design_{r}x{t}.json") for r, t in configs]
+for d in designs:
+    d["evaluations"] = json.loads(d["stdout"])["evaluations"]
+fields_identical = all(x["output"] == fields[0]["output"] for x in fields)
+designs_identical = all(x["output"] == designs[0]["output"] for x in designs)
+# The field's serial part: the lines (x, y_0, theta) and (x, y, theta_0), solved in order in every process.
+serial_share = (G * G + G * (G - 1)) / G**3
+
+
 def static_makespan(times, workers):
     """The wall time of a static split into contiguous blocks, with the measured case times."""
     n = len(times)
@@ -140,6 +170,10 @@ data = {
     "load_balance": [dict({k: v for k, v in s.items() if k not in ("table", "case_times")},
                           static_makespan=static_makespan(s["case_times"], s["workers"]),
                           case_min=min(s["case_times"]), case_max=max(s["case_times"])) for s in lb],
+    "field": {"grid": G, "serial_share": serial_share, "identical": fields_identical,
+              "runs": [{k: v for k, v in x.items() if k not in ("output", "stdout")} for x in fields]},
+    "design": {"identical": designs_identical,
+               "runs": [{k: v for k, v in x.items() if k not in ("output", "stdout")} for x in designs]},
     "identical_tables": identical, "fdatasync_seconds": fsync, "mean_case_seconds": t_case,
     "median_case_seconds": t_med, "bytes_per_case": bytes_case,
     "estimate": {"cases": N, "cores": P, "ideal_seconds": ideal, "arrival_rate": rate_needed,
@@ -222,6 +256,15 @@ sticking cases, self-scheduled, against a static split into contiguous blocks wi
 <table><tr><th>load balance (heave_yaw_stick_slip)</th><th>case times [s]</th><th>wall [s]</th><th>busy / (wall x workers)</th>
 <th>static blocks' makespan [s]</th><th>failed rows</th></tr>{lrows}</table>
 <p>{reasons_sentence}</p>
+<h3>One large field, one design</h3>
+<p><code>plate field</code>, <code>plate fixed-points</code> and <code>plate design</code> share their work the same way under
+<code>mpirun</code>: a field's planes x = const (after the lines (x, y<sub>0</sub>, theta) and (x, y, theta<sub>0</sub>), which every
+process solves in order because each cycle start is predicted from those before it: {f(100 * serial_share, 2)} % of a {G}<sup>3</sup>
+grid, so at most {f(1 / serial_share, 3)}x over any number of ranks), a design's starts and its verification. The outputs of the runs below
+are {'identical byte for byte' if fields_identical and designs_identical else '<b>NOT identical</b>'}.</p>
+<table><tr><th></th>{''.join(f"<th>{x['ranks']} rank{'s' if x['ranks'] > 1 else ''} x {x['threads']}</th>" for x in fields)}</tr>
+<tr><td>fig4 field, {G}<sup>3</sup> = {G**3} configurations: wall [s] (speed-up)</td>{''.join(f"<td>{f(x['wall'])} ({f(fields[0]['wall'] / x['wall'])})</td>" for x in fields)}</tr>
+<tr><td>point-part sink design, {designs[0]['evaluations']} evaluations: wall [s] (speed-up)</td>{''.join(f"<td>{f(x['wall'])} ({f(designs[0]['wall'] / x['wall'])})</td>" for x in designs)}</tr></table>
 <h3>What a 1 000-core run of 10<sup>6</sup> cases would cost</h3>
 <p>A fig4 case (fixed points on a 7x7x7 field) took {f(t_case)} s on average here (median {f(t_med)} s) and sends {f(bytes_case, 4)} bytes
 (its row back, a 4-byte index out). 10<sup>6</sup> such cases are {f(N * t_case / 3600)} core-hours: on {P} cores, ideally {f(ideal)} s
@@ -247,6 +290,11 @@ if index.exists():
     tmp.replace(index)
 shutil.rmtree(work, ignore_errors=True)
 print(json.dumps({k: data[k] for k in ("machine", "identical_tables", "fdatasync_seconds", "mean_case_seconds", "estimate")}, indent=1))
+for x in fields:
+    print(f"field {G}^3 {x['ranks']} x {x['threads']}: wall {x['wall']:.3f} s, speed-up {fields[0]['wall'] / x['wall']:.3f}")
+for x in designs:
+    print(f"design {x['ranks']} x {x['threads']}: wall {x['wall']:.3f} s, speed-up {designs[0]['wall'] / x['wall']:.3f}")
+print(f"fields identical: {fields_identical}, designs identical: {designs_identical}")
 for s in strong:
     print(f"strong {s['farm']}: {s['cases']} cases, wall {s['wall']:.3f} s, speed-up {strong[0]['wall'] / s['wall']:.3f}")
 for s in weak:

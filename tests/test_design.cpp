@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
 
 using namespace plate;
 
@@ -138,6 +141,51 @@ TEST_CASE("designs are reproducible by seed whatever the threads, and other seed
     CHECK(a.rate == b.rate);
     o.seed = 2;
     CHECK(scene_to_json(design(part, t, o).scene) != scene_to_json(a.scene));
+}
+
+// Issue 20: under mpirun a design's starts, its verification field's planes and its verification runs
+// are computed on some rank and sent as text to all; a rank that computed none of them must reach the
+// same design. The replaying runner runs nothing: whatever the design reports came through the texts.
+TEST_CASE("a design whose tasks arrive as text from elsewhere is the same design", "[design][tasks]") {
+    const Scene part = scene("fig1_point");
+    DesignTarget t;
+    t.at = Vec2(0.01, -0.02);
+    DesignOptions o;
+    o.starts = 3;
+    o.local_evaluations = 60;
+    o.verify_starts = 3;
+    o.threads = 2;
+    const DesignSummary a = design(part, t, o);
+    std::vector<std::vector<std::string>> calls;
+    o.tasks = [&](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
+        calls.emplace_back(static_cast<std::size_t>(n));
+        for (int i = n - 1; i >= 0; --i) done(i, calls.back()[static_cast<std::size_t>(i)] = work(i));
+    };
+    const DesignSummary b = design(part, t, o);
+    REQUIRE(calls.size() == 3);   // the starts, the verification field, the verification runs
+    std::size_t call = 0;
+    o.tasks = [&](int n, const std::function<std::string(int)>&, const std::function<void(int, const std::string&)>& done) {
+        REQUIRE(calls.at(call).size() == static_cast<std::size_t>(n));
+        for (int i = 0; i < n; ++i) done(i, calls[call][static_cast<std::size_t>(i)]);
+        ++call;
+    };
+    const DesignSummary c = design(part, t, o);
+    for (const DesignSummary* d : {&b, &c}) {
+        CHECK(scene_to_json(d->scene) == scene_to_json(a.scene));
+        CHECK(d->verified == a.verified);
+        CHECK(d->rate == a.rate);
+        CHECK(d->evaluations == a.evaluations);
+        CHECK(d->cycles == a.cycles);
+        CHECK(d->fixed_point == a.fixed_point);
+        CHECK(d->worst_end_distance == a.worst_end_distance);
+        REQUIRE(d->runs.size() == a.runs.size());
+        for (std::size_t k = 0; k < a.runs.size(); ++k) {
+            CHECK(d->runs[k].end_distance == a.runs[k].end_distance);
+            CHECK(d->runs[k].stop == a.runs[k].stop);
+        }
+    }
+    CHECK(a.evaluations > 3);
+    CHECK(a.cycles >= 2 * a.evaluations);   // (every sink evaluation: at least the Jacobian's two cycles)
 }
 
 TEST_CASE("a sink at the centre keeps the signal symmetric: no vertical motion, an odd field", "[design]") {

@@ -6,6 +6,10 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
 
 using namespace plate;
 
@@ -251,4 +255,97 @@ TEST_CASE("fixed points: regions where the part is stuck all period are not refi
     CHECK(cut.cells == 6 * 6 * 7);
     CHECK(cut.rhs_evaluations < 100'000 + 50'000);   // at most one field evaluation beyond the budget
     CHECK(fixed_points_sentence(cut).find("work budget") != std::string::npos);
+}
+
+namespace {
+
+// A task runner that records the tasks' texts (running them in reverse order), and one that only
+// replays recorded texts through done() without running anything: what a rank that computed none
+// of the tasks sees under MPI. A field through the replay is whatever the texts carry.
+struct Recorder {
+    std::vector<std::vector<std::string>> calls;   // per runner call, per task
+    TaskRunner record() {
+        return [this](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
+            calls.emplace_back(static_cast<std::size_t>(n));
+            for (int i = n - 1; i >= 0; --i) {
+                calls.back()[static_cast<std::size_t>(i)] = work(i);
+                done(i, calls.back()[static_cast<std::size_t>(i)]);
+            }
+        };
+    }
+    TaskRunner replay() {
+        return [this, call = std::size_t{0}](int n, const std::function<std::string(int)>&,
+                                              const std::function<void(int, const std::string&)>& done) mutable {
+            REQUIRE(call < calls.size());
+            REQUIRE(calls[call].size() == static_cast<std::size_t>(n));
+            for (int i = 0; i < n; ++i) done(i, calls[call][static_cast<std::size_t>(i)]);
+            ++call;
+        };
+    }
+};
+
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+void require_same_field(const Field& a, const Field& b) {
+    REQUIRE(a.points.size() == b.points.size());
+    for (std::size_t i = 0; i < a.points.size(); ++i) {
+        const FieldPoint &p = a.points[i], &r = b.points[i];
+        INFO("point " << i << " at " << p.q.transpose());
+        CHECK(p.q == r.q);
+        for (int c = 0; c < 3; ++c) {
+            CHECK(same(p.twist[c], r.twist[c]));
+            CHECK(same(p.stick_fraction[c], r.stick_fraction[c]));
+        }
+        CHECK(same(p.residual, r.residual));
+        CHECK(same(p.min_normal_force, r.min_normal_force));
+        CHECK(p.converged == r.converged);
+        CHECK(p.periods == r.periods);
+        CHECK(p.stop == r.stop);
+        CHECK(p.rhs_evals == r.rhs_evals);
+    }
+    CHECK(a.rhs_evals == b.rhs_evals);
+}
+
+}  // namespace
+
+// Issue 20: a field shared over processes (plate field under mpirun) is the field of one process,
+// bit for bit, because every task's points are solved from the same inputs wherever it runs and
+// travel exactly. fig6 at 5x5x5 sticks in part (stick fractions, undefined points: NaN twists).
+TEST_CASE("field: its tasks, run anywhere and sent as text, give the one-process field bit for bit", "[field][tasks]") {
+    const Scene sc = scene("fig6");
+    GridSpec g;
+    g.nx = g.ny = g.nth = 5;
+    for (CycleSolver solver : {CycleSolver::Shooting, CycleSolver::Anderson}) {
+        INFO(cycle_solver_name(solver));
+        FieldOptions o;
+        o.cycle.solver = solver;
+        const Field one = compute_field(sc, g, o);
+        bool sticks = false;
+        for (const auto& p : one.points) sticks = sticks || p.stick_fraction[0] > 0 || p.stick_fraction[1] > 0 || p.stick_fraction[2] > 0;
+        REQUIRE(sticks);   // (the texts must carry stick fractions)
+        Recorder rec;
+        o.tasks = rec.record();
+        require_same_field(one, compute_field(sc, g, o));
+        REQUIRE(rec.calls.size() == 1);
+        // Shooting: the lines (x, y_0, theta), (x, y, theta_0) in every process, then a task per plane
+        // x_i; otherwise a task per line along theta.
+        CHECK(rec.calls[0].size() == static_cast<std::size_t>(solver == CycleSolver::Shooting ? g.nx : g.nx * g.ny));
+        o.tasks = rec.replay();
+        const Field replayed = compute_field(sc, g, o);
+        require_same_field(one, replayed);
+        CHECK(replayed.threads == 0);
+    }
+}
+
+TEST_CASE("exact_text reads back to the same double, nan and infinities included", "[tasks]") {
+    for (double x : {0.1, -1.0 / 3, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, -0.0, 1e-17})
+    {
+        const double y = exact_value(exact_text(x));
+        CHECK(std::memcmp(&x, &y, sizeof x) == 0);
+    }
+    CHECK(std::isnan(exact_value(exact_text(std::nan("")))));
+    CHECK(exact_value(exact_text(HUGE_VAL)) == HUGE_VAL);
+    CHECK(exact_value(exact_text(-HUGE_VAL)) == -HUGE_VAL);
+    CHECK_THROWS_AS(exact_value("0.1x"), std::invalid_argument);
+    CHECK_THROWS_AS(exact_value(""), std::invalid_argument);
 }

@@ -13,6 +13,7 @@
 #include <complex>
 #include <map>
 #include <stdexcept>
+#include <sstream>
 #include <thread>
 
 namespace plate {
@@ -104,19 +105,8 @@ PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& a
     return u;
 }
 
-// Runs `jobs` independent jobs on the option's threads.
-template <class Job>
-void run_parallel(int jobs, int threads, Job&& job) {
-    std::atomic<int> next{0};
-    auto worker = [&] {
-        for (int k; (k = next++) < jobs;) job(k);
-    };
-    const int nt = std::max(1, std::min(jobs, threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency())));
-    std::vector<std::thread> pool;
-    for (int i = 1; i < nt; ++i) pool.emplace_back(worker);
-    worker();
-    for (auto& th : pool) th.join();
-}
+// The option's task runner, else its threads.
+TaskRunner runner(const DesignOptions& opt) { return opt.tasks ? opt.tasks : thread_tasks(opt.threads); }
 
 // A search problem's bookkeeping. Derived (CRTP) supplies kParams, kConstraints, limit(i) (the
 // bound of parameter i), constraints(p, c) (c_k <= 0 when feasible) and evaluate(p).
@@ -169,8 +159,11 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
     std::vector<std::vector<double>> best_p(n_starts);
     std::vector<double> best_f(n_starts, std::numeric_limits<double>::infinity());
     std::vector<long> evals(n_starts, 0);
-    run_parallel(n_starts, opt.threads, [&](int k) {
+    std::atomic<long>* const cycles = make().cycles;   // (each start counts its own and sends it)
+    runner(opt)(n_starts, [&](int k) -> std::string {
         P prob = make();
+        std::atomic<long> own_cycles{0};
+        prob.cycles = &own_cycles;
         Rng rng(opt.seed * 1000003 + static_cast<std::uint64_t>(k));
         std::vector<double> p(n), lo(n), hi(n), step(n);
         bool ok = false;
@@ -178,7 +171,7 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
             for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) / std::sqrt(2.0);
             ok = prob.feasible(p);
         }
-        if (!ok) return;
+        if (!ok) return "inf 0 0";
         for (int i = 0; i < n; ++i) {
             lo[i] = -prob.limit(i);
             hi[i] = prob.limit(i);
@@ -205,9 +198,20 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
         } catch (const std::exception&) {
             // (a roundoff-limited stop: the best feasible point found stands)
         }
-        best_p[k] = prob.best_p;
-        best_f[k] = prob.best_f;
-        evals[k] = prob.evaluations;
+        // The start's result as text (it may have run in another process): f, evaluations, cycles, p.
+        std::string text = exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' +
+                           std::to_string(own_cycles.load());
+        for (double x : prob.best_p) text += ' ' + exact_text(x);
+        return text;
+    }, [&](int k, const std::string& text) {
+        std::istringstream in(text);
+        std::string f, x;
+        long c = 0;
+        in >> f >> evals[k] >> c;
+        *cycles += c;
+        best_f[k] = exact_value(f);
+        best_p[k].clear();
+        while (in >> x) best_p[k].push_back(exact_value(x));
     });
     for (long e : evals) evaluations += e;
     const auto best = std::min_element(best_f.begin(), best_f.end()) - best_f.begin();
@@ -225,6 +229,7 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
     g.x1 = g.y1 = opt.region;
     FieldOptions fo;
     fo.threads = opt.threads;
+    fo.tasks = opt.tasks;
     return compute_field(sc, g, fo);
 }
 
@@ -237,14 +242,19 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         r.y = rng.uniform(-opt.region, opt.region);
         r.seconds = seconds(Vec2(r.x, r.y));
     }
-    run_parallel(static_cast<int>(sum.runs.size()), opt.threads, [&](int k) {
-        DesignStartRun& r = sum.runs[k];
+    runner(opt)(static_cast<int>(sum.runs.size()), [&](int k) {
+        const DesignStartRun& r = sum.runs[k];
         IntegrationOptions io;
         io.rtol = 1e-7;
         const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, 0), Vec3::Zero(), r.seconds, r.seconds, io);
-        r.end_distance = tr.samples.empty() ? std::numeric_limits<double>::infinity()
+        const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity()
                                             : end_distance(r, Vec2(tr.samples.back().q.head<2>()));
-        if (tr.stop.reason != StopReason::None) r.stop = tr.stop.describe();
+        // (text: the distance, then why the run stopped early, if it did)
+        return exact_text(d) + (tr.stop.reason != StopReason::None ? ' ' + tr.stop.describe() : std::string());
+    }, [&](int k, const std::string& text) {
+        const std::size_t sp = text.find(' ');
+        sum.runs[k].end_distance = exact_value(text.substr(0, sp));
+        sum.runs[k].stop = sp == std::string::npos ? std::string() : text.substr(sp + 1);
     });
     int stopped = 0;
     sum.worst_end_distance = 0;

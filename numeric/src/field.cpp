@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <sstream>
+#include <stdexcept>
 #include <thread>
 
 namespace plate {
@@ -53,6 +55,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     // Solves one point from `warm`; with warm starts, the first step is the one the previous point of
     // the same task ended with (h0: its step hint, updated here), which saves the step-size ramp-up.
     std::atomic<long> spent{0};
+    bool report_progress = true;   // (with a task runner, the runner's done reports)
     std::atomic<bool> over{false};
     auto solve = [&](int i, int j, int k, const Vec3& warm, double& h0) {
         const int idx = grid.index(i, j, k);
@@ -88,25 +91,14 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         p.stick_fraction = lc.stick_fraction;
         if (lc.converged) start[idx] = lc.qd_start.cwiseQuotient(S);
         const int d = ++done;
-        if (opt.progress) {
+        if (opt.progress && report_progress) {
             std::lock_guard<std::mutex> lock(progress_mutex);
             opt.progress(d, grid.size());
         }
         return lc;
     };
-    // Anderson and period by period: lines along theta, each start the previous theta's cycle
-    // (neighbouring cycles along theta are the closest, ~0.025 v_ref apart on fig4).
-    auto theta_lines = [&]() {
-        for (int row; (row = next.fetch_add(1)) < rows;) {
-            const int i = row / grid.ny, j = row % grid.ny;
-            Vec3 warm = Vec3::Zero();
-            double h0 = 0;
-            for (int k = 0; k < grid.nth; ++k) {
-                const LimitCycleSummary lc = solve(i, j, k, opt.warm_start ? warm : Vec3::Zero(), h0);
-                warm = lc.converged ? lc.qd_start : Vec3::Zero();
-            }
-        }
-    };
+    // Anderson and period by period (no shooting): lines along theta, each start the previous theta's
+    // cycle (neighbouring cycles along theta are the closest, ~0.025 v_ref apart on fig4).
     // Shooting converges in two periods from a start within ~1e-2 v_ref of its cycle, so each start is
     // predicted from solved neighbours: extrapolated along one grid line by a polynomial through up
     // to three points, plus the difference between the neighbouring parallel line's value and the
@@ -148,29 +140,93 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         if (n == 0 && k > 0 && X(i, j, k - 1).allFinite()) return X(i, j, k - 1).cwiseProduct(S);
         return Vec3::Zero();
     };
-    auto planes = [&]() {
-        for (int i; (i = next.fetch_add(1)) < grid.nx;) {
-            double h0 = 0;
-            for (int k = 1; k < grid.nth; ++k)
-                for (int j = 1; j < grid.ny; ++j) solve(i, j, k, warm(i, j, k), h0);
-        }
-    };
+    // Phase 1 (shooting): the points (x, y_0, theta), then the lines (x, y, theta_0), in order.
     if (shooting) {
         double h0 = 0;
         for (int i = 0; i < grid.nx; ++i)
             for (int k = 0; k < grid.nth; ++k) solve(i, 0, k, warm(i, 0, k), h0);
         for (int i = 0; i < grid.nx; ++i)
             for (int j = 1; j < grid.ny; ++j) solve(i, j, 0, warm(i, j, 0), h0);
-        threads = std::max(1, std::min(threads, grid.nx));
-    } else {
-        threads = std::max(1, std::min(threads, rows));
     }
-    f.threads = threads;
-    auto worker = [&]() { shooting ? planes() : theta_lines(); };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
+    const int first_done = done.load();
+    // The task t: with shooting the plane x_t (its points but the lines above), else the line
+    // (x_i, y_j, theta) with t = i ny + j.
+    const int tasks = shooting ? grid.nx : rows;
+    auto task_points = [&](int t) {
+        std::vector<int> idx;
+        if (shooting) {
+            for (int k = 1; k < grid.nth; ++k)
+                for (int j = 1; j < grid.ny; ++j) idx.push_back(grid.index(t, j, k));
+        } else {
+            for (int k = 0; k < grid.nth; ++k) idx.push_back(grid.index(t / grid.ny, t % grid.ny, k));
+        }
+        return idx;
+    };
+    auto run_task = [&](int t) {
+        double h0 = 0;
+        if (shooting) {
+            for (int k = 1; k < grid.nth; ++k)
+                for (int j = 1; j < grid.ny; ++j) solve(t, j, k, warm(t, j, k), h0);
+        } else {
+            Vec3 w = Vec3::Zero();
+            for (int k = 0; k < grid.nth; ++k) {
+                const LimitCycleSummary lc = solve(t / grid.ny, t % grid.ny, k, opt.warm_start ? w : Vec3::Zero(), h0);
+                w = lc.converged ? lc.qd_start : Vec3::Zero();
+            }
+        }
+    };
+    if (opt.tasks) {
+        // A task's text: its points' results, doubles exact (q follows from the grid).
+        report_progress = false;
+        int reported = 0;
+        opt.tasks(tasks,
+                  [&](int t) {
+                      run_task(t);
+                      std::string text;
+                      for (int idx : task_points(t)) {
+                          const FieldPoint& p = f.points[idx];
+                          for (double x : {p.twist[0], p.twist[1], p.twist[2], p.residual, p.min_normal_force,
+                                           p.stick_fraction[0], p.stick_fraction[1], p.stick_fraction[2]})
+                              text += exact_text(x) + ' ';
+                          text += std::to_string(p.converged) + ' ' + std::to_string(p.periods) + ' ' +
+                                  std::to_string(static_cast<int>(p.stop)) + ' ' + std::to_string(p.rhs_evals) + '\n';
+                      }
+                      return text;
+                  },
+                  [&](int t, const std::string& text) {
+                      std::istringstream in(text);
+                      const std::vector<int> idx = task_points(t);
+                      for (int i : idx) {
+                          FieldPoint& p = f.points[i];
+                          std::string x[8];
+                          int converged = 0, stop = 0;
+                          for (auto& w : x) in >> w;
+                          in >> converged >> p.periods >> stop >> p.rhs_evals;
+                          if (!in) throw std::runtime_error("compute_field: a task's result is damaged");
+                          p.q = grid.at(i / (grid.ny * grid.nth), (i / grid.nth) % grid.ny, i % grid.nth);
+                          p.twist = Vec3(exact_value(x[0]), exact_value(x[1]), exact_value(x[2]));
+                          p.residual = exact_value(x[3]);
+                          p.min_normal_force = exact_value(x[4]);
+                          for (int c = 0; c < 3; ++c) p.stick_fraction[c] = exact_value(x[5 + c]);
+                          p.converged = converged != 0;
+                          p.stop = static_cast<StopReason>(stop);
+                          if (p.stop == StopReason::StepLimit && !p.converged && p.rhs_evals == 0) over = true;
+                      }
+                      reported += static_cast<int>(idx.size());
+                      if (opt.progress) opt.progress(first_done + reported, grid.size());
+                  });
+        f.threads = 0;
+    } else {
+        threads = std::max(1, std::min(threads, tasks));
+        f.threads = threads;
+        auto worker = [&]() {
+            for (int t; (t = next.fetch_add(1)) < tasks;) run_task(t);
+        };
+        std::vector<std::thread> pool;
+        for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+        worker();
+        for (auto& t : pool) t.join();
+    }
     for (const auto& p : f.points) f.rhs_evals += p.rhs_evals;
     f.budget_spent = over;
     f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

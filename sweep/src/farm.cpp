@@ -59,6 +59,35 @@ int env_int(const char* name) {
 
 std::unique_ptr<Farm> thread_farm(int threads) { return std::make_unique<ThreadFarm>(threads); }
 
+TaskRunner farm_tasks(Farm& farm) {
+    return [&farm](int n, const std::function<std::string(int)>& work,
+                   const std::function<void(int, const std::string&)>& done) {
+        std::vector<int> todo;
+        if (farm.root())
+            for (int i = 0; i < n; ++i) todo.push_back(i);
+        std::vector<std::string> results(farm.root() ? static_cast<std::size_t>(n) : 0);
+        farm.run(todo, work, [&](int i, const std::string& r) {
+            results[static_cast<std::size_t>(i)] = r;
+            done(i, r);
+        });
+        if (farm.ranks() == 1) return;
+        // Every result to every rank: "length:text" n times.
+        std::string all;
+        if (farm.root())
+            for (const std::string& r : results) all += std::to_string(r.size()) + ':' + r;
+        farm.broadcast(all);
+        if (farm.root()) return;
+        std::size_t at = 0;
+        for (int i = 0; i < n; ++i) {
+            const std::size_t colon = all.find(':', at);
+            if (colon == std::string::npos) throw std::runtime_error("farm_tasks: the broadcast results are damaged");
+            const std::size_t len = std::stoul(all.substr(at, colon - at));
+            done(i, all.substr(colon + 1, len));
+            at = colon + 1 + len;
+        }
+    };
+}
+
 bool mpi_launched() {
     for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"})
         if (env_int(v) > 1) return true;

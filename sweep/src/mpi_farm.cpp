@@ -113,7 +113,8 @@ public:
         unsigned long n = text.size();
         MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG, 0, MPI_COMM_WORLD);
         text.resize(n);
-        MPI_Bcast(text.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
+        for (unsigned long at = 0; at < n; at += 1UL << 30)   // (counts are ints)
+            MPI_Bcast(text.data() + at, static_cast<int>(std::min(n - at, 1UL << 30)), MPI_CHAR, 0, MPI_COMM_WORLD);
     }
     void abort(int code) override { MPI_Abort(MPI_COMM_WORLD, code); }
     void barrier() override { MPI_Barrier(MPI_COMM_WORLD); }

@@ -3,7 +3,8 @@
 threads and `mpirun -np 2`; a run killed mid-way (SIGKILL of the process, SIGKILL of one MPI rank,
 SIGINT of the launcher) leaves no table, and the same command resumes it to the uninterrupted table,
 skipping the finished cases and cutting a torn journal line; bad input exits 2 naming file and field.
-And `plate proofs` under `mpirun -np 2` gives the single-process summary to the last digit.
+And `plate proofs`, `plate field`, `plate fixed-points` and `plate design` under `mpirun -np 2` give the
+single-process output to the last digit (but wall times).
 
     check_sweep.py PLATE SOURCE_DIR WORKDIR [MPIRUN]
 
@@ -202,6 +203,48 @@ if MPI:
                 o[k].pop("seconds")   # (wall time)
     check(all(outs) and "2 MPI ranks" in mpi_said and outs[0] == outs[1] and outs[0]["thin"]["valid"] > 0,
           "plate proofs under mpirun -np 2: the same summary as one process, to the last digit (but its wall time)")
+
+# --- plate field, fixed-points and design under mpirun: planes and starts shared, the same output -----
+if MPI:
+    def outputs(args, out_name, launchers):
+        res = []
+        for i, (launcher, threads) in enumerate(launchers):
+            f = work / f"{out_name}{i}"
+            p = subprocess.run([*launcher, plate, *args, "--threads", threads, "--out", str(f)], env=env,
+                               capture_output=True, text=True, timeout=600)
+            res.append((p.returncode, f.read_bytes() if f.exists() else None, p.stdout, p.stderr))
+        return res
+    one_two_mpi = [((), "1"), ((), "2"), (MPI, "1")]
+    fig6 = str(source / "scenes" / "fig6.json")   # sticks in part: stick fractions, undefined points
+    r = outputs(["field", fig6, "--grid", "9", "--format", "csv"], "field", one_two_mpi)
+    check(all(x[0] == 0 for x in r) and r[0][1] and r[0][1] == r[1][1] == r[2][1] and r[0][1].count(b"\n") == 730,
+          "plate field fig6 (9x9x9) CSV: 1 thread, 2 threads and mpirun -np 2 byte-identical")
+    r = outputs(["field", fig6, "--grid", "5"], "fieldjson", [((), "1"), (MPI, "1")])
+    if all(x[0] == 0 for x in r):
+        a, b = (json.loads(x[1]) for x in r)
+        said = b.pop("mpi", "")
+        for o in (a, b):
+            o.pop("seconds"), o.pop("threads")
+    check(all(x[0] == 0 for x in r) and a == b and "2 MPI ranks" in said,
+          "plate field JSON under mpirun: the same but wall time and who computed it")
+    r = outputs(["fixed-points", str(source / "scenes" / "fig4.json")], "fp", [((), "2"), (MPI, "1")])
+    check(all(x[0] == 0 for x in r) and r[0][1] == r[1][1] and b"stable" in r[0][1],
+          "plate fixed-points fig4 under mpirun -np 2: byte-identical")
+    r = outputs(["design", str(source / "scenes" / "fig1_point.json"), "--target", "sink", "0.02", "-0.01",
+                 "--limits", "15", "100", "--starts", "4"], "design", [((), "2"), (MPI, "1")])
+    ok = all(x[0] == 0 for x in r) and r[0][1] and r[0][1] == r[1][1]
+    if ok:
+        a, b = (json.loads(x[2]) for x in r)
+        for o in (a, b):
+            o.pop("seconds"), o.pop("scene")
+            for run_ in o["full_dynamics_runs"]:
+                run_.pop("seconds")
+        ok = a == b and a["verified"]
+    check(ok, "plate design (sink, 4 starts) under mpirun -np 2: the same scene byte for byte, the same summary")
+    p = subprocess.run([*MPI, plate, "field", str(work / "missing.json"), "--out", str(work / "nofield.json")], env=env,
+                       capture_output=True, text=True, timeout=120)
+    check(p.returncode == 2 and p.stderr.count("missing.json") == 1 and not (work / "nofield.json").exists(),
+          f"plate field under mpirun, scene missing: exit 2, said once, no output ({p.returncode}: {p.stderr.strip()[:200]})")
 
 if failures:
     print(f"{len(failures)} check(s) failed", file=sys.stderr)

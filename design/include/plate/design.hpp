@@ -55,6 +55,9 @@ struct DesignOptions {
     int starts = 16;           // multi-start: seeded feasible random motions, each refined locally
     int local_evaluations = 400;   // per start (NLopt COBYLA)
     int threads = 0;           // starts in parallel (0: all cores)
+    // Shares the starts, the verification field's planes and the verification runs (set: `threads`
+    // is not used; e.g. sweep::farm_tasks over MPI ranks). The design is the same either way.
+    TaskRunner tasks;
     LimitCycleOptions cycle = cycle_defaults();
     // Verification: the field's fixed points on a verify_grid^2 grid over the region, and the full
     // dynamics from verify_starts seeded random starts in the region, which must end within

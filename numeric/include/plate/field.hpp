@@ -4,6 +4,7 @@
 #pragma once
 
 #include "plate/limit_cycle.hpp"
+#include "plate/tasks.hpp"
 
 #include <functional>
 #include <string>
@@ -44,7 +45,7 @@ struct Field {
     std::vector<FieldPoint> points;   // GridSpec::index order
     double seconds = 0;               // wall time
     long rhs_evals = 0;
-    int threads = 0;
+    int threads = 0;                  // (0: FieldOptions::tasks shared the work)
     bool budget_spent = false;        // FieldOptions::max_rhs_evaluations was reached
 };
 
@@ -57,6 +58,14 @@ struct FieldOptions {
     // started are left undefined with stop StepLimit and Field::budget_spent is set (which ones
     // depends on the threads' order: such a field is not a result, see the CLI).
     long max_rhs_evaluations = 0;
+    // Shares the field's independent tasks (set: `threads` is not used). With the shooting solver
+    // the lines (x_i, y_0, theta_k) and (x_i, y_j, theta_0) are solved first, in order, in every
+    // process (each start is predicted from the points solved before it); then a task per plane x_i
+    // solves its other points from those and its own (the plane is its own predictor). Otherwise a
+    // task per line (x_i, y_j, theta), warm-started along theta. A task's points do not depend on
+    // where it ran, so the field is the same, bit for bit, on any threads or ranks (sweep/farm.hpp
+    // shares them over MPI ranks). The budget above is then counted per process.
+    TaskRunner tasks;
 };
 
 Field compute_field(const Scene& scene, GridSpec grid, const FieldOptions& opt = {});

@@ -5,6 +5,8 @@
 // ran, so the results are the same, bit for bit, whatever the ranks and threads.
 #pragma once
 
+#include "plate/tasks.hpp"
+
 #include <functional>
 #include <memory>
 #include <string>
@@ -37,6 +39,12 @@ public:
 
 // Threads of this process (0: all cores).
 std::unique_ptr<Farm> thread_farm(int threads);
+
+// The farm as a TaskRunner (plate/tasks.hpp), for a field's planes or a design's starts: the tasks are
+// shared like a campaign's cases, then rank 0 broadcasts every result, so every rank gets every
+// done(i, ...) and all ranks take the same path afterwards. Collective: every rank calls it with the
+// same n. The farm must outlive the runner.
+TaskRunner farm_tasks(Farm& farm);
 
 // This program was built with MPI (Open MPI found at configure time).
 bool mpi_built();
