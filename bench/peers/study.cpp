@@ -1,0 +1,271 @@
+// The peers study (issue 19): the same four questions to Bullet, ODE, MuJoCo and `plate`, against
+// converged references, one run, one machine. Writes a JSON file that bench/peers/study.py charts
+// into the report's speed-accuracy section (a benchmark, not a test).
+//
+//   bench_peers --out FILE [--quick] [--source DIR]
+//
+// (a) fig4's full-dynamics trajectory from rest at (0.04, -0.04, 1.0), 20 s (quick: 5 s): final
+//     configuration error (relative to rho, rho, 1 rad) vs CPU time, engines over a ladder of steps,
+//     plate's event-driven integrator over tolerances. Reference: plate at rtol 1e-12.
+// (b) fig4's asymptotic twist at (0.02, -0.01, 0.5): an engine simulates k periods from rest and
+//     averages over the next, (q((k+1)T) - q(kT)) / T; the part moves meanwhile, so this estimate has
+//     a method error besides the step error, shown by plate's own full dynamics under the same
+//     protocol. plate: the limit cycle over tolerances. Reference: the cycle at tol 1e-11.
+// (c) fig4's 343-configuration field, each engine configuration estimated as in (b); plate's field
+//     on one thread over tolerances. Error: the largest over the field.
+// (d) fig6's sticking configurations (stick fraction > 0 in plate's field), as in (c).
+#include "peers.hpp"
+
+#include "plate/field.hpp"
+#include "plate/scene_io.hpp"
+#include "plate/simulate.hpp"
+#include "plate/study.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace plate;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string machine() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown CPU";
+}
+
+void say(const std::string& s) { std::cerr << "bench_peers: " << s << std::endl; }
+
+json point(const std::string& system, const std::string& setting, double cpu, double error, const std::string& failure = "") {
+    json p = {{"system", system}, {"setting", setting}, {"cpu", cpu}, {"error", error}};
+    if (!failure.empty()) p["failure"] = failure;
+    return p;
+}
+
+std::vector<double> flat(const std::vector<Vec3>& q) {
+    std::vector<double> v;
+    for (const Vec3& x : q) v.insert(v.end(), {x[0], x[1], x[2]});
+    return v;
+}
+
+// The twist estimated from a run sampled every period: after k periods, averaged over the next.
+Vec3 twist_after(const std::vector<Vec3>& q, int k, double T) { return (q[k + 1] - q[k]) / T; }
+
+double twist_err(const Scene& sc, const Vec3& a, const Vec3& b) {
+    return twist_error(sc, {a[0], a[1], a[2]}, {b[0], b[1], b[2]});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string out, source = PLATE_SOURCE_DIR;
+    bool quick = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--out" && i + 1 < argc) out = argv[++i];
+        else if (a == "--source" && i + 1 < argc) source = argv[++i];
+        else if (a == "--quick") quick = true;
+        else {
+            std::cerr << "usage: bench_peers --out FILE [--quick] [--source DIR]\n";
+            return 2;
+        }
+    }
+    if (out.empty()) {
+        std::cerr << "bench_peers: missing --out FILE\n";
+        return 2;
+    }
+    const Scene fig4 = load_scene(source + "/scenes/fig4.json"), fig6 = load_scene(source + "/scenes/fig6.json");
+    const std::vector<peers::Engine> engines = peers::engines();
+    json j;
+    j["machine"] = machine();
+    j["quick"] = quick;
+    j["engines"] = json::array();
+    for (const auto& e : engines) {
+        const peers::PeerRun r = e.run(fig4, Vec3::Zero(), 1e-3, 1e-3, peers::PeerOptions{});
+        j["engines"].push_back({{"name", r.engine}, {"settings", r.settings}});
+    }
+    const std::vector<double> dts = quick ? std::vector<double>{1e-3, 3e-4, 1e-4}
+                                          : std::vector<double>{1e-3, 5e-4, 2e-4, 1e-4, 5e-5};
+
+    // (a) the trajectory.
+    {
+        const Vec3 q0(0.04, -0.04, 1.0);
+        const double dur = quick ? 5 : 20, dt_s = 0.05;
+        say("(a) reference");
+        IntegrationOptions io;
+        io.rtol = 1e-12;
+        const Trajectory ref = simulate(fig4, Dynamics::Full, q0, Vec3::Zero(), dur, dt_s, io);
+        io.rtol = 1e-11;
+        const Trajectory ref2 = simulate(fig4, Dynamics::Full, q0, Vec3::Zero(), dur, dt_s, io);
+        auto qs = [](const Trajectory& tr) {
+            std::vector<Vec3> q;
+            for (const auto& s : tr.samples) q.push_back(s.q);
+            return q;
+        };
+        const std::vector<double> R = flat(qs(ref));
+        double fe = 0, me = 0;
+        path_error(fig4, flat(qs(ref2)), R, fe, me);
+        json pts = json::array();
+        for (double rtol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10}) {
+            io.rtol = rtol;
+            const auto t0 = Clock::now();
+            const Trajectory tr = simulate(fig4, Dynamics::Full, q0, Vec3::Zero(), dur, dt_s, io);
+            const double cpu = since(t0);
+            double f = 0, m = 0;
+            path_error(fig4, flat(qs(tr)), R, f, m);
+            pts.push_back(point("plate", "rtol " + std::to_string(rtol), cpu, f, tr.stop.reason == StopReason::None ? "" : tr.stop.describe()));
+        }
+        for (const auto& e : engines)
+            for (double dt : dts) {
+                peers::PeerOptions o;
+                o.dt = dt;
+                const peers::PeerRun r = e.run(fig4, q0, dur, dt_s, o);
+                double f = INFINITY, m = INFINITY;
+                if (r.failure.empty()) path_error(fig4, flat(r.q), R, f, m);
+                pts.push_back(point(r.engine, "dt " + std::to_string(dt), r.cpu_seconds, f, r.failure));
+                say("(a) " + r.engine + " dt " + std::to_string(dt) + ": error " + std::to_string(f) + ", cpu " + std::to_string(r.cpu_seconds));
+            }
+        j["a"] = {{"question", "fig4: full dynamics from rest at (0.04, -0.04, 1.0) for " + std::to_string(static_cast<int>(dur)) + " s, final configuration"},
+                  {"reference_error", fe}, {"points", pts}};
+    }
+
+    // (b) one asymptotic twist.
+    const std::vector<int> ks = {2, 5, 10, 20};
+    {
+        const Vec3 q0(0.02, -0.01, 0.5);
+        const double T = fig4.plate.T;
+        LimitCycleOptions tight;
+        tight.tol = 1e-11;
+        tight.integration.rtol = 1e-12;
+        const LimitCycleSummary ref = limit_cycle(fig4, q0, tight);
+        tight.tol = 1e-10;
+        tight.integration.rtol = 1e-11;
+        const double ref_err = twist_err(fig4, limit_cycle(fig4, q0, tight).twist, ref.twist);
+        json pts = json::array();
+        for (double tol : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
+            LimitCycleOptions o;
+            o.tol = tol;
+            o.integration.rtol = tol / 10;
+            const auto t0 = Clock::now();
+            const LimitCycleSummary lc = limit_cycle(fig4, q0, o);
+            const double cpu = since(t0);
+            pts.push_back(point("plate", "tol " + std::to_string(tol), cpu, twist_err(fig4, lc.twist, ref.twist), lc.converged ? "" : "not converged"));
+        }
+        // The method error of the protocol itself: plate's full dynamics, k periods, then one averaged.
+        IntegrationOptions io;
+        io.rtol = 1e-11;
+        const auto t0 = Clock::now();
+        const Trajectory full = simulate(fig4, Dynamics::Full, q0, Vec3::Zero(), (ks.back() + 1) * T, T, io);
+        const double cpu_full = since(t0);
+        std::vector<Vec3> fq;
+        for (const auto& s : full.samples) fq.push_back(s.q);
+        json protocol = json::array();
+        for (int k : ks)
+            if (static_cast<int>(fq.size()) > k + 1)
+                protocol.push_back(point("plate full dynamics, k periods", "k " + std::to_string(k), cpu_full * (k + 1) / (ks.back() + 1),
+                                         twist_err(fig4, twist_after(fq, k, T), ref.twist)));
+        for (const auto& e : engines)
+            for (double dt : dts) {
+                peers::PeerOptions o;
+                o.dt = dt;
+                const peers::PeerRun r = e.run(fig4, q0, (ks.back() + 1) * T, T, o);
+                for (int k : ks) {
+                    const bool ok = r.failure.empty() && static_cast<int>(r.q.size()) > k + 1;
+                    pts.push_back(point(r.engine, "dt " + std::to_string(dt) + ", k " + std::to_string(k),
+                                        r.cpu_seconds * (k + 1) / (ks.back() + 1),
+                                        ok ? twist_err(fig4, twist_after(r.q, k, T), ref.twist) : INFINITY, r.failure));
+                }
+                say("(b) " + r.engine + " dt " + std::to_string(dt));
+            }
+        j["b"] = {{"question", "fig4: the asymptotic twist at (0.02, -0.01, 0.5)"}, {"reference_error", ref_err},
+                  {"twist", {ref.twist[0], ref.twist[1], ref.twist[2]}}, {"protocol_error", protocol}, {"points", pts}};
+    }
+
+    // (c), (d): fields.
+    auto field_question = [&](const Scene& sc, const std::string& id, const std::string& question, bool sticking_only) {
+        GridSpec g;   // 7 x 7 x 7 over [-0.05, 0.05]^2 x [0, 2 pi)
+        FieldOptions tight;
+        tight.cycle.tol = 1e-10;
+        tight.cycle.integration.rtol = 1e-11;
+        say("(" + id + ") reference field");
+        const Field ref = compute_field(sc, g, tight);
+        std::vector<int> idx;
+        for (int i = 0; i < g.size(); ++i) {
+            const FieldPoint& p = ref.points[i];
+            const bool sticks = p.stick_fraction[0] > 0 || p.stick_fraction[1] > 0 || p.stick_fraction[2] > 0;
+            if (p.converged && (!sticking_only || sticks)) idx.push_back(i);
+        }
+        if (sticking_only && quick && idx.size() > 8) idx.resize(8);
+        json pts = json::array();
+        for (double tol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
+            LimitCycleOptions o;
+            o.tol = tol;
+            o.integration.rtol = tol / 10;
+            double err = 0, cpu = 0;
+            if (!sticking_only) {
+                FieldOptions fo;
+                fo.cycle = o;
+                fo.threads = 1;
+                const auto t0 = Clock::now();
+                const Field f = compute_field(sc, g, fo);
+                cpu = since(t0);
+                err = field_max_error(sc, f, ref);
+            } else {
+                const auto t0 = Clock::now();
+                for (int i : idx) {
+                    const LimitCycleSummary lc = limit_cycle(sc, ref.points[i].q, o);
+                    err = std::max(err, lc.converged ? twist_err(sc, lc.twist, ref.points[i].twist) : INFINITY);
+                }
+                cpu = since(t0);
+            }
+            pts.push_back(point("plate", "tol " + std::to_string(tol), cpu, err));
+        }
+        const std::vector<std::pair<double, int>> settings = quick ? std::vector<std::pair<double, int>>{{2e-4, 5}}
+                                                                   : std::vector<std::pair<double, int>>{{5e-4, 5}, {2e-4, 5}, {1e-4, 10}};
+        for (const auto& e : engines)
+            for (const auto& [dt, k] : settings) {
+                peers::PeerOptions o;
+                o.dt = dt;
+                double err = 0, cpu = 0;
+                std::string failure;
+                for (int i : idx) {
+                    const peers::PeerRun r = e.run(sc, ref.points[i].q, (k + 1) * sc.plate.T, sc.plate.T, o);
+                    cpu += r.cpu_seconds;
+                    if (!r.failure.empty() || static_cast<int>(r.q.size()) <= k + 1) {
+                        failure = r.failure;
+                        err = INFINITY;
+                        continue;
+                    }
+                    err = std::max(err, twist_err(sc, twist_after(r.q, k, sc.plate.T), ref.points[i].twist));
+                }
+                pts.push_back(point(e.name, "dt " + std::to_string(dt) + ", k " + std::to_string(k), cpu, err, failure));
+                say("(" + id + ") " + e.name + " dt " + std::to_string(dt) + " k " + std::to_string(k) + ": error " + std::to_string(err) + ", cpu " + std::to_string(cpu));
+            }
+        j[id] = {{"question", question}, {"configurations", idx.size()}, {"points", pts}};
+    };
+    field_question(fig4, "c", "fig4: the 343-configuration field (7 x 7 x 7), largest twist error", false);
+    field_question(fig6, "d", "fig6: its sticking configurations (stick fraction > 0 in the 7 x 7 x 7 field), largest twist error", true);
+
+    std::ofstream f(out + ".tmp");
+    f << j.dump(1) << "\n";
+    f.close();
+    if (!f || std::rename((out + ".tmp").c_str(), out.c_str()) != 0) {
+        std::cerr << "bench_peers: cannot write " << out << "\n";
+        return 1;
+    }
+    return 0;
+}
