@@ -26,6 +26,7 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -203,9 +204,27 @@ private:
 };
 
 // The scene file; its warnings (scene_warnings: admissible, outside the intended regime) to err.
+// The scene of a command. Under mpirun (cio.farm) rank 0 reads the file and sends its text to every
+// rank (the others may not see the file: nodes without a shared filesystem), so that every rank has
+// the same scene or the same error, and only rank 0 prints warnings.
 Scene scene_arg(const std::string& file, Io& cio) {
-    Scene sc = load_scene(file);
-    for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
+    if (!cio.farm || cio.farm->ranks() == 1) {
+        Scene sc = load_scene(file);
+        for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
+        return sc;
+    }
+    std::string text;
+    if (cio.farm->root()) {
+        std::ifstream in(file, std::ios::binary);
+        std::stringstream buf;
+        buf << in.rdbuf();
+        text = in ? "S" + buf.str() : "E";
+    }
+    cio.farm->broadcast(text);
+    if (text.empty() || text[0] != 'S') throw InputError(file + ": cannot open scene file");
+    Scene sc = parse_scene(text.substr(1), file);
+    if (cio.farm->root())
+        for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
     return sc;
 }
 
@@ -412,11 +431,11 @@ struct FieldArgs : Options {
 };
 
 int cmd_field(const FieldArgs& a, Io& cio) {
+    launched_farm(cio, a.grid.threads);
     const Scene sc = scene_arg(a.scene, cio);
     const GridSpec g = grid_opts(a, a.grid);
     const std::string format = a.format;
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
-    launched_farm(cio, a.grid.threads);
     const Field f = bounded_field(sc, g, cycle_opts(a, a.cycle), a.grid.threads, a.max_work, cio);
     if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 writes)
     write_file_atomic(a.out, [&](std::ostream& out) {
@@ -450,10 +469,10 @@ struct FixedPointsArgs : Options {
 };
 
 int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
+    launched_farm(cio, a.grid.threads);
     const Scene sc = scene_arg(a.scene, cio);
     const LimitCycleOptions cycle = cycle_opts(a, a.cycle);
     const GridSpec g = grid_opts(a, a.grid);
-    launched_farm(cio, a.grid.threads);
     const Field f = bounded_field(sc, g, cycle, a.grid.threads, a.max_work, cio);
     if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 refines the zeros and writes)
     FixedPointOptions fpo;   // (the refinement has its own budget)
@@ -823,6 +842,7 @@ struct DesignArgs : Options {
 };
 
 int cmd_design(const DesignArgs& a, Io& cio) {
+    launched_farm(cio, a.threads);
     const Scene part = scene_arg(a.scene, cio);
     if (!a.has("--target")) throw UsageError("missing --target KIND A B");
     if (!a.has("--out")) throw UsageError("missing --out SCENE.json");
@@ -852,7 +872,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     o.local_evaluations = a.evaluations;
     // Under mpirun the starts, the verification field's planes and the verification runs are shared
     // over the ranks; every rank follows the same path, rank 0 writes.
-    if (sweep::Farm* farm = launched_farm(cio, a.threads)) o.tasks = sweep::farm_tasks(*farm);
+    if (cio.farm) o.tasks = sweep::farm_tasks(*cio.farm);
     DesignSummary d;
     try {
         d = design(part, t, o);
@@ -1131,8 +1151,13 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
             cio.farm->barrier();
             return 2;
         }
-        cio.err << "plate " << cmd << ": error on rank " << cio.farm->rank() << ": ";
-        fail(ep, true);
+        try {
+            std::rethrow_exception(ep);
+        } catch (const std::exception& e) {
+            cio.err << "plate " << cmd << ": error on rank " << cio.farm->rank() << ": " << e.what() << std::endl;
+        } catch (...) {
+            cio.err << "plate " << cmd << ": error on rank " << cio.farm->rank() << std::endl;
+        }
         cio.farm->abort(1);
         return 1;
     }

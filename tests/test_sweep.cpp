@@ -278,3 +278,29 @@ TEST_CASE("the thread farm runs every task once and reports them one at a time",
                                 }),
                       "disk full");
 }
+
+// farm_tasks on a rank other than 0 computes nothing itself in this fake: every result reaches it
+// through rank 0's broadcast, which it must cut back into the same texts (empty ones, colons and
+// line breaks included), in task order.
+TEST_CASE("farm_tasks: a rank other than 0 gets every task's text from the broadcast, exactly", "[sweep][tasks]") {
+    struct OtherRank : sweep::Farm {
+        int rank() const override { return 1; }
+        int ranks() const override { return 2; }
+        int workers() const override { return 1; }
+        std::string describe() const override { return "fake rank 1"; }
+        void broadcast(std::string& text) override { text = "3:a:b0:7:x\ny 1:2"; }
+        void run(const std::vector<int>& todo, const std::function<std::string(int)>&,
+                 const std::function<void(int, const std::string&)>&) override {
+            REQUIRE(todo.empty());   // (rank 0 alone hands out tasks)
+        }
+    } farm;
+    std::vector<std::string> got(3, "unset");
+    std::vector<int> order;
+    sweep::farm_tasks(farm)(3, [](int) -> std::string { FAIL("rank 1 ran a task itself"); return ""; },
+                            [&](int i, const std::string& t) {
+                                got[static_cast<std::size_t>(i)] = t;
+                                order.push_back(i);
+                            });
+    CHECK(got == std::vector<std::string>{"a:b", "", "x\ny 1:2"});
+    CHECK(order == std::vector<int>{0, 1, 2});
+}

@@ -228,7 +228,10 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         for (auto& t : pool) t.join();
     }
     for (const auto& p : f.points) f.rhs_evals += p.rhs_evals;
-    f.budget_spent = over;
+    // Over budget when the work exceeded it, however it was shared: each process cuts its own work
+    // once *it* has spent the budget (then the total is over too), and the total is compared here,
+    // so that one process and any number of ranks agree on whether the field is a result.
+    f.budget_spent = over || (opt.max_rhs_evaluations > 0 && f.rhs_evals > opt.max_rhs_evaluations);
     f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return f;
 }

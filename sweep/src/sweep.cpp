@@ -276,6 +276,17 @@ Campaign campaign_from_json(const json& file, const std::string& source) {
             r.fail("compute.cycle", "tol must be > 0 and rtol in (0, 1e-2)");
     }
     if (c.twist_at.empty() && !c.field && !c.design) r.fail("compute", "nothing to compute (twist_at, field, fixed_points or design)");
+    // A parameter named like a column the case itself fills would be overwritten by it.
+    std::set<std::string> builtin{"fixed_points"};   // (the JSON-lines table's list of fixed points)
+    {
+        const std::vector<std::string> col = columns(c);
+        builtin.insert(col.begin() + 1 + static_cast<long>(c.parameters.size()), col.end());
+        builtin.insert("case");
+    }
+    for (std::size_t i = 0; i < c.parameters.size(); ++i)
+        if (builtin.count(c.parameters[i].name))
+            r.fail("parameters[" + std::to_string(i) + "].name",
+                   "'" + c.parameters[i].name + "' is a column the table fills itself; choose another name");
     c.file = file;
     c.file["scene"] = c.base;
     return c;

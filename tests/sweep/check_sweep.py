@@ -95,7 +95,7 @@ failed = [r for r in rows if r["status"] == "failed"]
 check(len(rows) == CASES and [r["case"] for r in rows] == list(range(CASES)), "one row per case, in case order")
 check(len(failed) == CASES // 2 and all(r["mu"] == -0.2 and "friction" in r["reason"] for r in failed),
       "the 8 cases with friction -0.2 failed with a reason naming the friction; the others are ok")
-check(all(r["fp_stable"] is not None and r["stable_rate"] is None or r["stable_rate"] > 0 for r in rows if r["status"] == "ok"),
+check(all(r["fp_stable"] is not None and (r["stable_rate"] is None or r["stable_rate"] > 0) for r in rows if r["status"] == "ok"),
       "every ok row has its fixed points classified (a stable one converges: rate > 0)")
 check(s and s["failed"] == CASES // 2, "the summary counts the failed rows")
 
@@ -126,6 +126,10 @@ def resumed_equals_ref(out, label, launcher=()):
           f"{label}: resumed {before} cases, computed the other {CASES - before}, cut the torn line "
           f"({s and {k: s[k] for k in ('resumed', 'computed', 'torn_journal_lines_dropped')}} {p.stderr.strip()[:200]})")
     check(p.returncode == 0 and table(out) == table(ref), f"{label}: the resumed table equals the uninterrupted one")
+    # The resumed run appended after the cut journal (not over it): a third run finds every case.
+    p, s = run(out, "--threads", "1")
+    check(p.returncode == 0 and s and s["resumed"] == CASES and s["computed"] == 0 and s["torn_journal_lines_dropped"] == 0
+          and table(out) == table(ref), f"{label}: run again, every case is in the journal, nothing recomputed")
 
 
 out = work / "killed"
@@ -188,6 +192,37 @@ if MPI:
     check(p.returncode == 2 and p.stderr.count("parameters[0].pointer") == 1 and not (work / "never").exists(),
           f"the same under mpirun: exit 2, said once (by rank 0), no folder ({p.returncode}: {p.stderr.strip()[:300]})")
 
+# The fingerprint covers the base scene's contents, not its path: the same campaign on an edited scene
+# is another campaign.
+edited_scene = work / "fig4_heavier.json"
+sc = json.loads((source / "scenes" / "fig4.json").read_text())
+sc["part"]["mass"] *= 1.5
+edited_scene.write_text(json.dumps(sc))
+spec = json.loads(campaign.read_text())
+copy_dir = work / "edited"
+shutil.copytree(ref, copy_dir)
+spec["scene"] = str(edited_scene)
+same_path = work / "campaign_edited.json"
+same_path.write_text(json.dumps(spec))
+p = subprocess.run([plate, "sweep", str(same_path), "--out", str(copy_dir)], env=env, capture_output=True, text=True)
+check(p.returncode == 2 and "journal of another campaign" in p.stderr,
+      f"the same campaign with the base scene's mass changed: another campaign, exit 2 ({p.returncode}: {p.stderr.strip()[:200]})")
+# A parameter named like a column the table fills would be overwritten: refused.
+spec = json.loads(campaign.read_text())
+spec["parameters"][1]["name"] = "status"
+named = work / "named_status.json"
+named.write_text(json.dumps(spec))
+p = subprocess.run([plate, "sweep", str(named), "--out", str(work / "named")], env=env, capture_output=True, text=True)
+check(p.returncode == 2 and "parameters[1].name" in p.stderr and not (work / "named").exists(),
+      f"a parameter named 'status': exit 2 naming the field, no folder ({p.returncode}: {p.stderr.strip()[:200]})")
+# A second writer into a folder in use: refused while the first holds the lock.
+busy = work / "busy"
+proc = start_and_wait(busy, 1, delay=0.3)
+p = subprocess.run([plate, "sweep", str(campaign), "--out", str(busy)], env=env, capture_output=True, text=True)
+proc.kill()
+proc.wait()
+check(p.returncode == 2 and "is writing this folder" in p.stderr, f"a second run into a folder in use: exit 2 ({p.returncode}: {p.stderr.strip()[:200]})")
+
 # --- plate proofs under mpirun: the contraction cases shared over the ranks, the same summary ----------
 if MPI:
     outs = []
@@ -241,6 +276,20 @@ if MPI:
                 run_.pop("seconds")
         ok = a == b and a["verified"]
     check(ok, "plate design (sink, 4 starts) under mpirun -np 2: the same scene byte for byte, the same summary")
+    # The work budget means the same shared or not: heave_yaw's 5^3 field takes ~2.1e6 right-hand sides.
+    for budget, expect in (("1700000", 1), ("3000000", 0)):
+        codes = []
+        for launcher in ((), MPI):
+            p = subprocess.run([*launcher, plate, "field", str(source / "scenes" / "heave_yaw.json"), "--grid", "5", "--threads", "1",
+                                "--max-work", budget, "--out", str(work / "budget.json")], env=env, capture_output=True, text=True, timeout=600)
+            codes.append(p.returncode)
+        check(codes == [expect, expect], f"plate field --max-work {budget}: exit {expect} alone and under mpirun (got {codes})")
+    # Rank 0 reads the scene and sends it: a rank that cannot see the file still computes (nodes without
+    # a shared filesystem), and one that can while rank 0 cannot gets the same error, no hang.
+    mixed = [mpirun, "-np", "1", plate, "field", str(source / "scenes" / "fig4.json"), "--threads", "1", "--out", str(work / "mixed.json"),
+             ":", "-np", "1", plate, "field", str(work / "missing.json"), "--threads", "1", "--out", str(work / "mixed.json")]
+    p = subprocess.run(mixed, env=env, capture_output=True, text=True, timeout=120)
+    check(p.returncode == 0 and (work / "mixed.json").exists(), f"rank 1 without the scene file: rank 0's scene, exit 0 ({p.returncode})")
     p = subprocess.run([*MPI, plate, "field", str(work / "missing.json"), "--out", str(work / "nofield.json")], env=env,
                        capture_output=True, text=True, timeout=120)
     check(p.returncode == 2 and p.stderr.count("missing.json") == 1 and not (work / "nofield.json").exists(),

@@ -46,7 +46,7 @@ struct Field {
     double seconds = 0;               // wall time
     long rhs_evals = 0;
     int threads = 0;                  // (0: FieldOptions::tasks shared the work)
-    bool budget_spent = false;        // FieldOptions::max_rhs_evaluations was reached
+    bool budget_spent = false;        // FieldOptions::max_rhs_evaluations was exceeded
 };
 
 struct FieldOptions {
@@ -56,7 +56,8 @@ struct FieldOptions {
     std::function<void(int done, int total)> progress;   // called from worker threads, serialised
     // The field's work budget in right-hand sides (0: none). Once spent, the configurations not yet
     // started are left undefined with stop StepLimit and Field::budget_spent is set (which ones
-    // depends on the threads' order: such a field is not a result, see the CLI).
+    // depends on the threads' order: such a field is not a result, see the CLI); it is also set when
+    // the field's total work exceeds the budget, so that any sharing of the work agrees on it.
     long max_rhs_evaluations = 0;
     // Shares the field's independent tasks (set: `threads` is not used). With the shooting solver
     // the lines (x_i, y_0, theta_k) and (x_i, y_j, theta_0) are solved first, in order, in every
