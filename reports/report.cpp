@@ -612,6 +612,14 @@ void write_report(const ReportOptions& opt) {
     else html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
               << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
     html << kSpeedEnd << "\n";
+    // The peer engines' study (bench/peers/study.py) keeps its section between these.
+    html << kPeersBegin;
+    const fs::path peers = c.dir / "data" / "peers_section.html";
+    if (fs::exists(peers)) html << std::ifstream(peers).rdbuf();
+    else html << "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet: <code>bench/peers/study.py --out " << esc(opt.out)
+              << "</code> writes this section (the same questions to the engines found at build time and to plate, "
+                 "error against CPU time).</p>\n";
+    html << kPeersEnd << "\n";
     // The campaigns' scaling study (bench/scaling.py) keeps its section between these.
     html << kCampaignsBegin;
     const fs::path campaigns = c.dir / "data" / "campaigns_section.html";

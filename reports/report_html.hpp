@@ -115,6 +115,8 @@ inline const char* kSpeedEnd = "<!-- speed-accuracy:end -->";
 // ... and the campaigns' scaling study (bench/scaling.py) between these.
 inline const char* kCampaignsBegin = "<!-- campaigns:begin -->";
 inline const char* kCampaignsEnd = "<!-- campaigns:end -->";
+inline const char* kPeersBegin = "<!-- peers:begin -->";
+inline const char* kPeersEnd = "<!-- peers:end -->";
 
 // First in <head>: records every error the page meets (script errors, resources that fail to load,
 // console.error, rejected promises) for the browser check.

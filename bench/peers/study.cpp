@@ -50,6 +50,12 @@ std::string machine() {
 
 void say(const std::string& s) { std::cerr << "bench_peers: " << s << std::endl; }
 
+std::string sci(double x) {   // 1e-05 -> "1e-05", 0.0003 -> "3e-04"
+    char b[32];
+    std::snprintf(b, sizeof b, "%.0e", x);
+    return b;
+}
+
 json point(const std::string& system, const std::string& setting, double cpu, double error, const std::string& failure = "") {
     json p = {{"system", system}, {"setting", setting}, {"cpu", cpu}, {"error", error}};
     if (!failure.empty()) p["failure"] = failure;
@@ -127,7 +133,7 @@ int main(int argc, char** argv) {
             const double cpu = since(t0);
             double f = 0, m = 0;
             path_error(fig4, flat(qs(tr)), R, f, m);
-            pts.push_back(point("plate", "rtol " + std::to_string(rtol), cpu, f, tr.stop.reason == StopReason::None ? "" : tr.stop.describe()));
+            pts.push_back(point("plate", "rtol " + sci(rtol), cpu, f, tr.stop.reason == StopReason::None ? "" : tr.stop.describe()));
         }
         for (const auto& e : engines)
             for (double dt : dts) {
@@ -136,7 +142,7 @@ int main(int argc, char** argv) {
                 const peers::PeerRun r = e.run(fig4, q0, dur, dt_s, o);
                 double f = INFINITY, m = INFINITY;
                 if (r.failure.empty()) path_error(fig4, flat(r.q), R, f, m);
-                pts.push_back(point(r.engine, "dt " + std::to_string(dt), r.cpu_seconds, f, r.failure));
+                pts.push_back(point(r.engine, "dt " + sci(dt), r.cpu_seconds, f, r.failure));
                 say("(a) " + r.engine + " dt " + std::to_string(dt) + ": error " + std::to_string(f) + ", cpu " + std::to_string(r.cpu_seconds));
             }
         j["a"] = {{"question", "fig4: full dynamics from rest at (0.04, -0.04, 1.0) for " + std::to_string(static_cast<int>(dur)) + " s, final configuration"},
@@ -163,7 +169,7 @@ int main(int argc, char** argv) {
             const auto t0 = Clock::now();
             const LimitCycleSummary lc = limit_cycle(fig4, q0, o);
             const double cpu = since(t0);
-            pts.push_back(point("plate", "tol " + std::to_string(tol), cpu, twist_err(fig4, lc.twist, ref.twist), lc.converged ? "" : "not converged"));
+            pts.push_back(point("plate", "tol " + sci(tol), cpu, twist_err(fig4, lc.twist, ref.twist), lc.converged ? "" : "not converged"));
         }
         // The method error of the protocol itself: plate's full dynamics, k periods, then one averaged.
         IntegrationOptions io;
@@ -185,7 +191,7 @@ int main(int argc, char** argv) {
                 const peers::PeerRun r = e.run(fig4, q0, (ks.back() + 1) * T, T, o);
                 for (int k : ks) {
                     const bool ok = r.failure.empty() && static_cast<int>(r.q.size()) > k + 1;
-                    pts.push_back(point(r.engine, "dt " + std::to_string(dt) + ", k " + std::to_string(k),
+                    pts.push_back(point(r.engine, "dt " + sci(dt) + ", k " + std::to_string(k),
                                         r.cpu_seconds * (k + 1) / (ks.back() + 1),
                                         ok ? twist_err(fig4, twist_after(r.q, k, T), ref.twist) : INFINITY, r.failure));
                 }
@@ -203,6 +209,10 @@ int main(int argc, char** argv) {
         tight.cycle.integration.rtol = 1e-11;
         say("(" + id + ") reference field");
         const Field ref = compute_field(sc, g, tight);
+        FieldOptions tight2 = tight;   // (what the reference is worth: against one a decade looser)
+        tight2.cycle.tol = 1e-9;
+        tight2.cycle.integration.rtol = 1e-10;
+        const double ref_err = field_max_error(sc, compute_field(sc, g, tight2), ref);
         std::vector<int> idx;
         for (int i = 0; i < g.size(); ++i) {
             const FieldPoint& p = ref.points[i];
@@ -224,15 +234,22 @@ int main(int argc, char** argv) {
                 const Field f = compute_field(sc, g, fo);
                 cpu = since(t0);
                 err = field_max_error(sc, f, ref);
-            } else {
+            }
+            std::string failure;
+            if (sticking_only) {
                 const auto t0 = Clock::now();
                 for (int i : idx) {
                     const LimitCycleSummary lc = limit_cycle(sc, ref.points[i].q, o);
                     err = std::max(err, lc.converged ? twist_err(sc, lc.twist, ref.points[i].twist) : INFINITY);
+                    if (!lc.converged) {
+                        const Vec3& q = ref.points[i].q;
+                        failure = "no cycle at (" + std::to_string(q[0]) + ", " + std::to_string(q[1]) + ", " + std::to_string(q[2]) +
+                                  "): " + (lc.stop.reason != StopReason::None ? lc.stop.describe() : "not converged");
+                    }
                 }
                 cpu = since(t0);
             }
-            pts.push_back(point("plate", "tol " + std::to_string(tol), cpu, err));
+            pts.push_back(point("plate", "tol " + sci(tol), cpu, err, failure));
         }
         const std::vector<std::pair<double, int>> settings = quick ? std::vector<std::pair<double, int>>{{2e-4, 5}}
                                                                    : std::vector<std::pair<double, int>>{{5e-4, 5}, {2e-4, 5}, {1e-4, 10}};
@@ -252,10 +269,10 @@ int main(int argc, char** argv) {
                     }
                     err = std::max(err, twist_err(sc, twist_after(r.q, k, sc.plate.T), ref.points[i].twist));
                 }
-                pts.push_back(point(e.name, "dt " + std::to_string(dt) + ", k " + std::to_string(k), cpu, err, failure));
+                pts.push_back(point(e.name, "dt " + sci(dt) + ", k " + std::to_string(k), cpu, err, failure));
                 say("(" + id + ") " + e.name + " dt " + std::to_string(dt) + " k " + std::to_string(k) + ": error " + std::to_string(err) + ", cpu " + std::to_string(cpu));
             }
-        j[id] = {{"question", question}, {"configurations", idx.size()}, {"points", pts}};
+        j[id] = {{"question", question}, {"configurations", idx.size()}, {"reference_error", ref_err}, {"points", pts}};
     };
     field_question(fig4, "c", "fig4: the 343-configuration field (7 x 7 x 7), largest twist error", false);
     field_question(fig6, "d", "fig6: its sticking configurations (stick fraction > 0 in the 7 x 7 x 7 field), largest twist error", true);
