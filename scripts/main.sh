@@ -24,6 +24,8 @@ echo "== verification report (derivation, Theorem 1 on 10^4 thin and 10^3 thick 
 build/plate report --out "$out/report"
 echo "== speed-accuracy study (methods, limit-cycle solvers, failure maps, model hierarchy; a few minutes)" >&2
 build/plate bench --out "$out/report"
+echo "== side by side with Bullet, ODE and MuJoCo (the engines found; a few minutes)" >&2
+/usr/bin/python3 bench/peers/study.py --out "$out/report"
 echo "== campaigns' scaling study (threads and MPI ranks; about a minute)" >&2
 /usr/bin/python3 bench/scaling.py --out "$out/report"
 scripts/check-report.sh "$out/report" --screenshot "$out/report/screenshot.png"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The peers study (issue 19): Bullet, ODE, MuJoCo and plate on the same questions, one run.
 
-    bench/peers/study.py --out DIR [--build build] [--quick]
+    bench/peers/study.py --out DIR [--build build] [--quick] [--data PEERS.json]
 
 Runs BUILD/bench_peers (the engines found when plate was built; see bench/peers/peers.hpp for each
 engine's settings and why), then writes DIR/peers_*.svg (error against CPU time, one curve per engine
@@ -26,6 +26,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--out", required=True)
 ap.add_argument("--build", default=None)
 ap.add_argument("--quick", action="store_true")
+ap.add_argument("--data", default=None, help="chart this bench_peers JSON instead of running it")
 a = ap.parse_args()
 src = pathlib.Path(__file__).resolve().parent.parent.parent
 build = pathlib.Path(a.build).resolve() if a.build else src / "build"
@@ -33,7 +34,9 @@ out = pathlib.Path(a.out).resolve()
 (out / "data").mkdir(parents=True, exist_ok=True)
 exe = build / "bench_peers"
 data_file = out / "data" / "peers.json"
-if not exe.exists():
+if a.data:
+    d = json.loads(pathlib.Path(a.data).read_text())
+elif not exe.exists():
     section = ("<h2>Side by side with Bullet, ODE and MuJoCo</h2><p><b>Not run</b>: no peer engine was found when plate was built "
                "(Debian libbullet-dev, libode-dev, libmujoco-dev), so <code>bench_peers</code> does not exist.</p>\n")
     d = None
@@ -82,7 +85,15 @@ def ratios(points, floor):
         cheap = min(equal_acc, key=lambda p: p["cpu"]) if equal_acc else None
         in_time = [p for p in plate if p["cpu"] <= best["cpu"]]
         sharp = min(in_time, key=lambda p: p["error"]) if in_time else None
+        # The same against each of the engine's settings: the smallest is the ratio no setting beats.
+        per_setting = []
+        for p in mine:
+            ok = [x for x in plate if x["error"] <= p["error"]]
+            if ok:
+                per_setting.append((p["cpu"] / min(x["cpu"] for x in ok), p["setting"]))
+        worst = min(per_setting) if per_setting else None
         rows.append({"engine": eng, "best": best, "plate_equal_accuracy": cheap, "plate_in_time": sharp,
+                     "speedup_any_setting": worst[0] if worst else None, "speedup_any_setting_at": worst[1] if worst else None,
                      "speedup": best["cpu"] / cheap["cpu"] if cheap else None,
                      "accuracy_ratio": best["error"] / max(sharp["error"], floor) if sharp else None,
                      "accuracy_ratio_is_bound": bool(sharp and sharp["error"] < floor)})
@@ -129,19 +140,20 @@ if d is not None:
         rows = []
         for r in d["ratios"][q]:
             if r.get("failed"):
-                rows.append(f"<tr><td>{html.escape(r['engine'])}</td><td colspan=5>every setting failed</td></tr>")
+                rows.append(f"<tr><td>{html.escape(r['engine'])}</td><td colspan=6>every setting failed</td></tr>")
                 continue
             b, c, s = r["best"], r["plate_equal_accuracy"], r["plate_in_time"]
             rows.append(
                 f"<tr><td>{html.escape(r['engine'])}</td><td>{html.escape(b['setting'])}: {f(b['error'])} in {f(b['cpu'])} s</td>"
                 f"<td>{html.escape(c['setting']) + ': ' + f(c['error']) + ' in ' + f(c['cpu']) + ' s' if c else 'none as accurate'}</td>"
                 f"<td><b>{f(r['speedup'], 3) + 'x' if r['speedup'] else '-'}</b></td>"
+                f"<td>{f(r['speedup_any_setting'], 3) + 'x (' + html.escape(r['speedup_any_setting_at']) + ')' if r['speedup_any_setting'] else '-'}</td>"
                 f"<td>{html.escape(s['setting']) + ': ' + f(s['error']) if s else 'none as fast'}</td>"
                 f"<td><b>{('>= ' if r['accuracy_ratio_is_bound'] else '') + f(r['accuracy_ratio'], 3) + 'x' if r['accuracy_ratio'] else '-'}</b></td></tr>")
         note = (f"<p>Errors are resolved down to the reference's own, {f(d[q]['reference_error'])} (its change against a reference a "
                 "decade looser); an accuracy ratio marked &gt;= met that floor.</p>")
         return note + ("<table><tr><th>engine</th><th>its best setting: error in CPU time</th><th>plate's cheapest setting at least as accurate</th>"
-                "<th>speed-up at equal accuracy</th><th>plate's best setting in the engine's time</th><th>accuracy ratio at equal time</th></tr>"
+                "<th>speed-up at equal accuracy</th><th>the smallest against any of the engine's settings</th><th>plate's best setting in the engine's time</th><th>accuracy ratio at equal time</th></tr>"
                 + "".join(rows) + "</table>")
 
     def minimum(q, key):
@@ -163,6 +175,7 @@ if d is not None:
     engines = "".join(f"<li><b>{html.escape(e['name'])}</b>: {html.escape(e['settings'])}</li>" for e in d["engines"])
     goal_c = minimum("c", "speedup"), minimum("c", "accuracy_ratio")
     goal_a = minimum("a", "speedup")
+    any_c, any_a = minimum("c", "speedup_any_setting"), minimum("a", "speedup_any_setting")
 
     def goal(x, target):
         return "-" if x is None else (f"{f(x, 3)}x, " + ("met" if x >= target else "<b>NOT met</b>"))
@@ -183,7 +196,8 @@ engines over steps dt, plate's event-driven integrator over tolerances (referenc
 {f(d['a']['reference_error'])} of rtol 1e-11).</figcaption></figure>
 {ratio_rows('a')}
 {failures('a')}
-<p>Goal: plate at least 10x faster at equal or better accuracy: the smallest speed-up over the engines is {goal(goal_a, 10)}.</p>
+<p>Goal: plate at least 10x faster at equal or better accuracy: the smallest speed-up over the engines (each at its most accurate
+setting) is {goal(goal_a, 10)}; against any of their settings, {goal(any_a, 10)}.</p>
 <h3>(b) {html.escape(b['question'])}</h3>
 <figure><img src="peers_twist.svg" alt="twist error against CPU time"><figcaption>An engine cannot hold the configuration still: it simulates
 k periods from rest and averages the next, (q((k+1)T) - q(kT))/T. Dashed: each engine at k = 2, 5, 10, 20 over dt; crosses: plate's own full
@@ -199,8 +213,9 @@ holds q fixed and converges to the reference.</p>
 configurations against the whole field's CPU time: engines with the protocol of (b) at each configuration, plate's field (shooting, warm
 starts) on one thread over tolerances.</figcaption></figure>
 {ratio_rows('c')}
-<p>Goals: plate at least 100x faster than every engine, and at least 100x more accurate. Smallest speed-up at equal accuracy over the engines:
-{goal(goal_c[0], 100)}; smallest accuracy ratio at equal time: {goal(goal_c[1], 100)}.</p>
+<p>Goals: plate at least 100x faster than every engine, and at least 100x more accurate. Smallest speed-up at equal accuracy over the engines
+(each at its most accurate setting): {goal(goal_c[0], 100)}; against any of their settings (a cheaper step that is nearly as accurate):
+{goal(any_c, 100)}; smallest accuracy ratio at equal time: {goal(goal_c[1], 100)}.</p>
 <h3>(d) {html.escape(d['d']['question'])}</h3>
 <figure><img src="peers_sticking.svg" alt="sticking twists error against CPU time"><figcaption>The {d['d']['configurations']} sticking
 configurations: plate's stick-slip limit cycles against the engines' protocol.</figcaption></figure>
@@ -225,5 +240,6 @@ if d is not None:
     for q in ("a", "b", "c", "d"):
         for r in d["ratios"][q]:
             if not r.get("failed"):
-                print(f"({q}) {r['engine']}: speed-up at equal accuracy {r['speedup']}, accuracy ratio at equal time {r['accuracy_ratio']}")
+                print(f"({q}) {r['engine']}: speed-up at equal accuracy {r['speedup']} (smallest over its settings {r['speedup_any_setting']}), "
+                      f"accuracy ratio at equal time {r['accuracy_ratio']}")
 print(f"peers: {out / 'data' / 'peers_section.html'}")
