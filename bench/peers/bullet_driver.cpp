@@ -82,7 +82,7 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     world.addRigidBody(&part);
     r.settings = std::string("fixed step, 100 sequential-impulse iterations, no split impulse, ") +
                  (opt.pyramid ? "TWO FIXED friction directions (box), " : "friction along the slip, ") +
-                 "margins 0.1 mm, no deactivation, spheres r = " + std::to_string(rad * 1e3) + " mm";
+                 "margins 0.1 mm, no deactivation, spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
     auto read = [&](double prev) {
         const btTransform& T = part.getCenterOfMassTransform();
         const btQuaternion q = T.getRotation();

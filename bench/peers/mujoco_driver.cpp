@@ -62,7 +62,7 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
     }
     mjData* d = mj_makeData(m);
     r.settings = std::string(opt.pyramid ? "PYRAMIDAL cone" : "elliptic cone") + ", impratio 100, Newton solver (100 iterations, tol 1e-12), solref (2 dt, 1), "
-                 "solimp 0.95 0.99 1e-4, Euler integrator, spheres r = " + std::to_string(rad * 1e3) + " mm";
+                 "solimp 0.95 0.99 1e-4, Euler integrator, spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
     PlateTrack plate(sc.plate, opt.drift);
     auto set_plate = [&] {
         d->qpos[0] = plate.p.x(), d->qpos[1] = plate.p.y(), d->qpos[2] = plate.p.z();

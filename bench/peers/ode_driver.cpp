@@ -99,7 +99,7 @@ PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_
     }
     r.settings = std::string("dWorldStep (Dantzig LCP), dContactApprox1, ") +
                  (opt.pyramid ? "FIXED friction directions (box)" : "first friction direction along the slip") + ", ERP 0.2, "
-                 "CFM 1e-9, spheres r = " + std::to_string(rad * 1e3) + " mm";
+                 "CFM 1e-9, spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
     PlateTrack plate(sc.plate, opt.drift);
     auto set_plate = [&] {
         dBodySetPosition(w.plate, plate.p.x(), plate.p.y(), plate.p.z());
