@@ -61,8 +61,12 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
         return r;
     }
     mjData* d = mj_makeData(m);
-    r.settings = std::string(opt.pyramid ? "PYRAMIDAL cone" : "elliptic cone") + ", impratio 100, Newton solver (100 iterations, tol 1e-12), solref (2 dt, 1), "
-                 "solimp 0.95 0.99 1e-4, Euler integrator, spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
+    r.settings = std::string(opt.pyramid ? "PYRAMIDAL cone (MuJoCo's default)" : "elliptic cone (the friction disk; the default pyramid turns the part the wrong way in yaw)") +
+                 ", impratio 100 (friction rows stiffer than the normal's: little creep while sticking), Newton solver with 100 "
+                 "iterations to 1e-12 (the contact problem solved, not approximated), solref (2 dt, 1) (the shortest time constant "
+                 "MuJoCo allows, critically damped), solimp 0.95 0.99 1e-4 (stiff), Euler integrator; the plate a 10 t free body set "
+                 "to the plate's pose and velocity every step (a mocap body would have zero velocity in the contact rows); spheres r = " +
+                 std::to_string(std::lround(rad * 1e6)) + " um";
     PlateTrack plate(sc.plate, opt.drift);
     auto set_plate = [&] {
         d->qpos[0] = plate.p.x(), d->qpos[1] = plate.p.y(), d->qpos[2] = plate.p.z();

@@ -97,9 +97,13 @@ PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_
         dGeomSetOffsetPosition(w.spheres[i], P.c[i].x(), P.c[i].y(), P.c[i].z() + rad);
         w.mu[i] = P.mu[i];
     }
-    r.settings = std::string("dWorldStep (Dantzig LCP), dContactApprox1, ") +
-                 (opt.pyramid ? "FIXED friction directions (box)" : "first friction direction along the slip") + ", ERP 0.2, "
-                 "CFM 1e-9, spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
+    r.settings = std::string("dWorldStep (the Dantzig LCP, exact for the step, not the iterative QuickStep), dContactApprox1 "
+                             "(friction bounded by mu N, not a force in newtons), ") +
+                 (opt.pyramid ? "FIXED friction directions (ODE's box)"
+                              : "the first friction direction set along the slip every step (ODE's friction is a box: so a sliding "
+                                "contact feels mu N against its slip)") +
+                 ", ERP 0.2 and CFM 1e-9 (stiff contacts); the plate a kinematic body; spheres r = " +
+                 std::to_string(std::lround(rad * 1e6)) + " um";
     PlateTrack plate(sc.plate, opt.drift);
     auto set_plate = [&] {
         dBodySetPosition(w.plate, plate.p.x(), plate.p.y(), plate.p.z());

@@ -182,8 +182,8 @@ if d is not None:
 
     section = f"""<h2>Side by side with Bullet, ODE and MuJoCo</h2>
 <p>Measured by <code>bench/peers/study.py</code>{' (quick: shorter runs, fewer settings)' if d['quick'] else ''} on {html.escape(d['machine'])},
-one run, one thread each. The engines found when this plate was built, each set up as a careful user would (the reasons are in
-<code>bench/peers/*_driver.cpp</code>): the part as one body with three spheres of 0.5 mm whose lowest points are the contacts, the plate as a
+one run, one thread each. The engines found when this plate was built, each set up as a careful user would (what was set and why;
+more in <code>bench/peers/*_driver.cpp</code>): the part as one body with three spheres of 0.5 mm whose lowest points are the contacts, the plate as a
 kinematic box moved along the full dynamics' plate trajectory, Coulomb friction mu:</p><ul>{engines}</ul>
 <p>Before their numbers are used the drivers are tested (<code>tests/test_peers.cpp</code>): on a plate at rest and on a plate translating
 uniformly each keeps the part in place within 0.1 mm and 1 mrad over 2 s, and on fig4's plate each moves the part within a fifth of plate's
