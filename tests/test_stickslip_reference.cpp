@@ -170,3 +170,26 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         CHECK((sh.twist - ref.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < 1e-7);   // measured 5e-10
     }
 }
+
+// A contact sliding at the rim of its friction disk with a slip that stays ~2e-9 m/s for 15 ms (neither
+// lingering nor crossing zero) was integrated along v/|v| in steps of 3e-9 s: 2.1e7 right-hand sides
+// for heave_yaw's cycle with z 2 m/s^2 and rz 60 rad/s^2 at (0, 0.02, 0). It creeps again now (its
+// friction along the consistent direction): at the default settings the cycle must cost < 1e6 and
+// still be the regularised reference's, within the default tolerance's reach (tol 1e-7 plus the
+// integrator's ~60 rtol).
+TEST_CASE("a slip that stays at the disk's rim creeps: cheap, and the regularised reference's twist", "[stick][reference]") {
+    Scene sc = scene("heave_yaw");
+    sc.plate.harmonics[0].amp = 2;    // z
+    sc.plate.harmonics[1].amp = 60;   // rz
+    const Vec3 q(0, 0.02, 0);
+    const LimitCycleSummary lc = limit_cycle(sc, q);
+    REQUIRE(lc.converged);
+    CHECK(lc.stats.rhs_evals < 1'000'000);
+    CHECK(*std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end()) > 0.3);   // (it sticks)
+    const RegularisedReference r = regularised_reference(sc, q);
+    REQUIRE(r.ok);
+    INFO("engine " << lc.twist.transpose() << ", reference " << r.twist.transpose() << " (order " << r.order
+                   << ", error " << r.error << ")");
+    CHECK(twist_distance(sc, lc.twist, r.twist) <= 1e-7 + 60 * 1e-8 + r.error);
+    CHECK(r.error < 1e-6);
+}
