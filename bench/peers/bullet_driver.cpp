@@ -32,7 +32,13 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
         r.failure = "point parts are not modelled here (a ball would roll)";
         return r;
     }
+    if (P.mu.maxCoeff() != P.mu.minCoeff()) {
+        r.failure = "Bullet has one friction coefficient per body: contacts with different mu are not modelled";
+        return r;
+    }
     const double dt = opt.dt, rad = opt.sphere_radius;
+    const long n = whole_steps(duration, dt, r.failure), every = whole_steps(sample_dt, dt, r.failure);
+    if (!r.failure.empty()) return r;
     btDefaultCollisionConfiguration config;
     btCollisionDispatcher dispatcher(&config);
     btDbvtBroadphase broadphase;
@@ -62,12 +68,11 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     const Eigen::Quaterniond Vq(V);
     btCompoundShape part_shape;
     std::vector<std::unique_ptr<btSphereShape>> spheres;
-    double mu = 0;
+    const double mu = P.mu[0];
     for (int i = 0; i < 3; ++i) {
         spheres.push_back(std::make_unique<btSphereShape>(rad));
         const Vec3 at = V.transpose() * (P.c[i] + Vec3(0, 0, rad));
         part_shape.addChildShape(btTransform(btQuaternion::getIdentity(), bt(at)), spheres.back().get());
-        mu += P.mu[i] / 3;
     }
     part_shape.setMargin(1e-4);
     const BodyState b = at_rest_on_plate(P, plate, q0);
@@ -95,18 +100,18 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     };
     r.t.push_back(0);
     r.q.push_back(read(q0[2]));
-    const long n = std::lround(duration / dt), every = std::max(1L, std::lround(sample_dt / dt));
     double cpu = 0;
     for (long k = 1; k <= n; ++k) {
         plate.advance(k * dt);   // the plate's pose at the end of the step
         plate_motion.setWorldTransform(btTransform(bt(plate.R), bt(plate.p)));
-        const auto c0 = std::chrono::steady_clock::now();
+        const double c0 = cpu_now();
         world.stepSimulation(dt, 0);
-        cpu += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
+        cpu += cpu_now() - c0;
         if (k % every == 0 || k == n) {
             const Vec3 q = read(r.q.back()[2]);
             const btVector3 o = part.getCenterOfMassPosition();
             const double h = (plate.R.conjugate() * (Vec3(o.x(), o.y(), o.z()) - plate.p)).z();
+            r.max_lift = std::max(r.max_lift, std::abs(h - P.s_z()));
             if (!q.allFinite() || std::abs(h - P.s_z()) > 0.01) {
                 r.failure = "the part left the plate at t = " + std::to_string(k * dt) + " s";
                 break;

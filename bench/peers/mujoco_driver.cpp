@@ -2,8 +2,12 @@
 //   cone="elliptic"     the friction disk (the default pyramid turns a part the wrong way in yaw);
 //   impratio=100        friction rows 100x stiffer than the normal's: little creep while sticking;
 //   solver Newton, 100 iterations, tolerance 1e-12: the contact problem solved, not approximated;
-//   solref (2 dt, 1)    the contacts' time constant as short as MuJoCo allows (2 steps), critically
-//                       damped; solimp 0.95 0.99 1e-4: stiff impedance (penetration ~ microns);
+//   solref (4 dt, 1)    the contacts' time constant a few steps, critically damped. Measured on fig4's
+//                       first second against plate (turn ratio, 1 = plate's): at MuJoCo's floor of 2 dt
+//                       a part sliding at 1 m/s hops 3.8 mm with Euler and fig4's turn flips sign
+//                       between dt 1e-4 and 5e-5; at 4 dt 0.69-0.72 for dt 5e-5 and 2.5e-5; from ~10 dt
+//                       on the soft contact turns the part the wrong way (MuJoCo's default 0.02 s: -6.8);
+//                       solimp 0.95 0.99 1e-4: stiff impedance (penetration ~ microns);
 //   the plate: a free body of 10 t whose pose and velocity are set to the plate's before every step,
 //   with the force and torque that give it u(t) during the step (a mocap body would have zero
 //   velocity in the contact rows: friction would see the wrong slip).
@@ -34,11 +38,13 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
         return r;
     }
     const double dt = opt.dt, rad = opt.sphere_radius;
+    const long n = whole_steps(duration, dt, r.failure), every = whole_steps(sample_dt, dt, r.failure);
+    if (!r.failure.empty()) return r;
     std::ostringstream x;
     x.precision(17);
     x << "<mujoco><option timestep=\"" << dt << "\" gravity=\"0 0 " << -sc.g
       << "\" cone=\"" << (opt.pyramid ? "pyramidal" : "elliptic") << "\" impratio=\"100\" solver=\"Newton\" iterations=\"100\" tolerance=\"1e-12\"/>"
-      << "<default><geom condim=\"3\" solref=\"" << 2 * dt << " 1\" solimp=\"0.95 0.99 0.0001\"/></default>"
+      << "<default><geom condim=\"3\" solref=\"" << (opt.contact_time > 0 ? opt.contact_time : 4 * dt) << " 1\" solimp=\"0.95 0.99 0.0001\"/></default>"
       << "<worldbody><body name=\"plate\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << kPlateMass
       << "\" diaginertia=\"" << kPlateInertia << " " << kPlateInertia << " " << kPlateInertia << "\"/>"
       << "<geom type=\"box\" size=\"1 1 0.05\" pos=\"0 0 -0.05\" friction=\"0 0 0\"/></body>"
@@ -63,8 +69,8 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
     mjData* d = mj_makeData(m);
     r.settings = std::string(opt.pyramid ? "PYRAMIDAL cone (MuJoCo's default)" : "elliptic cone (the friction disk; the default pyramid turns the part the wrong way in yaw)") +
                  ", impratio 100 (friction rows stiffer than the normal's: little creep while sticking), Newton solver with 100 "
-                 "iterations to 1e-12 (the contact problem solved, not approximated), solref (2 dt, 1) (the shortest time constant "
-                 "MuJoCo allows, critically damped), solimp 0.95 0.99 1e-4 (stiff), Euler integrator; the plate a 10 t free body set "
+                 "iterations to 1e-12 (the contact problem solved, not approximated), solref (4 dt, 1) (a few steps, critically damped: "
+                 "at MuJoCo's floor of 2 dt a sliding part hops, from ~10 dt on the soft contact turns it the wrong way), solimp 0.95 0.99 1e-4 (stiff), Euler integrator; the plate a 10 t free body set "
                  "to the plate's pose and velocity every step (a mocap body would have zero velocity in the contact rows); spheres r = " +
                  std::to_string(std::lround(rad * 1e6)) + " um";
     PlateTrack plate(sc.plate, opt.drift);
@@ -96,17 +102,17 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
     };
     r.t.push_back(0);
     r.q.push_back(read(q0[2]));
-    const long n = std::lround(duration / dt), every = std::max(1L, std::lround(sample_dt / dt));
     double cpu = 0;
     for (long k = 1; k <= n; ++k) {
         set_plate();
-        const auto c0 = std::chrono::steady_clock::now();
+        const double c0 = cpu_now();
         mj_step(m, d);
-        cpu += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
+        cpu += cpu_now() - c0;
         plate.advance(k * dt);
         if (k % every == 0 || k == n) {
             const Vec3 q = read(r.q.back()[2]);
             const double h = (plate.R.conjugate() * (Vec3(d->qpos[7], d->qpos[8], d->qpos[9]) - plate.p)).z();
+            r.max_lift = std::max(r.max_lift, std::abs(h - P.s_z()));
             if (!q.allFinite() || std::abs(h - P.s_z()) > 0.01) {
                 r.failure = "the part left the plate at t = " + std::to_string(k * dt) + " s";
                 break;

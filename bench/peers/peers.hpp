@@ -56,6 +56,7 @@ struct PeerOptions {
     // The pitfall, for the study and the tests to show: the engine's friction pyramid/box (MuJoCo's
     // default pyramidal cone, ODE's box along fixed directions; Bullet: two fixed friction directions).
     bool pyramid = false;
+    double contact_time = 0;       // MuJoCo's contact time constant (solref) [s]; 0: the driver's choice
 };
 
 struct PeerRun {
@@ -64,9 +65,15 @@ struct PeerRun {
     std::string failure;       // empty if the run went through
     std::vector<double> t;     // samples every sample_dt from 0
     std::vector<Vec3> q;       // (s_x, s_y, theta) in the plate frame
-    double cpu_seconds = 0;    // the engine's stepping only (set-up excluded)
+    double cpu_seconds = 0;    // the engine's stepping only (set-up excluded), this thread's CPU time
     long steps = 0;
+    double max_lift = 0;       // largest |centre of mass height above the plate - s_z| over the samples [m]
 };
+
+// This thread's CPU time [s] (the study runs one thread each).
+double cpu_now();
+// The whole number of steps dt in `span`; 0 and `failure` set if span is not one (samples would drift).
+long whole_steps(double span, double dt, std::string& failure);
 
 // One engine: its name and its run. The part starts at rest relative to the plate at q0.
 struct Engine {

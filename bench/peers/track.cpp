@@ -2,6 +2,7 @@
 #include "peers.hpp"
 
 #include <cmath>
+#include <ctime>
 
 namespace plate::peers {
 
@@ -55,6 +56,21 @@ void PlateTrack::advance(double to) {
     }
     t = to;
     read(to);
+}
+
+double cpu_now() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+long whole_steps(double span, double dt, std::string& failure) {
+    const long n = std::lround(span / dt);
+    if (n < 1 || std::abs(static_cast<double>(n) * dt - span) > 1e-9 * span) {
+        failure = "the step " + std::to_string(dt) + " s does not divide " + std::to_string(span) + " s";
+        return 0;
+    }
+    return n;
 }
 
 BodyState at_rest_on_plate(const Part& part, const PlateTrack& plate, const Vec3& q) {
