@@ -50,10 +50,13 @@ std::string machine() {
 
 void say(const std::string& s) { std::cerr << "bench_peers: " << s << std::endl; }
 
-std::string sci(double x) {   // 1e-05 -> "1e-05", 0.0003 -> "3e-04"
+std::string sci(double x) {   // 1e-05 -> "1e-05", 0.00025 -> "2.5e-04"
     char b[32];
-    std::snprintf(b, sizeof b, "%.0e", x);
-    return b;
+    std::snprintf(b, sizeof b, "%.1e", x);
+    std::string s = b;
+    const auto dot = s.find(".0e");
+    if (dot != std::string::npos) s.erase(dot, 2);
+    return s;
 }
 
 json point(const std::string& system, const std::string& setting, double cpu, double error, const std::string& failure = "") {
@@ -223,7 +226,7 @@ int main(int argc, char** argv) {
         }
         if (sticking_only && quick && idx.size() > 8) idx.resize(8);
         json pts = json::array();
-        for (double tol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
+        for (double tol : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
             LimitCycleOptions o;
             o.tol = tol;
             o.integration.rtol = tol / 10;
