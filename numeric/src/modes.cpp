@@ -207,14 +207,26 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     // Hessian unbounded): drawn there, the line search stalled with the gradient far from zero and
     // the gauge came out low (fig6 at (0.0167, 0, 2.693), t = 0.01759: 0.967 where the minimum gives
     // 0.992 -- the part was held 0.13 ms too long, its cycle's twist 1.8e-4 v_ref off the regularised
-    // reference). Then a compass search in the plane decides (h is convex: some of 64 directions
-    // descends until the step is at rounding), and Newton polishes a smooth minimum again.
+    // reference). Then the kinks and a pattern search in the plane decide (h is convex: one of 16
+    // directions descends until the step is at rounding).
     if (last_gy > 1e-7 * h * wn) {
-        double step = 0.1 / wn;
-        while (step > 1e-14 / wn) {
+        // (the minimum may sit at a kink whose test above failed by rounding: h there first)
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 e(R[k].y(), -R[k].x(), 1);
+            const double s = w.dot(e);
+            if (!(std::abs(s) > 1e-14 * wn * e.norm())) continue;
+            const double hk = h_at(e / s);
+            if (hk < h) {
+                h = hk;
+                y = B.transpose() * (e / s - d0);
+            }
+        }
+        // Pattern search: 16 directions, the step doubled after a success and halved after a failure.
+        double step = 1e-2 / wn;
+        while (step > 1e-9 / wn) {   // (h then within ~1e-18 of its minimum where smooth)
             bool better = false;
-            for (int k = 0; k < 64; ++k) {
-                const double a = 2 * kPi * k / 64;
+            for (int k = 0; k < 16; ++k) {
+                const double a = 2 * kPi * k / 16;
                 const Vec2 y1 = y + step * Vec2(std::cos(a), std::sin(a));
                 const double h1 = h_at(d0 + B * y1);
                 if (h1 < h) {
@@ -223,9 +235,9 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
                     better = true;
                 }
             }
-            d = d0 + B * y;
-            if (!better) step *= 0.5;
+            step = better ? std::min(2 * step, 1 / wn) : 0.5 * step;
         }
+        d = d0 + B * y;
     }
     finish(d, h);
     for (int i = 0; i < 3; ++i) {
