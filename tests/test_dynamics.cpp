@@ -464,6 +464,7 @@ TEST_CASE("the friction gauge is the support function's optimum: brute force, an
     for (std::uint64_t seed = 1; seed <= 100; ++seed) {
         const Scene sc = random_scene(seed);
         if (sc.part.point) continue;
+        ws.prepare(sc);   // (each seed's scene may sit at the last one's address: load its constants)
         for (int j = 0; j < 5; ++j) {
             const Vec3 q(0.01 * j - 0.02, 0.02 - 0.01 * j, 1.3 * j);
             const PlateState ps = plate_state(sc.plate, sc.plate.T * (0.13 + 0.17 * j), Dynamics::ReducedU);
