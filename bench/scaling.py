@@ -37,6 +37,8 @@ ap.add_argument("--source", default=str(pathlib.Path(__file__).resolve().parent.
 ap.add_argument("--mpirun", default=shutil.which("mpirun") or "")
 ap.add_argument("--quick", action="store_true", help="a quarter of the cases (a smoke run)")
 a = ap.parse_args()
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from report_section import splice  # noqa: E402
 src = pathlib.Path(a.source).resolve()
 plate = str(pathlib.Path(a.plate).resolve()) if a.plate else str(src / "build" / "plate")
 out = pathlib.Path(a.out).resolve()
@@ -275,19 +277,7 @@ are {'identical byte for byte' if fields_identical and designs_identical else '<
 The launcher's start-up is in the wall times above: {launch_sentence}.</p>
 """
 (out / "data" / "campaigns_section.html").write_text(section)
-index = out / "index.html"
-B, E = "<!-- campaigns:begin -->", "<!-- campaigns:end -->"
-if index.exists():
-    page = index.read_text()
-    if B in page and E in page:
-        page = page[:page.index(B) + len(B)] + section + page[page.index(E):]
-    elif "<!-- speed-accuracy:end -->" in page:   # (a page from before these markers: after the speed section)
-        page = page.replace("<!-- speed-accuracy:end -->", "<!-- speed-accuracy:end -->" + B + section + E, 1)
-    else:
-        page = page.replace("</body>", B + section + E + "\n</body>", 1)
-    tmp = index.with_suffix(".html.tmp")
-    tmp.write_text(page)
-    tmp.replace(index)
+splice(out, "<!-- campaigns:begin -->", "<!-- campaigns:end -->", section)
 shutil.rmtree(work, ignore_errors=True)
 print(json.dumps({k: data[k] for k in ("machine", "identical_tables", "fdatasync_seconds", "mean_case_seconds", "estimate")}, indent=1))
 for x in fields:

@@ -92,14 +92,13 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
                                 "slip), ") +
                  "collision margins 0.1 mm (the default 4 cm lifts a small part off the plate), no deactivation (a sleeping part "
                  "stops); the plate a kinematic body; spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
-    auto read = [&](double prev) {
+    auto record = [&](double t) {
         const btTransform& T = part.getCenterOfMassTransform();
         const btQuaternion q = T.getRotation();
         const Eigen::Quaterniond R = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()) * Vq.conjugate();
-        return plate_frame_config(P, plate, Vec3(T.getOrigin().x(), T.getOrigin().y(), T.getOrigin().z()), R.normalized(), prev);
+        return record_sample(r, P, plate, t, Vec3(T.getOrigin().x(), T.getOrigin().y(), T.getOrigin().z()), R, q0[2]);
     };
-    r.t.push_back(0);
-    r.q.push_back(read(q0[2]));
+    record(0);
     double cpu = 0;
     for (long k = 1; k <= n; ++k) {
         plate.advance(k * dt);   // the plate's pose at the end of the step
@@ -107,18 +106,7 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
         const double c0 = cpu_now();
         world.stepSimulation(dt, 0);
         cpu += cpu_now() - c0;
-        if (k % every == 0 || k == n) {
-            const Vec3 q = read(r.q.back()[2]);
-            const btVector3 o = part.getCenterOfMassPosition();
-            const double h = (plate.R.conjugate() * (Vec3(o.x(), o.y(), o.z()) - plate.p)).z();
-            r.max_lift = std::max(r.max_lift, std::abs(h - P.s_z()));
-            if (!q.allFinite() || std::abs(h - P.s_z()) > 0.01) {
-                r.failure = "the part left the plate at t = " + std::to_string(k * dt) + " s";
-                break;
-            }
-            r.t.push_back(k * dt);
-            r.q.push_back(q);
-        }
+        if ((k % every == 0 || k == n) && !record(k * dt)) break;
     }
     r.cpu_seconds = cpu;
     r.steps = n;

@@ -70,6 +70,11 @@ struct PeerRun {
     double max_lift = 0;       // largest |centre of mass height above the plate - s_z| over the samples [m]
 };
 
+// Records the part's body pose (x, R: its centre of mass and frame in W) at time t as a sample of r in
+// the plate frame, and its lift off the resting height; false (r.failure set) if it left the plate.
+bool record_sample(PeerRun& r, const Part& part, const PlateTrack& plate, double t, const Vec3& x,
+                   const Eigen::Quaterniond& R, double first_theta);
+
 // This thread's CPU time [s] (the study runs one thread each).
 double cpu_now();
 // The whole number of steps dt in `span`; 0 and `failure` set if span is not one (samples would drift).

@@ -28,6 +28,8 @@ ap.add_argument("--build", default=None)
 ap.add_argument("--quick", action="store_true")
 ap.add_argument("--data", default=None, help="chart this bench_peers JSON instead of running it")
 a = ap.parse_args()
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
+from report_section import splice  # noqa: E402
 src = pathlib.Path(__file__).resolve().parent.parent.parent
 build = pathlib.Path(a.build).resolve() if a.build else src / "build"
 out = pathlib.Path(a.out).resolve()
@@ -232,19 +234,7 @@ configurations: plate's stick-slip limit cycles against the engines' protocol.</
 {failures('d')}
 """
 (out / "data" / "peers_section.html").write_text(section)
-index = out / "index.html"
-B, E = "<!-- peers:begin -->", "<!-- peers:end -->"
-if index.exists():
-    page = index.read_text()
-    if B in page and E in page:
-        page = page[:page.index(B) + len(B)] + section + page[page.index(E):]
-    elif "<!-- speed-accuracy:end -->" in page:
-        page = page.replace("<!-- speed-accuracy:end -->", "<!-- speed-accuracy:end -->" + B + section + E, 1)
-    else:
-        page = page.replace("</body>", B + section + E + "\n</body>", 1)
-    tmp = index.with_suffix(".html.tmp")
-    tmp.write_text(page)
-    tmp.replace(index)
+splice(out, "<!-- peers:begin -->", "<!-- peers:end -->", section)
 if d is not None:
     for q in ("a", "b", "c", "d"):
         for r in d["ratios"][q]:

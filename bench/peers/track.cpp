@@ -1,6 +1,7 @@
 // The plate's trajectory as the full dynamics move it, and poses relative to it (peers.hpp).
 #include "peers.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 
@@ -71,6 +72,20 @@ long whole_steps(double span, double dt, std::string& failure) {
         return 0;
     }
     return n;
+}
+
+bool record_sample(PeerRun& r, const Part& part, const PlateTrack& plate, double t, const Vec3& x,
+                   const Eigen::Quaterniond& R, double first_theta) {
+    const Vec3 q = plate_frame_config(part, plate, x, R.normalized(), r.q.empty() ? first_theta : r.q.back()[2]);
+    const double lift = std::abs((plate.R.conjugate() * (x - plate.p)).z() - part.s_z());
+    r.max_lift = std::max(r.max_lift, lift);
+    if (!q.allFinite() || lift > 0.01) {
+        r.failure = "the part left the plate at t = " + std::to_string(t) + " s";
+        return false;
+    }
+    r.t.push_back(t);
+    r.q.push_back(q);
+    return true;
 }
 
 BodyState at_rest_on_plate(const Part& part, const PlateTrack& plate, const Vec3& q) {

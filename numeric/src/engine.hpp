@@ -363,19 +363,13 @@ private:
                 // heave_yaw (z 2, rz 60) at (0, 0.02, 0) had a contact slide at ~2e-9 m/s for 15 ms
                 // in steps of 3e-9 s, 3.2e6 right-hand sides a period.
                 slow_[i] = sn > 0 && sn < zero_abs_ ? slow_[i] + 1 : 0;
-                if ((creep_spent_ >> i & 1u) && slow_[i] >= recreep_need_[i]) {
+                const bool recreep = (creep_spent_ >> i & 1u) && slow_[i] >= recreep_need_[i];
+                if (recreep) {
                     creep_spent_ &= ~(1u << i);
                     recreep_need_[i] = std::min(2 * recreep_need_[i], 1 << 20);
                     slow_[i] = 0;
-                    ws.creep |= 1u << i;
-                    ws.hint[i] = slip[i] / sn;
-                    creep_err_[i] = 0;
-                    creep_dir_[i] = Vec2::Zero();
-                    creep_h_ = std::min(creep_h_, kCreepFirst * scene_.plate.T);
-                    changed = true;
-                    continue;
                 }
-                if (sn > 0 && sn < zero_abs_ && sn < std::abs(g0_[3 + i]) && !(creep_spent_ >> i & 1u)) {
+                if (recreep || (sn > 0 && sn < zero_abs_ && sn < std::abs(g0_[3 + i]) && !(creep_spent_ >> i & 1u))) {
                     ws.creep |= 1u << i;
                     ws.hint[i] = slip[i] / sn;
                     creep_err_[i] = 0;
