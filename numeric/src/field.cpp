@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <mutex>
 #include <sstream>
@@ -107,9 +108,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     // grid, against the 1e-11 cycles, in v_ref): along y with theta's line 3.6e-4 (cubic), 6.3e-4
     // (quadratic), 2.7e-3 (parallelogram); along y with x's line 2.6e-3 (quadratic) and 8.2e-3
     // (parallelogram); along x with theta's line 2.6e-3 (quadratic); the nearest neighbour alone
-    // 0.03-0.08. Phase 1, in order: the points (x, y_0, theta), then the lines (x, y, theta_0); phase 2,
-    // a task per plane x_i: its lines (x_i, y, theta_k), k >= 1, in order. Every prediction reads only
-    // points solved before it in the same task, so the field does not depend on the number of threads.
+    // 0.03-0.08. The lines and their order: below (A, B, C).
     auto X = [&](int i, int j, int k) { return start[grid.index(i, j, k)]; };
     // Extrapolation to index n from n-1, n-2, n-3 along a line, order 0-2 (backward differences).
     static constexpr double kExtrap[3][3] = {{1, 0, 0}, {2, -1, 0}, {3, -3, 1}};
@@ -140,16 +139,56 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         if (n == 0 && k > 0 && X(i, j, k - 1).allFinite()) return X(i, j, k - 1).cwiseProduct(S);
         return Vec3::Zero();
     };
-    // Phase 1 (shooting): the points (x, y_0, theta), then the lines (x, y, theta_0), in order.
+    // The shooting field's lines and what each start is predicted from (warm above):
+    //   A_k (k = 0..nth-1): the points (x_i, y_0, theta_k), i = 0..nx-1, along x; after A_{k-1};
+    //   B_i (i = 0..nx-1):  the points (x_i, y_j, theta_0), j >= 1, along y;    after A_0, B_{i-1};
+    //   C_ik (k >= 1):      the points (x_i, y_j, theta_k), j >= 1, along y;    after A_k and
+    //                       C_i,k-1 (B_i for k = 1).
+    // Every prediction reads only points of lines before it in that order, and each line's first step
+    // is the step hint of a fixed point of a line before it (A_k: (x_0, y_0, theta_k-1); B_i and C_ik:
+    // (x_i, y_0, theta_k)), then each point's goes to the next. So the field is the same however the
+    // lines are scheduled: threads take any line whose predecessors are done (critical path ~ a
+    // quarter of the 7^3 grid), a task runner gets the planes {C_ik, k >= 1} after every process has
+    // solved the A and B lines.
+    std::vector<double> hint(grid.size(), 0.0);
+    struct Line { char kind; int i, k; };   // 'A': k; 'B': i; 'C': i, k
+    auto line_points = [&](const Line& l) {
+        std::vector<int> idx;
+        if (l.kind == 'A') for (int i = 0; i < grid.nx; ++i) idx.push_back(grid.index(i, 0, l.k));
+        else for (int j = 1; j < grid.ny; ++j) idx.push_back(grid.index(l.i, j, l.kind == 'B' ? 0 : l.k));
+        return idx;
+    };
+    auto run_line = [&](const Line& l) {
+        const std::vector<int> idx = line_points(l);
+        if (idx.empty()) return;
+        double h0 = l.kind == 'A' ? (l.k > 0 ? hint[grid.index(0, 0, l.k - 1)] : 0.0)
+                                  : hint[grid.index(l.i, 0, l.kind == 'B' ? 0 : l.k)];
+        for (int id : idx) {
+            const int i = id / (grid.ny * grid.nth), j = (id / grid.nth) % grid.ny, k = id % grid.nth;
+            solve(i, j, k, warm(i, j, k), h0);
+            hint[id] = h0;
+        }
+    };
+    std::vector<Line> lines;   // in an order that respects the predecessors
     if (shooting) {
-        double h0 = 0;
-        for (int i = 0; i < grid.nx; ++i)
-            for (int k = 0; k < grid.nth; ++k) solve(i, 0, k, warm(i, 0, k), h0);
-        for (int i = 0; i < grid.nx; ++i)
-            for (int j = 1; j < grid.ny; ++j) solve(i, j, 0, warm(i, j, 0), h0);
+        for (int k = 0; k < grid.nth; ++k) lines.push_back({'A', 0, k});
+        for (int i = 0; i < grid.nx; ++i) lines.push_back({'B', i, 0});
     }
-    const int first_done = done.load();
-    // The task t: with shooting the plane x_t (its points but the lines above), else the line
+    const int phase1_lines = static_cast<int>(lines.size());
+    if (shooting)
+        for (int i = 0; i < grid.nx; ++i)
+            for (int k = 1; k < grid.nth; ++k) lines.push_back({'C', i, k});
+    auto predecessors = [&](const Line& l) {
+        std::vector<int> d;   // indices into lines
+        if (l.kind == 'A' && l.k > 0) d.push_back(l.k - 1);
+        if (l.kind == 'B') { d.push_back(0); if (l.i > 0) d.push_back(grid.nth + l.i - 1); }
+        if (l.kind == 'C') {
+            d.push_back(l.k);
+            d.push_back(l.k == 1 ? grid.nth + l.i : phase1_lines + l.i * (grid.nth - 1) + l.k - 2);
+        }
+        return d;
+    };
+    // A runner's task t: with shooting the plane x_t (its lines C_tk), else the line
     // (x_i, y_j, theta) with t = i ny + j.
     const int tasks = shooting ? grid.nx : rows;
     auto task_points = [&](int t) {
@@ -163,11 +202,10 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         return idx;
     };
     auto run_task = [&](int t) {
-        double h0 = 0;
         if (shooting) {
-            for (int k = 1; k < grid.nth; ++k)
-                for (int j = 1; j < grid.ny; ++j) solve(t, j, k, warm(t, j, k), h0);
+            for (int k = 1; k < grid.nth; ++k) run_line({'C', t, k});
         } else {
+            double h0 = 0;
             Vec3 w = Vec3::Zero();
             for (int k = 0; k < grid.nth; ++k) {
                 const LimitCycleSummary lc = solve(t / grid.ny, t % grid.ny, k, opt.warm_start ? w : Vec3::Zero(), h0);
@@ -175,6 +213,10 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
             }
         }
     };
+    const int first_done = opt.tasks && shooting ? [&] {
+        for (int n = 0; n < phase1_lines; ++n) run_line(lines[n]);
+        return done.load();
+    }() : 0;
     if (opt.tasks) {
         // A task's text: its points' results, doubles exact (q follows from the grid).
         report_progress = false;
@@ -217,15 +259,53 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
                   });
         f.threads = 0;
     } else {
-        threads = std::max(1, std::min(threads, tasks));
-        f.threads = threads;
-        auto worker = [&]() {
-            for (int t; (t = next.fetch_add(1)) < tasks;) run_task(t);
-        };
-        std::vector<std::thread> pool;
-        for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-        worker();
-        for (auto& t : pool) t.join();
+        if (shooting) {
+            // Threads take the first line (in `lines` order) whose predecessors are done.
+            const int n = static_cast<int>(lines.size());
+            std::vector<int> waiting(n, 0);
+            std::vector<std::vector<int>> after(n);
+            for (int l = 0; l < n; ++l)
+                for (int d : predecessors(lines[l])) { ++waiting[l]; after[d].push_back(l); }
+            std::vector<char> taken(n, 0);
+            int finished = 0;
+            std::mutex m;
+            std::condition_variable cv;
+            threads = std::max(1, std::min(threads, n));
+            f.threads = threads;
+            auto worker = [&]() {
+                std::unique_lock<std::mutex> lock(m);
+                for (;;) {
+                    int l = -1;
+                    cv.wait(lock, [&] {
+                        for (int c = 0; c < n; ++c)
+                            if (!taken[c] && waiting[c] == 0) { l = c; return true; }
+                        return finished == n;
+                    });
+                    if (l < 0) return;
+                    taken[l] = 1;
+                    lock.unlock();
+                    run_line(lines[l]);
+                    lock.lock();
+                    ++finished;
+                    for (int a : after[l]) --waiting[a];
+                    cv.notify_all();
+                }
+            };
+            std::vector<std::thread> pool;
+            for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+            worker();
+            for (auto& t : pool) t.join();
+        } else {
+            threads = std::max(1, std::min(threads, tasks));
+            f.threads = threads;
+            auto worker = [&]() {
+                for (int t; (t = next.fetch_add(1)) < tasks;) run_task(t);
+            };
+            std::vector<std::thread> pool;
+            for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+            worker();
+            for (auto& t : pool) t.join();
+        }
     }
     for (const auto& p : f.points) f.rhs_evals += p.rhs_evals;
     // Over budget when the work exceeded it, however it was shared: each process cuts its own work
