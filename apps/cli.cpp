@@ -168,6 +168,17 @@ public:
                                           v = s;
                                       });
     }
+    // From lo to hi words.
+    void words(const std::string& name, std::vector<std::string>& v, std::size_t lo, std::size_t hi, const std::string& names,
+               const std::string& help) {
+        add<std::vector<std::string>>(name, static_cast<int>(hi), names, help,
+                                      [name, &v, lo, hi](const std::vector<std::string>& s) {
+                                          if (s.size() < lo || s.size() > hi)
+                                              throw UsageError("option " + name + " expects " + std::to_string(lo) +
+                                                               " to " + std::to_string(hi) + " values");
+                                          v = s;
+                                      });
+    }
     void text(const std::string& name, std::string& s, const std::string& value, const std::string& help) {
         add<std::string>(name, 1, value, help, [&s](const std::string& t) { s = t; });
     }
@@ -821,16 +832,20 @@ struct DesignArgs : Options {
     int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations;
     explicit DesignArgs(CLI::App* cmd)
         : Options(cmd, "Designs a plate motion for the part of PART_SCENE (its plate block is ignored but for its period)\n"
-                       "and verifies it before reporting. Targets (point parts in this version):\n"
-                       "  sink X Y          (or fixed-point X Y) the unique stable fixed point of the velocity field at (X, Y)\n"
-                       "  transport VX VY   a uniform velocity (VX, VY) [m/s] over the plate\n"
+                       "and verifies it before reporting. Targets:\n"
+                       "  sink X Y          point part: the unique stable fixed point of the velocity field at (X, Y)\n"
+                       "  fixed-point X Y THETA  rigid part: (X, Y, THETA) the unique stable fixed point of the twist field\n"
+                       "                    (or, where that is out of reach, the target's basin share and the competing\n"
+                       "                    fixed points); point part: fixed-point X Y = sink X Y\n"
+                       "  orient THETA      rigid part: every start ends at orientation THETA (position free)\n"
+                       "  transport VX VY   point part: a uniform velocity (VX, VY) [m/s] over the plate\n"
                        "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
                        "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
                        "seeded feasible motions (default 16), --evaluations each (default 400). Verification: the field's\n"
                        "fixed points on a 7x7 grid and full dynamics from 20 seeded random starts. Writes the designed\n"
                        "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
-        words("--target", target, 3, "KIND A B", "sink X Y, fixed-point X Y or transport VX VY; required");
+        words("--target", target, 2, 4, "KIND ...", "sink X Y, fixed-point X Y [THETA], orient THETA or transport VX VY; required");
         text("--out", out, "SCENE.json", "the designed scene; required");
         numbers("--limits", limits, 2, 2, "LIN ANG", "the largest harmonic amplitudes (default 20 m/s^2, 150 rad/s^2)");
         number("--period", period, "the plate's period [s]", "the part scene's");
@@ -848,13 +863,24 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     if (!a.has("--out")) throw UsageError("missing --out SCENE.json");
     const std::string kind = a.target[0];
     DesignTarget t;
-    const Vec2 ab(parse_num("--target", a.target[1]), parse_num("--target", a.target[2]));
-    if (kind == "sink" || kind == "fixed-point") t.at = ab;
-    else if (kind == "transport") {
+    std::vector<double> v;
+    for (std::size_t i = 1; i < a.target.size(); ++i) v.push_back(parse_num("--target", a.target[i]));
+    const std::size_t want = kind == "orient" ? 1 : kind == "fixed-point" && !part.part.point ? 3 : 2;
+    const std::string usage = "expected sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA "
+                              "or transport VX VY";
+    if (v.size() != want) throw UsageError("--target " + kind + ": " + usage);
+    if (kind == "sink" || kind == "fixed-point") {
+        t.kind = kind == "sink" ? DesignTargetKind::Sink : DesignTargetKind::FixedPoint;
+        t.at = Vec2(v[0], v[1]);
+        if (v.size() == 3) t.theta = v[2];
+    } else if (kind == "orient") {
+        t.kind = DesignTargetKind::Orient;
+        t.theta = v[0];
+    } else if (kind == "transport") {
         t.kind = DesignTargetKind::Transport;
-        t.velocity = ab;
+        t.velocity = Vec2(v[0], v[1]);
     } else {
-        throw UsageError("--target: expected sink X Y, fixed-point X Y or transport VX VY, got '" + kind + "'");
+        throw UsageError("--target: " + usage + ", got '" + kind + "'");
     }
     DesignOptions o;
     if (a.has("--limits")) {
@@ -880,17 +906,35 @@ int cmd_design(const DesignArgs& a, Io& cio) {
         throw UsageError(e.what());
     }
     if (cio.farm && !cio.farm->root()) return d.verified ? 0 : 4;
-    const bool sink = t.kind == DesignTargetKind::Sink;
+    const bool transport = t.kind == DesignTargetKind::Transport, rigid = !part.part.point;
     nlohmann::json j;
-    j["target"] = {{"kind", sink ? "sink" : "transport"}, {sink ? "at" : "velocity", {ab.x(), ab.y()}}};
+    j["target"] = {{"kind", kind}};
+    if (transport) j["target"]["velocity"] = {t.velocity.x(), t.velocity.y()};
+    else if (t.kind != DesignTargetKind::Orient) j["target"]["at"] = {t.at.x(), t.at.y()};
+    if (rigid) j["target"]["theta"] = t.theta;
     j["verified"] = d.verified;
     if (!d.verified) j["failure"] = d.failure;
     j["scene"] = a.out;
-    if (sink) {
+    if (!transport) {
         j["unique"] = d.unique;
         j["convergence_rate_per_s"] = d.rate;
-        j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1]};
-        j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]), complex_json(d.fixed_point_eigenvalues[1])};
+        if (rigid) {
+            j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1], d.fixed_point[2]};
+            j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]),
+                                            complex_json(d.fixed_point_eigenvalues[1]),
+                                            complex_json(d.fixed_point_eigenvalues[2])};
+            j["basin_share"] = d.basin_share;
+            nlohmann::json comp = nlohmann::json::array();
+            for (const auto& c : d.competitors)
+                comp.push_back({{"at", {c.point.q[0], c.point.q[1], c.point.q[2]}},
+                                {"eigenvalues", {complex_json(c.point.eigenvalues[0]), complex_json(c.point.eigenvalues[1]),
+                                                 complex_json(c.point.eigenvalues[2])}},
+                                {"basin_share", c.basin_share}});
+            j["competing_fixed_points"] = comp;
+        } else {
+            j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1]};
+            j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]), complex_json(d.fixed_point_eigenvalues[1])};
+        }
         j["fixed_points_on_grid"] = fixed_points_sentence(d.fixed_points);
     } else {
         j["mean_velocity"] = {d.transport_mean.x(), d.transport_mean.y()};
@@ -899,7 +943,9 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     }
     nlohmann::json runs = nlohmann::json::array();
     for (const DesignStartRun& r : d.runs) {
-        nlohmann::json x = {{"start", {r.x, r.y}}, {"seconds", r.seconds}, {"end_distance", r.end_distance}};
+        nlohmann::json x = {{"start", rigid ? nlohmann::json{r.x, r.y, r.theta} : nlohmann::json{r.x, r.y}},
+                            {"end", rigid ? nlohmann::json{r.end[0], r.end[1], r.end[2]} : nlohmann::json{r.end[0], r.end[1]}},
+                            {"seconds", r.seconds}, {"end_distance", r.end_distance}};
         if (!r.stop.empty()) x["stop"] = r.stop;
         runs.push_back(x);
     }
@@ -1104,7 +1150,7 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
     BenchArgs bench(
         command("bench", "the speed-accuracy study, written into the report in DIR (--full: the long campaign)"));
     DesignArgs design(
-        command("design", "the plate motion that sends a (point) part where wanted: a sink or a transport, verified"));
+        command("design", "the plate motion that sends a part where wanted: a sink, fixed point, orientation or transport, verified"));
     SweepArgs sweep_cmd(command("sweep", "a campaign over parameters (resumable; shared over mpirun ranks), a table per case"));
     const std::pair<const Options*, std::function<int()>> commands[] = {
         {&twist, [&] { return cmd_twist(twist, cio); }},

@@ -55,6 +55,23 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D) {
     return r;
 }
 
+double coning_rate(const PlateMotion& u) {
+    // Phasors amp e^{i phase} of rx and ry per harmonic n: sum_n Im(A_rx conj(A_ry)) / (2 (n w)^3).
+    std::map<int, std::complex<double>> rx, ry;
+    for (const Harmonic& h : u.harmonics) {
+        if (h.axis == Axis::rx) rx[h.n] += std::polar(h.amp, h.phase);
+        if (h.axis == Axis::ry) ry[h.n] += std::polar(h.amp, h.phase);
+    }
+    double r = 0;
+    for (const auto& [n, a] : rx) {
+        const auto b = ry.find(n);
+        if (b == ry.end()) continue;
+        const double nw = n * 2 * kPi / u.T;
+        r += std::imag(a * std::conj(b->second)) / (2 * nw * nw * nw);
+    }
+    return r;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -105,6 +122,20 @@ PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& a
     return u;
 }
 
+// The coefficients of u in motion_from's layout; empty if u has a harmonic outside it.
+std::vector<double> params_from(const PlateMotion& u, const std::vector<Axis>& axes, const std::vector<int>& harmonics) {
+    const int H = static_cast<int>(harmonics.size());
+    std::vector<double> p(2 * axes.size() * H, 0.0);
+    for (const auto& [k, z] : phasors(u)) {
+        const auto a = std::find(axes.begin(), axes.end(), static_cast<Axis>(k.first)) - axes.begin();
+        const auto h = std::find(harmonics.begin(), harmonics.end(), k.second) - harmonics.begin();
+        if (a == static_cast<long>(axes.size()) || h == H) return {};
+        p[2 * (a * H + h)] = z.imag();       // amp sin(phase): the cosine's coefficient
+        p[2 * (a * H + h) + 1] = z.real();   // amp cos(phase): the sine's
+    }
+    return p;
+}
+
 // The option's task runner, else its threads.
 TaskRunner runner(const DesignOptions& opt) { return opt.tasks ? opt.tasks : thread_tasks(opt.threads); }
 
@@ -118,6 +149,7 @@ struct Problem {
     const DesignOptions& opt;
     double T;
     std::atomic<long>* cycles;
+    std::vector<double> guess;   // a first start (the part scene's motion), if the problem can express it
     long evaluations = 0;
     // The best point evaluated that satisfies every constraint (COBYLA's own answer may violate one
     // by its tolerance: the limits and the flight margin are hard, so that is never taken).
@@ -148,8 +180,9 @@ struct Problem {
     }
 };
 
-// The multi-start search: from opt.starts seeded feasible random points (each parameter uniform in
-// +-limit/sqrt 2, up to 1000 tries), NLopt COBYLA with the constraints, opt.local_evaluations each,
+// The multi-start search: from opt.starts seeded feasible random points (start 0: the problem's guess
+// if it has a feasible one; else each parameter uniform in +-limit/sqrt 2, the box shrinking after
+// every 100 infeasible tries, up to 1000), NLopt COBYLA with the constraints, opt.local_evaluations each,
 // starts in parallel; make(k) builds start k's problem. Returns the best feasible point over the
 // starts (empty if none) and adds the evaluations to `evaluations`.
 template <class P, class Make>
@@ -167,8 +200,17 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
         Rng rng(opt.seed * 1000003 + static_cast<std::uint64_t>(k));
         std::vector<double> p(n), lo(n), hi(n), step(n);
         bool ok = false;
+        // Start 0 from the part scene's own plate motion when the problem can express it and it is
+        // feasible (the "starting guess").
+        if (k == 0 && !prob.guess.empty()) {
+            p = prob.guess;
+            ok = prob.feasible(p);
+        }
+        // (every 100 infeasible draws the box shrinks by 0.7: with z and rx, ry motion most of the full
+        // box lets the part fly)
         for (int tries = 0; tries < 1000 && !ok; ++tries) {
-            for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) / std::sqrt(2.0);
+            const double box = std::pow(0.7, tries / 100) / std::sqrt(2.0);
+            for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) * box;
             ok = prob.feasible(p);
         }
         if (!ok) return "inf 0 0";
@@ -227,6 +269,7 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
     g.nth = 1;
     g.x0 = g.y0 = -opt.region;
     g.x1 = g.y1 = opt.region;
+    if (!sc.part.point) g.nth = opt.verify_grid;   // theta: a full turn
     FieldOptions fo;
     fo.threads = opt.threads;
     fo.tasks = opt.tasks;
@@ -236,25 +279,32 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
 template <class Seconds, class EndDistance>
 int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& seconds, EndDistance&& end_distance) {
     Rng rng(opt.seed ^ 0x5DEECE66DULL);
+    const bool rigid = !sum.scene.part.point;
     sum.runs.resize(opt.verify_starts);
     for (DesignStartRun& r : sum.runs) {
         r.x = rng.uniform(-opt.region, opt.region);
         r.y = rng.uniform(-opt.region, opt.region);
+        if (rigid) r.theta = rng.uniform(-kPi, kPi);   // (drawn after x, y: point parts' starts unchanged)
         r.seconds = seconds(Vec2(r.x, r.y));
     }
     runner(opt)(static_cast<int>(sum.runs.size()), [&](int k) {
-        const DesignStartRun& r = sum.runs[k];
+        DesignStartRun r = sum.runs[k];
         IntegrationOptions io;
         io.rtol = 1e-7;
-        const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, 0), Vec3::Zero(), r.seconds, r.seconds, io);
-        const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity()
-                                            : end_distance(r, Vec2(tr.samples.back().q.head<2>()));
-        // (text: the distance, then why the run stopped early, if it did)
-        return exact_text(d) + (tr.stop.reason != StopReason::None ? ' ' + tr.stop.describe() : std::string());
+        const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds, r.seconds, io);
+        r.end = tr.samples.empty() ? Vec3::Constant(std::numeric_limits<double>::quiet_NaN()) : tr.samples.back().q;
+        const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity() : end_distance(r, r.end);
+        // (text: the distance, the end, then why the run stopped early, if it did)
+        return exact_text(d) + ' ' + exact_text(r.end[0]) + ' ' + exact_text(r.end[1]) + ' ' + exact_text(r.end[2]) +
+               (tr.stop.reason != StopReason::None ? ' ' + tr.stop.describe() : std::string());
     }, [&](int k, const std::string& text) {
-        const std::size_t sp = text.find(' ');
-        sum.runs[k].end_distance = exact_value(text.substr(0, sp));
-        sum.runs[k].stop = sp == std::string::npos ? std::string() : text.substr(sp + 1);
+        std::istringstream in(text);
+        std::string x[4];
+        for (auto& w : x) in >> w;
+        DesignStartRun& r = sum.runs[k];
+        r.end_distance = exact_value(x[0]);
+        r.end = Vec3(exact_value(x[1]), exact_value(x[2]), exact_value(x[3]));
+        std::getline(in >> std::ws, r.stop);
     });
     int stopped = 0;
     sum.worst_end_distance = 0;
@@ -381,7 +431,7 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
             const double d0 = (start - target.at).norm();
             return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
         },
-        [&](const DesignStartRun&, const Vec2& end) { return (end - target.at).norm(); });
+        [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); });
     if (!sum.unique)
         sum.failure = "the designed field has " + std::to_string(stable) + " stable fixed point(s) or line(s) on the " +
                       std::to_string(opt.verify_grid) + "x" + std::to_string(opt.verify_grid) + " grid, " +
@@ -457,7 +507,9 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     const int stopped = verification_runs(
         sum, opt, [&](const Vec2&) { return std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0); },   // a region's width
         // the distance from where the target velocity would have taken it
-        [&](const DesignStartRun& r, const Vec2& end) { return (end - Vec2(r.x, r.y) - target.velocity * r.seconds).norm(); });
+        [&](const DesignStartRun& r, const Vec3& end) {
+            return (end.head<2>() - Vec2(r.x, r.y) - target.velocity * r.seconds).norm();
+        });
     sum.unique = true;   // (no fixed point is sought)
     if (undefined) sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
     else if (!((sum.transport_mean - target.velocity).norm() <= sum.transport_tolerance))
@@ -475,6 +527,236 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     return sum;
 }
 
+// --- the rigid part's fixed point (and orientation) ----------------------------------------------
+// Parameters: cosine and sine coefficients of harmonics n = 1, 2 on all six axes (24). z, rz and the
+// second harmonics break the pairing of fixed points (s, theta), (-s, theta + pi) that odd x, y, rx,
+// ry motions force (design.hpp), so the centre is no longer a fixed point by construction: the search
+// makes (0, 0, 0) one -- fast, and pulling the region's edge and every orientation towards it -- and
+// the fixed point found near the centre, q*, is then placed exactly on the target by the two
+// symmetries: turned by THETA - theta*, shifted by the target minus the turned s*.
+PlateMotion rigid_motion(const std::vector<double>& p, double T) {
+    return motion_from(p, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, {1, 2}, T);
+}
+
+constexpr double kConingLimit = 1e-4;   // [rad/s] (coning_rate, design.hpp): 0.01 rad of lag at 0.01 1/s
+
+// Constraints c_k <= 0 on a motion as placed: each (axis, n) amplitude within its limit times
+// `room`, no flight over the region, and no coning beyond kConingLimit either way.
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, double g, double room, double* c) {
+    const auto ph = phasors(fin);
+    int k = 0;
+    for (int axis = 0; axis < 6; ++axis)
+        for (int n = 1; n <= 2; ++n) {
+            const auto it = ph.find({axis, n});
+            const double amp = it == ph.end() ? 0.0 : std::abs(it->second);
+            const double lim = axis < 3 ? opt.lin_limit : opt.ang_limit;
+            c[k++] = (amp - room * lim) / std::max(lim, 1e-12);
+        }
+    c[k++] = opt.flight_margin - vertical_margin(fin, g, opt.region);
+    const double cone = coning_rate(fin) / kConingLimit;
+    c[k++] = cone - 1;
+    c[k] = -cone - 1;
+}
+
+// The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
+// from the cycle at q. False if a cycle did not converge.
+bool twist_and_jacobian(const Scene& sc, const Vec3& q, const LimitCycleOptions& cyc, Vec3& xi, Mat3& J,
+                        std::atomic<long>& cycles) {
+    const LimitCycleSummary c0 = limit_cycle(sc, q, cyc);
+    ++cycles;
+    if (!c0.converged) return false;
+    xi = c0.twist;
+    const double h[3] = {0.003, 0.003, 0.1};
+    for (int d = 0; d < 3; ++d) {
+        Vec3 e = Vec3::Zero();
+        e[d] = h[d];
+        const LimitCycleSummary p = limit_cycle(sc, q + e, cyc, c0.qd_start), m = limit_cycle(sc, q - e, cyc, c0.qd_start);
+        cycles += 2;
+        if (!p.converged || !m.converged) return false;
+        J.col(d) = (p.twist - m.twist) / (2 * h[d]);
+    }
+    return true;
+}
+
+struct RigidProblem : Problem<RigidProblem> {
+    RigidProblem(const Scene& part_, const DesignTarget& t_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
+        : Problem(part_, opt_, T_, cycles_), target(t_) {
+        if (std::abs(part_.plate.T - T_) <= 1e-12 * T_)
+            guess = params_from(part_.plate, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, {1, 2});
+    }
+    DesignTarget target;
+    static constexpr int kParams = 24;
+    static constexpr int kConstraints = 15;   // twelve amplitudes, the flight margin, coning both ways
+    // The search keeps 3% of each limit in hand for the final placement's correction (shifting by the
+    // found fixed point's offset, a few mm, adds alpha x offset to the linear amplitudes).
+    static constexpr double kRoom = 0.97;
+    double limit(int i) const { return i < 12 ? opt.lin_limit : opt.ang_limit; }
+    void constraints(const std::vector<double>& p, double* c) const {
+        placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt,
+                           part.g, kRoom, c);
+    }
+    // -rate at the centre, plus how far the centre is from being the fixed point (the Newton step
+    // J^-1 xi there, over 1 cm / 0.1 rad), plus how much the region's edge (8 points, theta = 0) and
+    // the orientations at the centre (8, all round) are not drawn towards the centre.
+    double evaluate(const std::vector<double>& p, double* rate_out = nullptr, Eigen::Vector3cd* eig_out = nullptr) {
+        ++evaluations;
+        Scene sc = part;
+        sc.plate = rigid_motion(p, T);
+        Vec3 xi;
+        Mat3 J;
+        if (!twist_and_jacobian(sc, Vec3::Zero(), opt.cycle, xi, J, *cycles)) return 1e3;
+        const Eigen::Vector3cd ev = J.eigenvalues();
+        const double rate = -std::max({ev[0].real(), ev[1].real(), ev[2].real()});
+        if (rate_out) *rate_out = rate;
+        if (eig_out) *eig_out = ev;
+        const Vec3 step = J.fullPivLu().solve(xi);
+        const double off = step.allFinite() ? std::hypot(step.head<2>().norm() / 0.01, step[2] / 0.1) : 10.0;
+        double outward = 0;
+        const double R = opt.region;
+        const Vec2 edge[8] = {{-R, -R}, {0, -R}, {R, -R}, {R, 0}, {R, R}, {0, R}, {-R, R}, {-R, 0}};
+        for (const Vec2& s : edge) {
+            const LimitCycleSummary c = limit_cycle(sc, Vec3(s.x(), s.y(), 0), opt.cycle);
+            ++*cycles;
+            if (!c.converged) return 1e3;
+            outward += std::max(0.0, s.dot(c.twist.head<2>()) / s.squaredNorm());   // [1/s]
+        }
+        Vec3 warm = Vec3::Zero();
+        for (int k = 0; k < 8; ++k) {
+            const double th = -kPi + (k + 0.5) * kPi / 4;
+            const LimitCycleSummary c = limit_cycle(sc, Vec3(0, 0, th), opt.cycle, warm);
+            ++*cycles;
+            if (!c.converged) return 1e3;
+            warm = c.qd_start;
+            outward += std::max(0.0, c.twist[2] * th / (th * th));   // [1/s]
+        }
+        return -rate + 10 * outward + 5 * off * off;
+    }
+};
+
+DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
+    const auto t0 = Clock::now();
+    DesignSummary sum;
+    const bool orient = target.kind == DesignTargetKind::Orient;
+    sum.notes.push_back("harmonics n = 1, 2 on x, y, z, rx, ry, rz: z, rz and n = 2 break the pairing of fixed points "
+                        "(s, theta), (-s, theta + pi) that odd x, y, rx, ry motions force");
+    sum.notes.push_back("designed for a fixed point at the centre, theta = 0; the one found, q*, placed on the target by "
+                        "turning the motion by THETA - theta* (the field turns) and adding -alpha x D (the field shifts by D)");
+    sum.notes.push_back("no coning (|rx, ry out of phase| turns the plate about z, which the field does not see and the "
+                        "full dynamics does): the plate's yaw drift held within 1e-4 rad/s");
+    if (orient) sum.notes.push_back("orient: designed as a fixed point at the region's centre with orientation THETA "
+                                    "(a stronger target); verified on the orientation only");
+    std::atomic<long> cycles{0};
+    const auto make = [&] { return RigidProblem(part_scene, target, opt, T, &cycles); };
+    const std::vector<double> best = multistart<RigidProblem>(opt, -HUGE_VAL, make, sum.evaluations);
+    start_summary(sum, part_scene, orient ? "_orient" : "_fixed_point", T);
+    auto finish = [&] {
+        sum.cycles = cycles;
+        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        return sum;
+    };
+    if (best.empty()) {
+        sum.failure = kNoFeasibleMotion;
+        return finish();
+    }
+    make().evaluate(best, &sum.rate, &sum.eigenvalues3);
+    // The fixed point near the centre: Newton with the central-difference Jacobian, at the
+    // refinement's tolerances (FixedPointOptions: field noise well below the step).
+    Scene centred = part_scene;
+    centred.plate = rigid_motion(best, T);
+    LimitCycleOptions fine = opt.cycle;
+    fine.integration.rtol = 1e-9;
+    fine.tol = 1e-8;
+    Vec3 q = Vec3::Zero();
+    bool found = false;
+    for (int it = 0; it < 12; ++it) {
+        Vec3 xi;
+        Mat3 J;
+        if (!twist_and_jacobian(centred, q, fine, xi, J, cycles)) break;
+        const Vec3 step = J.fullPivLu().solve(xi);
+        if (!step.allFinite()) break;
+        q -= step;
+        if (step.head<2>().norm() < 1e-7 && std::abs(step[2]) < 1e-6) { found = true; break; }
+    }
+    if (!found || q.head<2>().norm() > opt.region || std::abs(q[2]) > kPi / 2) {
+        sum.failure = "the search's best motion has no fixed point near the design's centre";
+        return finish();
+    }
+    const double turn = target.theta - q[2];
+    const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
+    const Vec2 at = orient ? Vec2::Zero() : target.at;
+    sum.scene.plate = combined(shift_motion(rotate_motion(centred.plate, turn), at - s_turned));
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    double c[RigidProblem::kConstraints];
+    placed_constraints(sum.scene.plate, opt, sum.scene.g, 1.0, c);
+    if (*std::max_element(c, c + RigidProblem::kConstraints) > 1e-9) {
+        sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning limit";
+        return finish();
+    }
+    const Vec3 goal(at.x(), at.y(), wrap_angle(target.theta));
+    auto reached = [&](const Vec3& a, const Vec3& b, double dist, double ang) {
+        return (orient || (a.head<2>() - b.head<2>()).norm() <= dist) && std::abs(wrap_angle(a[2] - b[2])) <= ang;
+    };
+
+    // --- verification: the field's fixed points on the 7^3 grid, then full dynamics from random starts.
+    sum.fixed_points = find_fixed_points(sum.scene, verification_field(sum.scene, opt));
+    int stable = 0, stable_at_target = 0;
+    double nearest = std::numeric_limits<double>::infinity();
+    std::vector<FixedPoint> others;
+    for (const FixedPoint& p : sum.fixed_points.points) {
+        if (p.stability != Stability::Stable) continue;
+        ++stable;
+        const double d = std::hypot(orient ? 0.0 : (p.q.head<2>() - at).norm() / 0.002, wrap_angle(p.q[2] - goal[2]) / 0.02);
+        if (d < nearest) {
+            nearest = d;
+            sum.fixed_point = p.q;
+            sum.fixed_point_eigenvalues = p.eigenvalues;
+        }
+        if (reached(p.q, goal, opt.fixed_point_tolerance, 0.02)) ++stable_at_target;
+        else others.push_back(p);
+    }
+    int stable_lines = 0;
+    for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
+    sum.unique = stable == 1 && stable_at_target == 1 && stable_lines == 0;
+    const double rate = std::max(sum.rate, 1e-3);
+    const int stopped = verification_runs(
+        sum, opt,
+        [&](const Vec2&) {
+            // The slowest mode brings a start from across the region within a fifth of the distance asked.
+            return std::clamp(std::log(2 * opt.region / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
+        },
+        [&](const DesignStartRun&, const Vec3& end) {
+            return std::max(orient ? 0.0 : (end.head<2>() - at).norm(),
+                            std::abs(wrap_angle(end[2] - goal[2])) * opt.verify_distance / 0.05);
+        });
+    // The basin shares: of the runs, those that end at the target and at each competing stable point.
+    int at_target = 0;
+    for (const DesignStartRun& r : sum.runs) at_target += r.stop.empty() && r.end_distance <= opt.verify_distance;
+    sum.basin_share = sum.runs.empty() ? 0.0 : static_cast<double>(at_target) / sum.runs.size();
+    int accounted = at_target;
+    for (const FixedPoint& p : others) {
+        int n = 0;
+        for (const DesignStartRun& r : sum.runs) n += r.stop.empty() && reached(r.end, p.q, opt.verify_distance, 0.05);
+        accounted += n;
+        sum.competitors.push_back({p, sum.runs.empty() ? 0.0 : static_cast<double>(n) / sum.runs.size()});
+    }
+    if (stable_at_target != 1)
+        sum.failure = "the designed field has " + std::to_string(stable_at_target) + " stable fixed point(s) at the target on the " +
+                      std::to_string(opt.verify_grid) + "^3 grid (" + std::to_string(stable) + " stable in all)";
+    else if (stopped)
+        sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
+    else if (sum.unique && !(sum.worst_end_distance <= opt.verify_distance))
+        sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) + " m (0.05 rad counted as " +
+                      std::to_string(opt.verify_distance) + " m) from the target";
+    else if (!sum.unique && accounted < static_cast<int>(sum.runs.size()))
+        sum.failure = "of " + std::to_string(sum.runs.size()) + " full-dynamics runs, " +
+                      std::to_string(static_cast<int>(sum.runs.size()) - accounted) +
+                      " ended at neither the target nor a competing stable fixed point";
+    else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
+        sum.failure = "the vertical acceleration margin is below the one asked";
+    sum.verified = sum.failure.empty();
+    return finish();
+}
+
 }  // namespace
 
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
@@ -486,11 +768,15 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
         if (!(target.velocity.norm() > 0)) throw std::invalid_argument("a transport target needs a velocity");
         return design_transport(part_scene, target, opt, T);
     }
-    if (!part_scene.part.point)
-        throw std::invalid_argument("this version designs sinks for point parts; a rigid part's fixed point, "
-                                    "transport and orientation targets are not built yet");
     if (!(std::abs(target.at.x()) <= opt.region && std::abs(target.at.y()) <= opt.region))
         throw std::invalid_argument("the target lies outside the plate region");
+    if (!part_scene.part.point) {
+        if (target.kind == DesignTargetKind::Sink)
+            throw std::invalid_argument("a sink for every orientation of a rigid part is not built yet: ask for "
+                                        "fixed-point X Y THETA (or orient THETA)");
+        return design_rigid(part_scene, target, opt, T);
+    }
+    if (target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");
     return design_sink(part_scene, target, opt, T);
 }
 

@@ -30,7 +30,19 @@ namespace plate {
 PlateMotion rotate_motion(const PlateMotion& u, double angle);
 PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 
-enum class DesignTargetKind { Sink, Transport };
+// CONING. The plate's angular acceleration is periodic with zero-mean angular velocity, but rotations
+// do not commute: rx and ry out of phase (circular tilting, fig4's) turn the plate about z at a
+// steady second-order rate psi' = (1/2) <(theta x theta')_z> for the small rotation theta(t). With
+// theta_a = -A_a e^{i n w t} / (n w)^2 per harmonic (A = amp e^{i phase} of the angular acceleration,
+// as amp sin(n w t + phase)) it is sum_n Im(A_rx,n conj(A_ry,n)) / (2 (n w)^3) [rad/s] (harmonics of
+// different n average out): 0.0025 rad/s for fig4. The asymptotic field (first-order averaging) does
+// not see it; the full dynamics does: fig4's part, at the field's stable fixed point (0, 0, 0),
+// turns steadily in the plate frame at that rate. Rigid-part designs are constrained to
+// |psi'| <= 1e-4 rad/s. (Checked in tests/test_design.cpp against an independent integration of the
+// plate's rotation and against the full dynamics.)
+double coning_rate(const PlateMotion& u);
+
+enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient };
 struct DesignTarget {
     // Sink: every start in the region ends at position `at`: for a point part the unique stable
     // fixed point of its velocity field ("fixed-point X Y" is the same target).
@@ -38,8 +50,12 @@ struct DesignTarget {
     // that only translates (x, y, z harmonics n = 1, 2) gives a point part the same velocity at every
     // position (nothing in its dynamics depends on where it is), so the field is uniform by
     // construction and the search only sets its value.
+    // FixedPoint: (at, theta) the unique stable fixed point of the twist field (a rigid part; for a
+    // point part the same as Sink). Orient: every start ends at orientation theta, position free
+    // (designed as a fixed point at the region's centre; verified on the orientation).
     DesignTargetKind kind = DesignTargetKind::Sink;
     Vec2 at = Vec2::Zero();
+    double theta = 0;               // [rad]
     Vec2 velocity = Vec2::Zero();   // [m/s]
 };
 
@@ -78,7 +94,10 @@ struct DesignOptions {
 
 struct DesignStartRun {
     double x = 0, y = 0;        // the start [m]
-    double end_distance = 0;    // from the target after `seconds` of full dynamics [m]
+    double theta = 0;           // (rigid parts: drawn uniformly over the turn)
+    Vec3 end = Vec3::Zero();    // where the run ended
+    double end_distance = 0;    // from the target after `seconds` of full dynamics [m] (rigid: the
+                                // larger of the position's and the angle's, 0.05 rad counted as 5 mm)
     double seconds = 0;
     std::string stop;           // why the run stopped early, if it did
 };
@@ -91,13 +110,22 @@ struct DesignSummary {
     // The search, at the centre before the shift: the field's Jacobian there and its convergence
     // rate (-max Re of the eigenvalues) [1/s].
     double rate = 0;
-    Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();
+    Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();     // (point parts)
+    Eigen::Vector3cd eigenvalues3 = Eigen::Vector3cd::Zero();    // (rigid parts)
     long evaluations = 0;       // objective evaluations (each a few limit cycles)
     long cycles = 0;            // limit cycles computed in the search
     // Verification.
     FixedPoints fixed_points;   // of the designed field on the grid
     Vec3 fixed_point = Vec3::Zero();   // the stable one nearest the target
     Eigen::Vector3cd fixed_point_eigenvalues = Eigen::Vector3cd::Zero();
+    // Rigid parts: the share of the runs below that end at the target, and the other stable fixed
+    // points on the grid with the share that ends at each (a design that is not unique says so).
+    double basin_share = 0;
+    struct Competitor {
+        FixedPoint point;
+        double basin_share = 0;
+    };
+    std::vector<Competitor> competitors;
     std::vector<DesignStartRun> runs;   // full dynamics from random starts
     double worst_end_distance = 0;
     double min_vertical_margin = 0;     // min over the period and the region of (g + a_z) / g
