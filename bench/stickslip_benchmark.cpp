@@ -120,6 +120,8 @@ int main() {
         std::printf("  regularised eps %.0e v_ref:   %8.2f ms per configuration (median %.2f), error median %.1e, largest %.1e at "
                     "(%.4f, %.4f, %.3f)%s\n", eps, 1e3 * t / sample.size(), rms[rms.size() / 2], errs.empty() ? 0.0 : errs[errs.size() / 2],
                     worst, sample[at][0], sample[at][1], sample[at][2], ok ? "" : " (some runs failed)");
+        std::printf("                                 %.0fx the engine's time in all, %.0fx at the median\n", t / t_engine,
+                    rms[rms.size() / 2] / ms[ms.size() / 2]);
         if (ok && worst <= 1e-6 && chosen_eps == 0) {
             chosen_eps = eps;
             chosen_time = t;
