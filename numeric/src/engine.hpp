@@ -408,7 +408,7 @@ private:
         bool off = false;
         for (int i = 0; i < scene_.part.contacts(); ++i) {
             const double sn = slip[i].norm();
-            if ((ws.creep >> i & 1u) && sn > ws.hint_speed && slip[i].dot(ws.hint[i]) < 0.9 * sn) {
+            if ((ws.creep >> i & 1u) && sn > kCreepJudged * ws.hint_speed && slip[i].dot(ws.hint[i]) < 0.9 * sn) {
                 stop_creep(i, true);
                 off = true;
             }
@@ -613,6 +613,12 @@ private:
     unsigned creep_spent_ = 0;
     double creep_h_ = std::numeric_limits<double>::infinity();
     static constexpr double kCreepFirst = 1e-4;   // the first step of a creep, relative to T
+    // creep_inconsistent judges a creeping slip's direction only above this many hint_speeds: below, a
+    // slip is within a few times the integration's noise and so is its direction (heave_yaw at
+    // (0, 0.02, 0), rtol 1e-9: a rim-sliding slip at ~1.5 hint speeds stopped its creep after every
+    // step, 2.2e7 right-hand sides for the cycle; now 2.5e5; 10 let a creep run on where it no longer
+    // held, 1.2e-6 v_ref off the regularised reference).
+    static constexpr double kCreepJudged = 4;
     static constexpr int kBurst = 1000;
     static constexpr int kLinger = 4;
     std::array<int, 3> low_{};
