@@ -364,6 +364,13 @@ PYBIND11_MODULE(_plate, m) {
         .def_readonly("notes", &DesignSummary::notes)
         .def_readonly("transport_mean", &DesignSummary::transport_mean)
         .def_readonly("transport_spread", &DesignSummary::transport_spread)
+        .def_readonly("basin_share", &DesignSummary::basin_share,
+                      "rigid parts: the share of the verification runs that end at the target")
+        .def_property_readonly("competitors", [](const DesignSummary& s) {
+            std::vector<std::tuple<Vec3, double>> r;
+            for (const auto& c : s.competitors) r.emplace_back(c.point.q, c.basin_share);
+            return r;
+        }, "rigid parts: the other stable fixed points on the grid, (q, share of the runs ending there)")
         .def_property_readonly("runs", [](const DesignSummary& s) {
             std::vector<std::tuple<double, double, double, double>> r;
             for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
@@ -371,14 +378,25 @@ PYBIND11_MODULE(_plate, m) {
         }, "(x, y, seconds, end distance) of each verification run");
     m.def("design",
           [](const Scene& part, std::optional<std::pair<double, double>> sink,
-             std::optional<std::pair<double, double>> transport, double lin_limit, double ang_limit, double period,
+             std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
+             std::optional<double> orient, double lin_limit, double ang_limit, double period,
              std::uint64_t seed, int starts, int local_evaluations, int threads) {
-              require(sink.has_value() != transport.has_value(), "design: give one target, sink=(x, y) or transport=(vx, vy)");
+              require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() == 1,
+                      "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta) or orient=theta");
               DesignTarget t;
               if (sink) t.at = Vec2(sink->first, sink->second);
               if (transport) {
                   t.kind = DesignTargetKind::Transport;
                   t.velocity = Vec2(transport->first, transport->second);
+              }
+              if (fixed_point) {
+                  t.kind = DesignTargetKind::FixedPoint;
+                  t.at = Vec2(std::get<0>(*fixed_point), std::get<1>(*fixed_point));
+                  t.theta = std::get<2>(*fixed_point);
+              }
+              if (orient) {
+                  t.kind = DesignTargetKind::Orient;
+                  t.theta = *orient;
               }
               DesignOptions o;
               require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
@@ -399,12 +417,18 @@ PYBIND11_MODULE(_plate, m) {
               }
           },
           py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
+          py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(),
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 16, py::arg("local_evaluations") = 400,
           py::arg("threads") = 0,
-          "Designs a plate motion for a point part, within the amplitude limits and without flight, and verifies\n"
-          "it (grid and full dynamics): sink=(x, y) the unique stable fixed point of its field, or\n"
-          "transport=(vx, vy) a uniform velocity over the plate.");
+          "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
+          "full dynamics). Point parts: sink=(x, y) the unique stable fixed point of its field, or\n"
+          "transport=(vx, vy) a uniform velocity over the plate. Rigid parts (not yet successful, see the\n"
+          "README): fixed_point=(x, y, theta), orient=theta; the summary gives the basin share and the\n"
+          "competing fixed points.");
+    m.def("coning_rate", [](const Scene& sc) { return coning_rate(sc.plate); }, py::arg("scene"),
+          "The plate's steady yaw drift from rx and ry out of phase [rad/s], which the asymptotic field does\n"
+          "not see and the full dynamics does: sum_n Im(A_rx,n conj A_ry,n) / (2 (n w)^3).");
 
     // --- simulate ------------------------------------------------------------------------------
     py::class_<PyTrajectory>(m, "Trajectory", "Samples of a simulation, with the contact mode on each step.")

@@ -291,3 +291,14 @@ def test_a_designed_sink_gathers_parts_released_anywhere_on_the_plate():
         assert not tr.stop
         assert np.hypot(tr.q[-1, 0] - 0.02, tr.q[-1, 1] + 0.01) < 0.005
     assert np.hypot(*(d.fixed_point[:2] - np.array([0.02, -0.01]))) < 0.002
+
+
+def test_coning_turns_the_part_at_the_closed_form_rate():
+    # fig4: rx, ry 100 rad/s^2 a quarter period apart turn the plate about z at -1e4 / (2 (40 pi)^3)
+    # rad/s; the part, at the field's stable fixed point (0, 0, 0), turns with it in the full dynamics.
+    sc = plate.load_scene(scene_path("fig4"))
+    expected = -1e4 / (2 * (40 * math.pi) ** 3)
+    assert plate.coning_rate(sc) == pytest.approx(expected, rel=1e-12)
+    tr = plate.simulate(sc, start=(0.0, 0.0, 0.0), time=200, sample=50, dynamics="full")
+    assert not tr.stop
+    assert (tr.q[-1, 2] - tr.q[1, 2]) / 150 == pytest.approx(expected, rel=0.01)
