@@ -78,6 +78,14 @@ double twist_err(const Scene& sc, const Vec3& a, const Vec3& b) {
     return twist_error(sc, {a[0], a[1], a[2]}, {b[0], b[1], b[2]});
 }
 
+// plate's limit-cycle settings (cycle tol, rtol) for (b)-(d): rtol = tol / 10, and below 1e-3 a loose
+// cycle tolerance on an rtol of 1e-4 (a coarser rtol makes the period map too noisy for the
+// shooting's test: fig4's field at tol 1e-2, rtol 1e-3 took 0.34 s; at rtol 1e-4 its starts predicted
+// from their neighbours take 1.05 periods each, largest error 2.9e-4 m/s).
+const std::vector<std::pair<double, double>> kCycleSettings = {
+    {1e-2, 1e-4}, {1e-3, 1e-4}, {1e-4, 1e-5}, {1e-5, 1e-6}, {1e-6, 1e-7}, {1e-7, 1e-8}, {1e-8, 1e-9}, {1e-9, 1e-10}};
+std::string cycle_setting(double tol, double rtol) { return "tol " + sci(tol) + ", rtol " + sci(rtol); }
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -167,19 +175,14 @@ int main(int argc, char** argv) {
         tight.integration.rtol = 1e-11;
         const double ref_err = twist_err(fig4, limit_cycle(fig4, q0, tight).twist, ref.twist);
         json pts = json::array();
-        // (tol, rtol): rtol = tol / 10, and below 1e-3 a loose cycle tolerance on an rtol of 1e-4 (a
-        // coarser rtol makes the period map too noisy for the shooting's test: fig4's field at tol 1e-2,
-        // rtol 1e-3 took 0.34 s; at rtol 1e-4 its starts predicted from their neighbours take 1.05
-        // periods each, largest error 2.9e-4 m/s).
-        for (const auto& [tol, rtol] : std::vector<std::pair<double, double>>{
-                 {1e-2, 1e-4}, {1e-3, 1e-4}, {1e-4, 1e-5}, {1e-5, 1e-6}, {1e-6, 1e-7}, {1e-7, 1e-8}, {1e-8, 1e-9}, {1e-9, 1e-10}}) {
+        for (const auto& [tol, rtol] : kCycleSettings) {
             LimitCycleOptions o;
             o.tol = tol;
             o.integration.rtol = rtol;
             const double t0 = peers::cpu_now();
             const LimitCycleSummary lc = limit_cycle(fig4, q0, o);
             const double cpu = since(t0);
-            pts.push_back(point("plate", "tol " + sci(tol), cpu, twist_err(fig4, lc.twist, ref.twist), lc.converged ? "" : "not converged"));
+            pts.push_back(point("plate", cycle_setting(tol, rtol), cpu, twist_err(fig4, lc.twist, ref.twist), lc.converged ? "" : "not converged"));
         }
         // The method error of the protocol itself: plate's full dynamics, k periods, then one averaged.
         IntegrationOptions io;
@@ -231,12 +234,7 @@ int main(int argc, char** argv) {
         }
         if (sticking_only && quick && idx.size() > 8) idx.resize(8);
         json pts = json::array();
-        // (tol, rtol): rtol = tol / 10, and below 1e-3 a loose cycle tolerance on an rtol of 1e-4 (a
-        // coarser rtol makes the period map too noisy for the shooting's test: fig4's field at tol 1e-2,
-        // rtol 1e-3 took 0.34 s; at rtol 1e-4 its starts predicted from their neighbours take 1.05
-        // periods each, largest error 2.9e-4 m/s).
-        for (const auto& [tol, rtol] : std::vector<std::pair<double, double>>{
-                 {1e-2, 1e-4}, {1e-3, 1e-4}, {1e-4, 1e-5}, {1e-5, 1e-6}, {1e-6, 1e-7}, {1e-7, 1e-8}, {1e-8, 1e-9}, {1e-9, 1e-10}}) {
+        for (const auto& [tol, rtol] : kCycleSettings) {
             LimitCycleOptions o;
             o.tol = tol;
             o.integration.rtol = rtol;
@@ -252,7 +250,7 @@ int main(int argc, char** argv) {
                 err = field_max_error(sc, f, ref, &missing);
                 if (missing > 0) {   // (a point without a cycle fails the setting, as it does an engine's)
                     err = INFINITY;
-                    pts.push_back(point("plate", "tol " + sci(tol) + ", rtol " + sci(rtol), cpu, err,
+                    pts.push_back(point("plate", cycle_setting(tol, rtol), cpu, err,
                                         std::to_string(missing) + " configurations without a cycle"));
                     continue;
                 }
@@ -271,7 +269,7 @@ int main(int argc, char** argv) {
                 }
                 cpu = since(t0);
             }
-            pts.push_back(point("plate", "tol " + sci(tol) + ", rtol " + sci(rtol), cpu, err, failure));
+            pts.push_back(point("plate", cycle_setting(tol, rtol), cpu, err, failure));
         }
         const std::vector<std::pair<double, int>> settings = quick ? std::vector<std::pair<double, int>>{{2.5e-4, 5}}
                                                                    : std::vector<std::pair<double, int>>{{5e-4, 5}, {2.5e-4, 5}, {1e-4, 10}};

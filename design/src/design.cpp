@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -51,23 +52,6 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D) {
         const Vec3 add = -alpha.cross(d);   // the same harmonic, on the linear axes
         for (int k = 0; k < 3; ++k)
             if (add[k] != 0) r.harmonics.push_back({static_cast<Axis>(k), h.n, add[k], h.phase});
-    }
-    return r;
-}
-
-double coning_rate(const PlateMotion& u) {
-    // Phasors amp e^{i phase} of rx and ry per harmonic n: sum_n Im(A_rx conj(A_ry)) / (2 (n w)^3).
-    std::map<int, std::complex<double>> rx, ry;
-    for (const Harmonic& h : u.harmonics) {
-        if (h.axis == Axis::rx) rx[h.n] += std::polar(h.amp, h.phase);
-        if (h.axis == Axis::ry) ry[h.n] += std::polar(h.amp, h.phase);
-    }
-    double r = 0;
-    for (const auto& [n, a] : rx) {
-        const auto b = ry.find(n);
-        if (b == ry.end()) continue;
-        const double nw = n * 2 * kPi / u.T;
-        r += std::imag(a * std::conj(b->second)) / (2 * nw * nw * nw);
     }
     return r;
 }
@@ -134,6 +118,11 @@ std::vector<double> params_from(const PlateMotion& u, const std::vector<Axis>& a
         p[2 * (a * H + h) + 1] = z.real();   // amp cos(phase): the sine's
     }
     return p;
+}
+
+// Eight points on the edge of the region |s_x|, |s_y| <= R: corners and midpoints.
+std::array<Vec2, 8> region_edge(double R) {
+    return {Vec2(-R, -R), Vec2(0, -R), Vec2(R, -R), Vec2(R, 0), Vec2(R, R), Vec2(0, R), Vec2(-R, R), Vec2(-R, 0)};
 }
 
 // The option's task runner, else its threads.
@@ -372,9 +361,7 @@ struct SinkProblem : Problem<SinkProblem> {
         if (eig_out) *eig_out = ev;
         // The region's edge, relative to the centre of the design: eight points on its boundary.
         double outward = 0;
-        const double R = opt.region;
-        const Vec2 edge[8] = {{-R, -R}, {0, -R}, {R, -R}, {R, 0}, {R, R}, {0, R}, {-R, R}, {-R, 0}};
-        for (const Vec2& e : edge) {
+        for (const Vec2& e : region_edge(opt.region)) {
             const Vec2 s = e - D;
             Vec2 v;
             if (!twist_at(sc, s, v)) return 1e3;
@@ -534,9 +521,8 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
 // makes (0, 0, 0) one -- fast, and pulling the region's edge and every orientation towards it -- and
 // the fixed point found near the centre, q*, is then placed exactly on the target by the two
 // symmetries: turned by THETA - theta*, shifted by the target minus the turned s*.
-PlateMotion rigid_motion(const std::vector<double>& p, double T) {
-    return motion_from(p, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, {1, 2}, T);
-}
+const std::vector<Axis> kRigidAxes = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
+PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion_from(p, kRigidAxes, {1, 2}, T); }
 
 constexpr double kConingLimit = 1e-4;   // [rad/s] (coning_rate, design.hpp): 0.01 rad of lag at 0.01 1/s
 
@@ -582,7 +568,7 @@ struct RigidProblem : Problem<RigidProblem> {
     RigidProblem(const Scene& part_, const DesignTarget& t_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
         : Problem(part_, opt_, T_, cycles_), target(t_) {
         if (std::abs(part_.plate.T - T_) <= 1e-12 * T_)
-            guess = params_from(part_.plate, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, {1, 2});
+            guess = params_from(part_.plate, kRigidAxes, {1, 2});
     }
     DesignTarget target;
     static constexpr int kParams = 24;
@@ -612,9 +598,7 @@ struct RigidProblem : Problem<RigidProblem> {
         const Vec3 step = J.fullPivLu().solve(xi);
         const double off = step.allFinite() ? std::hypot(step.head<2>().norm() / 0.01, step[2] / 0.1) : 10.0;
         double outward = 0;
-        const double R = opt.region;
-        const Vec2 edge[8] = {{-R, -R}, {0, -R}, {R, -R}, {R, 0}, {R, R}, {0, R}, {-R, R}, {-R, 0}};
-        for (const Vec2& s : edge) {
+        for (const Vec2& s : region_edge(opt.region)) {
             const LimitCycleSummary c = limit_cycle(sc, Vec3(s.x(), s.y(), 0), opt.cycle);
             ++*cycles;
             if (!c.converged) return 1e3;
@@ -758,6 +742,20 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
 }
 
 }  // namespace
+
+double coning_rate(const PlateMotion& u) {
+    // sum_n Im(A_rx,n conj(A_ry,n)) / (2 (n w)^3) over the phasors amp e^{i phase} of each (axis, n).
+    const auto ph = phasors(u);
+    double r = 0;
+    for (const auto& [k, a] : ph) {
+        if (k.first != static_cast<int>(Axis::rx)) continue;
+        const auto b = ph.find({static_cast<int>(Axis::ry), k.second});
+        if (b == ph.end()) continue;
+        const double nw = k.second * 2 * kPi / u.T;
+        r += std::imag(a * std::conj(b->second)) / (2 * nw * nw * nw);
+    }
+    return r;
+}
 
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
     const double T = opt.period > 0 ? opt.period : part_scene.plate.T;

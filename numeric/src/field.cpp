@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <cmath>
 #include <mutex>
 #include <sstream>
@@ -259,6 +260,15 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
                   });
         f.threads = 0;
     } else {
+        // min(threads, units) workers, this thread one of them.
+        auto run_workers = [&](int units, const std::function<void()>& worker) {
+            threads = std::max(1, std::min(threads, units));
+            f.threads = threads;
+            std::vector<std::thread> pool;
+            for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+            worker();
+            for (auto& t : pool) t.join();
+        };
         if (shooting) {
             // Threads take the first line (in `lines` order) whose predecessors are done.
             const int n = static_cast<int>(lines.size());
@@ -270,8 +280,6 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
             int finished = 0;
             std::mutex m;
             std::condition_variable cv;
-            threads = std::max(1, std::min(threads, n));
-            f.threads = threads;
             auto worker = [&]() {
                 std::unique_lock<std::mutex> lock(m);
                 for (;;) {
@@ -291,20 +299,11 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
                     cv.notify_all();
                 }
             };
-            std::vector<std::thread> pool;
-            for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-            worker();
-            for (auto& t : pool) t.join();
+            run_workers(n, worker);
         } else {
-            threads = std::max(1, std::min(threads, tasks));
-            f.threads = threads;
-            auto worker = [&]() {
+            run_workers(tasks, [&]() {
                 for (int t; (t = next.fetch_add(1)) < tasks;) run_task(t);
-            };
-            std::vector<std::thread> pool;
-            for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-            worker();
-            for (auto& t : pool) t.join();
+            });
         }
     }
     for (const auto& p : f.points) f.rhs_evals += p.rhs_evals;
