@@ -205,3 +205,29 @@ TEST_CASE("friction never does positive work, in every mode (slide, pivot, stuck
         else CHECK(seen[2] > 0);
     }
 }
+
+TEST_CASE("a loose tolerance does not invent sticks: fig4's sliding part stays sliding at rtol 1e-2 to 1e-4",
+          "[trajectory][stick]") {
+    // Fig. 4's part from (0.04, -0.04, 1.0) slides for 20 s without a stick (the rtol 1e-12 run has
+    // no mode change). The engine's slip thresholds grow with rtol; were they not capped (hint speed
+    // 1e-4 v_ref, zero bound 3e-3 v_ref, below the creep speed 1e-2 v_ref), rtol 1e-2 would count
+    // every slip below 3 v_ref as zero: 797 sticks, 3 rad off. An rtol-controlled run's global error
+    // over these 400 periods is a few rtol (measured <= 1.6 rtol); bound 10 rtol (rad, and rho).
+    const Scene sc = scene("fig4");
+    const Vec3 q0(0.04, -0.04, 1.0);
+    IntegrationOptions io;
+    io.rtol = 1e-12;
+    const Trajectory ref = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), 20, 20, io);
+    REQUIRE(ref.stop.reason == StopReason::None);
+    REQUIRE(ref.stats.mode_switches == 0);
+    for (double rtol : {1e-2, 1e-3, 1e-4}) {
+        io.rtol = rtol;
+        const Trajectory tr = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), 20, 20, io);
+        INFO("rtol " << rtol);
+        REQUIRE(tr.stop.reason == StopReason::None);
+        CHECK(tr.stats.mode_switches == 0);
+        const Vec3 d = tr.samples.back().q - ref.samples.back().q;
+        CHECK(d.head<2>().norm() < 10 * rtol * sc.part.rho());
+        CHECK(std::abs(d[2]) < 10 * rtol);
+    }
+}
