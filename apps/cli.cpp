@@ -918,6 +918,11 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     if (!transport) {
         j["unique"] = d.unique;
         j["convergence_rate_per_s"] = d.rate;
+        if (t.kind == DesignTargetKind::Orient) {
+            // (position free: the orientation, and the velocity the part travels at there)
+            j["orientation"] = d.fixed_point[2];
+            j["velocity_at_orientation"] = {d.transport_mean.x(), d.transport_mean.y()};
+        }
         if (rigid) {
             j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1], d.fixed_point[2]};
             j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]),

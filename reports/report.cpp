@@ -569,6 +569,72 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     }
 }
 
+// The orienter (design.cpp's weathervane): a part with a rubber foot turned to one orientation from
+// anywhere by a plate that only translates; theta' over a turn and the full-dynamics runs' theta(t).
+void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
+    const Scene part = load_scene((src / "scenes" / "foot.json").string());
+    DesignOptions o;
+    o.threads = opt.threads;
+    o.seed = opt.seed;
+    if (opt.quick) {
+        o.starts = 2;
+        o.local_evaluations = 80;
+        o.verify_starts = 8;
+    }
+    DesignTarget t;
+    t.kind = DesignTargetKind::Orient;
+    t.theta = 2.0;
+    const DesignSummary d = design(part, t, o);
+    const auto mu = part.part.mu;
+    c.html << "<h3>Orienting a part</h3>\n<p>" << esc(part.name) << ": Fig. 4's triangle with friction coefficients "
+           << fmt(mu[0], 3) << ", " << fmt(mu[1], 3) << ", " << fmt(mu[2], 3)
+           << " on its contacts (a rubber foot), target orientation θ = " << fmt(t.theta, 3)
+           << " rad, position free. A plate that only translates makes the twist the same at every position "
+              "(full dynamics = U-dynamics: no tilt, no coning); with one friction coefficient on every contact it "
+              "cannot turn the part at all (friction's torque −(Σ μ<sub>i</sub>N<sub>i</sub>r<sub>i</sub>)×u "
+              "vanishes when the normal forces balance friction's moment), with unequal ones it is a weathervane. "
+              "Designed on a ring of 12 orientations (" << o.starts << " starts, " << o.local_evaluations
+           << " evaluations each), turned onto θ, verified on a ring of " << d.ring_theta.size()
+           << " orientations and by " << d.runs.size() << " full-dynamics runs from random starts.</p>\n"
+           << "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
+              "<th>cycles</th><th>worst end angle [rad]</th><th>travel at θ [m/s]</th><th>seconds</th></tr>\n"
+           << "<tr><td>orient " << fmt(t.theta, 3) << "</td><td>" << verdict(d.verified)
+           << (d.verified ? "" : " " + esc(d.failure)) << "</td><td>" << (d.unique ? "yes" : "no") << "</td><td>"
+           << fmt(d.rate, 3) << "</td><td>" << d.evaluations << "</td><td>" << d.cycles << "</td><td>"
+           << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3) << "</td><td>" << fmt(d.transport_mean.norm(), 3)
+           << "</td><td>" << fmt(d.seconds, 3) << "</td></tr>\n</table>\n";
+    if (d.ring_theta.empty()) return;
+    {
+        auto r = c.data("design_orient_ring.dat");
+        for (std::size_t k = 0; k <= d.ring_theta.size(); ++k) {
+            const std::size_t i = k % d.ring_theta.size();
+            r << (k == d.ring_theta.size() ? 2 * kPi : d.ring_theta[i]) << ' ' << d.ring_twist[i][2] << '\n';
+        }
+        c.data("design_orient_target.dat") << wrap_angle(t.theta) + (wrap_angle(t.theta) < 0 ? 2 * kPi : 0) << " 0\n";
+        auto runs = c.data("design_orient_runs.dat");
+        for (const DesignStartRun& s : d.runs) {
+            const Trajectory tr = simulate(d.scene, Dynamics::Full, Vec3(s.x, s.y, s.theta), Vec3::Zero(), s.seconds, s.seconds / 200);
+            double prev = 0, unwrapped = 0;
+            for (std::size_t k = 0; k < tr.samples.size(); ++k) {
+                const double th = tr.samples[k].q[2];
+                unwrapped = k == 0 ? th : unwrapped + wrap_angle(th - prev);
+                prev = th;
+                // (shown as the distance to the target orientation, in (-pi, pi])
+                runs << tr.samples[k].t << ' ' << wrap_angle(unwrapped - t.theta) << '\n';
+            }
+            runs << "\n\n";
+        }
+    }
+    c.plot("design_orient_ring", "set xlabel 'θ [rad]'\nset ylabel 'θ′ [rad/s]'\nset xrange [0:2*pi]\nset key outside right\n"
+           "plot 'data/design_orient_ring.dat' u 1:2 w lp pt 7 ps 0.5 lw 2 t 'designed: θ′ at every position', 0 w l lc rgb '#999999' notitle, "
+           "'data/design_orient_target.dat' u 1:2 w p pt 7 ps 2 lc rgb '#c02020' t 'target θ'\n",
+           "The designed plate motion's turning rate over a full turn of the part: one stable zero (θ′ falling through "
+           "zero), at the target.", "800,420");
+    c.plot("design_orient_runs", "set xlabel 't [s]'\nset ylabel 'θ − target [rad]'\nset yrange [-pi:pi]\nset key off\n"
+           "plot 'data/design_orient_runs.dat' u 1:2 w l lw 1.5\n",
+           "The verification's full-dynamics runs from random starts: every orientation reaches the target.", "800,420");
+}
+
 void write_report(const ReportOptions& opt) {
     if (opt.out.empty()) throw std::runtime_error("report: no output folder");
     Ctx c;
@@ -586,6 +652,7 @@ void write_report(const ReportOptions& opt) {
     c.timed("Fig. 3", [&] { section_fig3(c, src); });
     section_fields(c, src, opt);
     c.timed("inverse design", [&] { section_design(c, src, opt); });
+    c.timed("orienter", [&] { section_orient(c, src, opt); });
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // KaTeX from Debian's libjs-katex, copied beside the report when present.

@@ -312,3 +312,84 @@ TEST_CASE("coning: rx and ry out of phase turn the plate about z at the closed-f
         if (h.axis == Axis::ry) h.n = 2;
     CHECK(coning_rate(mixed.plate) == 0.0);
 }
+
+TEST_CASE("a translating plate: the same twist everywhere, full = U dynamics, no turn with one friction "
+          "coefficient, a weathervane with a rubber foot",
+          "[design][orient]") {
+    // foot.json: fig4's triangle (mirror symmetric about its y axis) with its lone contact, on that
+    // axis, at mu 0.6 and the pair at 0.2; the plate shaken along x with a heave in phase (x 15, z 7
+    // m/s^2), mirror symmetric about the x axis.
+    const Scene foot = scene("foot");
+    Scene plain = foot;   // every contact at 0.3: sum_i N_i r_i is parallel to the common slip, no torque
+    plain.part.mu = Vec3(0.3, 0.3, 0.3);
+    const Vec3 S(foot.v_ref(), foot.v_ref(), foot.v_ref() / foot.part.rho());
+    const Vec3 xi0 = xi(plain, Vec3(0, 0, 0));
+    CHECK(std::abs(xi0[0]) > 0.01);   // it is carried along x...
+    for (int k = 0; k < 8; ++k) {
+        const double th = 2 * kPi * k / 8;
+        INFO("theta " << th);
+        // ...the same way at every orientation and position, and never turned.
+        CHECK((xi(plain, Vec3(0.03 * std::cos(3 * th), -0.02, th)) - xi0).cwiseQuotient(S).cwiseAbs().maxCoeff() < 1e-8);
+    }
+    // With the foot: by the two mirror symmetries theta' vanishes at theta = +-pi/2 (the part's axis
+    // along the shaking); the foot tows the part, so the orientation with the foot ahead of the
+    // travel (+x), theta = -pi/2, is the stable one, the other unstable.
+    const Vec3 lead = xi(foot, Vec3(0, 0, -kPi / 2)), trail = xi(foot, Vec3(0, 0, kPi / 2));
+    CHECK(lead[0] > 0.01);   // travels along +x: R(-pi/2) (0, 0.03) = (0.03, 0), the foot ahead
+    CHECK(std::abs(lead[2]) < 1e-8 * S[2]);
+    CHECK(std::abs(trail[2]) < 1e-8 * S[2]);
+    CHECK(xi(foot, Vec3(0, 0, -kPi / 2 - 0.2))[2] > 0);
+    CHECK(xi(foot, Vec3(0, 0, -kPi / 2 + 0.2))[2] < 0);
+    CHECK(xi(foot, Vec3(0, 0, kPi / 2 - 0.2))[2] < 0);
+    CHECK(xi(foot, Vec3(0, 0, kPi / 2 + 0.2))[2] > 0);
+    // Nothing depends on position or tilt: the full dynamics are the U-dynamics (to the integrator's
+    // tolerance; rtol 1e-10 over 2 s).
+    IntegrationOptions io;
+    io.rtol = 1e-10;
+    const Vec3 q0(0.01, -0.02, 0.4);
+    const Trajectory f = simulate(foot, Dynamics::Full, q0, Vec3::Zero(), 2, 2, io);
+    const Trajectory u = simulate(foot, Dynamics::U, q0, Vec3::Zero(), 2, 2, io);
+    REQUIRE(f.stop.reason == StopReason::None);
+    REQUIRE(u.stop.reason == StopReason::None);
+    CHECK((f.samples.back().q - u.samples.back().q).norm() < 1e-7);
+}
+
+TEST_CASE("orient: a part with a rubber foot is turned to THETA from anywhere, by a plate that only translates",
+          "[design][orient]") {
+    const Scene foot = scene("foot");
+    DesignTarget t;
+    t.kind = DesignTargetKind::Orient;
+    t.theta = 2.0;
+    DesignOptions o;
+    o.starts = 2;
+    o.local_evaluations = 80;
+    o.verify_starts = 8;
+    o.threads = 2;
+    const DesignSummary s = design(foot, t, o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    CHECK(s.unique);
+    CHECK(s.basin_share == 1.0);
+    CHECK(std::abs(wrap_angle(s.fixed_point[2] - t.theta)) <= 0.02);
+    // An independent look at the verification's ring: theta' falls through zero once, at THETA.
+    REQUIRE(s.ring_twist.size() == 72u);
+    int stable = 0, unstable = 0;
+    for (std::size_t k = 0; k < 72; ++k) {
+        const double a = s.ring_twist[k][2], b = s.ring_twist[(k + 1) % 72][2];
+        stable += a > 0 && b <= 0;
+        unstable += a < 0 && b >= 0;
+    }
+    CHECK(stable == 1);
+    CHECK(unstable == 1);
+    CHECK(s.rate > 0);
+    // Within the limits, translating only, no flight; every run ends turned to THETA.
+    for (const Harmonic& h : s.scene.plate.harmonics) {
+        CHECK(static_cast<int>(h.axis) < 3);
+        CHECK(std::abs(h.amp) <= o.lin_limit * (1 + 1e-9));
+    }
+    CHECK(s.min_vertical_margin >= o.flight_margin - 1e-9);
+    for (const DesignStartRun& r : s.runs) CHECK(std::abs(wrap_angle(r.end[2] - t.theta)) <= 0.05);
+    // Reproducible by seed.
+    const DesignSummary again = design(foot, t, o);
+    CHECK(scene_to_json(again.scene).dump() == scene_to_json(s.scene).dump());
+}

@@ -364,6 +364,11 @@ PYBIND11_MODULE(_plate, m) {
         .def_readonly("notes", &DesignSummary::notes)
         .def_readonly("transport_mean", &DesignSummary::transport_mean)
         .def_readonly("transport_spread", &DesignSummary::transport_spread)
+        .def_property_readonly("ring", [](const DesignSummary& s) {
+            std::vector<std::tuple<double, Vec3>> r;
+            for (std::size_t k = 0; k < s.ring_theta.size(); ++k) r.emplace_back(s.ring_theta[k], s.ring_twist[k]);
+            return r;
+        }, "orient by transport: (theta, twist) at the centre on the verification's ring of orientations")
         .def_readonly("basin_share", &DesignSummary::basin_share,
                       "rigid parts: the share of the verification runs that end at the target")
         .def_property_readonly("competitors", [](const DesignSummary& s) {
@@ -380,7 +385,7 @@ PYBIND11_MODULE(_plate, m) {
           [](const Scene& part, std::optional<std::pair<double, double>> sink,
              std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
              std::optional<double> orient, double lin_limit, double ang_limit, double period,
-             std::uint64_t seed, int starts, int local_evaluations, int threads) {
+             std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads) {
               require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() == 1,
                       "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta) or orient=theta");
               DesignTarget t;
@@ -400,13 +405,15 @@ PYBIND11_MODULE(_plate, m) {
               }
               DesignOptions o;
               require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
-              require(starts >= 1 && local_evaluations >= 1, "starts, local_evaluations: expected >= 1");
+              require(starts >= 1 && local_evaluations >= 1 && verify_starts >= 1,
+                      "starts, local_evaluations, verify_starts: expected >= 1");
               o.lin_limit = lin_limit;
               o.ang_limit = ang_limit;
               o.period = period;
               o.seed = seed;
               o.starts = starts;
               o.local_evaluations = local_evaluations;
+              o.verify_starts = verify_starts;
               o.threads = threads;
               py::gil_scoped_release free;
               try {
@@ -420,12 +427,13 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(),
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 16, py::arg("local_evaluations") = 400,
-          py::arg("threads") = 0,
+          py::arg("verify_starts") = 20, py::arg("threads") = 0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
           "full dynamics). Point parts: sink=(x, y) the unique stable fixed point of its field, or\n"
-          "transport=(vx, vy) a uniform velocity over the plate. Rigid parts (not yet successful, see the\n"
-          "README): fixed_point=(x, y, theta), orient=theta; the summary gives the basin share and the\n"
-          "competing fixed points.");
+          "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
+          "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
+          "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient (not yet\n"
+          "successful, see the README): the summary gives the basin share and the competing fixed points.");
     m.def("coning_rate", [](const Scene& sc) { return coning_rate(sc.plate); }, py::arg("scene"),
           "The plate's steady yaw drift from rx and ry out of phase [rad/s], which the asymptotic field does\n"
           "not see and the full dynamics does: sum_n Im(A_rx,n conj A_ry,n) / (2 (n w)^3).");

@@ -302,3 +302,23 @@ def test_coning_turns_the_part_at_the_closed_form_rate():
     tr = plate.simulate(sc, start=(0.0, 0.0, 0.0), time=200, sample=50, dynamics="full")
     assert not tr.stop
     assert (tr.q[-1, 2] - tr.q[1, 2]) / 150 == pytest.approx(expected, rel=0.01)
+
+
+def test_a_rubber_footed_part_is_oriented_by_a_plate_that_only_translates():
+    # The module's own full dynamics from orientations of our choosing (not the design's): every one
+    # ends at THETA, wherever the transport has carried the part.
+    part = plate.load_scene(scene_path("foot"))
+    d = plate.design(part, orient=-1.0, starts=2, local_evaluations=80, verify_starts=4)
+    assert d.verified, d.failure
+    assert d.unique
+    harmonics = d.scene.to_dict()["plate"]["harmonics"]
+    assert all(h["axis"] in ("x", "y", "z") for h in harmonics)
+    ring = d.ring
+    assert len(ring) == 72
+    stable = sum(1 for k in range(72) if ring[k][1][2] > 0 >= ring[(k + 1) % 72][1][2])
+    assert stable == 1
+    T_end = 8 / d.rate + 5
+    for theta0 in (-3.0, 0.0, 1.5, 2.8):
+        tr = plate.simulate(d.scene, start=(0.0, 0.0, theta0), time=T_end, sample=T_end, dynamics="full")
+        assert not tr.stop
+        assert abs(math.remainder(tr.q[-1, 2] + 1.0, 2 * math.pi)) < 0.05

@@ -129,6 +129,12 @@ struct DesignSummary {
     std::vector<DesignStartRun> runs;   // full dynamics from random starts
     double worst_end_distance = 0;
     double min_vertical_margin = 0;     // min over the period and the region of (g + a_z) / g
+    // Orient by transport (a weathervane, for parts with unequal friction coefficients): the twist at
+    // the centre on the verification's ring of orientations (the same at every position); the stable
+    // orientation is fixed_point[2], the travel there transport_mean, and transport_spread the largest
+    // difference between positions on the grid (relative to v_ref and v_ref / rho).
+    std::vector<double> ring_theta;
+    std::vector<Vec3> ring_twist;
     // Transport: the field's mean velocity over the verification grid and its largest deviation from it.
     Vec2 transport_mean = Vec2::Zero();
     double transport_spread = 0;       // [m/s]
