@@ -837,7 +837,9 @@ struct DesignArgs : Options {
                        "  fixed-point X Y THETA  rigid part: (X, Y, THETA) the unique stable fixed point of the twist field\n"
                        "                    (or, where that is out of reach, the target's basin share and the competing\n"
                        "                    fixed points); point part: fixed-point X Y = sink X Y\n"
-                       "  orient THETA      rigid part: every start ends at orientation THETA (position free)\n"
+                       "  orient THETA      rigid part: every start ends at orientation THETA (position free; a part\n"
+                       "                    whose contacts' friction differs: by a plate that only translates)\n"
+                       "  line-sink X Y PHI point part: every start ends on the line through (X, Y) along PHI [rad]\n"
                        "  transport VX VY   point part: a uniform velocity (VX, VY) [m/s] over the plate\n"
                        "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
                        "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
@@ -845,7 +847,8 @@ struct DesignArgs : Options {
                        "fixed points on a 7x7 grid and full dynamics from 20 seeded random starts. Writes the designed\n"
                        "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
-        words("--target", target, 2, 4, "KIND ...", "sink X Y, fixed-point X Y [THETA], orient THETA or transport VX VY; required");
+        words("--target", target, 2, 4, "KIND ...",
+              "sink X Y, fixed-point X Y [THETA], orient THETA, line-sink X Y PHI or transport VX VY; required");
         text("--out", out, "SCENE.json", "the designed scene; required");
         numbers("--limits", limits, 2, 2, "LIN ANG", "the largest harmonic amplitudes (default 20 m/s^2, 150 rad/s^2)");
         number("--period", period, "the plate's period [s]", "the part scene's");
@@ -865,9 +868,9 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     DesignTarget t;
     std::vector<double> v;
     for (std::size_t i = 1; i < a.target.size(); ++i) v.push_back(parse_num("--target", a.target[i]));
-    const std::size_t want = kind == "orient" ? 1 : kind == "fixed-point" && !part.part.point ? 3 : 2;
-    const std::string usage = "expected sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA "
-                              "or transport VX VY";
+    const std::size_t want = kind == "orient" ? 1 : (kind == "fixed-point" && !part.part.point) || kind == "line-sink" ? 3 : 2;
+    const std::string usage = "expected sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA, "
+                              "line-sink X Y PHI or transport VX VY";
     if (v.size() != want) throw UsageError("--target " + kind + ": " + usage);
     if (kind == "sink" || kind == "fixed-point") {
         t.kind = kind == "sink" ? DesignTargetKind::Sink : DesignTargetKind::FixedPoint;
@@ -876,6 +879,10 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     } else if (kind == "orient") {
         t.kind = DesignTargetKind::Orient;
         t.theta = v[0];
+    } else if (kind == "line-sink") {
+        t.kind = DesignTargetKind::LineSink;
+        t.at = Vec2(v[0], v[1]);
+        t.theta = v[2];
     } else if (kind == "transport") {
         t.kind = DesignTargetKind::Transport;
         t.velocity = Vec2(v[0], v[1]);
@@ -912,12 +919,15 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     if (transport) j["target"]["velocity"] = {t.velocity.x(), t.velocity.y()};
     else if (t.kind != DesignTargetKind::Orient) j["target"]["at"] = {t.at.x(), t.at.y()};
     if (rigid) j["target"]["theta"] = t.theta;
+    if (t.kind == DesignTargetKind::LineSink) j["target"]["direction"] = t.theta;
     j["verified"] = d.verified;
     if (!d.verified) j["failure"] = d.failure;
     j["scene"] = a.out;
     if (!transport) {
         j["unique"] = d.unique;
         j["convergence_rate_per_s"] = d.rate;
+        if (t.kind == DesignTargetKind::LineSink)   // (the grid's largest speed along the line, and its bound)
+            j["speed_along_line"] = {{"largest_on_grid", d.transport_spread}, {"tolerance", d.transport_tolerance}};
         if (t.kind == DesignTargetKind::Orient) {
             // (position free: the orientation, and the velocity the part travels at there)
             j["orientation"] = d.fixed_point[2];

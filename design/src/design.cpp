@@ -125,6 +125,10 @@ std::array<Vec2, 8> region_edge(double R) {
     return {Vec2(-R, -R), Vec2(0, -R), Vec2(R, -R), Vec2(R, 0), Vec2(R, R), Vec2(0, R), Vec2(-R, R), Vec2(-R, 0)};
 }
 
+// A limit cycle's twist error relative to v_ref (and v_ref / rho): its tolerance plus the integrator's,
+// ~60 rtol v_ref (field.hpp).
+double cycle_noise(const LimitCycleOptions& o) { return o.tol + 60 * o.integration.rtol; }
+
 // The option's task runner, else its threads.
 TaskRunner runner(const DesignOptions& opt) { return opt.tasks ? opt.tasks : thread_tasks(opt.threads); }
 
@@ -435,6 +439,128 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     return sum;
 }
 
+// --- the point-part line sink ------------------------------------------------------------------
+// Parameters: cosine and sine coefficients of y and rx, first harmonic. rx couples the plate's
+// vertical acceleration to y (alpha x s = (0, 0, alpha_x y)), so the normal force swings with y in
+// step with the y shaking and a part drifts along y at a rate that changes sign with y. The line y = 0
+// is exact by construction: the motion is mirror symmetric about x = 0 (y and the pseudovector's x
+// component keep their signs) and nothing depends on x, so v_x = 0 everywhere; odd harmonics make
+// v_y odd in y. The search makes it attract (fast, and over the whole region); rotate_motion turns
+// the line onto the direction asked, shift_motion moves it through the point asked.
+PlateMotion line_motion(const std::vector<double>& p, double T) { return motion_from(p, {Axis::y, Axis::rx}, {1}, T); }
+
+struct LineSinkProblem : Problem<LineSinkProblem> {
+    LineSinkProblem(const Scene& part_, const DesignTarget& t_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
+        : Problem(part_, opt_, T_, cycles_), target(t_) {
+        // the farthest the region reaches from the line, across it
+        const Vec2 nrm(-std::sin(target.theta), std::cos(target.theta));
+        for (const Vec2& e : region_edge(opt.region)) reach = std::max(reach, std::abs((e - target.at).dot(nrm)));
+    }
+    DesignTarget target;
+    double reach = 0;
+    static constexpr int kParams = 4;
+    static constexpr int kConstraints = 7;   // six amplitudes, the flight margin
+    double limit(int i) const { return i < 2 ? opt.lin_limit : opt.ang_limit; }
+    PlateMotion placed(const std::vector<double>& p) const {
+        return shift_motion(rotate_motion(line_motion(p, T), target.theta), target.at);
+    }
+    void constraints(const std::vector<double>& p, double* c) const {
+        const auto ph = phasors(placed(p));
+        for (int axis = 0; axis < 6; ++axis) {
+            const auto it = ph.find({axis, 1});
+            const double L = axis < 3 ? opt.lin_limit : opt.ang_limit;
+            c[axis] = ((it == ph.end() ? 0.0 : std::abs(it->second)) - L) / std::max(L, 1e-12);
+        }
+        c[6] = opt.flight_margin - vertical_margin(placed(p), part.g, opt.region);
+    }
+    // The convergence rate onto the line, -dv_y/dy at y = 0 (v_y is odd: v_y(h) / h), and how much of
+    // the region the field does not pull towards the line (four distances out to its reach).
+    double evaluate(const std::vector<double>& p, double* rate_out = nullptr) {
+        ++evaluations;
+        Scene sc = part;
+        sc.plate = line_motion(p, T);
+        const double h = 0.003;
+        Vec2 v;
+        if (!twist_at(sc, Vec2(0, h), v)) return 1e3;
+        const double rate = -v.y() / h;
+        if (rate_out) *rate_out = rate;
+        double outward = 0;
+        for (int k = 1; k <= 4; ++k) {
+            const double y = reach * k / 4;
+            if (!twist_at(sc, Vec2(0, y), v)) return 1e3;
+            outward += std::max(0.0, v.y() / y);
+        }
+        return -rate + 10 * outward;
+    }
+};
+
+DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
+    const auto t0 = Clock::now();
+    DesignSummary sum;
+    sum.notes.push_back("y and rx, first harmonic: mirror symmetric about the line's normal and odd, so the field has a "
+                        "line of fixed points by construction (no drift along it)");
+    sum.notes.push_back("the line turned onto the direction asked (the field turns with the motion) and moved through "
+                        "the point asked by adding -alpha x D to the linear acceleration (the field shifts by D)");
+    std::atomic<long> cycles{0};
+    const auto make = [&] { return LineSinkProblem(part_scene, target, opt, T, &cycles); };
+    const std::vector<double> best = multistart<LineSinkProblem>(opt, -HUGE_VAL, make, sum.evaluations);
+    start_summary(sum, part_scene, "_line_sink", T);
+    auto finish = [&] {
+        sum.cycles = cycles;
+        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        return sum;
+    };
+    if (best.empty()) {
+        sum.failure = kNoFeasibleMotion;
+        return finish();
+    }
+    make().evaluate(best, &sum.rate);
+    sum.eigenvalues = Eigen::Vector2cd(0, -sum.rate);   // along the line neutral, across it the rate
+    sum.scene.plate = combined(make().placed(best));
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+
+    // --- verification: on the grid, no velocity along the line and every point off it (by more than
+    // the fixed-point tolerance) moving towards it; full dynamics from random starts ending on it.
+    const Vec2 dir(std::cos(target.theta), std::sin(target.theta)), nrm(-dir.y(), dir.x());
+    const Field f = verification_field(sum.scene, opt);
+    int undefined = 0, away = 0;
+    double along = 0;
+    for (const FieldPoint& p : f.points) {
+        if (!p.converged) { ++undefined; continue; }
+        const Vec2 v = p.twist.head<2>();
+        const double d = (p.q.head<2>() - target.at).dot(nrm);
+        along = std::max(along, std::abs(v.dot(dir)));
+        away += std::abs(d) > opt.fixed_point_tolerance && !(v.dot(nrm) * d < 0);
+    }
+    sum.transport_spread = along;   // (the largest speed along the line on the grid)
+    sum.transport_tolerance = cycle_noise(opt.cycle) * part_scene.v_ref();   // (zero by the symmetry)
+    sum.fixed_point = Vec3(target.at.x(), target.at.y(), 0);
+    sum.fixed_point_eigenvalues = Eigen::Vector3cd(sum.eigenvalues[0], sum.eigenvalues[1], 0);
+    const double rate = std::max(sum.rate, 1e-3);
+    const int stopped = verification_runs(
+        sum, opt,
+        [&](const DesignStartRun& r) {
+            const double d0 = std::abs((Vec2(r.x, r.y) - target.at).dot(nrm));
+            return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
+        },
+        [&](const DesignStartRun&, const Vec3& end) { return std::abs((end.head<2>() - target.at).dot(nrm)); });
+    sum.unique = undefined == 0 && away == 0 && along <= sum.transport_tolerance && sum.rate > 0;
+    if (undefined)
+        sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
+    else if (away)
+        sum.failure = std::to_string(away) + " of the grid's points off the line do not move towards it";
+    else if (!(along <= sum.transport_tolerance))
+        sum.failure = "the field moves parts along the line (" + std::to_string(along) + " m/s)";
+    else if (stopped)
+        sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
+    else if (!(sum.worst_end_distance <= opt.verify_distance))
+        sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) + " m from the line";
+    else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
+        sum.failure = "the vertical acceleration margin is below the one asked";
+    sum.verified = sum.failure.empty();
+    return finish();
+}
+
 // --- the point-part transport --------------------------------------------------------------------
 // Parameters: cosine and sine coefficients of harmonics n = 1, 2 on x, y and z (a plate that only
 // translates). The field is uniform; its value at the centre is driven onto the target.
@@ -525,9 +651,11 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
 // normal forces balance friction's moment about the horizontal axes, which makes sum_i N_i r_i
 // parallel to u: with one friction coefficient the torque vanishes, and such a plate never turns the
 // part (tests/test_design.cpp). With unequal ones it is a weathervane: the torque vanishes where
-// sum_i (mu_i - mu) N_i r_i lies along u; on a plate shaken along one line the part turns until its
-// high-friction contact, which tows it (friction drives the transport), leads -- one stable
-// orientation in the turn (richer motions put it elsewhere, still one). The search
+// sum_i (mu_i - mu) N_i r_i lies along u; on a plate shaken along one line with a heave in phase
+// (the transport driven by the normal force: the part slips backwards while pressed hardest, and
+// friction pushes it on) the part turns until its high-friction contact leads -- one stable
+// orientation in the turn (where the transport is driven otherwise, e.g. by a sawtooth, the foot
+// may trail; other motions put it elsewhere, still one). The search
 // shapes theta'(theta) on a ring of kRing orientations to one stable zero, as steep as it can be,
 // and rotate_motion turns that zero onto THETA.
 constexpr int kRing = 12, kFineRing = 72;
@@ -633,7 +761,8 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     sum.notes.push_back("orient by transport, a weathervane: a plate that only translates (x, y, z; n = 1, 2) gives the "
                         "part the same twist at every position and full dynamics equal to its U-dynamics (no tilt, no "
                         "coning); with unequal friction coefficients on its contacts the part turns to where friction's "
-                        "torque vanishes (on a plate shaken along one line: its high-friction contact leads)");
+                        "torque vanishes (on a plate shaken along one line with a heave in phase: its high-friction contact "
+                        "leads)");
     sum.notes.push_back("position free: the part travels while it turns and after (velocity_at_orientation)");
     sum.notes.push_back("designed on a ring of " + std::to_string(kRing) + " orientations and turned onto THETA "
                         "(the field turns with the motion); the limits hold at every turn");
@@ -681,12 +810,18 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
         sum.failure = "the ring's stable orientation did not survive the refinement's tolerances";
         return finish();
     }
-    while (hi - lo > 1e-7) {
-        const double m = 0.5 * (lo + hi);
-        (w_at(m) > 0 ? lo : hi) = m;
+    bool defined = true;
+    while (defined && hi - lo > 1e-7) {
+        const double m = 0.5 * (lo + hi), wm = w_at(m);
+        defined = std::isfinite(wm);
+        (wm > 0 ? lo : hi) = m;
     }
     const double theta_s = 0.5 * (lo + hi);
     sum.rate = -(w_at(theta_s + 0.01) - w_at(theta_s - 0.01)) / 0.02;
+    if (!defined || !std::isfinite(sum.rate)) {
+        sum.failure = "a cycle did not converge while the stable orientation was refined";
+        return finish();
+    }
     sum.eigenvalues3 = Eigen::Vector3cd(0, 0, -sum.rate);   // positions are neutral: the field is theta's alone
     sum.scene.plate = combined(rotate_motion(centred.plate, target.theta - theta_s));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
@@ -717,7 +852,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     const bool at_theta = zf.stable == 1 && std::abs(wrap_angle(zf.theta - target.theta)) <= 0.02;
     sum.unique = at_theta;
     const Field f = verification_field(sum.scene, opt);
-    // (the field's cycles converge to opt.cycle.tol of v_ref, from different warm starts)
+    // (each of the field's cycles is within cycle_noise of its limit, from its own warm start)
     const Vec3 S(part_scene.v_ref(), part_scene.v_ref(), part_scene.v_ref() / part_scene.part.rho());
     int undefined = 0;
     double spread = 0;
@@ -727,7 +862,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
             if (o.converged && o.q[2] == p.q[2]) spread = std::max(spread, (p.twist - o.twist).cwiseQuotient(S).cwiseAbs().maxCoeff());
     }
     sum.transport_spread = spread;   // (relative to v_ref and v_ref / rho)
-    sum.transport_tolerance = 10 * opt.cycle.tol;
+    sum.transport_tolerance = 2 * cycle_noise(opt.cycle);
     const int stopped = verification_runs(
         sum, opt,
         [&](const DesignStartRun& r) { return 1.5 * turn_time(w, r.theta, zf.theta, 0.01, 200) + 2; },
@@ -1015,12 +1150,15 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
         const auto mu = part_scene.part.mu.head(part_scene.part.contacts());
         if (target.kind == DesignTargetKind::Orient && mu.maxCoeff() > mu.minCoeff() * (1 + 1e-9))
             return design_orient(part_scene, target, opt, T);
+        if (target.kind == DesignTargetKind::LineSink)
+            throw std::invalid_argument("a line sink is built for point parts only");
         if (target.kind == DesignTargetKind::Sink)
             throw std::invalid_argument("a sink for every orientation of a rigid part is not built yet: ask for "
                                         "fixed-point X Y THETA (or orient THETA)");
         return design_rigid(part_scene, target, opt, T);
     }
     if (target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");
+    if (target.kind == DesignTargetKind::LineSink) return design_line_sink(part_scene, target, opt, T);
     return design_sink(part_scene, target, opt, T);
 }
 

@@ -384,10 +384,13 @@ PYBIND11_MODULE(_plate, m) {
     m.def("design",
           [](const Scene& part, std::optional<std::pair<double, double>> sink,
              std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
-             std::optional<double> orient, double lin_limit, double ang_limit, double period,
+             std::optional<double> orient, std::optional<std::tuple<double, double, double>> line_sink,
+             double lin_limit, double ang_limit, double period,
              std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads) {
-              require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() == 1,
-                      "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta) or orient=theta");
+              require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() +
+                                  line_sink.has_value() == 1,
+                      "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta "
+                      "or line_sink=(x, y, phi)");
               DesignTarget t;
               if (sink) t.at = Vec2(sink->first, sink->second);
               if (transport) {
@@ -402,6 +405,11 @@ PYBIND11_MODULE(_plate, m) {
               if (orient) {
                   t.kind = DesignTargetKind::Orient;
                   t.theta = *orient;
+              }
+              if (line_sink) {
+                  t.kind = DesignTargetKind::LineSink;
+                  t.at = Vec2(std::get<0>(*line_sink), std::get<1>(*line_sink));
+                  t.theta = std::get<2>(*line_sink);
               }
               DesignOptions o;
               require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
@@ -424,12 +432,13 @@ PYBIND11_MODULE(_plate, m) {
               }
           },
           py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
-          py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(),
+          py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 16, py::arg("local_evaluations") = 400,
           py::arg("verify_starts") = 20, py::arg("threads") = 0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
-          "full dynamics). Point parts: sink=(x, y) the unique stable fixed point of its field, or\n"
+          "full dynamics). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
+          "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
           "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
           "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
           "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient (not yet\n"

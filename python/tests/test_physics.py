@@ -322,3 +322,20 @@ def test_a_rubber_footed_part_is_oriented_by_a_plate_that_only_translates():
         tr = plate.simulate(d.scene, start=(0.0, 0.0, theta0), time=T_end, sample=T_end, dynamics="full")
         assert not tr.stop
         assert abs(math.remainder(tr.q[-1, 2] + 1.0, 2 * math.pi)) < 0.05
+
+
+def test_a_line_sink_gathers_parts_onto_the_line_and_leaves_them_where_they_arrive():
+    part = plate.load_scene(scene_path("fig1_point"))
+    d = plate.design(part, line_sink=(0.01, -0.02, 0.6), lin_limit=15, ang_limit=100, starts=2,
+                     local_evaluations=60, verify_starts=4)
+    assert d.verified, d.failure
+    n = np.array([-math.sin(0.6), math.cos(0.6)])
+    T_end = 8 / d.rate
+    ends = []
+    for start in [(-0.045, 0.045), (0.045, -0.045), (0.04, 0.04)]:
+        tr = plate.simulate(d.scene, start=start, time=T_end, sample=T_end, dynamics="full")
+        assert not tr.stop
+        end = tr.q[-1, :2]
+        assert abs((end - np.array([0.01, -0.02])) @ n) < 0.005     # on the line
+        ends.append(end)
+    assert np.linalg.norm(ends[0] - ends[1]) > 0.02                  # at different places along it

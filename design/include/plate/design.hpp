@@ -42,7 +42,7 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 // plate's rotation and against the full dynamics.)
 double coning_rate(const PlateMotion& u);
 
-enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient };
+enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };
 struct DesignTarget {
     // Sink: every start in the region ends at position `at`: for a point part the unique stable
     // fixed point of its velocity field ("fixed-point X Y" is the same target).
@@ -51,8 +51,11 @@ struct DesignTarget {
     // position (nothing in its dynamics depends on where it is), so the field is uniform by
     // construction and the search only sets its value.
     // FixedPoint: (at, theta) the unique stable fixed point of the twist field (a rigid part; for a
-    // point part the same as Sink). Orient: every start ends at orientation theta, position free
-    // (designed as a fixed point at the region's centre; verified on the orientation).
+    // point part the same as Sink). Orient: every start ends at orientation theta, position free (a
+    // part whose contacts' friction differs: by a plate that only translates, a weathervane; else
+    // designed as a fixed point at the region's centre and verified on the orientation).
+    // LineSink (point parts): every start ends on the line through `at` along direction `theta`, and
+    // stays where it arrives (a line of fixed points: no drift along it).
     DesignTargetKind kind = DesignTargetKind::Sink;
     Vec2 at = Vec2::Zero();
     double theta = 0;               // [rad]
