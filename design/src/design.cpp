@@ -212,18 +212,42 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
             hi[i] = prob.limit(i);
             step[i] = std::max(prob.limit(i), 1e-6) / 4;
         }
-        nlopt::opt local(nlopt::LN_COBYLA, n);
+        const bool gradients = opt.local == DesignOptions::Local::SlsqpFiniteDifferences;
+        nlopt::opt local(gradients ? nlopt::LD_SLSQP : nlopt::LN_COBYLA, n);
         local.set_lower_bounds(lo);
         local.set_upper_bounds(hi);
         local.set_initial_step(step);
-        local.set_maxeval(opt.local_evaluations);
+        // (SLSQP: forward differences of 1e-3 of each parameter's limit -- the objective's noise, the
+        // cycles' tolerance, is ~1e-6 relative; the evaluations' budget includes the differences)
+        local.set_maxeval(gradients ? std::max(1, opt.local_evaluations / (n + 1)) : opt.local_evaluations);
         local.set_stopval(stopval);
         local.set_min_objective(
-            [](const std::vector<double>& x, std::vector<double>&, void* d) { return static_cast<P*>(d)->objective(x); },
+            [](const std::vector<double>& x, std::vector<double>& g, void* d) {
+                P& pr = *static_cast<P*>(d);
+                const double f = pr.objective(x);
+                for (std::size_t i = 0; i < g.size(); ++i) {
+                    std::vector<double> xp = x;
+                    const double h = 1e-3 * std::max(pr.limit(static_cast<int>(i)), 1e-6);
+                    xp[i] += h;
+                    g[i] = (pr.objective(xp) - f) / h;
+                }
+                return f;
+            },
             &prob);
         local.add_inequality_mconstraint(
-            [](unsigned, double* c, unsigned, const double* x, double*, void* d) {
-                static_cast<P*>(d)->constraints(std::vector<double>(x, x + P::kParams), c);
+            [](unsigned, double* c, unsigned, const double* x, double* grad, void* d) {
+                const P& pr = *static_cast<P*>(d);
+                std::vector<double> xv(x, x + P::kParams);
+                pr.constraints(xv, c);
+                if (!grad) return;
+                double cp[P::kConstraints];
+                for (int i = 0; i < P::kParams; ++i) {   // grad[k n + i] = d c_k / d x_i
+                    std::vector<double> xp = xv;
+                    const double h = 1e-3 * std::max(pr.limit(i), 1e-6);
+                    xp[i] += h;
+                    pr.constraints(xp, cp);
+                    for (int k = 0; k < P::kConstraints; ++k) grad[k * P::kParams + i] = (cp[k] - c[k]) / h;
+                }
             },
             &prob, std::vector<double>(P::kConstraints, 1e-9));
         prob.objective(p);   // the feasible start itself

@@ -73,6 +73,11 @@ struct DesignOptions {
     std::uint64_t seed = 1;
     int starts = 16;           // multi-start: seeded feasible random motions, each refined locally
     int local_evaluations = 400;   // per start (NLopt COBYLA)
+    // The local search: COBYLA (derivative-free, the default), or SLSQP on forward-difference
+    // gradients (each gradient n + 1 objective evaluations, counted in `evaluations`), kept to
+    // measure what gradients buy (bench_design).
+    enum class Local { Cobyla, SlsqpFiniteDifferences };
+    Local local = Local::Cobyla;
     int threads = 0;           // starts in parallel (0: all cores)
     // Shares the starts, the verification field's planes and the verification runs (set: `threads`
     // is not used; e.g. sweep::farm_tasks over MPI ranks). The design is the same either way.
