@@ -507,7 +507,10 @@ struct SimulateArgs : Options {
     explicit SimulateArgs(CLI::App* cmd)
         : Options(cmd, "Trajectory from configuration --from with part twist --twist relative to the plate\n"
                        "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
-                       "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps).\n"
+                       "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps). averaged: stroboscopic\n"
+                       "averaging of the full dynamics (macro steps of many periods, each slope from a burst of the full\n"
+                       "dynamics; coning included; rows after the first five periods interpolated, their twist and\n"
+                       "normal forces nan).\n"
                        "auto: the cheapest of point/thin/thick part x field/u/full dynamics whose final configuration\n"
                        "is predicted within --model-tol E (default 1e-2; of rho and radians) of the scene's part\n"
                        "under full dynamics, decided up front from a few limit cycles at --from and the scene's\n"
@@ -521,7 +524,7 @@ struct SimulateArgs : Options {
                        "2e7, field 1e4). The work is estimated up front from one plate period (or one RK4 step) and a\n"
                        "run that would exceed the budget is refused with the estimate (exit 2); at most 10^7 rows.\n") {
         scene_file(scene);
-        text("--dynamics", dynamics, "full|u|field|auto", "the model; required");
+        text("--dynamics", dynamics, "full|u|field|averaged|auto", "the model; required");
         numbers("--from", from, 2, 3, "SX SY THETA", "the start (point parts: SX SY); required");
         number("--time", time, "the duration T [s]; required", "");
         numbers("--twist", twist, 2, 3, "VX VY OMEGA", "the part's twist relative to the plate at the start");
@@ -539,8 +542,8 @@ struct SimulateArgs : Options {
 int cmd_simulate(const SimulateArgs& a, Io& cio) {
     const Scene sc = scene_arg(a.scene, cio);
     std::string dyn = a.dynamics;
-    if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "auto")
-        throw UsageError("--dynamics: expected full, u, field or auto");
+    if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "averaged" && dyn != "auto")
+        throw UsageError("--dynamics: expected full, u, field, averaged or auto");
     const Vec3 q0 = config_arg(a, "--from", a.from, sc, true);
     const Vec3 qd0 = config_arg(a, "--twist", a.twist, sc, false);
     if (!a.has("--time")) throw UsageError("missing --time T");
@@ -601,7 +604,8 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
         } else {
             // Up to five periods: a start from rest can stick through the first.
             const double Tp = sc_run.plate.T, span = std::min(T, 5 * Tp);
-            const Trajectory pilot = simulate(sc_run, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, span, span, io);
+            // (averaged: its bursts are full dynamics; the estimate is the direct run's, an upper bound)
+            const Trajectory pilot = simulate(sc_run, dyn == "u" ? Dynamics::U : Dynamics::Full, q0, qd0, span, span, io);
             pilot_steps = std::max<double>(pilot.stats.steps, 1) * std::min(span, Tp) / span;   // per period
             steps = std::max(pilot_steps * T / std::min(span, Tp), rows);   // (every row ends a step)
             what = fmt(steps) + " integrator steps (" + fmt(T / Tp) + " plate periods at " + fmt(pilot_steps) +
@@ -618,6 +622,8 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
         LimitCycleOptions lo;
         lo.tol = a.tol;
         tr = field_curve(sc_run, q0, T, dt, lo);
+    } else if (dyn == "averaged") {
+        tr = simulate_averaged(sc_run, q0, qd0, T, dt, io);
     } else {
         tr = simulate(sc_run, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, dt, io);
     }

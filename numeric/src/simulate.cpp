@@ -125,4 +125,141 @@ Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3&
     return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, duration, sample_dt, opt);
 }
 
+Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
+                             const IntegrationOptions& opt, const AveragingOptions& avg) {
+    if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate_averaged: duration and sample_dt must be > 0");
+    if (avg.max_macro_periods < 1 || !(avg.macro_tol > 0) || avg.relax_periods < 0 || avg.start_periods < 0)
+        throw std::invalid_argument("simulate_averaged: macro_tol > 0, max_macro_periods >= 1, relax_periods and start_periods >= 0");
+    using State = detail::FullModel::State;
+    const double T = sc.plate.T;
+    constexpr int kSlow[6] = {0, 1, 2, 6, 7, 8};   // q and phi; the twist (3..5) is fast
+    Trajectory tr;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    // Runs the full dynamics from (t0, y) to t1; false (tr.stop set) if it stopped.
+    auto run_to = [&](double t0, State& y, double t1) {
+        detail::FullModel m(sc);
+        detail::Engine<detail::FullModel> e(m, sc, opt);
+        const bool ok = e.start(t0, y) && e.advance(t1, [](double, const auto&, const Vec3&) {});
+        tr.stats += e.stats;
+        tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
+        if (!ok) tr.stop = e.stop;
+        y = e.y();
+        return ok;
+    };
+    // A stage's slope of (q, phi) at y (time t = a whole number of periods), along `back` (the last
+    // slope); y's twist becomes the burst's end twist.
+    auto slope = [&](double t, State& y, const State& back, State& k) {
+        State b = y;
+        const double lead = (avg.relax_periods + 0.5) * T;
+        for (int i : kSlow) b[i] -= lead * back[i];
+        const double t0 = t - lead + 0.5 * T;   // (a whole number of periods before t)
+        if (!run_to(t0, b, t0 + avg.relax_periods * T)) return false;
+        const State a = b;
+        if (!run_to(t0 + avg.relax_periods * T, b, t0 + (avg.relax_periods + 1) * T)) return false;
+        for (int i = 0; i < 9; ++i) k[i] = (b[i] - a[i]) / T;
+        for (int i : {3, 4, 5}) y[i] = b[i];
+        return true;
+    };
+    Vec3 p, phi;
+    sc.plate.displacement(0.0, p, phi);
+    State y = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]};
+    tr.stats.min_normal_force = std::numeric_limits<double>::infinity();
+    // Macro points (t, q, dq/dt) for the samples.
+    struct Knot {
+        double t;
+        Vec3 q, v;
+    };
+    std::vector<Knot> knots;
+    const long N = static_cast<long>(std::floor(duration / T + 1e-9));
+    long n = std::min<long>(avg.start_periods, N);
+    double t = n * T;
+    State k1{}, k2{}, last{};
+    bool ok = true;
+    {   // the start, directly: its samples are the dynamics' own, and its last period's change is the
+        // first slope's guess (the burst's lead)
+        detail::FullModel m(sc);
+        detail::Engine<detail::FullModel> e(m, sc, opt);
+        ok = e.start(0, y);
+        // Stops: the samples before t, t - T (the last period's start), t.
+        std::vector<std::pair<double, int>> stops;   // (time, 1: a sample, 2: the last period's start)
+        for (long s = 1; s * sample_dt < t - 1e-12 * T; ++s) stops.push_back({s * sample_dt, 1});
+        if (n > 1) stops.push_back({t - T, 2});
+        stops.push_back({t, 0});
+        std::stable_sort(stops.begin(), stops.end());
+        if (ok) tr.samples.push_back(Sample{0, m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
+        State prev = y;
+        for (const auto& [ts, what] : stops) {
+            if (!(ok = e.advance(ts, [](double, const auto&, const Vec3&) {}))) break;
+            if (what == 1) tr.samples.push_back(Sample{e.t(), m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
+            if (what == 2) prev = e.y();
+        }
+        if (ok && n > 1)
+            for (int i = 0; i < 9; ++i) last[i] = (e.y()[i] - prev[i]) / T;
+        tr.stats += e.stats;
+        tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
+        if (!ok) tr.stop = e.stop;
+        y = e.y();
+    }
+    knots.push_back({t, Vec3(y[0], y[1], y[2]), Vec3::Constant(nan)});
+    // Macro steps of K periods, K chosen from Heun's local error estimate, H/2 |k2 - k1| in (rho, rho,
+    // 1 rad) against macro_tol (the usual controller, exponent 1/2; a rejected step keeps k1).
+    const double rho = sc.part.rho();
+    long K = std::min<long>(avg.start_periods > 0 ? avg.start_periods : 1, avg.max_macro_periods);
+    bool have_k1 = false;
+    while (ok && n < N) {
+        K = std::clamp<long>(K, 1, std::min<long>(avg.max_macro_periods, N - n));
+        const double H = K * T;
+        if (!have_k1 && !(ok = slope(t, y, last, k1))) break;
+        have_k1 = true;
+        State ye = y;
+        for (int i : kSlow) ye[i] += H * k1[i];
+        if (!(ok = slope(t + H, ye, k1, k2))) break;
+        const double err = 0.5 * H * std::max({std::abs(k2[0] - k1[0]) / rho, std::abs(k2[1] - k1[1]) / rho, std::abs(k2[2] - k1[2])});
+        const double grow = err > 0 ? 0.9 * std::sqrt(avg.macro_tol / err) : 2.0;
+        if (err > avg.macro_tol && K > 1) {
+            ++tr.stats.rejected;
+            K = std::clamp<long>(std::lround(K * std::max(0.3, grow)), 1, K - 1);
+            continue;
+        }
+        ++tr.stats.steps;
+        knots.back().v = Vec3(k1[0], k1[1], k1[2]);
+        for (int i : kSlow) y[i] += 0.5 * H * (k1[i] + k2[i]);
+        for (int i : {3, 4, 5}) y[i] = ye[i];
+        last = k2;
+        have_k1 = false;
+        n += K;
+        t = n * T;
+        knots.push_back({t, Vec3(y[0], y[1], y[2]), Vec3(k2[0], k2[1], k2[2])});
+        K = std::max<long>(1, std::lround(K * std::clamp(grow, 0.3, 2.0)));
+    }
+    if (ok && duration > t + 1e-12 * T) {   // the last partial period, directly
+        ok = run_to(t, y, duration);
+        const Vec3 v = knots.back().v;
+        knots.push_back({duration, Vec3(y[0], y[1], y[2]), v});
+    }
+    if (!ok) knots.push_back({tr.stop.t, Vec3(y[0], y[1], y[2]), Vec3::Constant(nan)});
+    // Samples after the start: cubic Hermite between knots with both slopes known, linear where one
+    // is not.
+    const double end = knots.back().t;
+    const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
+    std::size_t j = 0;
+    for (long s = static_cast<long>(tr.samples.size()); ok && s <= count; ++s) {
+        const double ts = std::min(s * sample_dt, duration);
+        if (ts > end) break;
+        while (j + 2 < knots.size() && knots[j + 1].t < ts) ++j;
+        const Knot& a = knots[j];
+        const Knot& b = knots[std::min(j + 1, knots.size() - 1)];
+        const double h = b.t - a.t, u = h > 0 ? (ts - a.t) / h : 1.0;
+        Vec3 q = (1 - u) * a.q + u * b.q;
+        if (a.v.allFinite() && b.v.allFinite())
+            q = (2 * u * u * u - 3 * u * u + 1) * a.q + (u * u * u - 2 * u * u + u) * h * a.v +
+                (-2 * u * u * u + 3 * u * u) * b.q + (u * u * u - u * u) * h * b.v;
+        tr.samples.push_back(Sample{ts, q, Vec3::Constant(nan), Vec3::Constant(nan), Mode{}});
+    }
+    if (!ok && (tr.samples.empty() || tr.samples.back().t < end))
+        tr.samples.push_back(Sample{end, knots.back().q, Vec3(y[3], y[4], y[5]), Vec3::Constant(nan), Mode{}});
+    if (!tr.samples.empty() && ok) tr.samples.back().qd = Vec3(y[3], y[4], y[5]);
+    return tr;
+}
+
 }  // namespace plate

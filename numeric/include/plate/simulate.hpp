@@ -95,4 +95,28 @@ double breakaway_time(const Scene& scene, const Vec3& q0, double t0, Dynamics le
 Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration,
                     double sample_dt, const IntegrationOptions& opt = {});
 
+// STROBOSCOPIC AVERAGING of the full dynamics (a heterogeneous multiscale method, after Calvo,
+// Chartier, Murua and Sanz-Serna's stroboscopic averaging). Over one period the configuration q and
+// the plate's orientation phi (which drifts: coning, design.hpp) move little, while the twist
+// settles onto its cycle within a period or two. Heun's method steps (q, phi) over macro steps of
+// K periods (K from the step's error estimate, H/2 |k2 - k1| relative to (rho, rho, 1 rad), held
+// below macro_tol, at most max_macro_periods); each stage's slope is measured by a burst of the
+// full dynamics at that stage's time:
+// `relax` periods for the twist to settle, then one period's change over T, the burst started
+// (relax + 1/2) periods' drift early so that the measured period is centred on the stage's point.
+// An accepted macro step costs 2 (relax + 1) periods instead of K. Unlike the asymptotic field's integral
+// curve (field_curve: U-dynamics, first-order average) it keeps everything the full dynamics have --
+// coning, the tilt's and the rotating frame's second-order drifts, stick-slip within a burst. The
+// first start_periods are integrated directly (the transient from qd0), and so is a last partial
+// period. Samples every sample_dt: the start's own, then cubic Hermite interpolants of the macro points
+// (their qd and n NaN). Stats and stop are the bursts' (steps and rejected: also the macro steps').
+struct AveragingOptions {
+    double macro_tol = 1e-3;      // local error of a macro step, relative to (rho, rho, 1 rad)
+    int max_macro_periods = 40;   // the largest K
+    int relax_periods = 2;
+    int start_periods = 5;        // (also the first K)
+};
+Trajectory simulate_averaged(const Scene& scene, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
+                             const IntegrationOptions& opt = {}, const AveragingOptions& avg = {});
+
 }  // namespace plate
