@@ -111,9 +111,9 @@ def chart(q, key_of, title, fname):
     for label, pts in sorted(groups.items()):
         pts.sort(key=lambda p: p["cpu"])
         fam = family(label)
-        style = "D:" if "averaged" in label else "o-" if fam == "plate" else "s--"
+        style = "D:" if "averag" in label else "o-" if fam == "plate" else "s--"
         ax.loglog([p["cpu"] for p in pts], [p["error"] for p in pts], style,
-                  color="#555555" if "averaged" in label else COLORS[fam], label=label, ms=4, lw=1.2,
+                  color="#555555" if "averag" in label else COLORS[fam], label=label, ms=4, lw=1.2,
                   alpha=1 if fam == "plate" or "k 5" in label or "k" not in label else 0.5)
     for p in d[q].get("protocol_error", []):
         ax.loglog([p["cpu"]], [p["error"]], "x", color="#e7298a", ms=8)
