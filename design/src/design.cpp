@@ -568,8 +568,21 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
             return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
         },
         [&](const DesignStartRun&, const Vec3& end) { return std::abs((end.head<2>() - target.at).dot(nrm)); });
-    sum.unique = undefined == 0 && away == 0 && along <= sum.transport_tolerance && sum.rate > 0;
-    if (undefined)
+    // The pull onto the line at 1 mm (the search's rate is a secant at 3 mm, and the grid and the runs
+    // do not look closer than 2 and 5 mm: a line that repels between two attracting ones nearby would
+    // pass them).
+    double pull = 0;
+    {
+        const Vec2 s1 = target.at + 1e-3 * nrm;
+        const LimitCycleSummary c = limit_cycle(sum.scene, Vec3(s1.x(), s1.y(), 0), opt.cycle);
+        ++cycles;
+        pull = c.converged ? -c.twist.head<2>().dot(nrm) / 1e-3 : std::numeric_limits<double>::quiet_NaN();
+    }
+    sum.unique = undefined == 0 && away == 0 && along <= sum.transport_tolerance && sum.rate > 0 && pull > 0;
+    if (!(sum.rate > 0 && pull > 0))
+        sum.failure = "the line does not attract (rate " + std::to_string(sum.rate) + " 1/s at 3 mm, " + std::to_string(pull) +
+                      " 1/s at 1 mm)";
+    else if (undefined)
         sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
     else if (away)
         sum.failure = std::to_string(away) + " of the grid's points off the line do not move towards it";

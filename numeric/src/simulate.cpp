@@ -183,7 +183,7 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
         // Stops: the samples before t, t - T (the last period's start), t.
         std::vector<std::pair<double, int>> stops;   // (time, 1: a sample, 2: the last period's start)
         for (long s = 1; s * sample_dt < t - 1e-12 * T; ++s) stops.push_back({s * sample_dt, 1});
-        if (n > 1) stops.push_back({t - T, 2});
+        if (n >= 1) stops.push_back({t - T, 2});
         stops.push_back({t, 0});
         std::stable_sort(stops.begin(), stops.end());
         if (ok) tr.samples.push_back(Sample{0, m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
@@ -193,7 +193,7 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
             if (what == 1) tr.samples.push_back(Sample{e.t(), m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
             if (what == 2) prev = e.y();
         }
-        if (ok && n > 1)
+        if (ok && n >= 1)
             for (int i = 0; i < 9; ++i) last[i] = (e.y()[i] - prev[i]) / T;
         tr.stats += e.stats;
         tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
@@ -209,19 +209,26 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
     while (ok && n < N) {
         K = std::clamp<long>(K, 1, std::min<long>(avg.max_macro_periods, N - n));
         const double H = K * T;
-        if (!have_k1 && !(ok = slope(t, y, last, k1))) break;
+        // A burst that stops (contact lost, a budget spent) ends the averaging: the rest is integrated
+        // directly from the last accepted point, where a real stop is found with its real time --
+        // except a predictor's at K > 1 (its point is Heun's guess): a rejected step.
+        if (!have_k1 && !slope(t, y, last, k1)) break;
         have_k1 = true;
         State ye = y;
         for (int i : kSlow) ye[i] += H * k1[i];
-        if (!(ok = slope(t + H, ye, k1, k2))) break;
-        const double err = 0.5 * H * std::max({std::abs(k2[0] - k1[0]) / rho, std::abs(k2[1] - k1[1]) / rho, std::abs(k2[2] - k1[2])});
+        const bool k2_ok = slope(t + H, ye, k1, k2);
+        if (!k2_ok && K == 1) break;
+        const double err = k2_ok ? 0.5 * H * std::max({std::abs(k2[0] - k1[0]) / rho, std::abs(k2[1] - k1[1]) / rho,
+                                                        std::abs(k2[2] - k1[2])})
+                                 : std::numeric_limits<double>::infinity();
         const double grow = err > 0 ? 0.9 * std::sqrt(avg.macro_tol / err) : 2.0;
-        if (err > avg.macro_tol && K > 1) {
+        if (!(err <= avg.macro_tol) && K > 1) {   // (also a NaN or a stopped predictor)
             ++tr.stats.rejected;
-            K = std::clamp<long>(std::lround(K * std::max(0.3, grow)), 1, K - 1);
+            tr.stop = StopEvent{};
+            K = std::clamp<long>(std::lround(K * std::clamp(grow, 0.3, 1.0)), 1, K - 1);
             continue;
         }
-        ++tr.stats.steps;
+        ++tr.stats.steps;   // (at K = 1 the step is taken whatever the estimate)
         knots.back().v = Vec3(k1[0], k1[1], k1[2]);
         for (int i : kSlow) y[i] += 0.5 * H * (k1[i] + k2[i]);
         for (int i : {3, 4, 5}) y[i] = ye[i];
@@ -232,20 +239,13 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
         knots.push_back({t, Vec3(y[0], y[1], y[2]), Vec3(k2[0], k2[1], k2[2])});
         K = std::max<long>(1, std::lround(K * std::clamp(grow, 0.3, 2.0)));
     }
-    if (ok && duration > t + 1e-12 * T) {   // the last partial period, directly
-        ok = run_to(t, y, duration);
-        const Vec3 v = knots.back().v;
-        knots.push_back({duration, Vec3(y[0], y[1], y[2]), v});
-    }
-    if (!ok) knots.push_back({tr.stop.t, Vec3(y[0], y[1], y[2]), Vec3::Constant(nan)});
-    // Samples after the start: cubic Hermite between knots with both slopes known, linear where one
-    // is not.
-    const double end = knots.back().t;
+    if (ok) tr.stop = StopEvent{};   // (a burst's stop: the direct run below finds the real one)
+    // Samples of the macro phase: cubic Hermite between knots with both slopes known, else linear.
     const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
+    long s = static_cast<long>(tr.samples.size());
     std::size_t j = 0;
-    for (long s = static_cast<long>(tr.samples.size()); ok && s <= count; ++s) {
+    for (; ok && s <= count && std::min(s * sample_dt, duration) <= t; ++s) {
         const double ts = std::min(s * sample_dt, duration);
-        if (ts > end) break;
         while (j + 2 < knots.size() && knots[j + 1].t < ts) ++j;
         const Knot& a = knots[j];
         const Knot& b = knots[std::min(j + 1, knots.size() - 1)];
@@ -256,9 +256,26 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
                 (-2 * u * u * u + 3 * u * u) * b.q + (u * u * u - u * u) * h * b.v;
         tr.samples.push_back(Sample{ts, q, Vec3::Constant(nan), Vec3::Constant(nan), Mode{}});
     }
-    if (!ok && (tr.samples.empty() || tr.samples.back().t < end))
-        tr.samples.push_back(Sample{end, knots.back().q, Vec3(y[3], y[4], y[5]), Vec3::Constant(nan), Mode{}});
-    if (!tr.samples.empty() && ok) tr.samples.back().qd = Vec3(y[3], y[4], y[5]);
+    // The rest -- the last partial period, or all of it after a burst stopped -- directly, with the
+    // dynamics' own samples (and stop).
+    if (ok && duration > t) {
+        detail::FullModel m(sc);
+        detail::Engine<detail::FullModel> e(m, sc, opt);
+        ok = e.start(t, y);
+        for (; ok && s <= count; ++s)
+            if ((ok = e.advance(std::min(s * sample_dt, duration), [](double, const auto&, const Vec3&) {})))
+                tr.samples.push_back(Sample{e.t(), m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
+        tr.stats += e.stats;
+        tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
+        if (!ok) {
+            tr.stop = e.stop;
+            tr.samples.push_back(Sample{e.t(), m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
+        }
+    } else if (!ok && !tr.samples.empty() && tr.samples.back().t < tr.stop.t) {   // (stopped in the start)
+        tr.samples.push_back(Sample{tr.stop.t, Vec3(y[0], y[1], y[2]), Vec3(y[3], y[4], y[5]), Vec3::Constant(nan), Mode{}});
+    }
+    if (ok && !tr.samples.empty() && !tr.samples.back().qd.allFinite() && tr.samples.back().t == t)
+        tr.samples.back().qd = Vec3(y[3], y[4], y[5]);
     return tr;
 }
 

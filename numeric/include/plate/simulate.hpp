@@ -109,7 +109,10 @@ Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Ve
 // coning, the tilt's and the rotating frame's second-order drifts, stick-slip within a burst. The
 // first start_periods are integrated directly (the transient from qd0), and so is a last partial
 // period. Samples every sample_dt: the start's own, then cubic Hermite interpolants of the macro points
-// (their qd and n NaN). Stats and stop are the bursts' (steps and rejected: also the macro steps').
+// (their qd and n NaN). A burst that stops ends the averaging: the rest is integrated directly from
+// the last accepted macro point, so a stop (contact lost) is reported with its real time and state
+// (a stopped predictor at K > 1 is only a rejected step). Stats are the bursts' (steps and rejected:
+// also the macro steps'); events and held_time are not kept; opt.max_steps bounds each burst.
 struct AveragingOptions {
     double macro_tol = 1e-3;      // local error of a macro step, relative to (rho, rho, 1 rad)
     int max_macro_periods = 40;   // the largest K
