@@ -849,8 +849,9 @@ struct DesignArgs : Options {
                        "  transport VX VY   point part: a uniform velocity (VX, VY) [m/s] over the plate\n"
                        "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
                        "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
-                       "seeded feasible motions (default 16), --evaluations each (default 400). Verification: the field's\n"
-                       "fixed points on a 7x7 grid and full dynamics from 20 seeded random starts. Writes the designed\n"
+                       "seeded feasible motions (default 4 for a point part's sink and line sink, 16 otherwise),\n"
+                       "--evaluations each (default 400). Verification: the field's fixed points on a 7x7 grid and full\n"
+                       "dynamics from 20 seeded random starts. Writes the designed\n"
                        "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
         words("--target", target, 2, 4, "KIND ...",
@@ -974,6 +975,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     j["worst_end_distance"] = d.worst_end_distance;
     j["min_vertical_acceleration_margin_over_g"] = d.min_vertical_margin;
     j["limits"] = {o.lin_limit, o.ang_limit};
+    j["starts"] = d.starts;
     j["evaluations"] = d.evaluations;
     j["limit_cycles"] = d.cycles;
     j["seconds"] = d.seconds;

@@ -468,6 +468,21 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
 
 // Inverse design (design.hpp): point-part sinks designed, verified, and shown -- the signal, the field
 // with its fixed point, and full-dynamics runs from the verification's random starts.
+// A design table row's first cells: the target, the verdict (with why it failed), unique, the rate,
+// evaluations and cycles.
+std::string design_cells(const std::string& target, const DesignSummary& d) {
+    return "<tr><td>" + target + "</td><td>" + verdict(d.verified) + (d.verified ? "" : " " + esc(d.failure)) + "</td><td>" +
+           (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) + "</td><td>" + std::to_string(d.evaluations) +
+           "</td><td>" + std::to_string(d.cycles) + "</td>";
+}
+
+// The cell of the part released at the target: how far it is after the hold, marked beyond `allowed`.
+std::string held_cell(double walked, double allowed, const std::string& from, const Trajectory& hold) {
+    const std::string v = fmt(1e3 * walked, 3);
+    return "<td>" + (walked > allowed ? "<span class=\"fail\">" + v + "</span>" : v) + from +
+           (hold.stop.reason != StopReason::None ? " (" + esc(hold.stop.describe()) + ")" : "") + "</td></tr>\n";
+}
+
 void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     const Scene part = load_scene((src / "scenes" / "fig1_point.json").string());
     DesignOptions o;
@@ -475,8 +490,8 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     o.ang_limit = 100;
     o.threads = opt.threads;
     o.seed = opt.seed;
+    o.starts = default_starts(part, DesignTarget{});   // (the sink's and the line sink's)
     if (opt.quick) {
-        o.starts = 4;
         o.local_evaluations = 120;
         o.verify_starts = 6;
     }
@@ -505,12 +520,9 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const Trajectory hold = simulate(d.scene, Dynamics::Full, Vec3(at.x(), at.y(), 0), Vec3::Zero(), 120, 120);
         const double walked = hold.samples.empty() ? std::numeric_limits<double>::quiet_NaN()
                                                    : (hold.samples.back().q.head<2>() - at).norm();
-        c.html << "<tr><td>sink (" << fmt(at.x(), 3) << ", " << fmt(at.y(), 3) << ")</td><td>" << verdict(d.verified)
-               << (d.verified ? "" : " " + esc(d.failure)) << "</td><td>" << (d.unique ? "yes" : "no") << "</td><td>"
-               << fmt(d.rate, 3) << "</td><td>" << d.evaluations << "</td><td>" << d.cycles << "</td><td>"
-               << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td><td>"
-               << (walked > o.verify_distance ? "<span class=\"fail\">" + fmt(1e3 * walked, 3) + "</span>" : fmt(1e3 * walked, 3))
-               << (hold.stop.reason != StopReason::None ? " (" + esc(hold.stop.describe()) + ")" : "") << "</td></tr>\n";
+        c.html << design_cells("sink (" + fmt(at.x(), 3) + ", " + fmt(at.y(), 3) + ")", d) << "<td>"
+               << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td>"
+               << held_cell(walked, o.verify_distance, "", hold);
         if (k++ == 0) {   // the figures are the first target's
             first = d;
             first_at = at;
@@ -526,14 +538,10 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const Trajectory hold = simulate(d.scene, Dynamics::Full, Vec3(t.at.x(), t.at.y(), 0), Vec3::Zero(), 120, 120);
         const double walked = hold.samples.empty() ? std::numeric_limits<double>::quiet_NaN()
                                                    : std::abs((hold.samples.back().q.head<2>() - t.at).dot(nrm));
-        c.html << "<tr><td>line sink through (" << fmt(t.at.x(), 3) << ", " << fmt(t.at.y(), 3) << ") along "
-               << fmt(t.theta, 3) << " rad</td><td>" << verdict(d.verified) << (d.verified ? "" : " " + esc(d.failure))
-               << "</td><td>" << (d.unique ? "yes" : "no") << "</td><td>" << fmt(d.rate, 3) << "</td><td>" << d.evaluations
-               << "</td><td>" << d.cycles << "</td><td>" << fmt(1e3 * d.worst_end_distance, 3) << " (from the line)</td><td>"
-               << fmt(d.seconds, 3) << "</td><td>"
-               << (walked > o.verify_distance ? "<span class=\"fail\">" + fmt(1e3 * walked, 3) + "</span>" : fmt(1e3 * walked, 3))
-               << " (from the line)" << (hold.stop.reason != StopReason::None ? " (" + esc(hold.stop.describe()) + ")" : "")
-               << "</td></tr>\n";
+        c.html << design_cells("line sink through (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ") along " +
+                                   fmt(t.theta, 3) + " rad", d)
+               << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << " (from the line)</td><td>" << fmt(d.seconds, 3) << "</td>"
+               << held_cell(walked, o.verify_distance, " (from the line)", hold);
     }
     c.html << "</table>\n<p>The last column is not part of the verification: a design whose part, released at the "
               "target, has left it by more than the verification's distance two minutes later is marked; the "
@@ -612,14 +620,12 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
               "(full dynamics = U-dynamics: no tilt, no coning); with one friction coefficient on every contact it "
               "cannot turn the part at all (friction's torque −(Σ μ<sub>i</sub>N<sub>i</sub>r<sub>i</sub>)×u "
               "vanishes when the normal forces balance friction's moment), with unequal ones it is a weathervane. "
-              "Designed on a ring of 12 orientations (" << o.starts << " starts, " << o.local_evaluations
+              "Designed on a ring of 12 orientations (" << d.starts << " starts, " << o.local_evaluations
            << " evaluations each), turned onto θ, verified on a ring of " << d.ring_theta.size()
            << " orientations and by " << d.runs.size() << " full-dynamics runs from random starts.</p>\n"
            << "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
               "<th>cycles</th><th>worst end angle [rad]</th><th>travel at θ [m/s]</th><th>seconds</th></tr>\n"
-           << "<tr><td>orient " << fmt(t.theta, 3) << "</td><td>" << verdict(d.verified)
-           << (d.verified ? "" : " " + esc(d.failure)) << "</td><td>" << (d.unique ? "yes" : "no") << "</td><td>"
-           << fmt(d.rate, 3) << "</td><td>" << d.evaluations << "</td><td>" << d.cycles << "</td><td>"
+           << design_cells("orient " + fmt(t.theta, 3), d) << "<td>"
            << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3) << "</td><td>" << fmt(d.transport_mean.norm(), 3)
            << "</td><td>" << fmt(d.seconds, 3) << "</td></tr>\n</table>\n";
     if (d.ring_theta.empty()) return;

@@ -24,6 +24,16 @@ LimitCycleOptions tight() {
     return o;
 }
 
+// A short search: `starts` seeded starts of `evaluations` each, verified by `runs` full-dynamics runs.
+DesignOptions searched(int starts, int evaluations, int runs, int threads = 0) {
+    DesignOptions o;
+    o.starts = starts;
+    o.local_evaluations = evaluations;
+    o.verify_starts = runs;
+    o.threads = threads;
+    return o;
+}
+
 Vec3 xi(const Scene& sc, const Vec3& q) {
     const LimitCycleSummary lc = limit_cycle(sc, q, tight());
     REQUIRE(lc.converged);
@@ -129,11 +139,7 @@ TEST_CASE("designs are reproducible by seed whatever the threads, and other seed
     const Scene part = scene("fig1_point");
     DesignTarget t;
     t.at = Vec2(-0.01, 0.015);
-    DesignOptions o;
-    o.starts = 4;
-    o.local_evaluations = 80;
-    o.verify_starts = 4;
-    o.threads = 1;
+    DesignOptions o = searched(4, 80, 4, 1);
     const DesignSummary a = design(part, t, o);
     o.threads = 2;
     const DesignSummary b = design(part, t, o);
@@ -150,11 +156,7 @@ TEST_CASE("a design whose tasks arrive as text from elsewhere is the same design
     const Scene part = scene("fig1_point");
     DesignTarget t;
     t.at = Vec2(0.01, -0.02);
-    DesignOptions o;
-    o.starts = 3;
-    o.local_evaluations = 60;
-    o.verify_starts = 3;
-    o.threads = 2;
+    DesignOptions o = searched(3, 60, 3, 2);
     const DesignSummary a = design(part, t, o);
     std::vector<std::vector<std::string>> calls;
     o.tasks = [&](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
@@ -190,10 +192,7 @@ TEST_CASE("a design whose tasks arrive as text from elsewhere is the same design
 
 TEST_CASE("a sink at the centre keeps the signal symmetric: no vertical motion, an odd field", "[design]") {
     const Scene part = scene("fig1_point");
-    DesignOptions o;
-    o.starts = 4;
-    o.local_evaluations = 120;
-    o.verify_starts = 4;
+    DesignOptions o = searched(4, 120, 4);
     const DesignSummary s = design(part, DesignTarget{}, o);
     for (const Harmonic& h : s.scene.plate.harmonics) {
         CHECK(h.axis != Axis::z);
@@ -207,10 +206,7 @@ TEST_CASE("a sink at the centre keeps the signal symmetric: no vertical motion, 
 
 TEST_CASE("an impossible target fails cleanly, never reported as done", "[design]") {
     const Scene part = scene("fig1_point");
-    DesignOptions o;
-    o.starts = 2;
-    o.local_evaluations = 30;
-    o.verify_starts = 3;
+    DesignOptions o = searched(2, 30, 3);
     SECTION("no motion allowed: no sink") {
         o.lin_limit = 0.3;   // below mu g: the part cannot even be moved
         o.ang_limit = 0.3;
@@ -245,11 +241,8 @@ TEST_CASE("transport: a translating plate carries a point part at the target vel
     DesignTarget t;
     t.kind = DesignTargetKind::Transport;
     t.velocity = Vec2(0.02, 0.01);
-    DesignOptions o;
+    DesignOptions o = searched(8, 200, 6);
     o.lin_limit = 15;
-    o.starts = 8;
-    o.local_evaluations = 200;
-    o.verify_starts = 6;
     const DesignSummary s = design(part, t, o);
     INFO(s.failure);
     REQUIRE(s.verified);
@@ -361,11 +354,7 @@ TEST_CASE("orient: a part with a rubber foot is turned to THETA from anywhere, b
     DesignTarget t;
     t.kind = DesignTargetKind::Orient;
     t.theta = 2.0;
-    DesignOptions o;
-    o.starts = 2;
-    o.local_evaluations = 80;
-    o.verify_starts = 8;
-    o.threads = 2;
+    DesignOptions o = searched(2, 80, 8, 2);
     const DesignSummary s = design(foot, t, o);
     INFO(s.failure);
     REQUIRE(s.verified);
@@ -408,13 +397,9 @@ TEST_CASE("line sink: every start ends on the line asked and stays where it arri
     t.kind = DesignTargetKind::LineSink;
     t.at = Vec2(0.01, -0.02);
     t.theta = 0.6;
-    DesignOptions o;
+    DesignOptions o = searched(2, 60, 6, 2);
     o.lin_limit = 15;
     o.ang_limit = 100;
-    o.starts = 2;
-    o.local_evaluations = 60;
-    o.verify_starts = 6;
-    o.threads = 2;
     const DesignSummary s = design(part, t, o);
     INFO(s.failure);
     REQUIRE(s.verified);

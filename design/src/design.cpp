@@ -332,6 +332,36 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
     return stopped;
 }
 
+// The summary's last entries, whatever the outcome: the cycles computed and the wall time.
+DesignSummary& finished(DesignSummary& sum, const std::atomic<long>& cycles, Clock::time_point t0) {
+    sum.cycles = cycles;
+    sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return sum;
+}
+
+// A verification run's duration: long enough for the slowest mode, at `rate` [1/s], to bring a start
+// d0 away within a fifth of the distance asked (2 s to 120 s).
+double settle_time(double d0, double rate, const DesignOptions& opt) {
+    return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / std::max(rate, 1e-3), 2.0,
+                      120.0);
+}
+
+// c_k <= 0 for each axis' harmonics n = 1..n_max of `fin` within `room` times the axis' limit (6 n_max
+// entries, axis-major), then c <= 0 for no flight over the region; returns the entries written.
+int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, double g, int n_max, double room, double* c) {
+    const auto ph = phasors(fin);
+    int k = 0;
+    for (int axis = 0; axis < 6; ++axis)
+        for (int n = 1; n <= n_max; ++n) {
+            const auto it = ph.find({axis, n});
+            const double amp = it == ph.end() ? 0.0 : std::abs(it->second);
+            const double lim = axis < 3 ? opt.lin_limit : opt.ang_limit;
+            c[k++] = (amp - room * lim) / std::max(lim, 1e-12);
+        }
+    c[k++] = opt.flight_margin - vertical_margin(fin, g, opt.region);
+    return k;
+}
+
 // The summary's scene before a design is found: the part on a plate at rest.
 void start_summary(DesignSummary& sum, const Scene& part, const std::string& suffix, double T) {
     sum.scene = part;
@@ -361,15 +391,7 @@ struct SinkProblem : Problem<SinkProblem> {
     // Constraints c_k <= 0 on the final (shifted) motion: each harmonic's amplitude within its
     // limit, and no flight over the region.
     void constraints(const std::vector<double>& p, double* c) const {
-        const PlateMotion fin = shift_motion(sink_motion(p, T), D);
-        int k = 0;
-        const auto ph = phasors(fin);
-        for (int axis = 0; axis < 6; ++axis) {
-            const auto it = ph.find({axis, 1});
-            const double amp = it == ph.end() ? 0.0 : std::abs(it->second);
-            c[k++] = (amp - (axis < 3 ? opt.lin_limit : opt.ang_limit)) / (axis < 3 ? opt.lin_limit : opt.ang_limit);
-        }
-        c[k++] = opt.flight_margin - vertical_margin(fin, part.g, opt.region);
+        amplitude_constraints(shift_motion(sink_motion(p, T), D), opt, part.g, 1, 1.0, c);
     }
     // Convergence rate at the centre, and how much of the region's edge the field does not point
     // inwards (of the centred motion: the final field at s + D).
@@ -412,13 +434,10 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     start_summary(sum, part_scene, "_sink", T);   // (no motion unless a design is found)
     if (best.empty()) {
         sum.failure = kNoFeasibleMotion;
-        sum.cycles = cycles;
-        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        return sum;
+        return finished(sum, cycles, t0);
     }
     make().evaluate(best, &sum.rate, &sum.eigenvalues);
     sum.scene.plate = combined(shift_motion(sink_motion(best, T), target.at));
-    sum.cycles = cycles;
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
 
     // --- verification: the field's fixed points on the grid, then full dynamics from random starts.
@@ -438,14 +457,9 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     }
     for (const FixedLine& l : sum.fixed_points.lines) stable += l.stability == Stability::Stable;
     sum.unique = stable == 1 && stable_at_target == 1;
-    const double rate = std::max(sum.rate, 1e-3);
     const int stopped = verification_runs(
         sum, opt,
-        [&](const DesignStartRun& r) {
-            // Long enough for the linearised convergence to bring it within a fifth of the distance asked.
-            const double d0 = (Vec2(r.x, r.y) - target.at).norm();
-            return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
-        },
+        [&](const DesignStartRun& r) { return settle_time((Vec2(r.x, r.y) - target.at).norm(), sum.rate, opt); },
         [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); });
     if (!sum.unique)
         sum.failure = "the designed field has " + std::to_string(stable) + " stable fixed point(s) or line(s) on the " +
@@ -459,8 +473,7 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
         sum.failure = "the vertical acceleration margin is below the one asked";
     sum.verified = sum.failure.empty();
-    sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return sum;
+    return finished(sum, cycles, t0);
 }
 
 // --- the point-part line sink ------------------------------------------------------------------
@@ -489,13 +502,7 @@ struct LineSinkProblem : Problem<LineSinkProblem> {
         return shift_motion(rotate_motion(line_motion(p, T), target.theta), target.at);
     }
     void constraints(const std::vector<double>& p, double* c) const {
-        const auto ph = phasors(placed(p));
-        for (int axis = 0; axis < 6; ++axis) {
-            const auto it = ph.find({axis, 1});
-            const double L = axis < 3 ? opt.lin_limit : opt.ang_limit;
-            c[axis] = ((it == ph.end() ? 0.0 : std::abs(it->second)) - L) / std::max(L, 1e-12);
-        }
-        c[6] = opt.flight_margin - vertical_margin(placed(p), part.g, opt.region);
+        amplitude_constraints(placed(p), opt, part.g, 1, 1.0, c);
     }
     // The convergence rate onto the line, -dv_y/dy at y = 0 (v_y is odd: v_y(h) / h), and how much of
     // the region the field does not pull towards the line (four distances out to its reach).
@@ -529,14 +536,9 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
     const auto make = [&] { return LineSinkProblem(part_scene, target, opt, T, &cycles); };
     const std::vector<double> best = multistart<LineSinkProblem>(opt, -HUGE_VAL, make, sum.evaluations);
     start_summary(sum, part_scene, "_line_sink", T);
-    auto finish = [&] {
-        sum.cycles = cycles;
-        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        return sum;
-    };
     if (best.empty()) {
         sum.failure = kNoFeasibleMotion;
-        return finish();
+        return finished(sum, cycles, t0);
     }
     make().evaluate(best, &sum.rate);
     sum.eigenvalues = Eigen::Vector2cd(0, -sum.rate);   // along the line neutral, across it the rate
@@ -560,13 +562,9 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
     sum.transport_tolerance = cycle_noise(opt.cycle) * part_scene.v_ref();   // (zero by the symmetry)
     sum.fixed_point = Vec3(target.at.x(), target.at.y(), 0);
     sum.fixed_point_eigenvalues = Eigen::Vector3cd(sum.eigenvalues[0], sum.eigenvalues[1], 0);
-    const double rate = std::max(sum.rate, 1e-3);
     const int stopped = verification_runs(
         sum, opt,
-        [&](const DesignStartRun& r) {
-            const double d0 = std::abs((Vec2(r.x, r.y) - target.at).dot(nrm));
-            return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
-        },
+        [&](const DesignStartRun& r) { return settle_time(std::abs((Vec2(r.x, r.y) - target.at).dot(nrm)), sum.rate, opt); },
         [&](const DesignStartRun&, const Vec3& end) { return std::abs((end.head<2>() - target.at).dot(nrm)); });
     // The pull onto the line at 1 mm (the search's rate is a secant at 3 mm, and the grid and the runs
     // do not look closer than 2 and 5 mm: a line that repels between two attracting ones nearby would
@@ -595,7 +593,7 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
     else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
         sum.failure = "the vertical acceleration margin is below the one asked";
     sum.verified = sum.failure.empty();
-    return finish();
+    return finished(sum, cycles, t0);
 }
 
 // --- the point-part transport --------------------------------------------------------------------
@@ -638,11 +636,9 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     // (stop within 0.01% of the target speed)
     const std::vector<double> best = multistart<TransportProblem>(opt, 1e-4, make, sum.evaluations);
     start_summary(sum, part_scene, "_transport", T);
-    sum.cycles = cycles;
     if (best.empty()) {
         sum.failure = kNoFeasibleMotion;
-        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        return sum;
+        return finished(sum, cycles, t0);
     }
     sum.scene.plate = combined(transport_motion(best, T));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
@@ -676,8 +672,7 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
         sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) +
                       " m from where the target velocity takes it";
     sum.verified = sum.failure.empty();
-    sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return sum;
+    return finished(sum, cycles, t0);
 }
 
 // --- the rigid part's orientation: a weathervane ------------------------------------------------
@@ -811,14 +806,9 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     };
     const std::vector<double> best = multistart<OrientProblem>(opt, -HUGE_VAL, make, sum.evaluations);
     start_summary(sum, part_scene, "_orient", T);
-    auto finish = [&] {
-        sum.cycles = cycles;
-        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        return sum;
-    };
     if (best.empty()) {
         sum.failure = kNoFeasibleMotion;
-        return finish();
+        return finished(sum, cycles, t0);
     }
     Scene centred = part_scene;
     centred.plate = transport_motion(best, T);
@@ -829,7 +819,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
         sum.failure = "no plate motion that only translates found turns the part to one orientation" +
                       std::string(z.stable == 0 ? " (it does not turn it at all: with one friction coefficient on "
                                                   "every contact none can)" : "");
-        return finish();
+        return finished(sum, cycles, t0);
     }
     // The stable orientation by bisection on theta' (at the refinement's tolerances), its rate by
     // central differences.
@@ -845,7 +835,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     double lo = z.theta - 0.5 * h, hi = z.theta + 0.5 * h;
     if (!(w_at(lo) > 0 && w_at(hi) <= 0)) {
         sum.failure = "the ring's stable orientation did not survive the refinement's tolerances";
-        return finish();
+        return finished(sum, cycles, t0);
     }
     bool defined = true;
     while (defined && hi - lo > 1e-7) {
@@ -857,7 +847,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     sum.rate = -(w_at(theta_s + 0.01) - w_at(theta_s - 0.01)) / 0.02;
     if (!defined || !std::isfinite(sum.rate)) {
         sum.failure = "a cycle did not converge while the stable orientation was refined";
-        return finish();
+        return finished(sum, cycles, t0);
     }
     sum.eigenvalues3 = Eigen::Vector3cd(0, 0, -sum.rate);   // positions are neutral: the field is theta's alone
     sum.scene.plate = combined(rotate_motion(centred.plate, target.theta - theta_s));
@@ -866,7 +856,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     OrientProblem(part_scene, opt, T, &cycles).constraints(params_from(sum.scene.plate, kTranslationAxes, {1, 2}), c);
     if (*std::max_element(c, c + OrientProblem::kConstraints) > 1e-9) {
         sum.failure = "the turned motion exceeds the amplitude limits or the flight margin";
-        return finish();
+        return finished(sum, cycles, t0);
     }
 
     // --- verification: a fine ring at the centre (one stable orientation, at THETA), the 7^3 field
@@ -874,7 +864,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     std::vector<Vec3> ring;
     if (!orientation_ring(sum.scene, kFineRing, opt.cycle, cycles, th, w, &ring)) {
         sum.failure = "a cycle on the verification ring did not converge";
-        return finish();
+        return finished(sum, cycles, t0);
     }
     sum.ring_theta = th;
     sum.ring_twist = ring;
@@ -924,7 +914,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
         sum.failure = "the vertical acceleration margin is below the one asked";
     sum.verified = sum.failure.empty();
-    return finish();
+    return finished(sum, cycles, t0);
 }
 
 // --- the rigid part's fixed point (and orientation) ----------------------------------------------
@@ -942,19 +932,10 @@ constexpr double kConingLimit = 1e-4;   // [rad/s] (coning_rate, design.hpp): 0.
 // Constraints c_k <= 0 on a motion as placed: each (axis, n) amplitude within its limit times
 // `room`, no flight over the region, and no coning beyond kConingLimit either way.
 void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, double g, double room, double* c) {
-    const auto ph = phasors(fin);
-    int k = 0;
-    for (int axis = 0; axis < 6; ++axis)
-        for (int n = 1; n <= 2; ++n) {
-            const auto it = ph.find({axis, n});
-            const double amp = it == ph.end() ? 0.0 : std::abs(it->second);
-            const double lim = axis < 3 ? opt.lin_limit : opt.ang_limit;
-            c[k++] = (amp - room * lim) / std::max(lim, 1e-12);
-        }
-    c[k++] = opt.flight_margin - vertical_margin(fin, g, opt.region);
+    const int k = amplitude_constraints(fin, opt, g, 2, room, c);
     const double cone = coning_rate(fin) / kConingLimit;
-    c[k++] = cone - 1;
-    c[k] = -cone - 1;
+    c[k] = cone - 1;
+    c[k + 1] = -cone - 1;
 }
 
 // The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
@@ -1046,14 +1027,9 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     const auto make = [&] { return RigidProblem(part_scene, target, opt, T, &cycles); };
     const std::vector<double> best = multistart<RigidProblem>(opt, -HUGE_VAL, make, sum.evaluations);
     start_summary(sum, part_scene, orient ? "_orient" : "_fixed_point", T);
-    auto finish = [&] {
-        sum.cycles = cycles;
-        sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        return sum;
-    };
     if (best.empty()) {
         sum.failure = kNoFeasibleMotion;
-        return finish();
+        return finished(sum, cycles, t0);
     }
     make().evaluate(best, &sum.rate, &sum.eigenvalues3);
     // The fixed point near the centre: Newton with the central-difference Jacobian, at the
@@ -1076,7 +1052,7 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     }
     if (!found || q.head<2>().norm() > opt.region || std::abs(q[2]) > kPi / 2) {
         sum.failure = "the search's best motion has no fixed point near the design's centre";
-        return finish();
+        return finished(sum, cycles, t0);
     }
     const double turn = target.theta - q[2];
     const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
@@ -1087,7 +1063,7 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     placed_constraints(sum.scene.plate, opt, sum.scene.g, 1.0, c);
     if (*std::max_element(c, c + RigidProblem::kConstraints) > 1e-9) {
         sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning limit";
-        return finish();
+        return finished(sum, cycles, t0);
     }
     const Vec3 goal(at.x(), at.y(), wrap_angle(target.theta));
     auto reached = [&](const Vec3& a, const Vec3& b, double dist, double ang) {
@@ -1114,13 +1090,9 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     int stable_lines = 0;
     for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
     sum.unique = stable == 1 && stable_at_target == 1 && stable_lines == 0;
-    const double rate = std::max(sum.rate, 1e-3);
     const int stopped = verification_runs(
         sum, opt,
-        [&](const DesignStartRun&) {
-            // The slowest mode brings a start from across the region within a fifth of the distance asked.
-            return std::clamp(std::log(2 * opt.region / (0.2 * opt.verify_distance)) / rate, 2.0, 120.0);
-        },
+        [&](const DesignStartRun&) { return settle_time(2 * opt.region, sum.rate, opt); },   // (from across the region)
         [&](const DesignStartRun&, const Vec3& end) {
             return std::max(orient ? 0.0 : (end.head<2>() - at).norm(),
                             std::abs(wrap_angle(end[2] - goal[2])) * opt.verify_distance / 0.05);
@@ -1151,7 +1123,7 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
         sum.failure = "the vertical acceleration margin is below the one asked";
     sum.verified = sum.failure.empty();
-    return finish();
+    return finished(sum, cycles, t0);
 }
 
 }  // namespace
@@ -1170,7 +1142,14 @@ double coning_rate(const PlateMotion& u) {
     return r;
 }
 
-DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
+int default_starts(const Scene& part_scene, const DesignTarget& target) {
+    const bool sink = target.kind == DesignTargetKind::Sink || target.kind == DesignTargetKind::FixedPoint ||
+                      target.kind == DesignTargetKind::LineSink;
+    return part_scene.part.point && sink ? 4 : 16;
+}
+
+namespace {
+DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
     const double T = opt.period > 0 ? opt.period : part_scene.plate.T;
     if (!(T > 0)) throw std::invalid_argument("no plate period (give one)");
     if (target.kind == DesignTargetKind::Transport) {
@@ -1197,6 +1176,15 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
     if (target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");
     if (target.kind == DesignTargetKind::LineSink) return design_line_sink(part_scene, target, opt, T);
     return design_sink(part_scene, target, opt, T);
+}
+}  // namespace
+
+DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
+    DesignOptions o = opt;
+    if (o.starts <= 0) o.starts = default_starts(part_scene, target);
+    DesignSummary sum = dispatch(part_scene, target, o);
+    sum.starts = o.starts;
+    return sum;
 }
 
 }  // namespace plate

@@ -355,6 +355,7 @@ PYBIND11_MODULE(_plate, m) {
         .def_readonly("rate", &DesignSummary::rate, "convergence rate at the target, -max Re(eigenvalues) [1/s]")
         .def_readonly("eigenvalues", &DesignSummary::eigenvalues)
         .def_readonly("fixed_point", &DesignSummary::fixed_point)
+        .def_readonly("starts", &DesignSummary::starts)
         .def_readonly("evaluations", &DesignSummary::evaluations)
         .def_readonly("cycles", &DesignSummary::cycles)
         .def_readonly("worst_end_distance", &DesignSummary::worst_end_distance,
@@ -413,8 +414,8 @@ PYBIND11_MODULE(_plate, m) {
               }
               DesignOptions o;
               require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
-              require(starts >= 1 && local_evaluations >= 1 && verify_starts >= 1,
-                      "starts, local_evaluations, verify_starts: expected >= 1");
+              require(starts >= 0 && local_evaluations >= 1 && verify_starts >= 1,
+                      "starts: expected >= 0 (0: the target's default); local_evaluations, verify_starts: expected >= 1");
               o.lin_limit = lin_limit;
               o.ang_limit = ang_limit;
               o.period = period;
@@ -434,7 +435,7 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
           py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
-          py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 16, py::arg("local_evaluations") = 400,
+          py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0, py::arg("local_evaluations") = 400,
           py::arg("verify_starts") = 20, py::arg("threads") = 0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
           "full dynamics). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"

@@ -71,7 +71,9 @@ struct DesignOptions {
     // this fraction of g, all period long (a constraint of the search, never a penalty).
     double flight_margin = 0.2;
     std::uint64_t seed = 1;
-    int starts = 16;           // multi-start: seeded feasible random motions, each refined locally
+    // Multi-start: seeded feasible random motions, each refined locally; 0: the target's default
+    // (default_starts).
+    int starts = 0;
     int local_evaluations = 400;   // per start (NLopt COBYLA)
     // The local search: COBYLA (derivative-free, the default), or SLSQP on forward-difference
     // gradients (each gradient n + 1 objective evaluations, counted in `evaluations`), kept to
@@ -120,6 +122,7 @@ struct DesignSummary {
     double rate = 0;
     Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();     // (point parts)
     Eigen::Vector3cd eigenvalues3 = Eigen::Vector3cd::Zero();    // (rigid parts)
+    int starts = 0;             // the search's starts
     long evaluations = 0;       // objective evaluations (each a few limit cycles)
     long cycles = 0;            // limit cycles computed in the search
     // Verification.
@@ -150,6 +153,11 @@ struct DesignSummary {
     double seconds = 0;
     std::vector<std::string> notes;     // the symmetries used, and what they imply
 };
+
+// The starts a design makes when DesignOptions::starts is 0: 4 for a point part's sink and line sink
+// (8 and 4 parameters: on the sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
+// 16 starts' rate within 0.5% in a quarter of the time), 16 for the rest.
+int default_starts(const Scene& part_scene, const DesignTarget& target);
 
 // Designs a plate motion for the part of `part_scene` (its plate block is ignored but for its
 // period when opt.period is 0). Throws std::invalid_argument for a target the part cannot have.
