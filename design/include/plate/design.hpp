@@ -31,15 +31,16 @@ PlateMotion rotate_motion(const PlateMotion& u, double angle);
 PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 
 // CONING. The plate's angular acceleration is periodic with zero-mean angular velocity, but rotations
-// do not commute: rx and ry out of phase (circular tilting, fig4's) turn the plate about z at a
-// steady second-order rate psi' = (1/2) <(theta x theta')_z> for the small rotation theta(t). With
+// do not commute: rx and ry out of phase (circular tilting, fig4's) make the plate's orientation
+// precess about z at a steady second-order rate, |psi'| = (1/2) |<(theta x theta')_z>| for the small
+// rotation theta(t). With
 // theta_a = -A_a e^{i n w t} / (n w)^2 per harmonic (A = amp e^{i phase} of the angular acceleration,
 // as amp sin(n w t + phase)) it is sum_n Im(A_rx,n conj(A_ry,n)) / (2 (n w)^3) [rad/s] (harmonics of
 // different n average out): 0.0025 rad/s for fig4. The asymptotic field (first-order averaging) does
 // not see it; the full dynamics does: fig4's part, at the field's stable fixed point (0, 0, 0),
-// turns steadily in the plate frame at that rate. Rigid-part designs are constrained to
-// |psi'| <= 1e-4 rad/s. (Checked in tests/test_design.cpp against an independent integration of the
-// plate's rotation and against the full dynamics.)
+// turns steadily in the plate frame at psi', sign included. Rigid-part designs are constrained to
+// |psi'| <= 1e-4 rad/s. (Checked in tests/test_design.cpp against the full dynamics of fig4 and of its
+// mirror image, within 1 %; the plate's own world-frame turn is not tested separately.)
 double coning_rate(const PlateMotion& u);
 
 enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };

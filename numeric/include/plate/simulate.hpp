@@ -107,8 +107,9 @@ Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Ve
 // An accepted macro step costs 2 (relax + 1) periods instead of K. Unlike the asymptotic field's integral
 // curve (field_curve: U-dynamics, first-order average) it keeps everything the full dynamics have --
 // coning, the tilt's and the rotating frame's second-order drifts, stick-slip within a burst. The
-// first start_periods are integrated directly (the transient from qd0), and so is a last partial
-// period. Samples every sample_dt: the start's own, then cubic Hermite interpolants of the macro points
+// start is integrated directly (the transient from qd0): at least start_periods, and on until the
+// twist at the periods' starts changes by at most macro_tol of its scales over a period (the bursts'
+// relax periods assume a settled twist); so is a last partial period. Samples every sample_dt: the start's own, then cubic Hermite interpolants of the macro points
 // (their qd and n NaN). A burst that stops ends the averaging: the rest is integrated directly from
 // the last accepted macro point, so a stop (contact lost) is reported with its real time and state
 // (a stopped predictor at K > 1 is only a rejected step). Stats are the bursts' (steps and rejected:
@@ -117,7 +118,7 @@ struct AveragingOptions {
     double macro_tol = 1e-3;      // local error of a macro step, relative to (rho, rho, 1 rad)
     int max_macro_periods = 40;   // the largest K
     int relax_periods = 2;
-    int start_periods = 5;        // (also the first K)
+    int start_periods = 5;        // at least (also the first K); 0: no direct start
 };
 Trajectory simulate_averaged(const Scene& scene, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
                              const IntegrationOptions& opt = {}, const AveragingOptions& avg = {});
