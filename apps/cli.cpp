@@ -833,7 +833,7 @@ struct DesignArgs : Options {
     std::string scene, out;
     std::vector<std::string> target;
     std::vector<double> limits;
-    double period = 0;
+    double period = 0, hold = DesignOptions{}.hold;
     std::uint64_t seed = 1;
     int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations;
     explicit DesignArgs(CLI::App* cmd)
@@ -851,7 +851,9 @@ struct DesignArgs : Options {
                        "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
                        "seeded feasible motions (default 4 for a point part's sink and line sink, 16 otherwise),\n"
                        "--evaluations each (default 400). Verification: the field's fixed points on a 7x7 grid and full\n"
-                       "dynamics from 20 seeded random starts. Writes the designed\n"
+                       "dynamics from 20 seeded random starts; sinks and fixed points also hold: released at rest at the\n"
+                       "target, the part is still within 5 mm after --hold seconds (default 120; coning, rx and ry out of\n"
+                       "phase, turns the field about the plate's centre, so it limits the coning). Writes the designed\n"
                        "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
         words("--target", target, 2, 4, "KIND ...",
@@ -863,6 +865,7 @@ struct DesignArgs : Options {
         whole("--threads", threads, 0, 256, "threads (0: all cores)");
         whole("--starts", starts, 1, 10000, "seeded starts of the search");
         whole("--evaluations", evaluations, 1, 1'000'000, "evaluations per start");
+        number("--hold", hold, "seconds a part released at the target must stay within 5 mm (0: not checked)", "120");
     }
 };
 
@@ -906,6 +909,8 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     o.period = a.period;
     if (a.has("--period") && !(o.period >= kPeriodRange[0] && o.period <= kPeriodRange[1]))
         throw UsageError("--period: expected " + fmt(kPeriodRange[0]) + " to " + fmt(kPeriodRange[1]) + " s");
+    if (!(a.hold >= 0 && a.hold <= 3600)) throw UsageError("--hold: expected 0 to 3600 s");
+    o.hold = a.hold;
     o.seed = a.seed;
     o.threads = a.threads;
     o.starts = a.starts;
@@ -973,6 +978,14 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     }
     j["full_dynamics_runs"] = runs;
     j["worst_end_distance"] = d.worst_end_distance;
+    if (d.held.seconds > 0) {   // (sinks and fixed points)
+        const DesignStartRun& h = d.held;
+        nlohmann::json x = {{"seconds", h.seconds}, {"end_distance", h.end_distance},
+                            {"end", rigid ? nlohmann::json{h.end[0], h.end[1], h.end[2]} : nlohmann::json{h.end[0], h.end[1]}}};
+        if (!h.stop.empty()) x["stop"] = h.stop;
+        j["hold"] = x;
+    }
+    j["coning_rate"] = d.coning;
     j["min_vertical_acceleration_margin_over_g"] = d.min_vertical_margin;
     j["limits"] = {o.lin_limit, o.ang_limit};
     j["starts"] = d.starts;

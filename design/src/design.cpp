@@ -293,8 +293,12 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
     return compute_field(sc, g, fo);
 }
 
+//
+// With `hold` (sinks and fixed points, opt.hold > 0) one more run starts at rest at *hold, the target,
+// for opt.hold seconds: sum.held (not among sum.runs, nor in the worst distance).
 template <class Seconds, class EndDistance>
-int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& seconds, EndDistance&& end_distance) {
+int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& seconds, EndDistance&& end_distance,
+                      const Vec3* hold = nullptr) {
     Rng rng(opt.seed ^ 0x5DEECE66DULL);
     const bool rigid = !sum.scene.part.point;
     sum.runs.resize(opt.verify_starts);
@@ -304,8 +308,17 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         if (rigid) r.theta = rng.uniform(-kPi, kPi);   // (drawn after x, y: point parts' starts unchanged)
         r.seconds = seconds(r);
     }
-    runner(opt)(static_cast<int>(sum.runs.size()), [&](int k) {
-        DesignStartRun r = sum.runs[k];
+    const bool holding = hold && opt.hold > 0;
+    if (holding) {
+        sum.held = DesignStartRun{};
+        sum.held.x = (*hold)[0];
+        sum.held.y = (*hold)[1];
+        sum.held.theta = (*hold)[2];
+        sum.held.seconds = opt.hold;
+    }
+    auto job = [&](int k) -> DesignStartRun& { return k < opt.verify_starts ? sum.runs[k] : sum.held; };
+    runner(opt)(opt.verify_starts + holding, [&](int k) {
+        DesignStartRun r = job(k);
         IntegrationOptions io;
         io.rtol = 1e-7;
         const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds, r.seconds, io);
@@ -318,7 +331,7 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         std::istringstream in(text);
         std::string x[4];
         for (auto& w : x) in >> w;
-        DesignStartRun& r = sum.runs[k];
+        DesignStartRun& r = job(k);
         r.end_distance = exact_value(x[0]);
         r.end = Vec3(exact_value(x[1]), exact_value(x[2]), exact_value(x[3]));
         std::getline(in >> std::ws, r.stop);
@@ -329,7 +342,17 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         sum.worst_end_distance = std::max(sum.worst_end_distance, r.end_distance);
         stopped += !r.stop.empty();
     }
-    return stopped;
+    return stopped;   // (the hold's own verdict: hold_failure)
+}
+
+// The hold's verdict (empty: held, or no hold asked): released at the target, the part ended beyond
+// verify_distance (`unit` names the distance) or left the model.
+std::string hold_failure(const DesignSummary& sum, const DesignOptions& opt, const std::string& unit) {
+    if (!(opt.hold > 0) || (sum.held.stop.empty() && sum.held.end_distance <= opt.verify_distance)) return "";
+    return "released at rest at the target, the part " +
+           (sum.held.stop.empty() ? "ended " + std::to_string(sum.held.end_distance) + unit + " away after "
+                                  : "stopped (" + sum.held.stop + ") within ") +
+           std::to_string(opt.hold) + " s of full dynamics (coning " + std::to_string(sum.coning) + " rad/s)";
 }
 
 // The summary's last entries, whatever the outcome: the cycles computed and the wall time.
@@ -344,6 +367,31 @@ DesignSummary& finished(DesignSummary& sum, const std::atomic<long>& cycles, Clo
 double settle_time(double d0, double rate, const DesignOptions& opt) {
     return std::clamp(std::log(std::max(d0, opt.verify_distance) / (0.2 * opt.verify_distance)) / std::max(rate, 1e-3), 2.0,
                       120.0);
+}
+
+// A point part's verification run from `start`: the time the designed field, interpolated bilinearly
+// on the verification grid, takes to bring it within a fifth of verify_distance of `target` (RK4 in
+// 0.05 s steps), plus half again and 2 s for the interpolation's error; at most 120 s (also if the
+// interpolated curve never arrives). Far starts can take several times ln(d0 / d) / rate: the rate is
+// the centre's, and the field weakens away from it.
+double field_settle_time(const Field& f, const Vec2& start, const Vec2& target, const DesignOptions& opt) {
+    const GridSpec& g = f.grid;
+    auto v = [&](const Vec2& s) {
+        const double u = std::clamp((s.x() - g.x0) / g.dx(), 0.0, g.nx - 1.0), w = std::clamp((s.y() - g.y0) / g.dy(), 0.0, g.ny - 1.0);
+        const int i = std::min(static_cast<int>(u), g.nx - 2), j = std::min(static_cast<int>(w), g.ny - 2);
+        const double a = u - i, b = w - j;
+        auto at = [&](int di, int dj) -> Vec2 { return f.points[g.index(i + di, j + dj, 0)].twist.head<2>(); };
+        return Vec2((1 - a) * (1 - b) * at(0, 0) + a * (1 - b) * at(1, 0) + (1 - a) * b * at(0, 1) + a * b * at(1, 1));
+    };
+    constexpr double h = 0.05, cap = 120;
+    Vec2 s = start;
+    for (double t = 0; t < cap; t += h) {
+        if ((s - target).norm() <= 0.2 * opt.verify_distance) return std::min(1.5 * t + 2, cap);
+        const Vec2 k1 = v(s), k2 = v(s + 0.5 * h * k1), k3 = v(s + 0.5 * h * k2), k4 = v(s + h * k3);
+        s += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+        if (!s.allFinite()) break;
+    }
+    return cap;
 }
 
 // c_k <= 0 for each axis' harmonics n = 1..n_max of `fin` within `room` times the axis' limit (6 n_max
@@ -372,26 +420,35 @@ void start_summary(DesignSummary& sum, const Scene& part, const std::string& suf
 constexpr const char* kNoFeasibleMotion = "no motion within the limits keeps the part on the plate over the region";
 
 // --- the point-part sink ---------------------------------------------------------------------------
-// Parameters: per axis of {x, y, rx, ry}, the first harmonic's cosine and sine coefficients,
-// u_a = c cos(w t) + s sin(w t): odd harmonics without z or rz make the field odd about the centre,
-// so the centre is a fixed point by construction and the search only makes it attract, fast, over
-// the whole region (then shift_motion moves it onto the target).
+// Parameters: per axis of {x, y, rx, ry} and harmonic n = 1, 3, the cosine and sine coefficients,
+// u_a = c cos(n w t) + s sin(n w t): odd harmonics without z or rz make the field odd about the
+// centre, so the centre is a fixed point by construction and the search only makes it attract, fast,
+// over the whole region (then shift_motion moves it onto the target). The fastest sinks tilt the plate
+// in circles (rx, ry a quarter period apart: 1.1 1/s at (0.02, -0.01) under 15 / 100), which cones
+// (2e-3 rad/s: the sink walks 5.5 mm about the centre in two minutes); held to sink_coning_limit, the
+// first harmonic can tilt in circles only a little, and the third, which cones 27 times less for the
+// same amplitudes (coning pairs only equal n), adds the rest.
 PlateMotion sink_motion(const std::vector<double>& p, double T) {
-    return motion_from(p, {Axis::x, Axis::y, Axis::rx, Axis::ry}, {1}, T);
+    return motion_from(p, {Axis::x, Axis::y, Axis::rx, Axis::ry}, {1, 3}, T);
 }
 
 struct SinkProblem : Problem<SinkProblem> {
     SinkProblem(const Scene& part_, const Vec2& D_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
-        : Problem(part_, opt_, T_, cycles_), D(D_) {}
+        : Problem(part_, opt_, T_, cycles_), D(D_), cone_limit(sink_coning_limit(D_, opt_)) {}
     Vec2 D;
-    static constexpr int kParams = 8;
-    static constexpr int kConstraints = 7;   // six amplitudes, the flight margin
-    double limit(int i) const { return i < 4 ? opt.lin_limit : opt.ang_limit; }
+    double cone_limit;
+    static constexpr int kParams = 16;
+    static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
+    double limit(int i) const { return i < 8 ? opt.lin_limit : opt.ang_limit; }
 
     // Constraints c_k <= 0 on the final (shifted) motion: each harmonic's amplitude within its
-    // limit, and no flight over the region.
+    // limit, no flight over the region, and no more coning than the hold allows.
     void constraints(const std::vector<double>& p, double* c) const {
-        amplitude_constraints(shift_motion(sink_motion(p, T), D), opt, part.g, 1, 1.0, c);
+        const PlateMotion fin = shift_motion(sink_motion(p, T), D);
+        const int k = amplitude_constraints(fin, opt, part.g, 3, 1.0, c);
+        const double cone = std::isfinite(cone_limit) ? coning_rate(fin) / cone_limit : 0.0;
+        c[k] = cone - 1;
+        c[k + 1] = -cone - 1;
     }
     // Convergence rate at the centre, and how much of the region's edge the field does not point
     // inwards (of the centred motion: the final field at s + D).
@@ -428,6 +485,10 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
                         "centre is a fixed point by construction and fixed points come in pairs s, -s");
     sum.notes.push_back("the design's centre moved onto the target by adding -alpha x D to the linear acceleration "
                         "(exact: the field shifts by D)");
+    if (std::isfinite(sink_coning_limit(target.at, opt)))
+        sum.notes.push_back("coning held to " + std::to_string(sink_coning_limit(target.at, opt)) +
+                            " rad/s: the plate's second-order turn about z, which the field does not see, turns the "
+                            "sink about the plate's centre; at most half the verification distance over the hold");
     std::atomic<long> cycles{0};
     const auto make = [&] { return SinkProblem(part_scene, target.at, opt, T, &cycles); };
     const std::vector<double> best = multistart<SinkProblem>(opt, -HUGE_VAL, make, sum.evaluations);
@@ -439,9 +500,12 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     make().evaluate(best, &sum.rate, &sum.eigenvalues);
     sum.scene.plate = combined(shift_motion(sink_motion(best, T), target.at));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    sum.coning = coning_rate(sum.scene.plate);
 
-    // --- verification: the field's fixed points on the grid, then full dynamics from random starts.
-    sum.fixed_points = find_fixed_points(sum.scene, verification_field(sum.scene, opt));
+    // --- verification: the field's fixed points on the grid, then full dynamics from random starts
+    // (each for as long as the field takes to bring it in) and from the target itself (the hold).
+    const Field field = verification_field(sum.scene, opt);
+    sum.fixed_points = find_fixed_points(sum.scene, field);
     int stable = 0, stable_at_target = 0;
     double nearest = std::numeric_limits<double>::infinity();
     for (const FixedPoint& p : sum.fixed_points.points) {
@@ -457,10 +521,11 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     }
     for (const FixedLine& l : sum.fixed_points.lines) stable += l.stability == Stability::Stable;
     sum.unique = stable == 1 && stable_at_target == 1;
+    const Vec3 hold_at(target.at.x(), target.at.y(), 0);
     const int stopped = verification_runs(
-        sum, opt,
-        [&](const DesignStartRun& r) { return settle_time((Vec2(r.x, r.y) - target.at).norm(), sum.rate, opt); },
-        [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); });
+        sum, opt, [&](const DesignStartRun& r) { return field_settle_time(field, Vec2(r.x, r.y), target.at, opt); },
+        [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); }, &hold_at);
+    const std::string unheld = hold_failure(sum, opt, " m");
     if (!sum.unique)
         sum.failure = "the designed field has " + std::to_string(stable) + " stable fixed point(s) or line(s) on the " +
                       std::to_string(opt.verify_grid) + "x" + std::to_string(opt.verify_grid) + " grid, " +
@@ -470,6 +535,8 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
     else if (!(sum.worst_end_distance <= opt.verify_distance))
         sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) + " m from the target";
+    else if (!unheld.empty())
+        sum.failure = unheld;
     else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
         sum.failure = "the vertical acceleration margin is below the one asked";
     sum.verified = sum.failure.empty();
@@ -1090,13 +1157,16 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     int stable_lines = 0;
     for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
     sum.unique = stable == 1 && stable_at_target == 1 && stable_lines == 0;
+    sum.coning = coning_rate(sum.scene.plate);
     const int stopped = verification_runs(
         sum, opt,
         [&](const DesignStartRun&) { return settle_time(2 * opt.region, sum.rate, opt); },   // (from across the region)
         [&](const DesignStartRun&, const Vec3& end) {
             return std::max(orient ? 0.0 : (end.head<2>() - at).norm(),
                             std::abs(wrap_angle(end[2] - goal[2])) * opt.verify_distance / 0.05);
-        });
+        },
+        &goal);
+    const std::string unheld = hold_failure(sum, opt, " m (0.05 rad counted as " + std::to_string(opt.verify_distance) + " m)");
     // The basin shares: of the runs, those that end at the target and at each competing stable point.
     int at_target = 0;
     for (const DesignStartRun& r : sum.runs) at_target += r.stop.empty() && r.end_distance <= opt.verify_distance;
@@ -1120,6 +1190,8 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
         sum.failure = "of " + std::to_string(sum.runs.size()) + " full-dynamics runs, " +
                       std::to_string(static_cast<int>(sum.runs.size()) - accounted) +
                       " ended at neither the target nor a competing stable fixed point";
+    else if (!unheld.empty())
+        sum.failure = unheld;
     else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
         sum.failure = "the vertical acceleration margin is below the one asked";
     sum.verified = sum.failure.empty();
@@ -1140,6 +1212,11 @@ double coning_rate(const PlateMotion& u) {
         r += std::imag(a * std::conj(b->second)) / (2 * nw * nw * nw);
     }
     return r;
+}
+
+double sink_coning_limit(const Vec2& at, const DesignOptions& opt) {
+    const double walk = at.norm() * opt.hold;   // [m s]: the sink's walk per unit coning rate
+    return walk > 0 ? 0.5 * opt.verify_distance / walk : std::numeric_limits<double>::infinity();
 }
 
 int default_starts(const Scene& part_scene, const DesignTarget& target) {

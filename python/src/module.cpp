@@ -381,13 +381,17 @@ PYBIND11_MODULE(_plate, m) {
             std::vector<std::tuple<double, double, double, double>> r;
             for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
             return r;
-        }, "(x, y, seconds, end distance) of each verification run");
+        }, "(x, y, seconds, end distance) of each verification run")
+        .def_property_readonly("held", [](const DesignSummary& s) {
+            return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance);
+        }, "sinks and fixed points: (seconds, end, distance) of the part released at rest at the target")
+        .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)");
     m.def("design",
           [](const Scene& part, std::optional<std::pair<double, double>> sink,
              std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
              std::optional<double> orient, std::optional<std::tuple<double, double, double>> line_sink,
              double lin_limit, double ang_limit, double period,
-             std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads) {
+             std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold) {
               require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() +
                                   line_sink.has_value() == 1,
                       "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta "
@@ -424,6 +428,8 @@ PYBIND11_MODULE(_plate, m) {
               o.local_evaluations = local_evaluations;
               o.verify_starts = verify_starts;
               o.threads = threads;
+              require(hold >= 0, "hold: expected seconds >= 0 (0: not checked)");
+              o.hold = hold;
               py::gil_scoped_release free;
               try {
                   return design(part, t, o);
@@ -436,9 +442,10 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0, py::arg("local_evaluations") = 400,
-          py::arg("verify_starts") = 20, py::arg("threads") = 0,
+          py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
-          "full dynamics). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
+          "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
+          "for `hold` seconds, which limits the coning). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
           "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
           "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
           "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"

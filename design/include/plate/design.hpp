@@ -41,6 +41,10 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 // turns steadily in the plate frame at psi', sign included. Rigid-part designs are constrained to
 // |psi'| <= 1e-4 rad/s. (Checked in tests/test_design.cpp against the full dynamics of fig4 and of its
 // mirror image, within 1 %; the plate's own world-frame turn is not tested separately.)
+// The whole field turns with it about the plate's centre, so a sink placed at D off the centre walks
+// |D| |psi'| per second: a point-part sink is held to |psi'| <= sink_coning_limit (below), and every
+// sink and fixed point is verified by a part released at the target staying within verify_distance
+// over DesignOptions::hold seconds of full dynamics.
 double coning_rate(const PlateMotion& u);
 
 enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };
@@ -92,6 +96,10 @@ struct DesignOptions {
     int verify_grid = 7;
     int verify_starts = 20;
     double verify_distance = 0.005;   // [m]
+    // Hold: a part released at rest at the target stays within verify_distance for this long [s]
+    // (sinks and fixed points; 0: not checked). Coning turns the field about the plate's centre, so
+    // it bounds the coning a design may have (sink_coning_limit).
+    double hold = 120;
     double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
     static LimitCycleOptions cycle_defaults() {
         LimitCycleOptions o;
@@ -140,6 +148,10 @@ struct DesignSummary {
     std::vector<Competitor> competitors;
     std::vector<DesignStartRun> runs;   // full dynamics from random starts
     double worst_end_distance = 0;
+    // Hold (sinks and fixed points): released at rest at the target, where the part is after
+    // DesignOptions::hold seconds of full dynamics and how far that is (measured as end_distance).
+    DesignStartRun held;
+    double coning = 0;                  // the design's coning rate psi' [rad/s] (coning_rate)
     double min_vertical_margin = 0;     // min over the period and the region of (g + a_z) / g
     // Orient by transport (a weathervane, for parts with unequal friction coefficients): the twist at
     // the centre on the verification's ring of orientations (the same at every position); the stable
@@ -155,9 +167,15 @@ struct DesignSummary {
     std::vector<std::string> notes;     // the symmetries used, and what they imply
 };
 
+// The largest coning rate a point-part sink at `at` may have: the sink turns about the plate's centre
+// at psi', and over the hold it may walk at most half the verification distance,
+// |psi'| <= verify_distance / (2 |at| hold) (infinite at the centre or without a hold). At (0.02, -0.01)
+// with the defaults 9.3e-4 rad/s, at the region's corners 3e-4.
+double sink_coning_limit(const Vec2& at, const DesignOptions& opt);
+
 // The starts a design makes when DesignOptions::starts is 0: 4 for a point part's sink and line sink
-// (8 and 4 parameters: on the sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
-// 16 starts' rate within 0.5% in a quarter of the time), 16 for the rest.
+// (16 and 4 parameters: on the sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
+// 0.74-0.89 1/s in 2.7-3.7 s, 16 starts 0.77-0.94 1/s in 10-11 s, all verified), 16 for the rest.
 int default_starts(const Scene& part_scene, const DesignTarget& target);
 
 // Designs a plate motion for the part of `part_scene` (its plate block is ignored but for its
