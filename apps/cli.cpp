@@ -839,7 +839,8 @@ struct DesignArgs : Options {
     explicit DesignArgs(CLI::App* cmd)
         : Options(cmd, "Designs a plate motion for the part of PART_SCENE (its plate block is ignored but for its period)\n"
                        "and verifies it before reporting. Targets:\n"
-                       "  sink X Y          point part: the unique stable fixed point of the velocity field at (X, Y)\n"
+                       "  sink X Y          point part: the unique stable fixed point of the velocity field at (X, Y);\n"
+                       "                    rigid part: its position ends at (X, Y) whatever its orientation (left free)\n"
                        "  fixed-point X Y THETA  rigid part: (X, Y, THETA) the unique stable fixed point of the twist field\n"
                        "                    (or, where that is out of reach, the target's basin share and the competing\n"
                        "                    fixed points); point part: fixed-point X Y = sink X Y\n"
@@ -849,7 +850,7 @@ struct DesignArgs : Options {
                        "  transport VX VY   point part: a uniform velocity (VX, VY) [m/s] over the plate\n"
                        "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
                        "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
-                       "seeded feasible motions (default 4 for a point part's sink and line sink, 16 otherwise),\n"
+                       "seeded feasible motions (default 4 for sinks and line sinks, 16 otherwise),\n"
                        "--evaluations each (default 400). Verification: the field's fixed points on a 7x7 grid and full\n"
                        "dynamics from 20 seeded random starts; sinks and fixed points also hold: released at rest at the\n"
                        "target, the part is still within 5 mm after --hold seconds (default 120; coning, rx and ry out of\n"
@@ -945,7 +946,14 @@ int cmd_design(const DesignArgs& a, Io& cio) {
             j["orientation"] = d.fixed_point[2];
             j["velocity_at_orientation"] = {d.transport_mean.x(), d.transport_mean.y()};
         }
-        if (rigid) {
+        if (rigid && t.kind == DesignTargetKind::Sink) {
+            // (the orientation is free: where the position's field vanishes at each orientation)
+            nlohmann::json pulls = nlohmann::json::array();
+            for (const auto& p : d.pulls)
+                pulls.push_back({{"theta", p.theta}, {"position_zero", {p.zero.x(), p.zero.y()}},
+                                 {"eigenvalues", {complex_json(p.eigenvalues[0]), complex_json(p.eigenvalues[1])}}});
+            j["position_pull_per_orientation"] = pulls;
+        } else if (rigid) {
             j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1], d.fixed_point[2]};
             j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]),
                                             complex_json(d.fixed_point_eigenvalues[1]),

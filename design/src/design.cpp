@@ -89,6 +89,14 @@ double vertical_margin(const PlateMotion& u, double g, double region) {
     return worst;
 }
 
+// The square the flight check covers: the region, widened for a rigid part by its contacts' reach
+// from its centre of mass (they stand on plate points up to that far beyond it).
+double flight_region(const Scene& part, const DesignOptions& opt) {
+    double reach = 0;
+    for (int i = 0; i < part.part.contacts(); ++i) reach = std::max(reach, part.part.c[i].head<2>().norm());
+    return opt.region + (part.part.point ? 0.0 : reach);
+}
+
 // --- what the searches share -----------------------------------------------------------------------
 
 // A plate motion from coefficients: per axis a and harmonic h, u = c cos(n w t) + s sin(n w t) with
@@ -164,8 +172,8 @@ struct Problem {
         return f;
     }
     // The limit cycle at s; false if it did not converge.
-    bool twist_at(const Scene& sc, const Vec2& s, Vec2& v) const {
-        const LimitCycleSummary lc = limit_cycle(sc, Vec3(s.x(), s.y(), 0), opt.cycle);
+    bool twist_at(const Scene& sc, const Vec2& s, Vec2& v, double theta = 0) const {
+        const LimitCycleSummary lc = limit_cycle(sc, Vec3(s.x(), s.y(), theta), opt.cycle);
         ++*cycles;
         if (!lc.converged) return false;
         v = lc.twist.head<2>();
@@ -396,7 +404,8 @@ double field_settle_time(const Field& f, const Vec2& start, const Vec2& target, 
 
 // c_k <= 0 for each axis' harmonics n = 1..n_max of `fin` within `room` times the axis' limit (6 n_max
 // entries, axis-major), then c <= 0 for no flight over the region; returns the entries written.
-int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, double g, int n_max, double room, double* c) {
+int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
+                          double* c) {
     const auto ph = phasors(fin);
     int k = 0;
     for (int axis = 0; axis < 6; ++axis)
@@ -406,7 +415,7 @@ int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, doub
             const double lim = axis < 3 ? opt.lin_limit : opt.ang_limit;
             c[k++] = (amp - room * lim) / std::max(lim, 1e-12);
         }
-    c[k++] = opt.flight_margin - vertical_margin(fin, g, opt.region);
+    c[k++] = opt.flight_margin - vertical_margin(fin, part.g, flight_region(part, opt));
     return k;
 }
 
@@ -419,11 +428,14 @@ void start_summary(DesignSummary& sum, const Scene& part, const std::string& suf
 }
 constexpr const char* kNoFeasibleMotion = "no motion within the limits keeps the part on the plate over the region";
 
-// --- the point-part sink ---------------------------------------------------------------------------
+// --- the sink ---------------------------------------------------------------------------------------
 // Parameters: per axis of {x, y, rx, ry} and harmonic n = 1, 3, the cosine and sine coefficients,
 // u_a = c cos(n w t) + s sin(n w t): odd harmonics without z or rz make the field odd about the
-// centre, so the centre is a fixed point by construction and the search only makes it attract, fast,
-// over the whole region (then shift_motion moves it onto the target). The fastest sinks tilt the plate
+// centre, so the centre is a point part's fixed point by construction and the search only makes it
+// attract, fast, over the whole region (then shift_motion moves it onto the target). A rigid part's
+// position is pulled the same way at every orientation (fig4's: -0.5 1/s at each, while it turns on
+// at 0.08-0.44 rad/s); oddness only pairs (s, theta) with (-s, theta + pi), so its velocity at the
+// centre need not vanish, and the search also keeps that offset small. The fastest sinks tilt the plate
 // in circles (rx, ry a quarter period apart: 1.1 1/s at (0.02, -0.01) under 15 / 100), which cones
 // (2e-3 rad/s: the sink walks 5.5 mm about the centre in two minutes); held to sink_coning_limit, the
 // first harmonic can tilt in circles only a little, and the third, which cones 27 times less for the
@@ -437,6 +449,9 @@ struct SinkProblem : Problem<SinkProblem> {
         : Problem(part_, opt_, T_, cycles_), D(D_), cone_limit(sink_coning_limit(D_, opt_)) {}
     Vec2 D;
     double cone_limit;
+    // The orientations the pull is measured at: a point part has none; at a rigid part's centre the
+    // odd field repeats after a half turn, so theta = 0 and a quarter turn span it.
+    std::vector<double> thetas() const { return part.part.point ? std::vector<double>{0.0} : std::vector<double>{0.0, kPi / 2}; }
     static constexpr int kParams = 16;
     static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
     double limit(int i) const { return i < 8 ? opt.lin_limit : opt.ang_limit; }
@@ -445,27 +460,44 @@ struct SinkProblem : Problem<SinkProblem> {
     // limit, no flight over the region, and no more coning than the hold allows.
     void constraints(const std::vector<double>& p, double* c) const {
         const PlateMotion fin = shift_motion(sink_motion(p, T), D);
-        const int k = amplitude_constraints(fin, opt, part.g, 3, 1.0, c);
+        const int k = amplitude_constraints(fin, opt, part, 3, 1.0, c);
         const double cone = std::isfinite(cone_limit) ? coning_rate(fin) / cone_limit : 0.0;
         c[k] = cone - 1;
         c[k + 1] = -cone - 1;
     }
-    // Convergence rate at the centre, and how much of the region's edge the field does not point
-    // inwards (of the centred motion: the final field at s + D).
+    // Convergence rate at the centre (the slowest orientation's), and how much of the region's edge
+    // the field does not point inwards (of the centred motion: the final field at s + D); a rigid
+    // part's offset, where its position's field vanishes near the centre, beyond 1 mm.
     double evaluate(const std::vector<double>& p, double* rate_out = nullptr, Eigen::Vector2cd* eig_out = nullptr) {
         ++evaluations;
         Scene sc = part;
         sc.plate = sink_motion(p, T);
         const double h = 0.003;
-        Vec2 vx, vy;
-        if (!twist_at(sc, Vec2(h, 0), vx) || !twist_at(sc, Vec2(0, h), vy)) return 1e3;
-        Eigen::Matrix2d J;
-        J.col(0) = vx / h;   // the field is odd about the centre: v(h e) / h is the central difference
-        J.col(1) = vy / h;
-        const Eigen::Vector2cd ev = J.eigenvalues();
-        const double rate = -std::max(ev[0].real(), ev[1].real());
+        double rate = std::numeric_limits<double>::infinity(), offset = 0;
+        for (double th : thetas()) {
+            Vec2 vx = Vec2::Zero(), vy = Vec2::Zero();
+            if (!twist_at(sc, Vec2(h, 0), vx, th) || !twist_at(sc, Vec2(0, h), vy, th)) return 1e3;
+            Eigen::Matrix2d J;
+            if (part.part.point) {
+                J.col(0) = vx / h;   // the field is odd about the centre: v(h e) / h is the central difference
+                J.col(1) = vy / h;
+            } else {
+                Vec2 v0 = Vec2::Zero(), wx = Vec2::Zero(), wy = Vec2::Zero();
+                if (!twist_at(sc, Vec2::Zero(), v0, th) || !twist_at(sc, Vec2(-h, 0), wx, th) || !twist_at(sc, Vec2(0, -h), wy, th))
+                    return 1e3;
+                J.col(0) = (vx - wx) / (2 * h);
+                J.col(1) = (vy - wy) / (2 * h);
+                const Vec2 step = J.fullPivLu().solve(v0);
+                offset = std::max(offset, step.allFinite() ? step.norm() : 1.0);
+            }
+            const Eigen::Vector2cd ev = J.eigenvalues();
+            const double r = -std::max(ev[0].real(), ev[1].real());
+            if (r < rate) {
+                rate = r;
+                if (eig_out) *eig_out = ev;
+            }
+        }
         if (rate_out) *rate_out = rate;
-        if (eig_out) *eig_out = ev;
         // The region's edge, relative to the centre of the design: eight points on its boundary.
         double outward = 0;
         for (const Vec2& e : region_edge(opt.region)) {
@@ -474,9 +506,102 @@ struct SinkProblem : Problem<SinkProblem> {
             if (!twist_at(sc, s, v)) return 1e3;
             outward += std::max(0.0, s.dot(v) / s.squaredNorm());   // [1/s]
         }
-        return -rate + 10 * outward;
+        return -rate + 10 * outward + 10 * std::max(0.0, offset / 0.001 - 1);
     }
 };
+
+// The checks every sink and fixed point ends with, where nothing before failed: the hold (`unheld`:
+// hold_failure's verdict) and the flight margin; then the summary's end.
+DesignSummary& last_checks(DesignSummary& sum, const DesignOptions& opt, const std::string& unheld,
+                           const std::atomic<long>& cycles, Clock::time_point t0) {
+    if (sum.failure.empty()) sum.failure = unheld;
+    if (sum.failure.empty() && !(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
+        sum.failure = "the vertical acceleration margin is below the one asked";
+    sum.verified = sum.failure.empty();
+    return finished(sum, cycles, t0);
+}
+
+// A sink's verdict, shared: full-dynamics runs from random starts (each as long as the position
+// field `settle` takes to bring it in) and from the target (the hold), then the first check that
+// fails: uniqueness (`not_unique` says why not), runs that left the model, a run ending too far, the
+// hold, the flight margin.
+DesignSummary& sink_verdict(DesignSummary& sum, const Field& settle, const DesignTarget& target, const DesignOptions& opt,
+                            const std::string& not_unique, std::atomic<long>& cycles, Clock::time_point t0) {
+    const Vec3 hold_at(target.at.x(), target.at.y(), 0);
+    const int stopped = verification_runs(
+        sum, opt, [&](const DesignStartRun& r) { return field_settle_time(settle, Vec2(r.x, r.y), target.at, opt); },
+        [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); }, &hold_at);
+    const std::string unheld = hold_failure(sum, opt, " m");
+    if (!sum.unique) sum.failure = not_unique;
+    else if (stopped)
+        sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
+    else if (!(sum.worst_end_distance <= opt.verify_distance))
+        sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) + " m from the target";
+    return last_checks(sum, opt, unheld, cycles, t0);
+}
+
+// A rigid part's sink, verified: at the target, for each orientation of the verification grid, the
+// position's field vanishes within fixed_point_tolerance (Newton from the target, 3 mm central
+// differences) with both eigenvalues' real parts negative; full-dynamics runs from random (x, y, theta)
+// end within verify_distance of the target's position, whatever their orientation; the hold.
+DesignSummary& verify_rigid_sink(DesignSummary& sum, const Field& field, const DesignTarget& target, const DesignOptions& opt,
+                                 std::atomic<long>& cycles, Clock::time_point t0) {
+    sum.fixed_points = FixedPoints{};
+    const double h = 0.003;
+    int held = 0;
+    std::string why;
+    for (int k = 0; k < field.grid.nth; ++k) {
+        DesignSummary::OrientationPull pull;
+        pull.theta = field.grid.th0 + k * field.grid.dth();
+        Vec2 s = target.at;
+        bool ok = false;
+        for (int it = 0; it < 6 && !ok; ++it) {
+            Vec2 v0 = Vec2::Zero(), v[4] = {Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero()};
+            const Vec2 d[4] = {Vec2(h, 0), Vec2(-h, 0), Vec2(0, h), Vec2(0, -h)};
+            auto twist = [&](const Vec2& at, Vec2& out) {
+                const LimitCycleSummary lc = limit_cycle(sum.scene, Vec3(at.x(), at.y(), pull.theta), opt.cycle);
+                ++cycles;
+                out = lc.twist.head<2>();
+                return lc.converged;
+            };
+            bool conv = twist(s, v0);
+            for (int j = 0; j < 4; ++j) conv = conv && twist(s + d[j], v[j]);
+            if (!conv) break;
+            Eigen::Matrix2d J;
+            J.col(0) = (v[0] - v[1]) / (2 * h);
+            J.col(1) = (v[2] - v[3]) / (2 * h);
+            pull.eigenvalues = J.eigenvalues();
+            const Vec2 step = J.fullPivLu().solve(v0);
+            if (!step.allFinite()) break;
+            s -= step;
+            ok = step.norm() < 1e-6;
+        }
+        pull.zero = s;
+        sum.pulls.push_back(pull);
+        const bool here = ok && (s - target.at).norm() <= opt.fixed_point_tolerance &&
+                          std::max(pull.eigenvalues[0].real(), pull.eigenvalues[1].real()) < 0;
+        held += here;
+        if (!here && why.empty())
+            why = "at orientation " + std::to_string(pull.theta) + " rad the position's field " +
+                  (ok ? "vanishes " + std::to_string((s - target.at).norm()) + " m from the target" +
+                            (std::max(pull.eigenvalues[0].real(), pull.eigenvalues[1].real()) < 0 ? "" : ", not attracting")
+                      : std::string("has no zero found near the target"));
+    }
+    sum.unique = held == field.grid.nth;   // (one position for every orientation)
+    sum.fixed_point = Vec3(sum.pulls.front().zero.x(), sum.pulls.front().zero.y(), sum.pulls.front().theta);
+    // The runs' durations: the position's field averaged over the grid's orientations (the part turns
+    // as it travels), interpolated as for a point part.
+    Field avg = field;
+    avg.grid.nth = 1;
+    avg.points.assign(field.grid.nx * field.grid.ny, FieldPoint{});
+    for (int i = 0; i < field.grid.nx; ++i)
+        for (int j = 0; j < field.grid.ny; ++j) {
+            Vec3 m = Vec3::Zero();
+            for (int k = 0; k < field.grid.nth; ++k) m += field.points[field.grid.index(i, j, k)].twist / field.grid.nth;
+            avg.points[avg.grid.index(i, j, 0)].twist = m;
+        }
+    return sink_verdict(sum, avg, target, opt, why, cycles, t0);
+}
 
 DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
@@ -499,12 +624,15 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     }
     make().evaluate(best, &sum.rate, &sum.eigenvalues);
     sum.scene.plate = combined(shift_motion(sink_motion(best, T), target.at));
-    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     sum.coning = coning_rate(sum.scene.plate);
 
-    // --- verification: the field's fixed points on the grid, then full dynamics from random starts
-    // (each for as long as the field takes to bring it in) and from the target itself (the hold).
+    // --- verification: the field's fixed points on the grid (a rigid part: where its position's
+    // field vanishes near the target, at each of the grid's orientations), then full dynamics from
+    // random starts (each for as long as the field takes to bring it in) and from the target itself
+    // (the hold).
     const Field field = verification_field(sum.scene, opt);
+    if (!part_scene.part.point) return verify_rigid_sink(sum, field, target, opt, cycles, t0);
     sum.fixed_points = find_fixed_points(sum.scene, field);
     int stable = 0, stable_at_target = 0;
     double nearest = std::numeric_limits<double>::infinity();
@@ -521,26 +649,12 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     }
     for (const FixedLine& l : sum.fixed_points.lines) stable += l.stability == Stability::Stable;
     sum.unique = stable == 1 && stable_at_target == 1;
-    const Vec3 hold_at(target.at.x(), target.at.y(), 0);
-    const int stopped = verification_runs(
-        sum, opt, [&](const DesignStartRun& r) { return field_settle_time(field, Vec2(r.x, r.y), target.at, opt); },
-        [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); }, &hold_at);
-    const std::string unheld = hold_failure(sum, opt, " m");
-    if (!sum.unique)
-        sum.failure = "the designed field has " + std::to_string(stable) + " stable fixed point(s) or line(s) on the " +
-                      std::to_string(opt.verify_grid) + "x" + std::to_string(opt.verify_grid) + " grid, " +
-                      std::to_string(stable_at_target) + " within " + std::to_string(opt.fixed_point_tolerance) +
-                      " m of the target";
-    else if (stopped)
-        sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
-    else if (!(sum.worst_end_distance <= opt.verify_distance))
-        sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) + " m from the target";
-    else if (!unheld.empty())
-        sum.failure = unheld;
-    else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
-        sum.failure = "the vertical acceleration margin is below the one asked";
-    sum.verified = sum.failure.empty();
-    return finished(sum, cycles, t0);
+    return sink_verdict(sum, field, target, opt,
+                        "the designed field has " + std::to_string(stable) + " stable fixed point(s) or line(s) on the " +
+                            std::to_string(opt.verify_grid) + "x" + std::to_string(opt.verify_grid) + " grid, " +
+                            std::to_string(stable_at_target) + " within " + std::to_string(opt.fixed_point_tolerance) +
+                            " m of the target",
+                        cycles, t0);
 }
 
 // --- the point-part line sink ------------------------------------------------------------------
@@ -569,7 +683,7 @@ struct LineSinkProblem : Problem<LineSinkProblem> {
         return shift_motion(rotate_motion(line_motion(p, T), target.theta), target.at);
     }
     void constraints(const std::vector<double>& p, double* c) const {
-        amplitude_constraints(placed(p), opt, part.g, 1, 1.0, c);
+        amplitude_constraints(placed(p), opt, part, 1, 1.0, c);
     }
     // The convergence rate onto the line, -dv_y/dy at y = 0 (v_y is odd: v_y(h) / h), and how much of
     // the region the field does not pull towards the line (four distances out to its reach).
@@ -610,7 +724,7 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
     make().evaluate(best, &sum.rate);
     sum.eigenvalues = Eigen::Vector2cd(0, -sum.rate);   // along the line neutral, across it the rate
     sum.scene.plate = combined(make().placed(best));
-    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
 
     // --- verification: on the grid, no velocity along the line and every point off it (by more than
     // the fixed-point tolerance) moving towards it; full dynamics from random starts ending on it.
@@ -708,7 +822,7 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
         return finished(sum, cycles, t0);
     }
     sum.scene.plate = combined(transport_motion(best, T));
-    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     // Verification: the field on the grid (mean and spread), then full dynamics from random starts.
     const Field f = verification_field(sum.scene, opt);
     int undefined = 0;
@@ -918,7 +1032,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     }
     sum.eigenvalues3 = Eigen::Vector3cd(0, 0, -sum.rate);   // positions are neutral: the field is theta's alone
     sum.scene.plate = combined(rotate_motion(centred.plate, target.theta - theta_s));
-    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     double c[OrientProblem::kConstraints];
     OrientProblem(part_scene, opt, T, &cycles).constraints(params_from(sum.scene.plate, kTranslationAxes, {1, 2}), c);
     if (*std::max_element(c, c + OrientProblem::kConstraints) > 1e-9) {
@@ -997,9 +1111,9 @@ PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion
 constexpr double kConingLimit = 1e-4;   // [rad/s] (coning_rate, design.hpp): 0.01 rad of lag at 0.01 1/s
 
 // Constraints c_k <= 0 on a motion as placed: each (axis, n) amplitude within its limit times
-// `room`, no flight over the region, and no coning beyond kConingLimit either way.
-void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, double g, double room, double* c) {
-    const int k = amplitude_constraints(fin, opt, g, 2, room, c);
+// `room`, no flight under the part's contacts over the region, and no coning beyond kConingLimit either way.
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
+    const int k = amplitude_constraints(fin, opt, part, 2, room, c);
     const double cone = coning_rate(fin) / kConingLimit;
     c[k] = cone - 1;
     c[k + 1] = -cone - 1;
@@ -1040,7 +1154,7 @@ struct RigidProblem : Problem<RigidProblem> {
     double limit(int i) const { return i < 12 ? opt.lin_limit : opt.ang_limit; }
     void constraints(const std::vector<double>& p, double* c) const {
         placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt,
-                           part.g, kRoom, c);
+                           part, kRoom, c);
     }
     // -rate at the centre, plus how far the centre is from being the fixed point (the Newton step
     // J^-1 xi there, over 1 cm / 0.1 rad), plus how much the region's edge (8 points, theta = 0) and
@@ -1125,9 +1239,9 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
     const Vec2 at = orient ? Vec2::Zero() : target.at;
     sum.scene.plate = combined(shift_motion(rotate_motion(centred.plate, turn), at - s_turned));
-    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, opt.region);
+    sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     double c[RigidProblem::kConstraints];
-    placed_constraints(sum.scene.plate, opt, sum.scene.g, 1.0, c);
+    placed_constraints(sum.scene.plate, opt, sum.scene, 1.0, c);
     if (*std::max_element(c, c + RigidProblem::kConstraints) > 1e-9) {
         sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning limit";
         return finished(sum, cycles, t0);
@@ -1190,12 +1304,7 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
         sum.failure = "of " + std::to_string(sum.runs.size()) + " full-dynamics runs, " +
                       std::to_string(static_cast<int>(sum.runs.size()) - accounted) +
                       " ended at neither the target nor a competing stable fixed point";
-    else if (!unheld.empty())
-        sum.failure = unheld;
-    else if (!(sum.min_vertical_margin >= opt.flight_margin - 1e-9))
-        sum.failure = "the vertical acceleration margin is below the one asked";
-    sum.verified = sum.failure.empty();
-    return finished(sum, cycles, t0);
+    return last_checks(sum, opt, unheld, cycles, t0);
 }
 
 }  // namespace
@@ -1220,9 +1329,9 @@ double sink_coning_limit(const Vec2& at, const DesignOptions& opt) {
 }
 
 int default_starts(const Scene& part_scene, const DesignTarget& target) {
-    const bool sink = target.kind == DesignTargetKind::Sink || target.kind == DesignTargetKind::FixedPoint ||
-                      target.kind == DesignTargetKind::LineSink;
-    return part_scene.part.point && sink ? 4 : 16;
+    const bool sink = target.kind == DesignTargetKind::Sink || target.kind == DesignTargetKind::LineSink ||
+                      (target.kind == DesignTargetKind::FixedPoint && part_scene.part.point);
+    return sink ? 4 : 16;
 }
 
 namespace {
@@ -1245,9 +1354,7 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
             return design_orient(part_scene, target, opt, T);
         if (target.kind == DesignTargetKind::LineSink)
             throw std::invalid_argument("a line sink is built for point parts only");
-        if (target.kind == DesignTargetKind::Sink)
-            throw std::invalid_argument("a sink for every orientation of a rigid part is not built yet: ask for "
-                                        "fixed-point X Y THETA (or orient THETA)");
+        if (target.kind == DesignTargetKind::Sink) return design_sink(part_scene, target, opt, T);
         return design_rigid(part_scene, target, opt, T);
     }
     if (target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");

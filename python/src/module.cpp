@@ -385,7 +385,12 @@ PYBIND11_MODULE(_plate, m) {
         .def_property_readonly("held", [](const DesignSummary& s) {
             return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance);
         }, "sinks and fixed points: (seconds, end, distance) of the part released at rest at the target")
-        .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)");
+        .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)")
+        .def_property_readonly("pulls", [](const DesignSummary& s) {
+            std::vector<std::tuple<double, Vec2, Eigen::Vector2cd>> r;
+            for (const auto& p : s.pulls) r.emplace_back(p.theta, p.zero, p.eigenvalues);
+            return r;
+        }, "a rigid part's sink: (theta, where the position's field vanishes, its eigenvalues) per orientation");
     m.def("design",
           [](const Scene& part, std::optional<std::pair<double, double>> sink,
              std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
@@ -445,7 +450,8 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
           "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
-          "for `hold` seconds, which limits the coning). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
+          "for `hold` seconds, which limits the coning). sink=(x, y) for a rigid part: its position ends at\n"
+          "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
           "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
           "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
           "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"

@@ -50,7 +50,8 @@ double coning_rate(const PlateMotion& u);
 enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };
 struct DesignTarget {
     // Sink: every start in the region ends at position `at`: for a point part the unique stable
-    // fixed point of its velocity field ("fixed-point X Y" is the same target).
+    // fixed point of its velocity field ("fixed-point X Y" is the same target); for a rigid part
+    // whatever its orientation, which is left free (it may turn on at the sink: the summary's pulls).
     // Transport: the part moves at the uniform velocity `velocity` everywhere in the region. A plate
     // that only translates (x, y, z harmonics n = 1, 2) gives a point part the same velocity at every
     // position (nothing in its dynamics depends on where it is), so the field is uniform by
@@ -72,8 +73,9 @@ struct DesignOptions {
     double ang_limit = 150;    // of an angular-acceleration harmonic [rad/s^2]
     double period = 0;         // plate period T [s]; 0: the part scene's
     double region = 0.05;      // the plate region |s_x|, |s_y| <= region [m]
-    // No flight: g + the vertical acceleration of every plate point in the region stays at or above
-    // this fraction of g, all period long (a constraint of the search, never a penalty).
+    // No flight: g + the vertical acceleration of every plate point in the region (for a rigid part
+    // widened by its contacts' reach from its centre of mass) stays at or above this fraction of g,
+    // all period long (a constraint of the search, never a penalty).
     double flight_margin = 0.2;
     std::uint64_t seed = 1;
     // Multi-start: seeded feasible random motions, each refined locally; 0: the target's default
@@ -152,7 +154,16 @@ struct DesignSummary {
     // DesignOptions::hold seconds of full dynamics and how far that is (measured as end_distance).
     DesignStartRun held;
     double coning = 0;                  // the design's coning rate psi' [rad/s] (coning_rate)
-    double min_vertical_margin = 0;     // min over the period and the region of (g + a_z) / g
+    double min_vertical_margin = 0;     // min over the period and the flight check's square of (g + a_z) / g
+    // A rigid part's sink (position only: the part may turn as it pleases): at the target, per
+    // orientation of the verification grid, where the position's velocity field vanishes and its
+    // Jacobian's eigenvalues there.
+    struct OrientationPull {
+        double theta = 0;
+        Vec2 zero = Vec2::Zero();
+        Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();
+    };
+    std::vector<OrientationPull> pulls;
     // Orient by transport (a weathervane, for parts with unequal friction coefficients): the twist at
     // the centre on the verification's ring of orientations (the same at every position); the stable
     // orientation is fixed_point[2], the travel there transport_mean, and transport_spread the largest
@@ -173,9 +184,10 @@ struct DesignSummary {
 // with the defaults 9.3e-4 rad/s, at the region's corners 3e-4.
 double sink_coning_limit(const Vec2& at, const DesignOptions& opt);
 
-// The starts a design makes when DesignOptions::starts is 0: 4 for a point part's sink and line sink
-// (16 and 4 parameters: on the sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
-// 0.74-0.89 1/s in 2.7-3.7 s, 16 starts 0.77-0.94 1/s in 10-11 s, all verified), 16 for the rest.
+// The starts a design makes when DesignOptions::starts is 0: 4 for sinks and line sinks (16 and 4
+// parameters: a point part's sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
+// 0.74-0.89 1/s in 2.7-3.7 s, 16 starts 0.77-0.94 1/s in 10-11 s, all verified; fig4's part's sink
+// there under 20 / 150, 0.96 1/s with 4 starts or 16), 16 for the rest.
 int default_starts(const Scene& part_scene, const DesignTarget& target);
 
 // Designs a plate motion for the part of `part_scene` (its plate block is ignored but for its
