@@ -509,7 +509,9 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
               "linear acceleration moves it onto the target exactly. Tilting in circles cones: the plate turns about z "
               "at a second-order rate the asymptotic field does not see, and the whole field, the sink with it, turns "
               "about the plate's centre; so a sink at D is held to a coning rate of at most (verification distance) / "
-              "(2 |D| hold).</p>\n"
+              "(2 |D| hold). The same construction pulls a rigid part's position at every orientation (its row: "
+              "verified at each of the grid's orientations, by runs from random positions and orientations, and "
+              "held; the part may turn on at the sink).</p>\n"
               "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
               "<th>cycles</th><th>worst end distance [mm]</th><th>seconds</th>"
               "<th>coning [rad/s]</th><th>from the target, after the hold [mm]</th></tr>\n";
@@ -528,6 +530,17 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             first = d;
             first_at = at;
         }
+    }
+    {   // a rigid part's sink: its position, whatever its orientation (the same construction)
+        const Scene rigid = load_scene((src / "scenes" / "fig4.json").string());
+        DesignTarget t;
+        t.at = targets[0];
+        const DesignSummary d = design(rigid, t, o);
+        c.html << design_cells(esc(rigid.name) + "'s rigid part: sink (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) +
+                                   "), any orientation",
+                               d)
+               << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td><td>"
+               << fmt(d.coning, 3) << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop);
     }
     {   // a line sink (design.cpp: y and rx, turned and shifted onto the line)
         DesignTarget t;

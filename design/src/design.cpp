@@ -384,6 +384,8 @@ double settle_time(double d0, double rate, const DesignOptions& opt) {
 // the centre's, and the field weakens away from it.
 double field_settle_time(const Field& f, const Vec2& start, const Vec2& target, const DesignOptions& opt) {
     const GridSpec& g = f.grid;
+    constexpr double h = 0.05, cap = 120;
+    if (g.nx < 2 || g.ny < 2) return cap;   // (no cell to interpolate in)
     auto v = [&](const Vec2& s) {
         const double u = std::clamp((s.x() - g.x0) / g.dx(), 0.0, g.nx - 1.0), w = std::clamp((s.y() - g.y0) / g.dy(), 0.0, g.ny - 1.0);
         const int i = std::min(static_cast<int>(u), g.nx - 2), j = std::min(static_cast<int>(w), g.ny - 2);
@@ -391,7 +393,6 @@ double field_settle_time(const Field& f, const Vec2& start, const Vec2& target, 
         auto at = [&](int di, int dj) -> Vec2 { return f.points[g.index(i + di, j + dj, 0)].twist.head<2>(); };
         return Vec2((1 - a) * (1 - b) * at(0, 0) + a * (1 - b) * at(1, 0) + (1 - a) * b * at(0, 1) + a * b * at(1, 1));
     };
-    constexpr double h = 0.05, cap = 120;
     Vec2 s = start;
     for (double t = 0; t < cap; t += h) {
         if ((s - target).norm() <= 0.2 * opt.verify_distance) return std::min(1.5 * t + 2, cap);
@@ -450,7 +451,8 @@ struct SinkProblem : Problem<SinkProblem> {
     Vec2 D;
     double cone_limit;
     // The orientations the pull is measured at: a point part has none; at a rigid part's centre the
-    // odd field repeats after a half turn, so theta = 0 and a quarter turn span it.
+    // odd field repeats after a half turn, so theta = 0 and a quarter turn sample it (the
+    // verification checks the grid's seven).
     std::vector<double> thetas() const { return part.part.point ? std::vector<double>{0.0} : std::vector<double>{0.0, kPi / 2}; }
     static constexpr int kParams = 16;
     static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
@@ -596,9 +598,16 @@ DesignSummary& verify_rigid_sink(DesignSummary& sum, const Field& field, const D
     avg.points.assign(field.grid.nx * field.grid.ny, FieldPoint{});
     for (int i = 0; i < field.grid.nx; ++i)
         for (int j = 0; j < field.grid.ny; ++j) {
+            // (over the orientations whose cycle converged; none: NaN, and the runs take the cap)
             Vec3 m = Vec3::Zero();
-            for (int k = 0; k < field.grid.nth; ++k) m += field.points[field.grid.index(i, j, k)].twist / field.grid.nth;
-            avg.points[avg.grid.index(i, j, 0)].twist = m;
+            int n = 0;
+            for (int k = 0; k < field.grid.nth; ++k) {
+                const Vec3& w = field.points[field.grid.index(i, j, k)].twist;
+                if (!w.allFinite()) continue;
+                m += w;
+                ++n;
+            }
+            avg.points[avg.grid.index(i, j, 0)].twist = m / n;
         }
     return sink_verdict(sum, avg, target, opt, why, cycles, t0);
 }
@@ -1324,6 +1333,7 @@ double coning_rate(const PlateMotion& u) {
 }
 
 double sink_coning_limit(const Vec2& at, const DesignOptions& opt) {
+    if (opt.max_coning >= 0) return opt.max_coning;
     const double walk = at.norm() * opt.hold;   // [m s]: the sink's walk per unit coning rate
     return walk > 0 ? 0.5 * opt.verify_distance / walk : std::numeric_limits<double>::infinity();
 }

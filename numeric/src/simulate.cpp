@@ -185,7 +185,8 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
         detail::Engine<detail::FullModel> e(m, sc, opt);
         ok = e.start(0, y);
         if (ok) tr.samples.push_back(Sample{0, m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
-        const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / rho);
+        const detail::Scales scale(sc);
+        const Vec3 S(scale.v, scale.v, scale.w);
         State begin = y;   // the state at the current period's start
         long s = 1;
         while (ok && avg.start_periods > 0 && n < N) {

@@ -102,6 +102,9 @@ struct DesignOptions {
     // (sinks and fixed points; 0: not checked). Coning turns the field about the plate's centre, so
     // it bounds the coning a design may have (sink_coning_limit).
     double hold = 120;
+    // The coning a point-part sink may have [rad/s]; negative: sink_coning_limit (from the hold).
+    // (Infinite with a hold: the fastest sink, which the hold then judges.)
+    double max_coning = -1;
     double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
     static LimitCycleOptions cycle_defaults() {
         LimitCycleOptions o;
@@ -138,7 +141,8 @@ struct DesignSummary {
     long cycles = 0;            // limit cycles computed in the search
     // Verification.
     FixedPoints fixed_points;   // of the designed field on the grid
-    Vec3 fixed_point = Vec3::Zero();   // the stable one nearest the target
+    Vec3 fixed_point = Vec3::Zero();   // the stable one nearest the target (a rigid part's sink: where
+                                       // its position's field vanishes at the grid's first orientation)
     Eigen::Vector3cd fixed_point_eigenvalues = Eigen::Vector3cd::Zero();
     // Rigid parts: the share of the runs below that end at the target, and the other stable fixed
     // points on the grid with the share that ends at each (a design that is not unique says so).
@@ -178,10 +182,10 @@ struct DesignSummary {
     std::vector<std::string> notes;     // the symmetries used, and what they imply
 };
 
-// The largest coning rate a point-part sink at `at` may have: the sink turns about the plate's centre
-// at psi', and over the hold it may walk at most half the verification distance,
-// |psi'| <= verify_distance / (2 |at| hold) (infinite at the centre or without a hold). At (0.02, -0.01)
-// with the defaults 9.3e-4 rad/s, at the region's corners 3e-4.
+// The largest coning rate a sink at `at` may have (DesignOptions::max_coning if set): the sink turns
+// about the plate's centre at psi', and over the hold it may walk at most half the verification
+// distance, |psi'| <= verify_distance / (2 |at| hold) (infinite at the centre or without a hold). At
+// (0.02, -0.01) with the defaults 9.3e-4 rad/s, at the region's corners 3e-4.
 double sink_coning_limit(const Vec2& at, const DesignOptions& opt);
 
 // The starts a design makes when DesignOptions::starts is 0: 4 for sinks and line sinks (16 and 4
