@@ -1288,7 +1288,7 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
             return std::max(orient ? 0.0 : (end.head<2>() - at).norm(),
                             std::abs(wrap_angle(end[2] - goal[2])) * opt.verify_distance / 0.05);
         },
-        &goal);
+        stable_at_target == 1 ? &goal : nullptr);   // (the hold only where the target is a stable fixed point)
     const std::string unheld = hold_failure(sum, opt, " m (0.05 rad counted as " + std::to_string(opt.verify_distance) + " m)");
     // The basin shares: of the runs, those that end at the target and at each competing stable point.
     int at_target = 0;
