@@ -301,7 +301,6 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
     return compute_field(sc, g, fo);
 }
 
-//
 // With `hold` (sinks and fixed points, opt.hold > 0) one more run starts at rest at *hold, the target,
 // for opt.hold seconds: sum.held (not among sum.runs, nor in the worst distance).
 template <class Seconds, class EndDistance>
@@ -450,20 +449,23 @@ struct SinkProblem : Problem<SinkProblem> {
         : Problem(part_, opt_, T_, cycles_), D(D_), cone_limit(sink_coning_limit(D_, opt_)) {}
     Vec2 D;
     double cone_limit;
-    // The orientations the pull is measured at: a point part has none; at a rigid part's centre the
-    // odd field repeats after a half turn, so theta = 0 and a quarter turn sample it (the
-    // verification checks the grid's seven).
+    // The orientations the pull is measured at: a point part's one (it has no orientation); at a rigid
+    // part's centre the odd field repeats after a half turn, so theta = 0 and a quarter turn sample it
+    // (the verification checks the grid's seven).
     std::vector<double> thetas() const { return part.part.point ? std::vector<double>{0.0} : std::vector<double>{0.0, kPi / 2}; }
     static constexpr int kParams = 16;
     static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
     double limit(int i) const { return i < 8 ? opt.lin_limit : opt.ang_limit; }
 
     // Constraints c_k <= 0 on the final (shifted) motion: each harmonic's amplitude within its
-    // limit, no flight over the region, and no more coning than the hold allows.
+    // limit, no flight under the part over the region, and no more coning than the hold allows.
     void constraints(const std::vector<double>& p, double* c) const {
         const PlateMotion fin = shift_motion(sink_motion(p, T), D);
         const int k = amplitude_constraints(fin, opt, part, 3, 1.0, c);
-        const double cone = std::isfinite(cone_limit) ? coning_rate(fin) / cone_limit : 0.0;
+        const double psi = coning_rate(fin);
+        const double cone = !std::isfinite(cone_limit) ? 0.0
+                            : cone_limit > 0       ? psi / cone_limit
+                                                   : (psi == 0 ? 0.0 : std::copysign(1e9, psi));   // (max_coning 0)
         c[k] = cone - 1;
         c[k + 1] = -cone - 1;
     }
