@@ -833,7 +833,7 @@ struct DesignArgs : Options {
     std::string scene, out;
     std::vector<std::string> target;
     std::vector<double> limits;
-    double period = 0, hold = DesignOptions{}.hold;
+    double period = 0, hold = DesignOptions{}.hold, max_coning = DesignOptions{}.max_coning;
     std::uint64_t seed = 1;
     int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations;
     explicit DesignArgs(CLI::App* cmd)
@@ -867,6 +867,7 @@ struct DesignArgs : Options {
         whole("--starts", starts, 1, 10000, "seeded starts of the search");
         whole("--evaluations", evaluations, 1, 1'000'000, "evaluations per start");
         number("--hold", hold, "seconds a part released at the target must stay within 5 mm (0: not checked)", "120");
+        number("--max-coning", max_coning, "a sink's largest coning rate [rad/s] (negative: from the hold)", "from the hold");
     }
 };
 
@@ -912,6 +913,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
         throw UsageError("--period: expected " + fmt(kPeriodRange[0]) + " to " + fmt(kPeriodRange[1]) + " s");
     if (!(a.hold >= 0 && a.hold <= 3600)) throw UsageError("--hold: expected 0 to 3600 s");
     o.hold = a.hold;
+    o.max_coning = a.max_coning;   // (any finite number: negative asks for the hold's limit)
     o.seed = a.seed;
     o.threads = a.threads;
     o.starts = a.starts;

@@ -444,6 +444,10 @@ TEST_CASE("plate design: a verified sink is a scene whose own field has its one 
     CHECK(j["verified"] == true);
     CHECK(j["unique"] == true);
     CHECK(j["convergence_rate_per_s"].get<double>() > 0.5);
+    // The hold and the coning it allows (5 mm / (2 |D| 120 s)), in the summary.
+    CHECK(j["hold"]["seconds"] == 120.0);
+    CHECK(j["hold"]["end_distance"].get<double>() <= 0.005);
+    CHECK(std::abs(j["coning_rate"].get<double>()) <= 0.005 / (2 * std::hypot(0.02, -0.01) * 120) * (1 + 1e-6));
     // The designed scene through the program's own fixed-point search (not the design's verification).
     const Run fp = run("fixed-points " + (d / "sink.json").string() + " --grid 9");
     REQUIRE(fp.code == 0);
@@ -466,4 +470,16 @@ TEST_CASE("plate design: a verified sink is a scene whose own field has its one 
     const Run bad = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target wobble 0 0 --out " + (d / "x.json").string());
     CHECK(bad.code == 2);
     CHECK(bad.err.find("--target") != std::string::npos);
+
+    // Coning allowed with the hold on: the fastest sink walks off its target, and the hold says so.
+    const Run coned = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
+                          "--max-coning 1e9 --out " + (d / "coned.json").string());
+    CHECK(coned.code == 4);
+    CHECK(coned.err.find("released at rest at the target") != std::string::npos);
+    CHECK(nlohmann::json::parse(coned.out)["hold"]["end_distance"].get<double>() > 0.005);
+    CHECK_FALSE(fs::exists(d / "coned.json"));
+    const Run negative = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0 0 --hold -1 --out " +
+                             (d / "y.json").string());
+    CHECK(negative.code == 2);
+    CHECK(negative.err.find("--hold") != std::string::npos);
 }

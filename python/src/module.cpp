@@ -396,7 +396,8 @@ PYBIND11_MODULE(_plate, m) {
              std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
              std::optional<double> orient, std::optional<std::tuple<double, double, double>> line_sink,
              double lin_limit, double ang_limit, double period,
-             std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold) {
+             std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold,
+             double max_coning) {
               require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() +
                                   line_sink.has_value() == 1,
                       "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta "
@@ -435,6 +436,7 @@ PYBIND11_MODULE(_plate, m) {
               o.threads = threads;
               require(hold >= 0, "hold: expected seconds >= 0 (0: not checked)");
               o.hold = hold;
+              o.max_coning = max_coning;
               py::gil_scoped_release free;
               try {
                   return design(part, t, o);
@@ -447,10 +449,11 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0, py::arg("local_evaluations") = 400,
-          py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0,
+          py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0, py::arg("max_coning") = -1.0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
           "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
-          "for `hold` seconds, which limits the coning). sink=(x, y) for a rigid part: its position ends at\n"
+          "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
+          "sink=(x, y) for a rigid part: its position ends at\n"
           "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
           "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
           "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
