@@ -172,8 +172,8 @@ struct Problem {
         return f;
     }
     // The limit cycle at s; false if it did not converge.
-    bool twist_at(const Scene& sc, const Vec2& s, Vec2& v, double theta = 0) const {
-        const LimitCycleSummary lc = limit_cycle(sc, Vec3(s.x(), s.y(), theta), opt.cycle);
+    bool twist_at(const Scene& sc, const Vec2& s, Vec2& v) const {
+        const LimitCycleSummary lc = limit_cycle(sc, Vec3(s.x(), s.y(), 0), opt.cycle);
         ++*cycles;
         if (!lc.converged) return false;
         v = lc.twist.head<2>();
@@ -428,6 +428,24 @@ void start_summary(DesignSummary& sum, const Scene& part, const std::string& suf
 }
 constexpr const char* kNoFeasibleMotion = "no motion within the limits keeps the part on the plate over the region";
 
+// The position's field v0 at (s, theta) and its Jacobian in s by central differences of h: five limit
+// cycles (counted in `cycles`); false if one did not converge.
+bool position_pull(const Scene& sc, const Vec2& s, double theta, const LimitCycleOptions& cyc, double h, Vec2& v0,
+                   Eigen::Matrix2d& J, std::atomic<long>& cycles) {
+    const Vec2 d[5] = {Vec2::Zero(), Vec2(h, 0), Vec2(-h, 0), Vec2(0, h), Vec2(0, -h)};
+    Vec2 v[5];
+    for (int j = 0; j < 5; ++j) {
+        const LimitCycleSummary lc = limit_cycle(sc, Vec3(s.x() + d[j].x(), s.y() + d[j].y(), theta), cyc);
+        ++cycles;
+        if (!lc.converged) return false;
+        v[j] = lc.twist.head<2>();
+    }
+    v0 = v[0];
+    J.col(0) = (v[1] - v[2]) / (2 * h);
+    J.col(1) = (v[3] - v[4]) / (2 * h);
+    return true;
+}
+
 // --- the sink ---------------------------------------------------------------------------------------
 // Parameters: per axis of {x, y, rx, ry} and harmonic n = 1, 3, the cosine and sine coefficients,
 // u_a = c cos(n w t) + s sin(n w t): odd harmonics without z or rz make the field odd about the
@@ -479,18 +497,15 @@ struct SinkProblem : Problem<SinkProblem> {
         const double h = 0.003;
         double rate = std::numeric_limits<double>::infinity(), offset = 0;
         for (double th : thetas()) {
-            Vec2 vx = Vec2::Zero(), vy = Vec2::Zero();
-            if (!twist_at(sc, Vec2(h, 0), vx, th) || !twist_at(sc, Vec2(0, h), vy, th)) return 1e3;
             Eigen::Matrix2d J;
             if (part.part.point) {
+                Vec2 vx = Vec2::Zero(), vy = Vec2::Zero();
+                if (!twist_at(sc, Vec2(h, 0), vx) || !twist_at(sc, Vec2(0, h), vy)) return 1e3;
                 J.col(0) = vx / h;   // the field is odd about the centre: v(h e) / h is the central difference
                 J.col(1) = vy / h;
             } else {
-                Vec2 v0 = Vec2::Zero(), wx = Vec2::Zero(), wy = Vec2::Zero();
-                if (!twist_at(sc, Vec2::Zero(), v0, th) || !twist_at(sc, Vec2(-h, 0), wx, th) || !twist_at(sc, Vec2(0, -h), wy, th))
-                    return 1e3;
-                J.col(0) = (vx - wx) / (2 * h);
-                J.col(1) = (vy - wy) / (2 * h);
+                Vec2 v0 = Vec2::Zero();
+                if (!position_pull(sc, Vec2::Zero(), th, opt.cycle, h, v0, J, *cycles)) return 1e3;
                 const Vec2 step = J.fullPivLu().solve(v0);
                 offset = std::max(offset, step.allFinite() ? step.norm() : 1.0);
             }
@@ -560,20 +575,9 @@ DesignSummary& verify_rigid_sink(DesignSummary& sum, const Field& field, const D
         Vec2 s = target.at;
         bool ok = false;
         for (int it = 0; it < 6 && !ok; ++it) {
-            Vec2 v0 = Vec2::Zero(), v[4] = {Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero()};
-            const Vec2 d[4] = {Vec2(h, 0), Vec2(-h, 0), Vec2(0, h), Vec2(0, -h)};
-            auto twist = [&](const Vec2& at, Vec2& out) {
-                const LimitCycleSummary lc = limit_cycle(sum.scene, Vec3(at.x(), at.y(), pull.theta), opt.cycle);
-                ++cycles;
-                out = lc.twist.head<2>();
-                return lc.converged;
-            };
-            bool conv = twist(s, v0);
-            for (int j = 0; j < 4; ++j) conv = conv && twist(s + d[j], v[j]);
-            if (!conv) break;
+            Vec2 v0 = Vec2::Zero();
             Eigen::Matrix2d J;
-            J.col(0) = (v[0] - v[1]) / (2 * h);
-            J.col(1) = (v[2] - v[3]) / (2 * h);
+            if (!position_pull(sum.scene, s, pull.theta, opt.cycle, h, v0, J, cycles)) break;
             pull.eigenvalues = J.eigenvalues();
             const Vec2 step = J.fullPivLu().solve(v0);
             if (!step.allFinite()) break;
