@@ -3,7 +3,9 @@
 #include "models.hpp"
 
 #include "plate/field.hpp"
+#include "plate/random_scene.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -405,6 +407,53 @@ RegularisedReference regularised_reference(const Scene& sc, const Vec3& q0, cons
     out.ok = true;
     out.seconds = seconds_since(t0);
     return out;
+}
+
+Scene sticking_random_scene(std::uint64_t seed, Vec3& q0, double* ratio) {
+    RandomSceneOptions ro;
+    ro.point = seed % 3 == 2;
+    ro.thin = seed % 3 == 1;
+    Scene sc = random_scene(seed, ro);
+    Rng r(seed ^ 0x5715C0FFEEull);   // its own stream: the part and motion are random_scene's
+    const double mu = sc.part.point ? sc.part.mu[0] : sc.part.mu.maxCoeff();
+    const double k = r.uniform(0.05, 2.0);
+    const double heave = r.uniform(0.5, 3.0);
+    double horizontal = 0;
+    for (const Harmonic& h : sc.plate.harmonics)
+        if (h.axis == Axis::x || h.axis == Axis::y) horizontal = std::max(horizontal, std::abs(h.amp));
+    for (Harmonic& h : sc.plate.harmonics) {
+        if (h.axis == Axis::x || h.axis == Axis::y) h.amp *= k * mu * sc.g / horizontal;
+        if (h.axis == Axis::z) h.amp *= heave;
+    }
+    const double rad = r.uniform(0, 0.05), a = r.uniform(0, 2 * kPi);
+    q0 = Vec3(rad * std::cos(a), rad * std::sin(a), sc.part.point ? 0.0 : r.uniform(0, 2 * kPi));
+    sc.name = "sticking-" + sc.name;
+    if (ratio) *ratio = k;
+    return sc;
+}
+
+RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& opt, const RegularisedOptions& ref) {
+    RandomStickCase c;
+    c.seed = seed;
+    c.scene = sticking_random_scene(seed, c.q0, &c.ratio);
+    const LimitCycleSummary lc = limit_cycle(c.scene, c.q0, opt);
+    c.converged = lc.converged;
+    if (!lc.converged) {
+        c.failure = "engine: " + (lc.stop.reason != StopReason::None ? lc.stop.describe() : std::string("not converged"));
+        return c;
+    }
+    c.held = *std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end());
+    c.mode_changes = static_cast<int>(lc.mode_events.size());
+    const RegularisedReference r = regularised_reference(c.scene, c.q0, ref);
+    c.reference_ok = r.ok;
+    if (!r.ok) {
+        c.failure = "reference: " + r.failure;
+        return c;
+    }
+    const double v = c.scene.v_ref();
+    c.error = (lc.twist - r.twist).cwiseQuotient(Vec3(v, v, v / c.scene.part.rho())).cwiseAbs().maxCoeff();
+    c.reference_error = r.error;
+    return c;
 }
 
 }  // namespace plate

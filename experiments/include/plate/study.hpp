@@ -8,6 +8,7 @@
 #include "plate/limit_cycle.hpp"
 #include "plate/methods.hpp"
 
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -90,6 +91,28 @@ struct RegularisedReference {
     double seconds = 0;
 };
 RegularisedReference regularised_reference(const Scene& scene, const Vec3& q0, const RegularisedOptions& opt = {});
+
+// STICK-SLIP ON SCENES NOBODY TUNED: seeded random scenes (random_scene's thick, thin and point parts
+// and six-axis motions, seed % 3 picking the kind) made to stick -- the horizontal amplitudes rescaled
+// so that the largest is `ratio` mu g, ratio uniform in [0.05, 2], the heave multiplied by a factor
+// uniform in [0.5, 3] -- each at one random configuration within 5 cm of the centre. The engine's
+// asymptotic twist (limit_cycle, default options) against the regularised-friction limit there.
+Scene sticking_random_scene(std::uint64_t seed, Vec3& q0, double* ratio = nullptr);
+struct RandomStickCase {
+    std::uint64_t seed = 0;
+    Scene scene;
+    Vec3 q0 = Vec3::Zero();
+    double ratio = 0;            // horizontal amplitude / (mu g)
+    bool converged = false;      // the engine's cycle
+    bool reference_ok = false;
+    std::string failure;         // why not (either)
+    double held = 0;             // largest stick fraction of a contact over the engine's cycle
+    int mode_changes = 0;        // over its last period
+    double error = 0;            // |engine - reference|, relative to (v_ref, v_ref, v_ref / rho)
+    double reference_error = 0;  // the reference's own
+};
+RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& opt = {},
+                                  const RegularisedOptions& ref = {});
 
 // The OdeSystem of the reduced U-dynamics at q0 in scaled coordinates, y = [q'/v, Q/(v T)], with
 // the generated Jacobian (twist_jacobian); exposed for tests of the methods.
