@@ -347,9 +347,9 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
     std::vector<std::pair<double, std::uint64_t>> diffs;
     for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(n); ++seed) {
         const RandomStickCase r = random_stick_case(seed);
-        converged += r.converged;
-        flew += !r.converged && r.failure.find("would fly") != std::string::npos;
-        if (!r.converged) continue;
+        converged += r.converged();
+        flew += !r.converged() && r.failure.find("would fly") != std::string::npos;
+        if (!r.converged()) continue;
         held += r.held > 0;
         stuck += r.held >= 1;
         if (!r.reference_ok) {
@@ -366,8 +366,8 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
     }
     std::sort(diffs.begin(), diffs.end());
     c.html << "<p><b>Scenes nobody tuned.</b> " << n << " seeded random scenes (thick, thin and point parts; motions on "
-           << "all six axes, the horizontal amplitude rescaled to 0.05–2 μg and the heave by 0.5–3; one random "
-           << "configuration within 5 cm of the centre each; <code>sticking_random_scene</code>), the engine at its default "
+           << "all six axes, the largest x or y harmonic rescaled to 0.05–1.2 μg and the heave by 0.5–2.5; one random "
+           << "configuration within 3 cm of the centre each; <code>sticking_random_scene</code>), the engine at its default "
            << "options (rtol 10<sup>-8</sup>, cycles to 10<sup>-7</sup> v<sub>ref</sub>): " << converged << " cycles found";
     if (flew > 0) c.html << ", " << flew << " left the model (a contact's normal force reached zero: the part would fly; said so)";
     c.html << "; " << held << " of the cycles hold a contact for part of the period, " << stuck << " of them all period. ";

@@ -272,28 +272,76 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
 
 TEST_CASE("stick-slip on scenes nobody tuned: 36 seeded random sticking scenes agree with the regularised limit",
           "[stick][reference][random]") {
-    // Thick, thin and point parts (seed % 3), six-axis motions with the horizontal amplitude rescaled
-    // to 0.05..2 mu g and the heave by 0.5..3 (sticking_random_scene, study.hpp), one random
-    // configuration each; the engine at its default options (rtol 1e-8, cycles to 1e-7 v_ref).
-    // The bound is the engine's own accuracy: a slip that passes within the zero band of zero (3e2 rtol
-    // v_ref, engine.hpp) is taken as reaching it, an error below the band's width (3e-6 v_ref), plus the
-    // cycle's tolerance (1e-7), plus three times the reference's own error estimate. Measured over 800
-    // seeds: the largest difference 7.9e-7 v_ref, the median 4e-9 (README). The median must stay below the
-    // cycle tolerance: a smooth slide has no band error. And at least a third must stick, or the test
-    // would not be about stick-slip.
-    const double band = 3e2 * 1e-8, tol = 1e-7;
-    int sticking = 0;
+    // Thick, thin and point parts (seed % 3), six-axis motions with the x, y amplitudes rescaled to
+    // 0.05..1.2 mu g and the heave by 0.5..2.5 (sticking_random_scene, study.hpp), one random
+    // configuration each within 3 cm. Two engines against the regularised limit, each bounded by its own
+    // accuracy plus the reference's error estimate (what the reference is worth: the difference of two
+    // estimates is at most the sum of their errors):
+    //   the default (rtol 1e-8, cycles to 1e-7 v_ref): a slip that passes within the zero band of zero
+    //     (3e2 rtol v_ref, engine.hpp) is taken as reaching it, an error below the band's width, plus
+    //     the cycle tolerance -- the accuracy the engine claims (measured over 800 seeds: README);
+    //   a tight one (rtol 1e-10, cycles to 1e-9): the same terms, 3e-8 + 1e-9 v_ref, so that a model
+    //     error of a few 1e-7 v_ref (a gauge that holds the part 0.3 % too long: 2.5e-6) cannot hide in
+    //     the default's band.
+    // The cases must cover what the test is about: cycles that hold a contact for part of the period
+    // (a cycle stuck all period has twist exactly 0 on both sides and proves nothing), pivots that break
+    // away at the disk's rim, point parts that stick and slip; the median over the partial ones within
+    // the cycle tolerance.
+    const double tol = 1e-7;
+    LimitCycleOptions tight;
+    tight.integration.rtol = 1e-10;
+    tight.tol = 1e-9;
+    int partial = 0, pivot_breaks = 0, point_partial = 0;
     std::vector<double> errors;
     for (std::uint64_t seed = 1; seed <= 36; ++seed) {
         const RandomStickCase c = random_stick_case(seed);
         INFO("seed " << seed << " (" << c.scene.name << ", ratio " << c.ratio << "): " << c.failure);
-        REQUIRE(c.converged);
+        REQUIRE(c.converged());
         REQUIRE(c.reference_ok);
-        sticking += c.held > 0;
-        CHECK(c.error <= band + tol + 3 * c.reference_error);
+        CHECK(c.error <= 3e2 * 1e-8 + tol + c.reference_error);
+        const LimitCycleSummary t = limit_cycle(c.scene, c.q0, tight);
+        REQUIRE(t.converged);
+        CHECK(twist_distance(c.scene, t.twist, c.reference_twist) <= 3e2 * 1e-10 + 1e-9 + c.reference_error);
+        if (c.held == 0 || c.cycle.stuck_all_period()) continue;
+        ++partial;
+        point_partial += c.scene.part.point;
+        pivot_breaks += std::any_of(c.cycle.mode_events.begin(), c.cycle.mode_events.end(), [](const ModeEvent& e) {
+            return e.from.kind == ModeKind::Pivot && e.to.kind == ModeKind::Slide;
+        });
         errors.push_back(c.error);
     }
+    CHECK(partial >= 18);
+    CHECK(pivot_breaks >= 6);
+    CHECK(point_partial >= 5);
     std::sort(errors.begin(), errors.end());
+    REQUIRE(!errors.empty());
     CHECK(errors[errors.size() / 2] <= tol);
-    CHECK(sticking >= 12);
+}
+
+TEST_CASE("a pivot that comes to rest for a moment inside one step is not missed (random scene 562)",
+          "[stick][reference][random]") {
+    // sticking_random_scene(562): a thin part pivoting about its third contact decelerates to rest at
+    // 0.9034 T, stays stuck for 3 ms and turns on the same way. The engine's step across it (0.011 T)
+    // ended with the turn positive at both ends, so the rest was missed from most starts: the period
+    // map jumped between two ends 5.3e-5 v_ref apart for starts 1e-6 v_ref apart, and the cycle was
+    // 1.9e-5 v_ref off the regularised limit. A period with a full stick forgets its start, so its map
+    // is flat: starts either side of the cycle's end at one point (to the integration's error), and the
+    // twist is the regularised limit's within the cycle tolerance and the reference's error.
+    const RandomStickCase c = random_stick_case(562);
+    REQUIRE(c.converged());
+    REQUIRE(c.reference_ok);
+    CHECK(c.error <= 1e-7 + c.reference_error);
+    CHECK(std::any_of(c.cycle.mode_events.begin(), c.cycle.mode_events.end(),
+                      [](const ModeEvent& e) { return e.from.kind == ModeKind::Pivot && e.to.kind == ModeKind::Stuck; }));
+    const double v = c.scene.v_ref();
+    const Vec3 S(v, v, v / c.scene.part.rho());
+    Vec3 first = Vec3::Zero();
+    double spread = 0;
+    for (int i = -6; i <= 6; ++i) {
+        Vec3 end;
+        REQUIRE(period_map(c.scene, c.q0, c.cycle.qd_start + Vec3(i * 1e-6 * v, 0, 0), end));
+        if (i == -6) first = end;
+        spread = std::max(spread, (end - first).cwiseQuotient(S).cwiseAbs().maxCoeff());
+    }
+    CHECK(spread <= 1e-7);
 }

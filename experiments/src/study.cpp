@@ -416,8 +416,8 @@ Scene sticking_random_scene(std::uint64_t seed, Vec3& q0, double* ratio) {
     Scene sc = random_scene(seed, ro);
     Rng r(seed ^ 0x5715C0FFEEull);   // its own stream: the part and motion are random_scene's
     const double mu = sc.part.point ? sc.part.mu[0] : sc.part.mu.maxCoeff();
-    const double k = r.uniform(0.05, 2.0);
-    const double heave = r.uniform(0.5, 3.0);
+    const double k = r.uniform(0.05, 1.2);
+    const double heave = r.uniform(0.5, 2.5);
     double horizontal = 0;
     for (const Harmonic& h : sc.plate.harmonics)
         if (h.axis == Axis::x || h.axis == Axis::y) horizontal = std::max(horizontal, std::abs(h.amp));
@@ -425,7 +425,7 @@ Scene sticking_random_scene(std::uint64_t seed, Vec3& q0, double* ratio) {
         if (h.axis == Axis::x || h.axis == Axis::y) h.amp *= k * mu * sc.g / horizontal;
         if (h.axis == Axis::z) h.amp *= heave;
     }
-    const double rad = r.uniform(0, 0.05), a = r.uniform(0, 2 * kPi);
+    const double rad = r.uniform(0, 0.03), a = r.uniform(0, 2 * kPi);
     q0 = Vec3(rad * std::cos(a), rad * std::sin(a), sc.part.point ? 0.0 : r.uniform(0, 2 * kPi));
     sc.name = "sticking-" + sc.name;
     if (ratio) *ratio = k;
@@ -436,8 +436,8 @@ RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& o
     RandomStickCase c;
     c.seed = seed;
     c.scene = sticking_random_scene(seed, c.q0, &c.ratio);
-    const LimitCycleSummary lc = limit_cycle(c.scene, c.q0, opt);
-    c.converged = lc.converged;
+    c.cycle = limit_cycle(c.scene, c.q0, opt);
+    const LimitCycleSummary& lc = c.cycle;
     if (!lc.converged) {
         c.failure = "engine: " + (lc.stop.reason != StopReason::None ? lc.stop.describe() : std::string("not converged"));
         return c;
@@ -451,6 +451,7 @@ RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& o
         return c;
     }
     const double v = c.scene.v_ref();
+    c.reference_twist = r.twist;
     c.error = (lc.twist - r.twist).cwiseQuotient(Vec3(v, v, v / c.scene.part.rho())).cwiseAbs().maxCoeff();
     c.reference_error = r.error;
     return c;
