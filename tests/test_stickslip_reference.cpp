@@ -345,3 +345,47 @@ TEST_CASE("a pivot that comes to rest for a moment inside one step is not missed
     }
     CHECK(spread <= 1e-7);
 }
+
+TEST_CASE("full dynamics through stick-slip on random scenes: the regularised trajectories converge to the engine's",
+          "[stick][reference][random][full]") {
+    // Five sticking_random_scene seeds (two thick, two thin, one point part) whose full-dynamics run from
+    // rest holds a contact again after its break-away (1 to 11 times in the 0.5 s). Both methods from the break-away for 0.5 s (trajectory_run,
+    // study.hpp: the engine at rtol 1e-10; GSL's bsimp with f = -mu N v / sqrt(|v|^2 + eps^2) at
+    // eps = 1e-4, 1e-5, 1e-6 v_ref, tol 1e-10), the configuration's difference at 0.5 s (relative to
+    // rho, rho, 1 rad). Where the engine is the eps -> 0 limit the difference shrinks like eps^p, p
+    // about 0.8 near sticking (README): at least 10^0.5 per decade here. A model error in the engine
+    // (mu 1 % off) makes it level off at that error instead.
+    int held = 0;
+    for (std::uint64_t seed : {22, 92, 102, 138, 148}) {
+        Vec3 q0;
+        const Scene sc = sticking_random_scene(seed, q0);
+        INFO("seed " << seed << " (" << sc.name << ")");
+        const Trajectory tr = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), 0.5, 0.5);
+        REQUIRE(tr.stop.reason == StopReason::None);
+        held += std::any_of(tr.events.begin(), tr.events.end(), [&](const ModeEvent& e) {
+            return e.t > tr.events.front().t && e.to.kind != ModeKind::Slide;
+        });
+        Solver engine;
+        engine.engine = true;
+        const RunResult e = trajectory_run(sc, q0, 0.5, 0.5, engine, 1e-10);
+        REQUIRE(e.ok);
+        std::vector<double> d;
+        for (double eps : {1e-4, 1e-5, 1e-6}) {
+            Solver s;
+            s.method = Method::GslBsimp;
+            s.law = FrictionLaw::Sqrt;
+            s.law_eps = eps;
+            const RunResult r = trajectory_run(sc, q0, 0.5, 0.5, s, 1e-10);
+            REQUIRE(r.ok);
+            const std::size_t n = e.value.size();
+            double dist = 0;
+            for (int i = 0; i < 3; ++i)
+                dist = std::max(dist, std::abs(e.value[n - 3 + i] - r.value[n - 3 + i]) / (i < 2 ? sc.part.rho() : 1.0));
+            d.push_back(dist);
+        }
+        INFO("differences at eps 1e-4, 1e-5, 1e-6 v_ref: " << d[0] << ", " << d[1] << ", " << d[2]);
+        CHECK(d[0] >= std::sqrt(10.0) * d[1]);
+        CHECK(d[1] >= std::sqrt(10.0) * d[2]);
+    }
+    CHECK(held == 5);
+}
