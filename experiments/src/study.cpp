@@ -443,7 +443,6 @@ RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& o
         return c;
     }
     c.held = *std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end());
-    c.mode_changes = static_cast<int>(lc.mode_events.size());
     const RegularisedReference r = regularised_reference(c.scene, c.q0, ref);
     c.reference_ok = r.ok;
     if (!r.ok) {

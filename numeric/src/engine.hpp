@@ -293,16 +293,23 @@ private:
         if (i > 4 || frozen_ || !(stage_min_[i] < 0) || !(g0_[i] >= 0 && g1 >= 0)) return false;
         const double ts = stage_t_[i];
         if (!(ts > t_ && ts < t1)) return false;
-        State ym, dym;
-        Guards gm;
-        dense(ts, t1, ym);
-        sys(ym, dym, ts);
-        guards(ym, gm);
-        if (!crossed(i, g0_[i], gm[i])) return false;
+        State ym;
+        const double gm = guard_at(i, ts, t1, ym);
+        if (!crossed(i, g0_[i], gm)) return false;
         tb = ts;
-        gb = gm[i];
+        gb = gm;
         yb = ym;
         return true;
+    }
+
+    // Guard i at time t of the step ending at t1, on its dense output (ym: the scaled state there).
+    double guard_at(int i, double t, double t1, State& ym) {
+        State dym;
+        Guards g;
+        dense(t, t1, ym);
+        sys(ym, dym, t);
+        guards(ym, g);
+        return g[i];
     }
 
     double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
@@ -548,16 +555,9 @@ private:
     // receives the scaled state at the returned time, where the guard is already violated.
     double locate(int i, double t1, double tb, double gb, const State& yb, State& yr) {
         yr = yb;
-        State ym, dym;
-        Guards gm;
+        State ym;
         return illinois_first_root(
-            t_, tb, g0_[i], gb, 1e-13 * scene_.plate.T,
-            [&](double m) {
-                dense(m, t1, ym);
-                sys(ym, dym, m);
-                guards(ym, gm);
-                return gm[i];
-            },
+            t_, tb, g0_[i], gb, 1e-13 * scene_.plate.T, [&](double m) { return guard_at(i, m, t1, ym); },
             [&](double ga, double gm_i) { return crossed(i, ga, gm_i); }, [&] { yr = ym; });
     }
 

@@ -110,7 +110,6 @@ struct RandomStickCase {
     bool reference_ok = false;
     std::string failure;         // why not (either)
     double held = 0;             // largest stick fraction of a contact over the engine's cycle
-    int mode_changes = 0;        // over its last period
     Vec3 reference_twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     double error = 0;            // |engine - reference|, relative to (v_ref, v_ref, v_ref / rho)
     double reference_error = 0;  // the reference's own
