@@ -7,12 +7,14 @@
 //       the regularised reference extrapolated to eps = 0, and its time; the regularised method at the
 //       largest eps whose error stays below 1e-6 v_ref on the whole sample, against the engine.
 // Ratios are measured in this run; absolute figures come with the machine.
+#include "plate/dynamics.hpp"
 #include "plate/field.hpp"
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
 #include "plate/study.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -72,6 +74,45 @@ int main() {
             std::printf("  %-8s %3d configurations: %4.1f %% of the right-hand sides, %.1f periods each, %.0f right-hand sides "
                         "a period\n", k ? "sticking" : "sliding", n[k], 100.0 * rhs[k] / f.rhs_evals,
                         n[k] ? double(periods[k]) / n[k] : 0.0, periods[k] ? double(rhs[k]) / periods[k] : 0.0);
+
+        // (1c) Why a sticking period costs more: the accepted steps of each cycle's last period
+        // (recorded), sorted by the smallest slip of a sliding contact at the step's start. Where a
+        // slip is small the friction direction relaxes at a rate ~ |a| / |v|, and an explicit step
+        // is bounded by it: the step over (T |v| / v_ref) is then about constant.
+        std::printf("\n(1c) fig6's cycles, last period's accepted steps by the smallest slip s at the step's start "
+                    "(slides only)\n");
+        const Scene sc = scene("fig6");
+        const double T = sc.plate.T, v = sc.v_ref();
+        for (int k : {1, 0}) {
+            long steps = 0, small = 0;
+            std::vector<double> ratio;
+            for (const auto& p : f.points) {
+                if ((*std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) > 0) != bool(k)) continue;
+                LimitCycleOptions o;
+                o.record = true;
+                const LimitCycleSummary lc = limit_cycle(sc, p.q, o);
+                if (!lc.converged || lc.path.empty()) continue;
+                const double t_end = lc.path.back().t;
+                for (std::size_t i = 1; i < lc.path.size(); ++i) {
+                    const Sample& a = lc.path[i - 1];
+                    if (a.t < t_end - T * (1 + 1e-12)) continue;
+                    ++steps;
+                    if (a.mode.kind != ModeKind::Slide || lc.path[i].mode.kind != ModeKind::Slide) continue;
+                    std::array<Vec2, 3> slip;
+                    slip_velocities(sc.part, p.q, a.qd, slip);
+                    double s = slip[0].norm();
+                    for (int c = 1; c < sc.part.contacts(); ++c) s = std::min(s, slip[c].norm());
+                    if (s < 5e-5 * v || s > 1e-2 * v) continue;
+                    ++small;
+                    ratio.push_back((lc.path[i].t - a.t) / (T * s / v));
+                }
+            }
+            std::sort(ratio.begin(), ratio.end());
+            const auto pct = [&](double f) { return ratio.empty() ? 0.0 : ratio[std::size_t(f * (ratio.size() - 1))]; };
+            std::printf("  %-8s %5ld steps, %4.1f %% with 5e-5 <= s / v_ref <= 1e-2; there step / (T s / v_ref): "
+                        "median %.2f (10-90 %%: %.2f-%.2f)\n", k ? "sticking" : "sliding", steps,
+                        steps ? 100.0 * small / steps : 0.0, pct(0.5), pct(0.1), pct(0.9));
+        }
     }
 
     std::printf("\n(2) fig6's sticking configurations, every 5th in grid order: error against the regularised\n"
