@@ -6,6 +6,7 @@
 #include "plate/scene_io.hpp"
 #include "plate/study.hpp"
 
+#include <Eigen/SVD>
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -168,6 +169,61 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         const LimitCycleSummary sh = limit_cycle(sc, q, o, ref.qd_start + Vec3(-2, 2, 2).cwiseProduct(S));
         REQUIRE(sh.converged);
         CHECK((sh.twist - ref.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < 1e-7);   // measured 5e-10
+    }
+}
+
+TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's period map has rank one",
+          "[limit_cycle][stick]") {
+    // Held about contact k, the twist satisfies two constraints (contact k's slip is zero), so it has
+    // one free component, theta'; whatever the period's start, its state on leaving the pivot is one
+    // number, and the period map's derivative is u v^T: one nonzero singular value. A sliding cycle
+    // has no such bottleneck (its map has full rank; the control below). Central differences of the
+    // period map at the cycle, h = 1e-3 of the scales at rtol 1e-11: truncation h^2 |P'''| and noise
+    // ~1e-8 / h (holds are entered at 3e2 rtol v_ref, engine.hpp), a bound of 1e-5 on sigma_2 / sigma_1
+    // (measured <= 8e-9 on these three; the sliding ones 0.70 and 0.16; a wrong hold -- a pivot whose
+    // contact kept slipping -- would leave the start's other components in the map).
+    const Scene sc = scene("fig6");
+    const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
+    const auto grid = [](int i, int j, int k) { return Vec3(-0.05 + i / 60.0, -0.05 + j / 60.0, 2 * kPi * k / 7); };
+    struct Case {
+        Vec3 q;
+        bool pivots;
+    };
+    const Case cases[] = {{grid(1, 3, 2), true},    // pivots about contact 2 three times a period
+                          {grid(4, 2, 1), true},    // about contact 1, three times
+                          {grid(5, 4, 2), true},    // about contact 1, twice
+                          {Vec3(1.0 / 60, 1.0 / 60, 1.0), false},    // slides all period long
+                          {Vec3(-0.025, 0.025, 1.5 * kPi), false}};
+    IntegrationOptions io;
+    io.rtol = 1e-11;
+    for (const Case& c : cases) {
+        INFO("q = " << c.q.transpose());
+        LimitCycleOptions plain;
+        plain.solver = CycleSolver::PeriodByPeriod;
+        plain.tol = 1e-11;
+        plain.integration = io;
+        const LimitCycleSummary ref = limit_cycle(sc, c.q, plain);
+        REQUIRE(ref.converged);
+        const bool pivots = std::any_of(ref.mode_events.begin(), ref.mode_events.end(),
+                                        [](const ModeEvent& e) { return e.to.kind == ModeKind::Pivot; });
+        REQUIRE(pivots == c.pivots);
+        REQUIRE(std::none_of(ref.mode_events.begin(), ref.mode_events.end(),
+                             [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; }));
+        Mat3 M;
+        const double h = 1e-3;
+        for (int j = 0; j < 3; ++j) {
+            Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
+            xp[j] += h * S[j];
+            xm[j] -= h * S[j];
+            REQUIRE(period_map(sc, c.q, xp, Pp, io));
+            REQUIRE(period_map(sc, c.q, xm, Pm, io));
+            M.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
+        }
+        const Vec3 sigma = Eigen::JacobiSVD<Mat3>(M).singularValues();
+        INFO("singular values " << sigma.transpose());
+        CHECK(sigma[0] > 1e-2);   // the start matters (no full stick)
+        if (c.pivots) CHECK(sigma[1] <= 1e-5 * sigma[0]);
+        else CHECK(sigma[1] > 1e-1 * sigma[0]);
     }
 }
 
