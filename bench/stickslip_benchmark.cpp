@@ -78,9 +78,9 @@ int main() {
         // (1c) Why a sticking period costs more: the accepted steps of each cycle's last period
         // (recorded), sorted by the smallest slip of a sliding contact at the step's start. Where a
         // slip is small the friction direction relaxes at a rate ~ |a| / |v|, and an explicit step
-        // is bounded by it: the step over (T |v| / v_ref) is then about constant.
-        std::printf("\n(1c) fig6's cycles, last period's accepted steps by the smallest slip s at the step's start "
-                    "(slides only)\n");
+        // is bounded by it: the step then grows with the slip (step / (T |v| / v_ref), its spread shown).
+        std::printf("\n(1c) fig6's cycles, last period's accepted steps (every mode), and among them the slides whose\n"
+                    "     smallest slip s at the step's start is small\n");
         const Scene sc = scene("fig6");
         const double T = sc.plate.T, v = sc.v_ref();
         for (int k : {1, 0}) {

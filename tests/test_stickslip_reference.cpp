@@ -176,12 +176,16 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
           "[limit_cycle][stick]") {
     // Held about contact k, the twist satisfies two constraints (contact k's slip is zero), so it has
     // one free component, theta'; whatever the period's start, its state on leaving the pivot is one
-    // number, and the period map's derivative is u v^T: one nonzero singular value. A sliding cycle
-    // has no such bottleneck (its map has full rank; the control below). Central differences of the
-    // period map at the cycle, h = 1e-3 of the scales at rtol 1e-11: truncation h^2 |P'''| and noise
-    // ~1e-8 / h (holds are entered at 3e2 rtol v_ref, engine.hpp), a bound of 1e-5 on sigma_2 / sigma_1
-    // (measured <= 8e-9 on these three; the sliding ones 0.70 and 0.16; a wrong hold -- a pivot whose
-    // contact kept slipping -- would leave the start's other components in the map).
+    // number, and the period map's derivative is u v^T: one nonzero singular value (as long as nearby
+    // starts keep the mode sequence, and up to the engine's snap onto a hold at 3e2 rtol v_ref). A
+    // sliding cycle has no such bottleneck (rank >= 2: the control below, on which the check fails).
+    // What this checks is that a pivot has exactly one degree of freedom and that the mode sequence
+    // is the same within +-h; that each hold is the right one is the regularised-reference tests' job
+    // (a hold that slips by up to a few percent of v_ref would pass here too: the near-stick
+    // relaxation contracts the other directions as well). Central differences at the cycle, rtol
+    // 1e-11, h = 1e-2 of the scales: truncation h^2 |P'''| and the hold snap's noise ~1e-8 / h
+    // (at h = 1e-3 the fourth case below is at 1.4e-5, growing as 1/h); bound 1e-4 on sigma_2 /
+    // sigma_1 (measured <= 7.6e-7 on these four; the sliding ones >= 0.157).
     const Scene sc = scene("fig6");
     const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
     const auto grid = [](int i, int j, int k) { return Vec3(-0.05 + i / 60.0, -0.05 + j / 60.0, 2 * kPi * k / 7); };
@@ -192,6 +196,7 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
     const Case cases[] = {{grid(1, 3, 2), true},    // pivots about contact 2 three times a period
                           {grid(4, 2, 1), true},    // about contact 1, three times
                           {grid(5, 4, 2), true},    // about contact 1, twice
+                          {grid(0, 0, 6), true},    // about contact 1, once (the noisiest)
                           {Vec3(1.0 / 60, 1.0 / 60, 1.0), false},    // slides all period long
                           {Vec3(-0.025, 0.025, 1.5 * kPi), false}};
     IntegrationOptions io;
@@ -210,7 +215,7 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
         REQUIRE(std::none_of(ref.mode_events.begin(), ref.mode_events.end(),
                              [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; }));
         Mat3 M;
-        const double h = 1e-3;
+        const double h = 1e-2;
         for (int j = 0; j < 3; ++j) {
             Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
             xp[j] += h * S[j];
@@ -222,7 +227,7 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
         const Vec3 sigma = Eigen::JacobiSVD<Mat3>(M).singularValues();
         INFO("singular values " << sigma.transpose());
         CHECK(sigma[0] > 1e-2);   // the start matters (no full stick)
-        if (c.pivots) CHECK(sigma[1] <= 1e-5 * sigma[0]);
+        if (c.pivots) CHECK(sigma[1] <= 1e-4 * sigma[0]);
         else CHECK(sigma[1] > 1e-1 * sigma[0]);
     }
 }
