@@ -25,6 +25,20 @@ double twist_distance(const Scene& sc, const Vec3& a, const Vec3& b) {
     return (a - b).cwiseQuotient(Vec3(v, v, v / sc.part.rho())).cwiseAbs().maxCoeff();
 }
 
+// dP/dx at start x by central differences of the period map, h of the scales (v_ref, v_ref,
+// v_ref / rho), in those scales; false if a period leaves the model.
+bool central_monodromy(const Scene& sc, const Vec3& q, const Vec3& x, double h, const IntegrationOptions& io, Mat3& M) {
+    const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
+    for (int j = 0; j < 3; ++j) {
+        Vec3 xp = x, xm = x, Pp, Pm;
+        xp[j] += h * S[j];
+        xm[j] -= h * S[j];
+        if (!period_map(sc, q, xp, Pp, io) || !period_map(sc, q, xm, Pm, io)) return false;
+        M.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
+    }
+    return true;
+}
+
 }  // namespace
 
 TEST_CASE("regularised reference: where nothing sticks it is today's twist at every eps",
@@ -130,15 +144,7 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         // Central differences of the period map at the cycle, independently of the solver (h = 1e-4
         // of the scales: truncation h^2 |P'''| and noise rtol/h ~ 1e-4 of |M|).
         Mat3 Mc;
-        const double h = 1e-4;
-        for (int j = 0; j < 3; ++j) {
-            Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
-            xp[j] += h * S[j];
-            xm[j] -= h * S[j];
-            REQUIRE(period_map(sc, c.q, xp, Pp));
-            REQUIRE(period_map(sc, c.q, xm, Pm));
-            Mc.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
-        }
+        REQUIRE(central_monodromy(sc, c.q, ref.qd_start, 1e-4, IntegrationOptions{}, Mc));
         INFO("shooting M\n" << sh.monodromy << "\ncentral differences\n" << Mc);
         if (c.full_stick) {
             CHECK(Mc.norm() < 1e-5);          // the period's end forgets its start (measured 1.4e-7)...
@@ -187,7 +193,6 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
     // (at h = 1e-3 the fourth case below is at 1.4e-5, growing as 1/h); bound 1e-4 on sigma_2 /
     // sigma_1 (measured <= 7.6e-7 on these four; the sliding ones >= 0.157).
     const Scene sc = scene("fig6");
-    const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
     const auto grid = [](int i, int j, int k) { return Vec3(-0.05 + i / 60.0, -0.05 + j / 60.0, 2 * kPi * k / 7); };
     struct Case {
         Vec3 q;
@@ -215,15 +220,7 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
         REQUIRE(std::none_of(ref.mode_events.begin(), ref.mode_events.end(),
                              [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; }));
         Mat3 M;
-        const double h = 1e-2;
-        for (int j = 0; j < 3; ++j) {
-            Vec3 xp = ref.qd_start, xm = ref.qd_start, Pp, Pm;
-            xp[j] += h * S[j];
-            xm[j] -= h * S[j];
-            REQUIRE(period_map(sc, c.q, xp, Pp, io));
-            REQUIRE(period_map(sc, c.q, xm, Pm, io));
-            M.col(j) = (Pp - Pm).cwiseQuotient(S) / (2 * h);
-        }
+        REQUIRE(central_monodromy(sc, c.q, ref.qd_start, 1e-2, io, M));
         const Vec3 sigma = Eigen::JacobiSVD<Mat3>(M).singularValues();
         INFO("singular values " << sigma.transpose());
         CHECK(sigma[0] > 1e-2);   // the start matters (no full stick)
