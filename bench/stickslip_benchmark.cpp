@@ -75,10 +75,10 @@ int main() {
                         "a period\n", k ? "sticking" : "sliding", n[k], 100.0 * rhs[k] / f.rhs_evals,
                         n[k] ? double(periods[k]) / n[k] : 0.0, periods[k] ? double(rhs[k]) / periods[k] : 0.0);
 
-        // (1c) Why a sticking period costs more: the accepted steps of each cycle's last period
-        // (recorded), sorted by the smallest slip of a sliding contact at the step's start. Where a
-        // slip is small the friction direction relaxes at a rate ~ |a| / |v|, and an explicit step
-        // is bounded by it: the step then grows with the slip (step / (T |v| / v_ref), its spread shown).
+        // (1c) Why a sticking period costs more: of the accepted steps of each cycle's last period
+        // (recorded), the slides whose smallest slip at the step's start is between 5e-5 and 1e-2
+        // v_ref, and there the step relative to T |v| / v_ref. Where a slip is small the friction
+        // direction relaxes at a rate ~ |a| / |v|, which bounds an explicit step: it grows with the slip.
         std::printf("\n(1c) fig6's cycles, last period's accepted steps (every mode), and among them the slides whose\n"
                     "     smallest slip s at the step's start is small\n");
         const Scene sc = scene("fig6");
