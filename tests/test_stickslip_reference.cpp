@@ -25,6 +25,11 @@ double twist_distance(const Scene& sc, const Vec3& a, const Vec3& b) {
     return (a - b).cwiseQuotient(Vec3(v, v, v / sc.part.rho())).cwiseAbs().maxCoeff();
 }
 
+// Does the cycle's last period change into mode `kind` somewhere?
+bool enters(const LimitCycleSummary& lc, ModeKind kind) {
+    return std::any_of(lc.mode_events.begin(), lc.mode_events.end(), [&](const ModeEvent& e) { return e.to.kind == kind; });
+}
+
 // dP/dx at start x by central differences of the period map, h of the scales (v_ref, v_ref,
 // v_ref / rho), in those scales; false if a period leaves the model.
 bool central_monodromy(const Scene& sc, const Vec3& q, const Vec3& x, double h, const IntegrationOptions& io, Mat3& M) {
@@ -79,9 +84,7 @@ TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-frictio
         REQUIRE(first.converged);
         const LimitCycleSummary& lc = first;
         const bool pivots = std::any_of(lc.stick_fraction.begin(), lc.stick_fraction.end(), [](double f) { return f > 0; });
-        const bool stuck = lc.start_mode.kind == ModeKind::Stuck ||
-                           std::any_of(lc.mode_events.begin(), lc.mode_events.end(),
-                                       [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
+        const bool stuck = lc.start_mode.kind == ModeKind::Stuck || enters(lc, ModeKind::Stuck);
         if (!pivots || stuck || seen++ % 4) continue;
         LimitCycleOptions o;
         o.integration.rtol = 1e-10;
@@ -129,10 +132,8 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         plain.tol = 1e-10;
         const LimitCycleSummary ref = limit_cycle(sc, c.q, plain);
         REQUIRE(ref.converged);
-        const bool stuck = std::any_of(ref.mode_events.begin(), ref.mode_events.end(),
-                                       [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
-        const bool pivots = std::any_of(ref.mode_events.begin(), ref.mode_events.end(),
-                                        [](const ModeEvent& e) { return e.to.kind == ModeKind::Pivot; });
+        const bool stuck = enters(ref, ModeKind::Stuck);
+        const bool pivots = enters(ref, ModeKind::Pivot);
         REQUIRE(stuck == c.full_stick);
         REQUIRE((pivots || stuck));
         const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());
@@ -214,11 +215,8 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
         plain.integration = io;
         const LimitCycleSummary ref = limit_cycle(sc, c.q, plain);
         REQUIRE(ref.converged);
-        const bool pivots = std::any_of(ref.mode_events.begin(), ref.mode_events.end(),
-                                        [](const ModeEvent& e) { return e.to.kind == ModeKind::Pivot; });
-        REQUIRE(pivots == c.pivots);
-        REQUIRE(std::none_of(ref.mode_events.begin(), ref.mode_events.end(),
-                             [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; }));
+        REQUIRE(enters(ref, ModeKind::Pivot) == c.pivots);
+        REQUIRE(!enters(ref, ModeKind::Stuck));
         Mat3 M;
         REQUIRE(central_monodromy(sc, c.q, ref.qd_start, 1e-2, io, M));
         const Vec3 sigma = Eigen::JacobiSVD<Mat3>(M).singularValues();
@@ -264,9 +262,7 @@ TEST_CASE("a cycle with a full stick is the regularised reference's: fig6 at (0.
     o.tol = 1e-9;
     const LimitCycleSummary lc = limit_cycle(sc, q, o);
     REQUIRE(lc.converged);
-    const bool stuck = std::any_of(lc.mode_events.begin(), lc.mode_events.end(),
-                                   [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
-    REQUIRE(stuck);
+    REQUIRE(enters(lc, ModeKind::Stuck));
     const RegularisedReference r = regularised_reference(sc, q);
     REQUIRE(r.ok);
     INFO("engine " << lc.twist.transpose() << ", reference " << r.twist.transpose() << " (order " << r.order
