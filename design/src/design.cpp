@@ -56,6 +56,26 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D) {
     return r;
 }
 
+// --- the flight check ----------------------------------------------------------------------------
+
+// (design.hpp) 256 samples over the period.
+double vertical_margin(const PlateMotion& u, double g, double half_width) {
+    double worst = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 256; ++k) {
+        Vec3 pdd, wd;
+        u.acceleration(u.T * k / 256, pdd, wd);
+        for (double x : {-half_width, half_width})
+            for (double y : {-half_width, half_width}) worst = std::min(worst, (g + pdd.z() + wd.x() * y - wd.y() * x) / g);
+    }
+    return worst;
+}
+
+double flight_region(const Scene& part, const DesignOptions& opt) {
+    double reach = 0;
+    for (int i = 0; i < part.part.contacts(); ++i) reach = std::max(reach, part.part.c[i].head<2>().norm());
+    return opt.region + (part.part.point ? 0.0 : reach);
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -74,27 +94,6 @@ PlateMotion combined(const PlateMotion& u) {
     for (const auto& [k, z] : phasors(u))
         if (std::abs(z) > 0) r.harmonics.push_back({static_cast<Axis>(k.first), k.second, std::abs(z), std::arg(z)});
     return r;
-}
-
-// min over the period (256 samples) and the region's corners of (g + vertical acceleration) / g, with
-// the plate's acceleration at r = p'' + alpha x r (what the part feels; the U-dynamics' plate).
-double vertical_margin(const PlateMotion& u, double g, double region) {
-    double worst = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 256; ++k) {
-        Vec3 pdd, wd;
-        u.acceleration(u.T * k / 256, pdd, wd);
-        for (double x : {-region, region})
-            for (double y : {-region, region}) worst = std::min(worst, (g + pdd.z() + wd.x() * y - wd.y() * x) / g);
-    }
-    return worst;
-}
-
-// The square the flight check covers: the region, widened for a rigid part by its contacts' reach
-// from its centre of mass (they stand on plate points up to that far beyond it).
-double flight_region(const Scene& part, const DesignOptions& opt) {
-    double reach = 0;
-    for (int i = 0; i < part.part.contacts(); ++i) reach = std::max(reach, part.part.c[i].head<2>().norm());
-    return opt.region + (part.part.point ? 0.0 : reach);
 }
 
 // --- what the searches share -----------------------------------------------------------------------

@@ -188,6 +188,14 @@ struct DesignSummary {
 // (0.02, -0.01) with the defaults 9.3e-4 rad/s, at the region's corners 3e-4.
 double sink_coning_limit(const Vec2& at, const DesignOptions& opt);
 
+// FLIGHT. The smallest (g + vertical acceleration) / g over the period and the corners of the square
+// |x|, |y| <= half_width, with the plate's acceleration at r = p'' + alpha x r (what a part there feels;
+// the U-dynamics' plate): every design keeps it at or above DesignOptions::flight_margin, on the square
+// flight_region gives -- the region, widened for a rigid part by its contacts' reach from its centre of
+// mass (they stand on plate points up to that far beyond it).
+double vertical_margin(const PlateMotion& u, double g, double half_width);
+double flight_region(const Scene& part, const DesignOptions& opt);
+
 // The starts a design makes when DesignOptions::starts is 0: 4 for sinks and line sinks (16 and 4
 // parameters: a point part's sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
 // 0.74-0.89 1/s in 2.7-3.7 s, 16 starts 0.77-0.94 1/s in 10-11 s, all verified; fig4's part's sink
