@@ -26,7 +26,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <complex>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -53,37 +52,9 @@ PlateMotion motion(const std::vector<double>& p, double T) {
     return u;
 }
 
-struct Ring {
-    bool ok = false;
-    double M = 0;
-    double B[kRing / 2 + 1] = {};   // B[k], k = 1..6 (B[0] unused)
-    double others() const {   // |M| + B_2 + ... + B_6
-        double o = std::abs(M);
-        for (int k = 2; k <= kRing / 2; ++k) o += B[k];
-        return o;
-    }
-    double ratio() const { return B[1] / (others() + 1e-3); }
-};
-
-Ring ring(const Scene& sc, const LimitCycleOptions& cyc) {
-    Ring r;
-    double th[kRing];
-    try {
-        Vec3 warm = Vec3::Zero();
-        for (int k = 0; k < kRing; ++k) th[k] = field_at(sc, Vec3(0, 0, 2 * kPi * k / kRing), cyc, &warm).z();
-    } catch (const FieldUndefined&) {
-        return r;
-    }
-    r.ok = true;
-    for (int m = 0; m <= kRing / 2; ++m) {
-        std::complex<double> z = 0;
-        for (int k = 0; k < kRing; ++k) z += th[k] * std::polar(1.0, -2 * kPi * m * k / kRing);
-        const double amp = (m == 0 || m == kRing / 2 ? 1.0 : 2.0) * std::abs(z) / kRing;
-        if (m == 0) r.M = z.real() / kRing;
-        else r.B[m] = amp;
-    }
-    return r;
-}
+// The measure: B_1 / (|M| + B_2 + ... + B_6 + 1e-3 rad/s) (the floor keeps a motion that turns
+// nothing from scoring).
+double ratio(const OrientationHarmonics& h) { return h.defined ? h.first() / (h.rest() + 1e-3) : -1.0; }
 
 struct Search {
     Scene part;
@@ -99,8 +70,7 @@ double objective(const std::vector<double>& p, std::vector<double>&, void* data)
     ++s.evaluations;
     Scene sc = s.part;
     sc.plate = motion(p, s.part.plate.T);
-    const Ring r = ring(sc, s.cyc);
-    return r.ok ? r.ratio() : -1.0;
+    return ratio(orientation_harmonics(sc, Vec2::Zero(), s.cyc, kRing));
 }
 
 struct Bound {
@@ -116,11 +86,11 @@ double constraint(const std::vector<double>& p, std::vector<double>&, void* data
 }
 
 // Starts: seeded normal coefficients (a tenth of each limit), shrunk until feasible.
-Ring search(Search& s, int starts, int evaluations, std::uint64_t seed) {
+OrientationHarmonics search(Search& s, int starts, int evaluations, std::uint64_t seed) {
     s.half_width = flight_region(s.part, s.limits);
     std::mt19937_64 rng(seed);
     std::normal_distribution<double> normal(0, 1);
-    Ring best;
+    OrientationHarmonics best;
     char buf[256];
     for (int start = 0; start < starts; ++start) {
         std::vector<double> p(kParams);
@@ -144,12 +114,16 @@ Ring search(Search& s, int starts, int evaluations, std::uint64_t seed) {
         }
         Scene sc = s.part;
         sc.plate = motion(p, s.part.plate.T);
-        const Ring r = ring(sc, s.cyc);
+        const OrientationHarmonics h = orientation_harmonics(sc, Vec2::Zero(), s.cyc, kRing);
+        if (!h.defined) {
+            s.lines += s.part.name + " start " + std::to_string(start) + ": a cycle on the ring did not converge\n";
+            continue;
+        }
         std::snprintf(buf, sizeof buf, "%-10s %5d %+9.5f %9.5f %9.5f %9.5f %9.5f %9.2f %9.3f %+10.1e\n", s.part.name.c_str(),
-                      start, r.M, r.B[1], r.B[2], r.B[3], r.B[4], r.ratio(), vertical_margin(sc.plate, sc.g, s.half_width),
-                      coning_rate(sc.plate));
+                      start, h.mean, h.amplitude[1], h.amplitude[2], h.amplitude[3], h.amplitude[4], ratio(h),
+                      vertical_margin(sc.plate, sc.g, s.half_width), coning_rate(sc.plate));
         s.lines += buf;
-        if (r.ok && (!best.ok || r.ratio() > best.ratio())) best = r;
+        if (!best.defined || ratio(h) > ratio(best)) best = h;
     }
     return best;
 }
@@ -166,7 +140,7 @@ int main(int argc, char** argv) {
     Search parts[2];
     parts[0].part = load_scene(PLATE_SOURCE_DIR "/scenes/fig4.json");
     parts[1].part = load_scene(PLATE_SOURCE_DIR "/scenes/foot.json");
-    Ring best[2];
+    OrientationHarmonics best[2];
     const auto t0 = std::chrono::steady_clock::now();
     std::thread other([&] { best[1] = search(parts[1], starts, evaluations, 1); });
     best[0] = search(parts[0], starts, evaluations, 1);
@@ -178,9 +152,9 @@ int main(int argc, char** argv) {
     std::printf("[rad/s; ratio = B1 / (|M| + B2 + ... + B6 + 1e-3); above 1 (the 1e-3 left out): every stable zero in one arc]\n");
     for (int i = 0; i < 2; ++i)
         std::printf("best %-10s ratio %.2f: B1 %.5f rad/s against |M| + B2 + ... + B6 = %.5f (%ld evaluations)\n",
-                    parts[i].part.name.c_str(), best[i].ratio(), best[i].B[1], best[i].others(),
+                    parts[i].part.name.c_str(), ratio(best[i]), best[i].first(), best[i].rest(),
                     parts[i].evaluations);
     std::printf("foot / fig4: best B1 %.0fx, best ratio %.0fx; wall %.1f s on 2 threads (one part each)\n",
-                best[1].B[1] / best[0].B[1], best[1].ratio() / best[0].ratio(), wall);
+                best[1].first() / best[0].first(), ratio(best[1]) / ratio(best[0]), wall);
     return 0;
 }

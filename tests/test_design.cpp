@@ -617,3 +617,67 @@ TEST_CASE("line sink: every start ends on the line asked and stays where it arri
     // A rigid part is not served.
     CHECK_THROWS_WITH(design(scene("fig4"), t, o), Catch::Contains("point parts only"));
 }
+
+TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientation, from the exact symmetries",
+          "[design][orient]") {
+    // theta' at a position, as M + sum_k B_k sin(k theta + phi_k) from 12 orientations. Each check below
+    // follows from a symmetry (design.hpp), and each has a case where the symmetry is broken and the
+    // harmonic it forbids is there. The cycles at tight() are within ~60 rtol v_ref of the limit: the
+    // harmonics' noise is about that times v_ref / rho (~5e-9 rad/s for fig4's part); 1e-6 rad/s is
+    // the bound, far below the harmonics that are allowed (1e-3 and up).
+    const Scene fig4 = scene("fig4"), foot = scene("foot");
+    const LimitCycleOptions o = tight();
+    const double noise = 1e-6;
+    auto harmonics = [&](const Scene& sc, const Vec2& s) {
+        const OrientationHarmonics h = orientation_harmonics(sc, s, o);
+        REQUIRE(h.defined);
+        REQUIRE(h.amplitude.size() == 7);
+        return h;
+    };
+    // (1) One friction coefficient on a plate that only translates: theta' = 0 is invariant, nothing
+    // turns the part. With the rubber foot (foot.json's own plate, the same motion) friction's torque
+    // -(sum_i (mu_i - mu) N_i r_i) x u turns it, and the same way everywhere (no position in the
+    // dynamics): a weathervane, whose first harmonic dominates (every stable orientation in one arc).
+    Scene plain = fig4;
+    plain.plate = foot.plate;
+    const OrientationHarmonics none = harmonics(plain, Vec2::Zero());
+    CHECK(none.first() + none.rest() < noise);
+    const OrientationHarmonics vane = harmonics(foot, Vec2::Zero()), there = harmonics(foot, Vec2(0.03, -0.02));
+    CHECK(vane.first() > 0.1);
+    CHECK(vane.first() > vane.rest());
+    for (int k = 0; k <= 6; ++k) CHECK(std::abs(there.amplitude[k] - vane.amplitude[k]) < noise);
+    // (2) Odd harmonics without z or rz (fig4's own plate): turning the motion by pi is shifting it by
+    // half a period, so at the centre theta'(theta + pi) = theta'(theta): no odd harmonic. (The foot's
+    // plate has a heave: B_1 above.)
+    const OrientationHarmonics odd = harmonics(fig4, Vec2::Zero());
+    CHECK(odd.amplitude[1] < noise);
+    CHECK(odd.amplitude[3] < noise);
+    CHECK(odd.amplitude[5] < noise);
+    CHECK(odd.amplitude[2] > 0.05);   // the half-turn pairing's own term
+    // (3) A quarter-turn-symmetric motion: x, y, rx, ry turning in circles one way at n = 1 and the
+    // other way at n = 3. Turning it by pi/2 is shifting it by T/4 (e^{i pi/2} at n = 1, e^{i 3 pi/2}
+    // = e^{-i pi/2} at n = 3), so theta' at the centre has period pi/2: only B_4 (and M) remain. With
+    // the third harmonic's tilt sqrt(27) times the first's the two harmonics' coning cancels exactly
+    // (coning_rate: Im(A_rx conj A_ry) / (2 (n w)^3) per harmonic). Turning the third harmonic the same
+    // way as the first breaks the symmetry (the motion is still odd): B_2 returns.
+    auto quarter_turn = [&](int sense3) {
+        const double a1 = 20, c = 9.5, a3 = 7.3, d = std::sqrt(27.0) * c, q = kPi / 2, flip = sense3 < 0 ? kPi : 0;
+        PlateMotion u;
+        u.T = fig4.plate.T;
+        u.harmonics = {{Axis::x, 1, a1, q},         {Axis::y, 1, a1, 0},          {Axis::rx, 1, c, q + 6.30},
+                       {Axis::ry, 1, c, 6.30},      {Axis::x, 3, a3, q + 3.06},   {Axis::y, 3, a3, 3.06 + flip},
+                       {Axis::rx, 3, d, q + 6.33},  {Axis::ry, 3, d, 6.33 + flip}};
+        return u;
+    };
+    Scene sym = fig4;
+    sym.plate = quarter_turn(-1);
+    CHECK(std::abs(coning_rate(sym.plate)) < 1e-12);
+    const OrientationHarmonics quarter = harmonics(sym, Vec2::Zero());
+    for (int k : {1, 2, 3, 5}) CHECK(quarter.amplitude[k] < noise);
+    CHECK(quarter.amplitude[4] > 1e-3);
+    sym.plate = quarter_turn(+1);
+    CHECK(std::abs(coning_rate(sym.plate)) > 1e-5);
+    const OrientationHarmonics broken = harmonics(sym, Vec2::Zero());
+    CHECK(broken.amplitude[2] > 1e-3);
+    CHECK(broken.amplitude[1] < noise);   // (still odd)
+}

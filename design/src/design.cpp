@@ -56,6 +56,37 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D) {
     return r;
 }
 
+// --- orientation harmonics ------------------------------------------------------------------------
+
+double OrientationHarmonics::rest() const {
+    double r = amplitude.empty() ? 0.0 : amplitude[0];
+    for (std::size_t k = 2; k < amplitude.size(); ++k) r += amplitude[k];
+    return r;
+}
+
+OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n) {
+    if (n < 4) throw std::invalid_argument("orientation_harmonics: a ring of at least 4 orientations");
+    OrientationHarmonics h;
+    std::vector<double> w(n);
+    Vec3 warm = Vec3::Zero();
+    for (int k = 0; k < n; ++k) {
+        const LimitCycleSummary lc = limit_cycle(scene, Vec3(s.x(), s.y(), 2 * kPi * k / n), opt, warm);
+        if (!lc.converged) return h;
+        w[k] = lc.twist[2];
+        warm = lc.qd_start;
+    }
+    h.defined = true;
+    h.amplitude.resize(n / 2 + 1);
+    for (int m = 0; m <= n / 2; ++m) {   // the discrete Fourier transform; B_m = 2 |c_m| (1 |c_m| at 0 and n/2)
+        std::complex<double> c = 0;
+        for (int k = 0; k < n; ++k) c += w[k] * std::polar(1.0, -2 * kPi * m * k / n);
+        c /= n;
+        if (m == 0) h.mean = c.real();
+        h.amplitude[m] = (m == 0 || 2 * m == n ? 1.0 : 2.0) * std::abs(c);
+    }
+    return h;
+}
+
 // --- the flight check ----------------------------------------------------------------------------
 
 // (design.hpp) 256 samples over the period.
@@ -1244,6 +1275,22 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
         if (!step.allFinite()) break;
         q -= step;
         if (step.head<2>().norm() < 1e-7 && std::abs(step[2]) < 1e-6) { found = true; break; }
+    }
+    {   // What the orientation has to work with there (orientation_harmonics, design.hpp).
+        const bool near = found && q.head<2>().norm() <= opt.region;
+        const OrientationHarmonics oh = orientation_harmonics(centred, near ? Vec2(q.head<2>()) : Vec2::Zero(), opt.cycle);
+        cycles += 12;
+        if (oh.defined) {
+            std::ostringstream note;
+            note.precision(2);
+            note << "theta' at the " << (near ? "fixed point's position" : "centre") << ": first harmonic " << oh.first()
+                 << " rad/s against " << oh.rest() << " for the mean and the others ("
+                 << (oh.first() > oh.rest() ? "it dominates: the stable orientations lie in one arc"
+                                            : "it does not: stable orientations pair about a half turn apart, each "
+                                              "basin near half the turn, unless the mean is tuned onto a saddle-node")
+                 << "; bench_orientation_drive measures how far the limits allow)";
+            sum.notes.push_back(note.str());
+        }
     }
     if (!found || q.head<2>().norm() > opt.region || std::abs(q[2]) > kPi / 2) {
         sum.failure = "the search's best motion has no fixed point near the design's centre";

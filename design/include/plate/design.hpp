@@ -47,6 +47,24 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 // over DesignOptions::hold seconds of full dynamics.
 double coning_rate(const PlateMotion& u);
 
+// ORIENTATION HARMONICS. At a position s the twist's theta' is a function of theta alone,
+//     theta'(theta) = M + sum_k B_k sin(k theta + phi_k)
+// (from a ring of n equally spaced orientations: harmonics up to n / 2). What a rigid part's one stable
+// orientation needs: if B_1 > |M| + B_2 + ... (first() > rest()), theta' is positive on one arc and
+// negative on the other, so every stable orientation lies in one arc, pulled at order B_1; if the
+// pi-periodic part (M, B_2, B_4, ...) dominates, stable orientations pair about a half turn apart,
+// each with a basin near half the turn, and one is unique only with M tuned onto a saddle-node, which
+// leaves a bottleneck of theta' ~ B_1 (README, inverse design). bench_orientation_drive measures how
+// large first() / rest() can be within the design limits (fig4's part: below 1).
+struct OrientationHarmonics {
+    bool defined = false;            // every cycle on the ring converged
+    double mean = 0;                 // M [rad/s]
+    std::vector<double> amplitude;   // B_k for k = 0..n/2 [rad/s] (amplitude[0] = |M|)
+    double first() const { return amplitude.size() > 1 ? amplitude[1] : 0.0; }
+    double rest() const;             // |M| + B_2 + ... + B_{n/2}
+};
+OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n = 12);
+
 enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };
 struct DesignTarget {
     // Sink: every start in the region ends at position `at`: for a point part the unique stable
