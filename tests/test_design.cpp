@@ -634,10 +634,28 @@ TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientati
         REQUIRE(h.amplitude.size() == 7);
         return h;
     };
+    // (0) The transform itself, on known series: M + B_1 sin(theta + 0.3) + B_2 sin(2 theta - 1) +
+    // B_6 cos(6 theta) on 12 points (k = 6 = n/2: only a cosine part is seen there).
+    {
+        std::vector<double> w(12);
+        for (int k = 0; k < 12; ++k) {
+            const double th = 2 * kPi * k / 12;
+            w[k] = -0.02 + 0.3 * std::sin(th + 0.3) + 0.1 * std::sin(2 * th - 1) + 0.05 * std::cos(6 * th);
+        }
+        const OrientationHarmonics h = harmonics_of(w);
+        CHECK(h.mean == Approx(-0.02).margin(1e-15));
+        const double expected[7] = {0.02, 0.3, 0.1, 0, 0, 0, 0.05};
+        for (int k = 0; k <= 6; ++k) CHECK(h.amplitude[k] == Approx(expected[k]).margin(1e-14));
+        CHECK(h.rest() == Approx(0.17));
+        CHECK(h.slope_bound() == Approx(2 * 0.1 + 6 * 0.05));
+        CHECK_FALSE(h.one_stable());   // 0.09 < 0.17^2 + 0.5^2
+    }
     // (1) One friction coefficient on a plate that only translates: theta' = 0 is invariant, nothing
     // turns the part. With the rubber foot (foot.json's own plate, the same motion) friction's torque
     // -(sum_i (mu_i - mu) N_i r_i) x u turns it, and the same way everywhere (no position in the
-    // dynamics): a weathervane, whose first harmonic dominates (every stable orientation in one arc).
+    // dynamics): a weathervane, its first harmonic above the rest (B_1 0.37 against 0.16 rad/s) -- but not
+    // enough for one stable orientation by one_stable(), and indeed there are three at a finer scale
+    // (design.hpp).
     Scene plain = fig4;
     plain.plate = foot.plate;
     const OrientationHarmonics none = harmonics(plain, Vec2::Zero());
@@ -645,6 +663,7 @@ TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientati
     const OrientationHarmonics vane = harmonics(foot, Vec2::Zero()), there = harmonics(foot, Vec2(0.03, -0.02));
     CHECK(vane.first() > 0.1);
     CHECK(vane.first() > vane.rest());
+    CHECK_FALSE(vane.one_stable());
     for (int k = 0; k <= 6; ++k) CHECK(std::abs(there.amplitude[k] - vane.amplitude[k]) < noise);
     // (2) Odd harmonics without z or rz (fig4's own plate): turning the motion by pi is shifting it by
     // half a period, so at the centre theta'(theta + pi) = theta'(theta): no odd harmonic. (The foot's
@@ -654,12 +673,16 @@ TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientati
     CHECK(odd.amplitude[3] < noise);
     CHECK(odd.amplitude[5] < noise);
     CHECK(odd.amplitude[2] > 0.05);   // the half-turn pairing's own term
+    // Away from the centre the pairing maps s to -s: nothing forbids B_1 there (the plate's tilt and
+    // alpha x s make the position matter).
+    CHECK(harmonics(fig4, Vec2(0.03, -0.02)).amplitude[1] > 1e-4);
     // (3) A quarter-turn-symmetric motion: x, y, rx, ry turning in circles one way at n = 1 and the
     // other way at n = 3. Turning it by pi/2 is shifting it by T/4 (e^{i pi/2} at n = 1, e^{i 3 pi/2}
     // = e^{-i pi/2} at n = 3), so theta' at the centre has period pi/2: only B_4 (and M) remain. With
-    // the third harmonic's tilt sqrt(27) times the first's the two harmonics' coning cancels exactly
-    // (coning_rate: Im(A_rx conj A_ry) / (2 (n w)^3) per harmonic). Turning the third harmonic the same
-    // way as the first breaks the symmetry (the motion is still odd): B_2 returns.
+    // the third harmonic's angular-acceleration amplitude sqrt(27) times the first's (its tilt angle
+    // 1/sqrt(3) times) the two harmonics' coning cancels exactly (coning_rate: Im(A_rx conj A_ry) /
+    // (2 (n w)^3) per harmonic). With n = 3 reversed, turning the same way as n = 1, the symmetry is
+    // broken (the motion is still odd): B_2 returns.
     auto quarter_turn = [&](int sense3) {
         const double a1 = 20, c = 9.5, a3 = 7.3, d = std::sqrt(27.0) * c, q = kPi / 2, flip = sense3 < 0 ? kPi : 0;
         PlateMotion u;
@@ -680,4 +703,43 @@ TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientati
     const OrientationHarmonics broken = harmonics(sym, Vec2::Zero());
     CHECK(broken.amplitude[2] > 1e-3);
     CHECK(broken.amplitude[1] < noise);   // (still odd)
+}
+
+TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair, verified and reported as not unique",
+          "[design][rigid]") {
+    // fig4's part at (0.02, -0.01, 0.5): within the limits no motion gives it one orientation
+    // (bench_orientation_drive), so after the unique search fails the design falls back on the sink's odd
+    // harmonics with THETA a stable zero of theta'. Turning such a motion by pi is shifting it by half a
+    // period, so the twin (s, theta) -> (-s, theta + pi) about the design's centre is a stable fixed
+    // point too, with the same eigenvalues; the runs end at one or the other, and the report says so.
+    const Scene part = scene("fig4");
+    DesignTarget t;
+    t.kind = DesignTargetKind::FixedPoint;
+    t.at = Vec2(0.02, -0.01);
+    t.theta = 0.5;
+    DesignOptions o = searched(2, 150, 10);
+    const DesignSummary s = design(part, t, o);
+    INFO(s.failure << "; rate " << s.rate << " 1/s");
+    REQUIRE(s.verified);
+    CHECK_FALSE(s.unique);
+    CHECK((s.fixed_point.head<2>() - t.at).norm() <= o.fixed_point_tolerance);
+    CHECK(std::abs(wrap_angle(s.fixed_point[2] - t.theta)) <= 0.02);
+    for (int k = 0; k < 3; ++k) CHECK(s.fixed_point_eigenvalues[k].real() < 0);
+    REQUIRE(s.competitors.size() == 1u);
+    const FixedPoint& twin = s.competitors[0].point;
+    CHECK((twin.q.head<2>() - t.at).norm() <= o.fixed_point_tolerance);
+    CHECK(std::abs(wrap_angle(twin.q[2] - t.theta - kPi)) <= 0.02);
+    // The pairing is exact: the same eigenvalues (measured 7e-10 1/s apart; adding rz at n = 2, 8 rad/s^2,
+    // which breaks the pairing, moves them 5e-7 apart and fails this).
+    for (int k = 0; k < 3; ++k) {
+        double nearest = HUGE_VAL;
+        for (int j = 0; j < 3; ++j) nearest = std::min(nearest, std::abs(twin.eigenvalues[j] - s.fixed_point_eigenvalues[k]));
+        CHECK(nearest < 1e-7);
+    }
+    CHECK(s.basin_share + s.competitors[0].basin_share == Approx(1.0));
+    CHECK(s.basin_share > 0);
+    CHECK(s.competitors[0].basin_share > 0);
+    CHECK(std::abs(s.coning) <= 1e-4);
+    CHECK(s.held.end_distance <= o.verify_distance);
+    CHECK(s.notes.front().find("unique fixed point failed") != std::string::npos);
 }

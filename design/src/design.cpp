@@ -64,20 +64,23 @@ double OrientationHarmonics::rest() const {
     return r;
 }
 
-OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n) {
-    if (n < 4) throw std::invalid_argument("orientation_harmonics: a ring of at least 4 orientations");
+double OrientationHarmonics::slope_bound() const {
+    double r = 0;
+    for (std::size_t k = 2; k < amplitude.size(); ++k) r += k * amplitude[k];
+    return r;
+}
+
+bool OrientationHarmonics::one_stable() const {
+    return defined && first() * first() > rest() * rest() + slope_bound() * slope_bound();
+}
+
+OrientationHarmonics harmonics_of(const std::vector<double>& w) {
+    const int n = static_cast<int>(w.size());
+    if (n < 4) throw std::invalid_argument("orientation harmonics: a ring of at least 4 orientations");
     OrientationHarmonics h;
-    std::vector<double> w(n);
-    Vec3 warm = Vec3::Zero();
-    for (int k = 0; k < n; ++k) {
-        const LimitCycleSummary lc = limit_cycle(scene, Vec3(s.x(), s.y(), 2 * kPi * k / n), opt, warm);
-        if (!lc.converged) return h;
-        w[k] = lc.twist[2];
-        warm = lc.qd_start;
-    }
     h.defined = true;
     h.amplitude.resize(n / 2 + 1);
-    for (int m = 0; m <= n / 2; ++m) {   // the discrete Fourier transform; B_m = 2 |c_m| (1 |c_m| at 0 and n/2)
+    for (int m = 0; m <= n / 2; ++m) {   // c_m = (1/n) sum_k w_k e^{-i 2 pi m k / n}; B_m = 2 |c_m| (|c_m| at 0 and n/2)
         std::complex<double> c = 0;
         for (int k = 0; k < n; ++k) c += w[k] * std::polar(1.0, -2 * kPi * m * k / n);
         c /= n;
@@ -85,6 +88,19 @@ OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, co
         h.amplitude[m] = (m == 0 || 2 * m == n ? 1.0 : 2.0) * std::abs(c);
     }
     return h;
+}
+
+OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n) {
+    if (n < 4) throw std::invalid_argument("orientation harmonics: a ring of at least 4 orientations");
+    std::vector<double> w(n);
+    Vec3 warm = Vec3::Zero();
+    for (int k = 0; k < n; ++k) {
+        const LimitCycleSummary lc = limit_cycle(scene, Vec3(s.x(), s.y(), 2 * kPi * k / n), opt, warm);
+        if (!lc.converged) return {};
+        w[k] = lc.twist[2];
+        warm = lc.qd_start;
+    }
+    return harmonics_of(w);
 }
 
 // --- the flight check ----------------------------------------------------------------------------
@@ -488,19 +504,32 @@ bool position_pull(const Scene& sc, const Vec2& s, double theta, const LimitCycl
 // (2e-3 rad/s: the sink walks 5.5 mm about the centre in two minutes); held to sink_coning_limit, the
 // first harmonic can tilt in circles only a little, and the third, which cones 27 times less for the
 // same amplitudes (coning pairs only equal n), adds the rest.
+constexpr double kConingLimit = 1e-4;   // [rad/s] rigid fixed points' coning (coning_rate, design.hpp): 0.012 rad over a 120 s hold
+
 PlateMotion sink_motion(const std::vector<double>& p, double T) {
     return motion_from(p, {Axis::x, Axis::y, Axis::rx, Axis::ry}, {1, 3}, T);
 }
 
 struct SinkProblem : Problem<SinkProblem> {
-    SinkProblem(const Scene& part_, const Vec2& D_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
-        : Problem(part_, opt_, T_, cycles_), D(D_), cone_limit(sink_coning_limit(D_, opt_)) {}
+    // With `orient` (a rigid part's fixed point as a half-turn pair, design_rigid_pair): the part's
+    // orientation THETA is to be a stable zero of theta' at the centre as well, and the coning is held to
+    // kConingLimit (the plate's turn would turn the part's orientation with it).
+    SinkProblem(const Scene& part_, const Vec2& D_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_,
+                const double* orient_ = nullptr)
+        : Problem(part_, opt_, T_, cycles_), D(D_), cone_limit(sink_coning_limit(D_, opt_)), orient(orient_ != nullptr),
+          theta(orient_ ? *orient_ : 0.0) {
+        if (orient) cone_limit = std::min(cone_limit, kConingLimit);
+    }
     Vec2 D;
     double cone_limit;
+    bool orient;
+    double theta;   // [rad] (orient)
     // The orientations the pull is measured at: a point part's one (it has no orientation); at a rigid
-    // part's centre the odd field repeats after a half turn, so theta = 0 and a quarter turn sample it
-    // (the verification checks the grid's seven).
-    std::vector<double> thetas() const { return part.part.point ? std::vector<double>{0.0} : std::vector<double>{0.0, kPi / 2}; }
+    // part's centre the odd field repeats after a half turn, so theta = 0 (or THETA) and a quarter turn
+    // sample it (the verification checks the grid's seven).
+    std::vector<double> thetas() const {
+        return part.part.point ? std::vector<double>{0.0} : std::vector<double>{theta, theta + kPi / 2};
+    }
     static constexpr int kParams = 16;
     static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
     double limit(int i) const { return i < 8 ? opt.lin_limit : opt.ang_limit; }
@@ -509,7 +538,10 @@ struct SinkProblem : Problem<SinkProblem> {
     // limit, no flight under the part over the region, and no more coning than the hold allows.
     void constraints(const std::vector<double>& p, double* c) const {
         const PlateMotion fin = shift_motion(sink_motion(p, T), D);
-        const int k = amplitude_constraints(fin, opt, part, 3, 1.0, c);
+        // (orient: 3 % of each limit and 0.02 g of the flight margin kept in hand for the placement's
+        // small turn and shift onto the fixed point found)
+        const int k = amplitude_constraints(fin, opt, part, 3, orient ? 0.97 : 1.0, c);
+        if (orient) c[k - 1] += 0.02;
         const double psi = coning_rate(fin);
         const double cone = !std::isfinite(cone_limit) ? 0.0
                             : cone_limit > 0       ? psi / cone_limit
@@ -555,7 +587,22 @@ struct SinkProblem : Problem<SinkProblem> {
             if (!twist_at(sc, s, v)) return 1e3;
             outward += std::max(0.0, s.dot(v) / s.squaredNorm());   // [1/s]
         }
-        return -rate + 10 * outward + 10 * std::max(0.0, offset / 0.001 - 1);
+        double turn = 0;   // orient: the orientation's own pull and how far its zero is from THETA
+        if (orient) {
+            const double d = 0.15;
+            double w[3];
+            for (int k = 0; k < 3; ++k) {
+                const LimitCycleSummary lc = limit_cycle(sc, Vec3(0, 0, theta + (k - 1) * d), opt.cycle);
+                ++*cycles;
+                if (!lc.converged) return 1e3;
+                w[k] = lc.twist[2];
+            }
+            const double slope = (w[0] - w[2]) / (2 * d);   // -d theta' / d theta [1/s]
+            rate = std::min(rate, slope);
+            if (rate_out) *rate_out = rate;
+            turn = std::abs(w[1]) / std::max(slope, 1e-3) / 0.01;   // the zero's distance from THETA, in 0.01 rad
+        }
+        return -rate + 10 * outward + 10 * std::max(0.0, offset / 0.001 - 1) + 10 * std::max(0.0, turn - 1);
     }
 };
 
@@ -1153,19 +1200,18 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
 const std::vector<Axis> kRigidAxes = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
 PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion_from(p, kRigidAxes, {1, 2}, T); }
 
-constexpr double kConingLimit = 1e-4;   // [rad/s] (coning_rate, design.hpp): 0.01 rad of lag at 0.01 1/s
 
-// Constraints c_k <= 0 on a motion as placed: each (axis, n) amplitude within its limit times
-// `room`, no flight under the part's contacts over the region, and no coning beyond kConingLimit either way.
-void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
-    const int k = amplitude_constraints(fin, opt, part, 2, room, c);
+// Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
+// `room`, no flight under the part's contacts over the region, and no coning beyond kConingLimit either
+// way (6 n_max + 3 entries).
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
+                        double* c) {
+    const int k = amplitude_constraints(fin, opt, part, n_max, room, c);
     const double cone = coning_rate(fin) / kConingLimit;
     c[k] = cone - 1;
     c[k + 1] = -cone - 1;
 }
 
-// The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
-// from the cycle at q. False if a cycle did not converge.
 bool twist_and_jacobian(const Scene& sc, const Vec3& q, const LimitCycleOptions& cyc, Vec3& xi, Mat3& J,
                         std::atomic<long>& cycles) {
     const LimitCycleSummary c0 = limit_cycle(sc, q, cyc);
@@ -1199,7 +1245,7 @@ struct RigidProblem : Problem<RigidProblem> {
     double limit(int i) const { return i < 12 ? opt.lin_limit : opt.ang_limit; }
     void constraints(const std::vector<double>& p, double* c) const {
         placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt,
-                           part, kRoom, c);
+                           part, 2, kRoom, c);
     }
     // -rate at the centre, plus how far the centre is from being the fixed point (the Newton step
     // J^-1 xi there, over 1 cm / 0.1 rad), plus how much the region's edge (8 points, theta = 0) and
@@ -1237,6 +1283,41 @@ struct RigidProblem : Problem<RigidProblem> {
     }
 };
 
+DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
+                                      const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
+                                      std::atomic<long>& cycles, Clock::time_point t0);
+
+// --- the rigid part's fixed point as a half-turn pair ----------------------------------------------
+// Where no unique fixed point is found (fig4's part: within the limits its first harmonic in theta,
+// which one orientation needs, stays below the rest -- bench_orientation_drive), the sink's motion (odd
+// harmonics on x, y, rx, ry; n = 1, 3) with theta' at THETA made a stable zero as well, coning held to
+// kConingLimit. Turning such a motion by pi is shifting it by half a period, so (s*, THETA) and
+// (-s*, THETA + pi) are both stable fixed points, at the centre (s* ~ 0) the same position: the part
+// is brought to the target's position from everywhere and to its orientation up to a half turn --
+// reported as not unique, with the twin and each one's share of the random starts.
+DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
+    const auto t0 = Clock::now();
+    DesignSummary sum;
+    sum.notes.push_back("a half-turn pair: odd harmonics on x, y, rx, ry (n = 1, 3) pull the position to the target at "
+                        "every orientation, and THETA is made a stable zero of theta' there; such a motion turned by pi "
+                        "is the same motion half a period later, so THETA + pi is one as well (not unique)");
+    sum.notes.push_back("coning held to 1e-4 rad/s (the plate's turn about z turns the part's orientation with it)");
+    std::atomic<long> cycles{0};
+    const double theta = wrap_angle(target.theta);
+    const auto make = [&] { return SinkProblem(part_scene, target.at, opt, T, &cycles, &theta); };
+    DesignOptions o = opt;
+    o.starts = std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (a sink's starts)
+    const std::vector<double> best = multistart<SinkProblem>(o, -HUGE_VAL, make, sum.evaluations);
+    start_summary(sum, part_scene, "_fixed_point", T);
+    if (best.empty()) {
+        sum.failure = kNoFeasibleMotion;
+        return finished(sum, cycles, t0);
+    }
+    // (the search's motion is centred: the placement shifts it by the target less the small offset of
+    // the fixed point found)
+    return place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0);
+}
+
 DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
@@ -1258,14 +1339,24 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
         return finished(sum, cycles, t0);
     }
     make().evaluate(best, &sum.rate, &sum.eigenvalues3);
-    // The fixed point near the centre: Newton with the central-difference Jacobian, at the
-    // refinement's tolerances (FixedPointOptions: field noise well below the step).
+    return place_and_verify_rigid(sum, part_scene, rigid_motion(best, T), Vec3::Zero(), target, opt, cycles, t0);
+}
+
+// A rigid design's last stages, shared: the fixed point of `centred` near q0 (Newton with the
+// central-difference Jacobian, at the refinement's tolerances: field noise well below the step),
+// placed exactly on the target by the two symmetries (turned by THETA - theta*, shifted by the target
+// minus the turned s*), checked against the limits, and verified: the 7^3 field's fixed points, full
+// dynamics from random starts (the target's basin share and each competing stable point's), the hold.
+DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
+                                      const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
+                                      std::atomic<long>& cycles, Clock::time_point t0) {
+    const bool orient = target.kind == DesignTargetKind::Orient;
     Scene centred = part_scene;
-    centred.plate = rigid_motion(best, T);
+    centred.plate = centred_motion;
     LimitCycleOptions fine = opt.cycle;
     fine.integration.rtol = 1e-9;
     fine.tol = 1e-8;
-    Vec3 q = Vec3::Zero();
+    Vec3 q = q0;
     bool found = false;
     for (int it = 0; it < 12; ++it) {
         Vec3 xi;
@@ -1274,25 +1365,32 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
         const Vec3 step = J.fullPivLu().solve(xi);
         if (!step.allFinite()) break;
         q -= step;
-        if (step.head<2>().norm() < 1e-7 && std::abs(step[2]) < 1e-6) { found = true; break; }
+        if (step.head<2>().norm() < 1e-7 && std::abs(step[2]) < 1e-6) {
+            found = true;
+            sum.eigenvalues3 = J.eigenvalues();   // (at the fixed point, a step away)
+            sum.rate = -std::max({sum.eigenvalues3[0].real(), sum.eigenvalues3[1].real(), sum.eigenvalues3[2].real()});
+            break;
+        }
     }
     {   // What the orientation has to work with there (orientation_harmonics, design.hpp).
         const bool near = found && q.head<2>().norm() <= opt.region;
-        const OrientationHarmonics oh = orientation_harmonics(centred, near ? Vec2(q.head<2>()) : Vec2::Zero(), opt.cycle);
-        cycles += 12;
+        const int ring = 12;
+        const OrientationHarmonics oh = orientation_harmonics(centred, near ? Vec2(q.head<2>()) : Vec2::Zero(), opt.cycle, ring);
+        cycles += ring;
         if (oh.defined) {
             std::ostringstream note;
             note.precision(2);
-            note << "theta' at the " << (near ? "fixed point's position" : "centre") << ": first harmonic " << oh.first()
-                 << " rad/s against " << oh.rest() << " for the mean and the others ("
-                 << (oh.first() > oh.rest() ? "it dominates: the stable orientations lie in one arc"
-                                            : "it does not: stable orientations pair about a half turn apart, each "
-                                              "basin near half the turn, unless the mean is tuned onto a saddle-node")
-                 << "; bench_orientation_drive measures how far the limits allow)";
+            note << "theta' at the " << (near ? "fixed point's position" : "centre") << " (12 orientations): first harmonic "
+                 << oh.first() << " rad/s against " << oh.rest() << " for the mean and the others ("
+                 << (oh.one_stable()            ? "enough for exactly one stable orientation"
+                     : oh.first() > oh.rest() ? "the zeros lie in two arcs, but more than one may be stable"
+                                              : "too small for one orientation: stable ones pair about a half turn apart "
+                                                "unless the mean is tuned onto a saddle-node")
+                 << "; orientation_harmonics, design.hpp)";
             sum.notes.push_back(note.str());
         }
     }
-    if (!found || q.head<2>().norm() > opt.region || std::abs(q[2]) > kPi / 2) {
+    if (!found || q.head<2>().norm() > opt.region || std::abs(wrap_angle(q[2] - q0[2])) > kPi / 2) {
         sum.failure = "the search's best motion has no fixed point near the design's centre";
         return finished(sum, cycles, t0);
     }
@@ -1301,9 +1399,11 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     const Vec2 at = orient ? Vec2::Zero() : target.at;
     sum.scene.plate = combined(shift_motion(rotate_motion(centred.plate, turn), at - s_turned));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
-    double c[RigidProblem::kConstraints];
-    placed_constraints(sum.scene.plate, opt, sum.scene, 1.0, c);
-    if (*std::max_element(c, c + RigidProblem::kConstraints) > 1e-9) {
+    int n_max = 1;
+    for (const Harmonic& h : sum.scene.plate.harmonics) n_max = std::max(n_max, h.n);
+    std::vector<double> c(6 * n_max + 3);
+    placed_constraints(sum.scene.plate, opt, sum.scene, n_max, 1.0, c.data());
+    if (*std::max_element(c.begin(), c.end()) > 1e-9) {
         sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning limit";
         return finished(sum, cycles, t0);
     }
@@ -1417,7 +1517,20 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
         if (target.kind == DesignTargetKind::LineSink)
             throw std::invalid_argument("a line sink is built for point parts only");
         if (target.kind == DesignTargetKind::Sink) return design_sink(part_scene, target, opt, T);
-        return design_rigid(part_scene, target, opt, T);
+        DesignSummary unique = design_rigid(part_scene, target, opt, T);
+        if (unique.verified || target.kind != DesignTargetKind::FixedPoint) return unique;
+        // No unique fixed point: the half-turn pair, which says so (design_rigid_pair).
+        DesignSummary pair = design_rigid_pair(part_scene, target, opt, T);
+        std::ostringstream note;
+        note.precision(3);
+        note << "the search for a unique fixed point failed (" << unique.failure << "; " << unique.evaluations
+             << " evaluations, " << unique.seconds << " s, counted below)";
+        pair.notes.insert(pair.notes.begin(), note.str());
+        pair.evaluations += unique.evaluations;
+        pair.cycles += unique.cycles;
+        pair.starts += unique.starts;
+        pair.seconds += unique.seconds;
+        return pair;
     }
     if (target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");
     if (target.kind == DesignTargetKind::LineSink) return design_line_sink(part_scene, target, opt, T);

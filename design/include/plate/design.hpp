@@ -49,20 +49,30 @@ double coning_rate(const PlateMotion& u);
 
 // ORIENTATION HARMONICS. At a position s the twist's theta' is a function of theta alone,
 //     theta'(theta) = M + sum_k B_k sin(k theta + phi_k)
-// (from a ring of n equally spaced orientations: harmonics up to n / 2). What a rigid part's one stable
-// orientation needs: if B_1 > |M| + B_2 + ... (first() > rest()), theta' is positive on one arc and
-// negative on the other, so every stable orientation lies in one arc, pulled at order B_1; if the
-// pi-periodic part (M, B_2, B_4, ...) dominates, stable orientations pair about a half turn apart,
-// each with a basin near half the turn, and one is unique only with M tuned onto a saddle-node, which
-// leaves a bottleneck of theta' ~ B_1 (README, inverse design). bench_orientation_drive measures how
-// large first() / rest() can be within the design limits (fig4's part: below 1).
+// sampled on a ring of n equally spaced orientations (harmonics_of: the discrete Fourier transform;
+// harmonics k < n/2 are resolved, k = n/2 only its cosine part, and harmonics above n/2 alias onto
+// lower ones). What a rigid part's one stable orientation needs: with r = rest() = |M| + B_2 + ...,
+// B_1 > r puts every zero of theta' in the two arcs |sin(theta + phi_1)| <= r / B_1, and if also
+// B_1^2 > r^2 + slope_bound()^2 (slope_bound = sum_{k>=2} k B_k) theta' is monotonic in them: exactly
+// one stable orientation (one_stable()). B_1 > r alone is not enough: scenes/foot.json's weathervane has
+// B_1 = 0.37 rad/s against 0.16 and three stable orientations (measured on a 0.01-rad ring: 0.035 rad
+// either side of the foot-ahead orientation, itself unstable at that scale, and one with a 0.09-rad
+// basin at the foot-behind one). If instead the pi-periodic part (M, B_2, B_4, ...)
+// dominates, stable orientations pair about a half turn apart (with B_2 dominant each basin is near half
+// the turn), and one is unique only with M tuned onto a saddle-node of that part, which leaves a
+// bottleneck of theta' < B_1 where its twin was (README, inverse design). bench_orientation_drive
+// measures how large B_1 can be within the design limits (fig4's part: below rest()).
 struct OrientationHarmonics {
     bool defined = false;            // every cycle on the ring converged
     double mean = 0;                 // M [rad/s]
     std::vector<double> amplitude;   // B_k for k = 0..n/2 [rad/s] (amplitude[0] = |M|)
     double first() const { return amplitude.size() > 1 ? amplitude[1] : 0.0; }
     double rest() const;             // |M| + B_2 + ... + B_{n/2}
+    double slope_bound() const;      // sum_{k>=2} k B_k >= |d theta' / d theta - B_1 cos(theta + phi_1)|
+    bool one_stable() const;         // B_1^2 > rest()^2 + slope_bound()^2: exactly one stable orientation
 };
+// theta' on the ring theta_k = 2 pi k / n (n >= 4) as harmonics.
+OrientationHarmonics harmonics_of(const std::vector<double>& theta_dot);
 OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n = 12);
 
 enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };
@@ -75,7 +85,8 @@ struct DesignTarget {
     // position (nothing in its dynamics depends on where it is), so the field is uniform by
     // construction and the search only sets its value.
     // FixedPoint: (at, theta) the unique stable fixed point of the twist field (a rigid part; for a
-    // point part the same as Sink). Orient: every start ends at orientation theta, position free (a
+    // point part the same as Sink). Where no unique one is found, a half-turn pair: (at, theta) and
+    // (at, theta + pi) both stable, reported as not unique with each one's basin share. Orient: every start ends at orientation theta, position free (a
     // part whose contacts' friction differs: by a plate that only translates, a weathervane; else
     // designed as a fixed point at the region's centre and verified on the orientation).
     // LineSink (point parts): every start ends on the line through `at` along direction `theta`, and
@@ -149,8 +160,8 @@ struct DesignSummary {
     bool unique = false;        // one stable fixed point on the grid, at the target
     std::string failure;        // why not verified
     Scene scene;                // the part with the designed plate motion
-    // The search, at the centre before the shift: the field's Jacobian there and its convergence
-    // rate (-max Re of the eigenvalues) [1/s].
+    // The search, at the centre before the shift (rigid fixed points: at the fixed point found near
+    // it): the field's Jacobian there and its convergence rate (-max Re of the eigenvalues) [1/s].
     double rate = 0;
     Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();     // (point parts)
     Eigen::Vector3cd eigenvalues3 = Eigen::Vector3cd::Zero();    // (rigid parts)
