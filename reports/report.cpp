@@ -723,6 +723,71 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
            std::to_string(d.runs.size()) + " end within 0.05 rad of the target.", "800,420");
 }
 
+// A rigid part's fixed point (design.cpp): fig4's part at (0.02, -0.01, 0.5). Where the search for a
+// unique one fails, the design returns the half-turn pair; the table and the runs' theta(t) show what
+// the verification found (the target's share of the random starts and any competitor's).
+void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) {
+    const Scene part = load_scene((src / "scenes" / "fig4.json").string());
+    DesignOptions o;
+    o.threads = opt.threads;
+    o.seed = opt.seed;
+    if (opt.quick) {
+        o.starts = 2;
+        o.local_evaluations = 150;
+        o.verify_starts = 10;
+    }
+    DesignTarget t;
+    t.kind = DesignTargetKind::FixedPoint;
+    t.at = Vec2(0.02, -0.01);
+    t.theta = 0.5;
+    const DesignSummary d = design(part, t, o);
+    c.html << "<h3>Fixing a rigid part: position and orientation</h3>\n<p>" << esc(part.name)
+           << "'s part, target (x, y, θ) = (" << fmt(t.at.x(), 3) << ", " << fmt(t.at.y(), 3) << ", " << fmt(t.theta, 3)
+           << "), default limits, " << d.starts << " starts in all, " << o.local_evaluations
+           << " evaluations each. What the design reports about how it got there:</p>\n<ul>\n";
+    for (const std::string& n : d.notes) c.html << "<li>" << esc(n) << "</li>\n";
+    c.html << "</ul>\n<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
+              "<th>cycles</th><th>target's share of the runs</th><th>other stable fixed points (share)</th><th>seconds</th>"
+              "<th>from the target, after the hold [mm]</th></tr>\n"
+           << design_cells("fixed point (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ", " + fmt(t.theta, 3) + ")", d)
+           << "<td>" << fmt(d.basin_share, 3) << "</td><td>";
+    for (const DesignSummary::Competitor& k : d.competitors)
+        c.html << "(" << fmt(k.point.q[0], 4) << ", " << fmt(k.point.q[1], 4) << ", " << fmt(k.point.q[2], 4) << "): "
+               << fmt(k.basin_share, 3) << "<br>";
+    c.html << "</td><td>" << fmt(d.seconds, 3) << "</td>"
+           << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop) << "</table>\n";
+    if (d.runs.empty()) return;
+    {
+        auto runs = c.data("design_fixed_point_runs.dat");
+        for (const DesignStartRun& s : d.runs) {
+            const Trajectory tr = simulate(d.scene, Dynamics::Full, Vec3(s.x, s.y, s.theta), Vec3::Zero(), s.seconds, s.seconds / 200);
+            double prev = 0, unwrapped = 0;
+            for (std::size_t k = 0; k < tr.samples.size(); ++k) {
+                const double th = tr.samples[k].q[2];
+                unwrapped = k == 0 ? th : unwrapped + wrap_angle(th - prev);
+                prev = th;
+                double off = wrap_angle(unwrapped - t.theta);   // (shown in [-pi/2, 3 pi/2): a half-turn twin at pi)
+                if (off < -kPi / 2) off += 2 * kPi;
+                runs << tr.samples[k].t << ' ' << (tr.samples[k].q.head<2>() - t.at).norm() << ' ' << off << '\n';
+            }
+            runs << "\n\n";
+        }
+    }
+    int at_target = 0;
+    for (const DesignStartRun& s : d.runs) at_target += s.stop.empty() && s.end_distance <= o.verify_distance;
+    c.plot("design_fixed_point_runs",
+           "set xlabel 't [s]'\nset ylabel 'θ − target [rad]'\nset y2label 'distance from the target [m]'\n"
+           "set ytics nomirror\nset y2tics\nset yrange [-pi/2:3*pi/2]\nset key outside right\n"
+           "plot 'data/design_fixed_point_runs.dat' u 1:3 w l lw 1.5 lc rgb '#3050c0' t 'θ − target', "
+           "'' u 1:2 axes x1y2 w l lw 1 lc rgb '#c08020' t 'distance'\n",
+           "The verification's full-dynamics runs from random (x, y, θ): " + std::to_string(at_target) + " of " +
+               std::to_string(d.runs.size()) + " end within 5 mm and 0.05 rad of the target" +
+               (d.competitors.empty() ? std::string(".")
+                                      : "; the others at the competing fixed point(s) in the table (θ − target near π "
+                                        "is the half-turn twin; angles shown from −π/2 to 3π/2)."),
+           "800,420");
+}
+
 void write_report(const ReportOptions& opt) {
     if (opt.out.empty()) throw std::runtime_error("report: no output folder");
     Ctx c;
@@ -741,6 +806,7 @@ void write_report(const ReportOptions& opt) {
     section_fields(c, src, opt);
     c.timed("inverse design", [&] { section_design(c, src, opt); });
     c.timed("orienter", [&] { section_orient(c, src, opt); });
+    c.timed("rigid fixed point", [&] { section_fixed_point(c, src, opt); });
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // KaTeX from Debian's libjs-katex, copied beside the report when present.
