@@ -458,8 +458,29 @@ PYBIND11_MODULE(_plate, m) {
           "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
           "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
           "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
-          "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient (not yet\n"
-          "successful, see the README): the summary gives the basin share and the competing fixed points.");
+          "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
+          "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
+          "pair: theta and theta + pi both stable, unique False; see the README).");
+    m.def(
+        "orientation_harmonics",
+        [](const Scene& sc, std::array<double, 2> at, int n, double tol, double rtol) {
+            require(n >= 4, "n: expected at least 4 orientations");
+            const OrientationHarmonics h =
+                orientation_harmonics(sc, Vec2(at[0], at[1]), cycle_options(tol, rtol, 400, "shooting", 20'000'000), n);
+            py::dict d;
+            d["defined"] = h.defined;
+            d["mean"] = h.mean;
+            d["amplitude"] = h.amplitude;
+            d["first"] = h.first();
+            d["rest"] = h.rest();
+            d["one_stable"] = h.one_stable();
+            return d;
+        },
+        py::arg("scene"), py::arg("at") = std::array<double, 2>{0, 0}, py::arg("n") = 12, py::arg("tol") = 1e-7,
+        py::arg("rtol") = 1e-8,
+        "theta' at position `at` on n orientations as M + sum_k B_k sin(k theta + phi_k): {defined, mean (M),\n"
+        "amplitude (B_0 = |M|, B_1 .. B_n/2), first (B_1), rest (|M| + B_2 + ...), one_stable (B_1^2 > rest^2 +\n"
+        "(sum_k>=2 k B_k)^2: exactly one stable orientation)} [rad/s]; what one orientation needs (design.hpp).");
     m.def("coning_rate", [](const Scene& sc) { return coning_rate(sc.plate); }, py::arg("scene"),
           "The plate's steady yaw drift from rx and ry out of phase [rad/s], which the asymptotic field does\n"
           "not see and the full dynamics does: sum_n Im(A_rx,n conj A_ry,n) / (2 (n w)^3).");

@@ -350,3 +350,23 @@ def test_a_line_sink_gathers_parts_onto_the_line_and_leaves_them_where_they_arri
         assert abs((end - np.array([0.01, -0.02])) @ n) < 0.005     # on the line
         ends.append(end)
     assert np.linalg.norm(ends[0] - ends[1]) > 0.02                  # at different places along it
+
+
+def test_orientation_harmonics_follow_the_exact_symmetries():
+    # One friction coefficient on a plate that only translates: nothing turns the part (theta' = 0 is
+    # invariant). The rubber foot on the same plate: a weathervane, the same at every position. fig4's
+    # own plate (odd harmonics, no z or rz): at the centre theta'(theta + pi) = theta'(theta), no B_1.
+    foot = plate.load_scene(scene_path("foot"))
+    fig4 = plate.load_scene(scene_path("fig4"))
+    plain = plate.scene_from_dict({**fig4.to_dict(), "plate": foot.to_dict()["plate"]})
+    tight = dict(tol=1e-10, rtol=1e-11)
+    none = plate.orientation_harmonics(plain, **tight)
+    assert none["defined"] and none["first"] + none["rest"] < 1e-6
+    vane = plate.orientation_harmonics(foot, **tight)
+    there = plate.orientation_harmonics(foot, at=(0.03, -0.02), **tight)
+    assert vane["first"] > 0.1 and vane["first"] > vane["rest"]
+    assert np.allclose(vane["amplitude"], there["amplitude"], atol=1e-6)
+    odd = plate.orientation_harmonics(fig4, **tight)
+    assert odd["amplitude"][1] < 1e-6 and odd["amplitude"][3] < 1e-6 and odd["amplitude"][2] > 0.05
+    with pytest.raises(ValueError):
+        plate.orientation_harmonics(fig4, n=3)
