@@ -736,10 +736,26 @@ TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair,
         for (int j = 0; j < 3; ++j) nearest = std::min(nearest, std::abs(twin.eigenvalues[j] - s.fixed_point_eigenvalues[k]));
         CHECK(nearest < 1e-7);
     }
-    CHECK(s.basin_share + s.competitors[0].basin_share == Approx(1.0));
-    CHECK(s.basin_share > 0);
-    CHECK(s.competitors[0].basin_share > 0);
+    // The shares, recounted from where the runs ended: each at the target or at the twin.
+    REQUIRE(s.runs.size() == 10u);
+    int at_target = 0, at_twin = 0;
+    for (const DesignStartRun& r : s.runs) {
+        CHECK(r.stop.empty());
+        const bool a = (r.end.head<2>() - t.at).norm() <= o.verify_distance && std::abs(wrap_angle(r.end[2] - t.theta)) <= 0.05;
+        const bool b = (r.end.head<2>() - twin.q.head<2>()).norm() <= o.verify_distance &&
+                       std::abs(wrap_angle(r.end[2] - twin.q[2])) <= 0.05;
+        CHECK(a != b);
+        at_target += a;
+        at_twin += b;
+    }
+    CHECK(s.basin_share == Approx(at_target / 10.0));
+    CHECK(s.competitors[0].basin_share == Approx(at_twin / 10.0));
+    CHECK(at_target > 0);
+    CHECK(at_twin > 0);   // (each basin half the starts in expectation; 10 runs)
     CHECK(std::abs(s.coning) <= 1e-4);
+    CHECK(s.held.seconds == o.hold);   // released at the target, held
+    CHECK(s.held.stop.empty());
     CHECK(s.held.end_distance <= o.verify_distance);
+    CHECK(s.starts == 4);   // two searches of two starts
     CHECK(s.notes.front().find("unique fixed point failed") != std::string::npos);
 }

@@ -600,7 +600,8 @@ struct SinkProblem : Problem<SinkProblem> {
             const double slope = (w[0] - w[2]) / (2 * d);   // -d theta' / d theta [1/s]
             rate = std::min(rate, slope);
             if (rate_out) *rate_out = rate;
-            turn = std::abs(w[1]) / std::max(slope, 1e-3) / 0.01;   // the zero's distance from THETA, in 0.01 rad
+            // the zero's distance from THETA, in 0.01 rad (capped: a motion whose cycles fail scores 1e3, worse)
+            turn = std::min(50.0, std::abs(w[1]) / std::max(slope, 1e-3) / 0.01);
         }
         return -rate + 10 * outward + 10 * std::max(0.0, offset / 0.001 - 1) + 10 * std::max(0.0, turn - 1);
     }
@@ -1285,7 +1286,7 @@ struct RigidProblem : Problem<RigidProblem> {
 
 DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
-                                      std::atomic<long>& cycles, Clock::time_point t0);
+                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair = false);
 
 // --- the rigid part's fixed point as a half-turn pair ----------------------------------------------
 // Where no unique fixed point is found (fig4's part: within the limits its first harmonic in theta,
@@ -1306,7 +1307,7 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
     const double theta = wrap_angle(target.theta);
     const auto make = [&] { return SinkProblem(part_scene, target.at, opt, T, &cycles, &theta); };
     DesignOptions o = opt;
-    o.starts = std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (a sink's starts)
+    o.starts = std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (a sink's starts; dispatch counts them)
     const std::vector<double> best = multistart<SinkProblem>(o, -HUGE_VAL, make, sum.evaluations);
     start_summary(sum, part_scene, "_fixed_point", T);
     if (best.empty()) {
@@ -1315,7 +1316,7 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
     }
     // (the search's motion is centred: the placement shifts it by the target less the small offset of
     // the fixed point found)
-    return place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0);
+    return place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0, true);
 }
 
 DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
@@ -1349,7 +1350,7 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
 // dynamics from random starts (the target's basin share and each competing stable point's), the hold.
 DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
-                                      std::atomic<long>& cycles, Clock::time_point t0) {
+                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair) {
     const bool orient = target.kind == DesignTargetKind::Orient;
     Scene centred = part_scene;
     centred.plate = centred_motion;
@@ -1442,20 +1443,30 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         },
         stable_at_target == 1 ? &goal : nullptr);   // (the hold only where the target is a stable fixed point)
     const std::string unheld = hold_failure(sum, opt, " m (0.05 rad counted as " + std::to_string(opt.verify_distance) + " m)");
-    // The basin shares: of the runs, those that end at the target and at each competing stable point.
-    int at_target = 0;
-    for (const DesignStartRun& r : sum.runs) at_target += r.stop.empty() && r.end_distance <= opt.verify_distance;
-    sum.basin_share = sum.runs.empty() ? 0.0 : static_cast<double>(at_target) / sum.runs.size();
-    int accounted = at_target;
-    for (const FixedPoint& p : others) {
-        int n = 0;
-        for (const DesignStartRun& r : sum.runs) n += r.stop.empty() && reached(r.end, p.q, opt.verify_distance, 0.05);
-        accounted += n;
-        sum.competitors.push_back({p, sum.runs.empty() ? 0.0 : static_cast<double>(n) / sum.runs.size()});
+    // The basin shares: of the runs, those that end at the target and at each competing stable point
+    // (each run counted once: at the target, else at the first competitor it reached).
+    std::vector<int> ended(others.size() + 1, 0);   // ended[0]: at the target
+    int accounted = 0;
+    for (const DesignStartRun& r : sum.runs) {
+        if (!r.stop.empty()) continue;
+        std::size_t where = r.end_distance <= opt.verify_distance ? 0 : ended.size();
+        for (std::size_t k = 0; where == ended.size() && k < others.size(); ++k)
+            if (reached(r.end, others[k].q, opt.verify_distance, 0.05)) where = k + 1;
+        if (where < ended.size()) ++ended[where], ++accounted;
     }
+    const double runs = static_cast<double>(std::max<std::size_t>(sum.runs.size(), 1));
+    sum.basin_share = ended[0] / runs;
+    for (std::size_t k = 0; k < others.size(); ++k) sum.competitors.push_back({others[k], ended[k + 1] / runs});
+    // A half-turn pair: exactly one competitor, the target's image under the pairing about the design's
+    // centre D = target - s_turned, i.e. at (2 D - target, THETA + pi).
+    const Vec2 twin_at = at - 2 * s_turned;
+    const bool twin_ok = others.size() == 1 && (others[0].q.head<2>() - twin_at).norm() <= opt.fixed_point_tolerance &&
+                         std::abs(wrap_angle(others[0].q[2] - goal[2] - kPi)) <= 0.02;
     if (stable_at_target != 1)
         sum.failure = "the designed field has " + std::to_string(stable_at_target) + " stable fixed point(s) at the target on the " +
                       std::to_string(opt.verify_grid) + "^3 grid (" + std::to_string(stable) + " stable in all)";
+    else if (sum.runs.empty())
+        sum.failure = "no full-dynamics runs (verify_starts is 0)";
     else if (stopped)
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
     else if (sum.unique && !(sum.worst_end_distance <= opt.verify_distance))
@@ -1465,6 +1476,11 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         sum.failure = "of " + std::to_string(sum.runs.size()) + " full-dynamics runs, " +
                       std::to_string(static_cast<int>(sum.runs.size()) - accounted) +
                       " ended at neither the target nor a competing stable fixed point";
+    else if (!sum.unique && ended[0] == 0)
+        sum.failure = "no full-dynamics run ended at the target";
+    else if (pair && !sum.unique && !twin_ok)
+        sum.failure = "the half-turn pair's stable fixed points are not the target and its twin alone (" +
+                      std::to_string(others.size()) + " other stable fixed point(s))";
     return last_checks(sum, opt, unheld, cycles, t0);
 }
 
@@ -1528,7 +1544,7 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
         pair.notes.insert(pair.notes.begin(), note.str());
         pair.evaluations += unique.evaluations;
         pair.cycles += unique.cycles;
-        pair.starts += unique.starts;
+        pair.starts = opt.starts + std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (both searches')
         pair.seconds += unique.seconds;
         return pair;
     }
@@ -1542,7 +1558,7 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
     DesignOptions o = opt;
     if (o.starts <= 0) o.starts = default_starts(part_scene, target);
     DesignSummary sum = dispatch(part_scene, target, o);
-    sum.starts = o.starts;
+    if (sum.starts == 0) sum.starts = o.starts;   // (set where a design runs more than one search)
     return sum;
 }
 
