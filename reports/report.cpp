@@ -650,18 +650,25 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     }
 }
 
-// The orienter (design.cpp's weathervane): a part with a rubber foot turned to one orientation from
-// anywhere by a plate that only translates; theta' over a turn and the full-dynamics runs' theta(t).
-void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
-    const Scene part = load_scene((src / "scenes" / "foot.json").string());
+// A design's options in the report: the defaults with the report's threads and seed; with --quick a
+// smaller search and fewer verification runs.
+DesignOptions report_design_options(const ReportOptions& opt, int quick_starts, int quick_evaluations, int quick_runs) {
     DesignOptions o;
     o.threads = opt.threads;
     o.seed = opt.seed;
     if (opt.quick) {
-        o.starts = 2;
-        o.local_evaluations = 80;
-        o.verify_starts = 8;
+        o.starts = quick_starts;
+        o.local_evaluations = quick_evaluations;
+        o.verify_starts = quick_runs;
     }
+    return o;
+}
+
+// The orienter (design.cpp's weathervane): a part with a rubber foot turned to one orientation from
+// anywhere by a plate that only translates; theta' over a turn and the full-dynamics runs' theta(t).
+void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
+    const Scene part = load_scene((src / "scenes" / "foot.json").string());
+    const DesignOptions o = report_design_options(opt, 2, 80, 8);
     DesignTarget t;
     t.kind = DesignTargetKind::Orient;
     t.theta = 2.0;
@@ -728,14 +735,7 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
 // the verification found (the target's share of the random starts and any competitor's).
 void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     const Scene part = load_scene((src / "scenes" / "fig4.json").string());
-    DesignOptions o;
-    o.threads = opt.threads;
-    o.seed = opt.seed;
-    if (opt.quick) {
-        o.starts = 2;
-        o.local_evaluations = 150;
-        o.verify_starts = 10;
-    }
+    const DesignOptions o = report_design_options(opt, 2, 150, 10);
     DesignTarget t;
     t.kind = DesignTargetKind::FixedPoint;
     t.at = Vec2(0.02, -0.01);
