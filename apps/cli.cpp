@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -1101,13 +1102,17 @@ struct ReportArgs : Options {
     std::uint64_t seed = 1;
     int threads = 0;
     bool quick = false;
+    std::vector<std::string> sections;
     explicit ReportArgs(CLI::App* cmd)
         : Options(cmd, "Writes DIR/index.html and its figures: the derivation and its findings, kernel equivalence,\n"
                        "Theorem 1 checks (10^4 thin, 10^3 thick parts; --quick: a few), limit surfaces, Fig. 3, and the\n"
                        "paper's fields with full-dynamics trajectories and fixed-point tables. ROOT: the project folder\n"
-                       "(scenes/, reports/generated/), default the one this program was built from.\n") {
+                       "(scenes/, reports/generated/), default the one this program was built from. --sections\n"
+                       "computes only the named ones (derivation kernels proofs fig3 fields design orient fixed-point;\n"
+                       "the page names those left out).\n") {
         text("--out", out, "DIR", "the report's folder; required");
         flag("--quick", quick, "small campaigns and grids");
+        words("--sections", sections, 1, 8, "NAME ...", "only these sections (default all)");
         whole("--seed", seed, 0, 1L << 40, "the seed");
         whole("--threads", threads, 0, 256, "threads (0: all cores)");
         text("--source", source, "ROOT", "the project folder");
@@ -1122,6 +1127,15 @@ int cmd_report(const ReportArgs& a, Io& cio) {
     o.seed = a.seed;
     o.quick = a.quick;
     o.threads = a.threads;
+    const auto& names = report::report_section_names();
+    for (const std::string& n : a.sections) {
+        if (std::find(names.begin(), names.end(), n) == names.end()) {
+            std::string all;
+            for (const auto& m : names) all += (all.empty() ? "" : ", ") + m;
+            throw UsageError("--sections: '" + n + "' is not a section (" + all + ")");
+        }
+    }
+    o.sections = a.sections;
     report::write_report(o);
     cio.err << "report: " << o.out << "/index.html" << std::endl;
     return 0;

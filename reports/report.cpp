@@ -815,14 +815,24 @@ void write_report(const ReportOptions& opt) {
     const fs::path src = opt.source_dir;
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream body;
-    c.timed("derivation", [&] { section_derivation(c); });
-    c.timed("kernel equivalence", [&] { section_kernels(c, opt.seed); });
-    section_proofs(c, opt);
-    c.timed("Fig. 3", [&] { section_fig3(c, src); });
-    section_fields(c, src, opt);
-    c.timed("inverse design", [&] { section_design(c, src, opt); });
-    c.timed("orienter", [&] { section_orient(c, src, opt); });
-    c.timed("rigid fixed point", [&] { section_fixed_point(c, src, opt); });
+    const auto& names = report_section_names();
+    for (const auto& n : opt.sections)
+        if (std::find(names.begin(), names.end(), n) == names.end())
+            throw std::invalid_argument("report: unknown section '" + n + "'");
+    auto wanted = [&](const char* n) {
+        return opt.sections.empty() || std::find(opt.sections.begin(), opt.sections.end(), n) != opt.sections.end();
+    };
+    std::string left_out;
+    for (const auto& n : names)
+        if (!wanted(n.c_str())) left_out += (left_out.empty() ? "" : ", ") + n;
+    if (wanted("derivation")) c.timed("derivation", [&] { section_derivation(c); });
+    if (wanted("kernels")) c.timed("kernel equivalence", [&] { section_kernels(c, opt.seed); });
+    if (wanted("proofs")) section_proofs(c, opt);
+    if (wanted("fig3")) c.timed("Fig. 3", [&] { section_fig3(c, src); });
+    if (wanted("fields")) section_fields(c, src, opt);
+    if (wanted("design")) c.timed("inverse design", [&] { section_design(c, src, opt); });
+    if (wanted("orient")) c.timed("orienter", [&] { section_orient(c, src, opt); });
+    if (wanted("fixed-point")) c.timed("rigid fixed point", [&] { section_fixed_point(c, src, opt); });
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // KaTeX from Debian's libjs-katex, copied beside the report when present.
@@ -839,7 +849,8 @@ void write_report(const ReportOptions& opt) {
          << "</head><body>\n<h1>Sliding manipulation on a 6-DoF plate: verification report</h1>\n";
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
          << "; machine: " << esc(machine_description()) << "; total "
-         << fmt(total, 4) << " s.</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
+         << fmt(total, 4) << " s." << (left_out.empty() ? "" : " Sections left out of this run (--sections): " + esc(left_out) + ".")
+         << "</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
     html << "</table>\n" << c.html.str();
     // The speed-accuracy study (plate bench) keeps its section between the markers.
@@ -866,6 +877,12 @@ void write_report(const ReportOptions& opt) {
                  "load balance, the cost of a 1 000-core campaign).</p>\n";
     html << kCampaignsEnd << "\n" << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
+}
+
+const std::vector<std::string>& report_section_names() {
+    static const std::vector<std::string> names = {"derivation", "kernels", "proofs", "fig3",
+                                                   "fields", "design", "orient", "fixed-point"};
+    return names;
 }
 
 std::string collinear_sentence(const std::vector<double>& conds, const std::vector<double>& gaps, double singular) {

@@ -15,9 +15,17 @@ struct ReportOptions {
     std::uint64_t seed = 1;
     bool quick = false;              // small campaigns and grids (tests); the main job runs the full one
     int threads = 0;
+    // The sections to compute (names from report_section_names()); empty: all of them. The page names
+    // the ones left out.
+    std::vector<std::string> sections;
 };
 
-// Writes the report; throws std::runtime_error (with the file or tool named) on failure.
+// The report's sections, in page order: derivation, kernels, proofs, fig3, fields, design, orient,
+// fixed-point.
+const std::vector<std::string>& report_section_names();
+
+// Writes the report; throws std::runtime_error (with the file or tool named) on failure, and
+// std::invalid_argument for a section name that is not one of report_section_names().
 void write_report(const ReportOptions& opt);
 
 // The report's sentence on Observation 1 for the thick parts (beyond Theorem 1), from the campaign's

@@ -301,6 +301,25 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
     CHECK(stopped == std::string::npos);
 }
 
+TEST_CASE("plate report --sections computes only the named sections and says which were left out", "[cli][report]") {
+    const fs::path dir = tmpdir() / "report-sections";
+    fs::remove_all(dir);
+    Run r = run("report --quick --sections fig3 derivation --out " + dir.string());
+    REQUIRE(r.code == 0);
+    const std::string html = slurp(dir / "index.html");
+    CHECK(html.find("Symbolic derivation") != std::string::npos);
+    CHECK(html.find("fig3.svg") != std::string::npos);
+    CHECK(html.find("Theorem 1: contraction") == std::string::npos);   // proofs: not computed
+    CHECK(html.find("The paper's fields") == std::string::npos);
+    CHECK(html.find("Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point.") !=
+          std::string::npos);
+    fs::remove_all(dir);
+    r = run("report --quick --sections fig3 figure4 --out " + dir.string());
+    CHECK(r.code == 2);
+    CHECK(r.err.find("--sections: 'figure4' is not a section (derivation, kernels, proofs, fig3, fields") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir));
+}
+
 TEST_CASE("a scene outside the intended regime runs with a warning on stderr", "[cli][precheck]") {
     const fs::path scene = tmpdir() / "sticky.json";
     std::ofstream(scene) << fig4_with("[0.3, 0.3, 0.3]", "[0.3, 2.5, 0.3]");
@@ -313,6 +332,7 @@ TEST_CASE("a scene outside the intended regime runs with a warning on stderr", "
 }
 
 TEST_CASE("a command interrupted while it writes leaves no output that looks complete", "[cli][atomic]") {
+    // (The report computes one section, Fig. 3: what is tested is how the page is written, not what is in it.)
     // The test hook PLATE_TEST_PAUSE_BEFORE_RENAME holds each command with its output complete under
     // the temporary name, just before the rename; the test waits for that moment (the hook's line on
     // stderr) and sends SIGTERM (the program removes its temporary and dies of the signal: nothing is
@@ -331,7 +351,7 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
              (d / "traj.csv").string(), d / "traj.csv"},
         {"proofs --thin 4 --thick 2 --surfaces 2 --out " + (d / "proofs.json").string(), d / "proofs.json"},
         {"random-scene --seed 3 --out " + (d / "scene.json").string(), d / "scene.json"},
-        {"report --quick --out " + (d / "report").string(), d / "report" / "index.html"},
+        {"report --quick --sections fig3 --out " + (d / "report").string(), d / "report" / "index.html"},
     };
     const fs::path err = tmpdir() / "paused.err";
     for (const char* sig : {"TERM", "KILL"}) {
@@ -356,9 +376,9 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
         }
     }
     // A report interrupted after an earlier one completed does not leave the old page beside new figures.
-    REQUIRE(run("report --quick --out " + (d / "report").string()).code == 0);
+    REQUIRE(run("report --quick --sections fig3 --out " + (d / "report").string()).code == 0);
     REQUIRE(fs::exists(d / "report" / "index.html"));
-    const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " report --quick --out " +
+    const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " report --quick --sections fig3 --out " +
                                (d / "report").string() + " > /dev/null 2> " + err.string() +
                                " & p=$!; for i in $(seq 6000); do grep -q paused " + err.string() +
                                " && break; sleep 0.1; done; kill -KILL $p; wait $p";
@@ -371,16 +391,16 @@ TEST_CASE("a report folder whose name holds quotes and a shell command is only a
     const fs::path d = tmpdir() / "rep'; touch PWNED; echo 'x";
     const fs::path witness = fs::current_path() / "PWNED";
     fs::remove(witness);
-    const std::string cmd = std::string(PLATE_EXE) + " report --quick --out \"" + d.string() + "\" > /dev/null 2>&1";
+    const std::string cmd = std::string(PLATE_EXE) + " report --quick --sections fig3 --out \"" + d.string() + "\" > /dev/null 2>&1";
     CHECK(std::system(cmd.c_str()) == 0);
     CHECK(fs::exists(d / "index.html"));
     CHECK_FALSE(fs::exists(witness));
     CHECK_FALSE(fs::exists(d.parent_path() / "PWNED"));
     // A relative folder: gnuplot's messages still go to each figure's log (data/NAME.log), not the terminal.
     fs::remove_all(tmpdir() / "relative-report");
-    const std::string rel = "cd " + tmpdir().string() + " && " + PLATE_EXE + " report --quick --out relative-report > /dev/null 2>&1";
+    const std::string rel = "cd " + tmpdir().string() + " && " + PLATE_EXE + " report --quick --sections fig3 --out relative-report > /dev/null 2>&1";
     CHECK(std::system(rel.c_str()) == 0);
-    CHECK(fs::exists(tmpdir() / "relative-report" / "data" / "fig1_xt.log"));
+    CHECK(fs::exists(tmpdir() / "relative-report" / "data" / "fig3.log"));
 }
 
 TEST_CASE("bounded work: a run over its budget is refused up front with the estimate, or stops with the reason",
