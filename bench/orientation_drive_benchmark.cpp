@@ -40,16 +40,10 @@ constexpr int kRing = 12;
 constexpr int kParams = 24;
 const Axis kAxes[6] = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
 
-// Parameter 4 a + 2 (n - 1) + {0, 1}: the cosine and sine coefficients of axis a's harmonic n.
+// Parameter 4 a + 2 (n - 1) + {0, 1}: the cosine and sine coefficients of axis a's harmonic n (the
+// rigid design's layout).
 PlateMotion motion(const std::vector<double>& p, double T) {
-    PlateMotion u;
-    u.T = T;
-    for (int a = 0; a < 6; ++a)
-        for (int n = 1; n <= 2; ++n) {
-            const double c = p[4 * a + 2 * (n - 1)], s = p[4 * a + 2 * (n - 1) + 1];
-            u.harmonics.push_back({kAxes[a], n, std::hypot(c, s), std::atan2(c, s)});   // c cos + s sin
-        }
-    return u;
+    return motion_from(p, {kAxes, kAxes + 6}, {1, 2}, T);
 }
 
 // The measure: B_1 / (|M| + B_2 + ... + B_6 + 1e-3 rad/s) (the floor keeps a motion that turns

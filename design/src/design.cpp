@@ -123,6 +123,19 @@ double flight_region(const Scene& part, const DesignOptions& opt) {
     return opt.region + (part.part.point ? 0.0 : reach);
 }
 
+PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& axes, const std::vector<int>& harmonics,
+                        double T) {
+    PlateMotion u;
+    u.T = T;
+    const int H = static_cast<int>(harmonics.size());
+    for (int a = 0; a < static_cast<int>(axes.size()); ++a)
+        for (int h = 0; h < H; ++h) {
+            const double c = p[2 * (a * H + h)], s = p[2 * (a * H + h) + 1], amp = std::hypot(c, s);
+            if (amp > 0) u.harmonics.push_back({axes[a], harmonics[h], amp, std::atan2(c, s)});
+        }
+    return u;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -144,21 +157,6 @@ PlateMotion combined(const PlateMotion& u) {
 }
 
 // --- what the searches share -----------------------------------------------------------------------
-
-// A plate motion from coefficients: per axis a and harmonic h, u = c cos(n w t) + s sin(n w t) with
-// c = p[2 (a H + h)], s = p[2 (a H + h) + 1] (H harmonics), i.e. amp sin(n w t + phase).
-PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& axes, const std::vector<int>& harmonics,
-                        double T) {
-    PlateMotion u;
-    u.T = T;
-    const int H = static_cast<int>(harmonics.size());
-    for (int a = 0; a < static_cast<int>(axes.size()); ++a)
-        for (int h = 0; h < H; ++h) {
-            const double c = p[2 * (a * H + h)], s = p[2 * (a * H + h) + 1], amp = std::hypot(c, s);
-            if (amp > 0) u.harmonics.push_back({axes[a], harmonics[h], amp, std::atan2(c, s)});
-        }
-    return u;
-}
 
 // The coefficients of u in motion_from's layout; empty if u has a harmonic outside it.
 std::vector<double> params_from(const PlateMotion& u, const std::vector<Axis>& axes, const std::vector<int>& harmonics) {

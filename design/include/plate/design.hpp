@@ -29,6 +29,11 @@ namespace plate {
 
 PlateMotion rotate_motion(const PlateMotion& u, double angle);
 PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
+// A plate motion from coefficients, the designs' parameter layout: per axis a (of `axes`) and harmonic
+// h (of `harmonics`), u = c cos(n w t) + s sin(n w t) with c = p[2 (a H + h)], s = p[2 (a H + h) + 1]
+// (H = harmonics.size()), i.e. amp sin(n w t + phase); zero amplitudes are left out.
+PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& axes, const std::vector<int>& harmonics,
+                        double T);
 
 // CONING. The plate's angular acceleration is periodic with zero-mean angular velocity, but rotations
 // do not commute: rx and ry out of phase (circular tilting, fig4's) make the plate's orientation
