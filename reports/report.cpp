@@ -806,6 +806,10 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
 
 void write_report(const ReportOptions& opt) {
     if (opt.out.empty()) throw std::runtime_error("report: no output folder");
+    const auto& names = report_section_names();
+    for (const auto& n : opt.sections)
+        if (std::find(names.begin(), names.end(), n) == names.end())
+            throw std::invalid_argument("report: unknown section '" + n + "'");
     Ctx c;
     c.dir = opt.out;
     fs::create_directories(c.dir / "data");
@@ -815,10 +819,6 @@ void write_report(const ReportOptions& opt) {
     const fs::path src = opt.source_dir;
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream body;
-    const auto& names = report_section_names();
-    for (const auto& n : opt.sections)
-        if (std::find(names.begin(), names.end(), n) == names.end())
-            throw std::invalid_argument("report: unknown section '" + n + "'");
     auto wanted = [&](const char* n) {
         return opt.sections.empty() || std::find(opt.sections.begin(), opt.sections.end(), n) != opt.sections.end();
     };

@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <stdexcept>
+
 using plate::report::observation1_sentence;
 
 TEST_CASE("report: the Observation 1 sentence follows the campaign's counts", "[report][text]") {
@@ -40,4 +43,17 @@ TEST_CASE("report: user text reaching the page is escaped (a script in a scene n
     CHECK(h.find("&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt;") != std::string::npos);
     CHECK(h.find("a&#39;b.json") != std::string::npos);
     CHECK(h.rfind("<h3>Fig. 6: rotation (<code>", 0) == 0);
+}
+
+TEST_CASE("write_report rejects an unknown section before it touches the report's folder", "[report][text]") {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "plate-report-unknown-section";
+    fs::remove_all(dir);
+    plate::report::ReportOptions o;
+    o.out = dir.string();
+    o.source_dir = PLATE_SOURCE_DIR;
+    o.sections = {"fig3", "figure4"};
+    CHECK_THROWS_AS(plate::report::write_report(o), std::invalid_argument);
+    CHECK_FALSE(fs::exists(dir));
+    CHECK(plate::report::report_section_names().size() == 8);
 }
