@@ -17,7 +17,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -1127,13 +1126,10 @@ int cmd_report(const ReportArgs& a, Io& cio) {
     o.seed = a.seed;
     o.quick = a.quick;
     o.threads = a.threads;
-    const auto& names = report::report_section_names();
-    for (const std::string& n : a.sections) {
-        if (std::find(names.begin(), names.end(), n) == names.end()) {
-            std::string all;
-            for (const auto& m : names) all += (all.empty() ? "" : ", ") + m;
-            throw UsageError("--sections: '" + n + "' is not a section (" + all + ")");
-        }
+    try {
+        report::check_sections(a.sections);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("--sections: ") + e.what());
     }
     o.sections = a.sections;
     report::write_report(o);

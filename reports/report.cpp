@@ -806,10 +806,7 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
 
 void write_report(const ReportOptions& opt) {
     if (opt.out.empty()) throw std::runtime_error("report: no output folder");
-    const auto& names = report_section_names();
-    for (const auto& n : opt.sections)
-        if (std::find(names.begin(), names.end(), n) == names.end())
-            throw std::invalid_argument("report: unknown section '" + n + "'");
+    check_sections(opt.sections);
     Ctx c;
     c.dir = opt.out;
     fs::create_directories(c.dir / "data");
@@ -818,12 +815,11 @@ void write_report(const ReportOptions& opt) {
     fs::remove(c.dir / "index.html");
     const fs::path src = opt.source_dir;
     const auto t0 = std::chrono::steady_clock::now();
-    std::ostringstream body;
     auto wanted = [&](const char* n) {
         return opt.sections.empty() || std::find(opt.sections.begin(), opt.sections.end(), n) != opt.sections.end();
     };
     std::string left_out;
-    for (const auto& n : names)
+    for (const auto& n : report_section_names())
         if (!wanted(n.c_str())) left_out += (left_out.empty() ? "" : ", ") + n;
     if (wanted("derivation")) c.timed("derivation", [&] { section_derivation(c); });
     if (wanted("kernels")) c.timed("kernel equivalence", [&] { section_kernels(c, opt.seed); });
@@ -883,6 +879,16 @@ const std::vector<std::string>& report_section_names() {
     static const std::vector<std::string> names = {"derivation", "kernels", "proofs", "fig3",
                                                    "fields", "design", "orient", "fixed-point"};
     return names;
+}
+
+void check_sections(const std::vector<std::string>& sections) {
+    const auto& names = report_section_names();
+    for (const auto& n : sections) {
+        if (std::find(names.begin(), names.end(), n) != names.end()) continue;
+        std::string all;
+        for (const auto& m : names) all += (all.empty() ? "" : ", ") + m;
+        throw std::invalid_argument("'" + n + "' is not a section (" + all + ")");
+    }
 }
 
 std::string collinear_sentence(const std::vector<double>& conds, const std::vector<double>& gaps, double singular) {

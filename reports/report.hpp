@@ -23,9 +23,12 @@ struct ReportOptions {
 // The report's sections, in page order: derivation, kernels, proofs, fig3, fields, design, orient,
 // fixed-point.
 const std::vector<std::string>& report_section_names();
+// Throws std::invalid_argument ("'NAME' is not a section (derivation, kernels, ...)") for the first
+// name in `sections` that is not one of them.
+void check_sections(const std::vector<std::string>& sections);
 
 // Writes the report; throws std::runtime_error (with the file or tool named) on failure, and
-// std::invalid_argument for a section name that is not one of report_section_names().
+// std::invalid_argument (check_sections) before anything is written for an unknown section name.
 void write_report(const ReportOptions& opt);
 
 // The report's sentence on Observation 1 for the thick parts (beyond Theorem 1), from the campaign's

@@ -707,8 +707,8 @@ TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientati
 
 TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair, verified and reported as not unique",
           "[design][rigid]") {
-    // fig4's part at (0.02, -0.01, 0.5): within the limits no motion gives it one orientation
-    // (bench_orientation_drive), so after the unique search fails the design falls back on the sink's odd
+    // fig4's part at (0.02, -0.01, 0.5): no motion found gives it one orientation together with the
+    // position's pull (README), so after the unique search fails the design falls back on the sink's odd
     // harmonics with THETA a stable zero of theta'. Turning such a motion by pi is shifting it by half a
     // period, so the twin (s, theta) -> (-s, theta + pi) about the design's centre is a stable fixed
     // point too, with the same eigenvalues; the runs end at one or the other, and the report says so.

@@ -1199,7 +1199,6 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
 const std::vector<Axis> kRigidAxes = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
 PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion_from(p, kRigidAxes, {1, 2}, T); }
 
-
 // Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
 // `room`, no flight under the part's contacts over the region, and no coning beyond kConingLimit either
 // way (6 n_max + 3 entries).
@@ -1211,6 +1210,8 @@ void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const 
     c[k + 1] = -cone - 1;
 }
 
+// The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
+// from the cycle at q. False if a cycle did not converge.
 bool twist_and_jacobian(const Scene& sc, const Vec3& q, const LimitCycleOptions& cyc, Vec3& xi, Mat3& J,
                         std::atomic<long>& cycles) {
     const LimitCycleSummary c0 = limit_cycle(sc, q, cyc);
@@ -1287,10 +1288,10 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
                                       std::atomic<long>& cycles, Clock::time_point t0, bool pair = false);
 
 // --- the rigid part's fixed point as a half-turn pair ----------------------------------------------
-// Where no unique fixed point is found (fig4's part: within the limits its first harmonic in theta,
-// which one orientation needs, stays below the rest -- bench_orientation_drive), the sink's motion (odd
-// harmonics on x, y, rx, ry; n = 1, 3) with theta' at THETA made a stable zero as well, coning held to
-// kConingLimit. Turning such a motion by pi is shifting it by half a period, so (s*, THETA) and
+// Where no unique fixed point is found (fig4's part: its first harmonic in theta stays below the rest
+// within the limits -- bench_orientation_drive -- and the one orientation reachable by tuning the mean
+// loses the position's pull, README), the sink's motion (odd harmonics on x, y, rx, ry; n = 1, 3) with
+// theta' at THETA made a stable zero as well, coning held to kConingLimit. Turning such a motion by pi is shifting it by half a period, so (s*, THETA) and
 // (-s*, THETA + pi) are both stable fixed points, at the centre (s* ~ 0) the same position: the part
 // is brought to the target's position from everywhere and to its orientation up to a half turn --
 // reported as not unique, with the twin and each one's share of the random starts.
@@ -1305,9 +1306,10 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
     const double theta = wrap_angle(target.theta);
     const auto make = [&] { return SinkProblem(part_scene, target.at, opt, T, &cycles, &theta); };
     DesignOptions o = opt;
-    o.starts = std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (a sink's starts; dispatch counts them)
+    o.starts = std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (a sink's starts)
     const std::vector<double> best = multistart<SinkProblem>(o, -HUGE_VAL, make, sum.evaluations);
     start_summary(sum, part_scene, "_fixed_point", T);
+    sum.starts = o.starts;
     if (best.empty()) {
         sum.failure = kNoFeasibleMotion;
         return finished(sum, cycles, t0);
@@ -1542,7 +1544,7 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
         pair.notes.insert(pair.notes.begin(), note.str());
         pair.evaluations += unique.evaluations;
         pair.cycles += unique.cycles;
-        pair.starts = opt.starts + std::min(opt.starts, default_starts(part_scene, DesignTarget{}));   // (both searches')
+        pair.starts += opt.starts;   // (both searches')
         pair.seconds += unique.seconds;
         return pair;
     }
@@ -1556,7 +1558,7 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
     DesignOptions o = opt;
     if (o.starts <= 0) o.starts = default_starts(part_scene, target);
     DesignSummary sum = dispatch(part_scene, target, o);
-    if (sum.starts == 0) sum.starts = o.starts;   // (set where a design runs more than one search)
+    if (sum.starts == 0) sum.starts = o.starts;   // (set where a search ran its own number of starts)
     return sum;
 }
 
