@@ -983,6 +983,10 @@ int cmd_design(const DesignArgs& a, Io& cio) {
         nlohmann::json x = {{"start", rigid ? nlohmann::json{r.x, r.y, r.theta} : nlohmann::json{r.x, r.y}},
                             {"end", rigid ? nlohmann::json{r.end[0], r.end[1], r.end[2]} : nlohmann::json{r.end[0], r.end[1]}},
                             {"seconds", r.seconds}, {"end_distance", r.end_distance}};
+        if (r.from > 0) {   // (transport: judged over [from, seconds])
+            x["from"] = r.from;
+            x["at_from"] = nlohmann::json{r.at_from[0], r.at_from[1]};
+        }
         if (!r.stop.empty()) x["stop"] = r.stop;
         runs.push_back(x);
     }

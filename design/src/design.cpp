@@ -346,10 +346,11 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
 }
 
 // With `hold` (sinks and fixed points, opt.hold > 0) one more run starts at rest at *hold, the target,
-// for opt.hold seconds: sum.held (not among sum.runs, nor in the worst distance).
+// for opt.hold seconds: sum.held (not among sum.runs, nor in the worst distance). With from > 0 each
+// run also records where it was at from * seconds (DesignStartRun::at_from) for end_distance.
 template <class Seconds, class EndDistance>
 int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& seconds, EndDistance&& end_distance,
-                      const Vec3* hold = nullptr) {
+                      const Vec3* hold = nullptr, double from = 0) {
     Rng rng(opt.seed ^ 0x5DEECE66DULL);
     const bool rigid = !sum.scene.part.point;
     sum.runs.resize(opt.verify_starts);
@@ -358,6 +359,7 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         r.y = rng.uniform(-opt.region, opt.region);
         if (rigid) r.theta = rng.uniform(-kPi, kPi);   // (drawn after x, y: point parts' starts unchanged)
         r.seconds = seconds(r);
+        r.from = from * r.seconds;
     }
     const bool holding = hold && opt.hold > 0;
     if (holding) {
@@ -372,19 +374,24 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         DesignStartRun r = job(k);
         IntegrationOptions io;
         io.rtol = 1e-7;
-        const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds, r.seconds, io);
+        const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds,
+                                       r.from > 0 ? r.from : r.seconds, io);
         r.end = tr.samples.empty() ? Vec3::Constant(std::numeric_limits<double>::quiet_NaN()) : tr.samples.back().q;
+        for (const Sample& smp : tr.samples)
+            if (r.from > 0 && std::abs(smp.t - r.from) <= 1e-9 * r.seconds) r.at_from = smp.q;
         const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity() : end_distance(r, r.end);
         // (text: the distance, the end, then why the run stopped early, if it did)
-        return exact_text(d) + ' ' + exact_text(r.end[0]) + ' ' + exact_text(r.end[1]) + ' ' + exact_text(r.end[2]) +
+        return exact_text(d) + ' ' + exact_text(r.end[0]) + ' ' + exact_text(r.end[1]) + ' ' + exact_text(r.end[2]) + ' ' +
+               exact_text(r.at_from[0]) + ' ' + exact_text(r.at_from[1]) + ' ' + exact_text(r.at_from[2]) +
                (tr.stop.reason != StopReason::None ? ' ' + tr.stop.describe() : std::string());
     }, [&](int k, const std::string& text) {
         std::istringstream in(text);
-        std::string x[4];
+        std::string x[7];
         for (auto& w : x) in >> w;
         DesignStartRun& r = job(k);
         r.end_distance = exact_value(x[0]);
         r.end = Vec3(exact_value(x[1]), exact_value(x[2]), exact_value(x[3]));
+        r.at_from = Vec3(exact_value(x[4]), exact_value(x[5]), exact_value(x[6]));
         std::getline(in >> std::ws, r.stop);
     });
     int stopped = 0;
@@ -925,12 +932,19 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     for (const FieldPoint& p : f.points)
         if (p.converged) sum.transport_spread = std::max(sum.transport_spread, (p.twist.head<2>() - sum.transport_mean).norm());
     sum.transport_tolerance = 0.02 * target.velocity.norm();
+    // Each run for a region's width of travel (1-20 s), judged over its second half: released at rest
+    // the part lags the plate's drive while its cycle builds up (about 0.1 s on fig1_point: 9.6 mm at
+    // 0.08 m/s, which a check from the start counted against the design; an outside audit found it),
+    // so the distance is from where the target velocity takes it from the run's midpoint, within the
+    // field's 2 % over that half (and 5 mm).
     const int stopped = verification_runs(
-        sum, opt, [&](const DesignStartRun&) { return std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0); },   // a region's width
-        // the distance from where the target velocity would have taken it
+        sum, opt, [&](const DesignStartRun&) { return std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0); },
         [&](const DesignStartRun& r, const Vec3& end) {
-            return (end.head<2>() - Vec2(r.x, r.y) - target.velocity * r.seconds).norm();
-        });
+            return (end.head<2>() - r.at_from.head<2>() - target.velocity * (r.seconds - r.from)).norm();
+        },
+        nullptr, 0.5);
+    double allowed = opt.verify_distance;
+    for (const DesignStartRun& r : sum.runs) allowed = std::min(allowed, sum.transport_tolerance * (r.seconds - r.from));
     sum.unique = true;   // (no fixed point is sought)
     if (undefined) sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
     else if (!((sum.transport_mean - target.velocity).norm() <= sum.transport_tolerance))
@@ -940,9 +954,10 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
         sum.failure = "the field is not uniform over the region";
     else if (stopped)
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
-    else if (!(sum.worst_end_distance <= opt.verify_distance))
+    else if (!(sum.worst_end_distance <= allowed))
         sum.failure = "a full-dynamics run ended " + std::to_string(sum.worst_end_distance) +
-                      " m from where the target velocity takes it";
+                      " m from where the target velocity takes it over the run's second half (allowed " +
+                      std::to_string(allowed) + " m: 2 % of the travel)";
     sum.verified = sum.failure.empty();
     return finished(sum, cycles, t0);
 }
@@ -1432,7 +1447,9 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     }
     int stable_lines = 0;
     for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
-    sum.unique = stable == 1 && stable_at_target == 1 && stable_lines == 0;
+    // A half-turn pair is never unique: its twin exists by the pairing whether or not the grid
+    // resolves it (an outside audit: nothing else kept a missed twin from reading unique).
+    sum.unique = !pair && stable == 1 && stable_at_target == 1 && stable_lines == 0;
     sum.coning = coning_rate(sum.scene.plate);
     const int stopped = verification_runs(
         sum, opt,
@@ -1465,8 +1482,6 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     if (stable_at_target != 1)
         sum.failure = "the designed field has " + std::to_string(stable_at_target) + " stable fixed point(s) at the target on the " +
                       std::to_string(opt.verify_grid) + "^3 grid (" + std::to_string(stable) + " stable in all)";
-    else if (sum.runs.empty())
-        sum.failure = "no full-dynamics runs (verify_starts is 0)";
     else if (stopped)
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
     else if (sum.unique && !(sum.worst_end_distance <= opt.verify_distance))
@@ -1478,7 +1493,7 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
                       " ended at neither the target nor a competing stable fixed point";
     else if (!sum.unique && ended[0] == 0)
         sum.failure = "no full-dynamics run ended at the target";
-    else if (pair && !sum.unique && !twin_ok)
+    else if (pair && !twin_ok)
         sum.failure = "the half-turn pair's stable fixed points are not the target and its twin alone (" +
                       std::to_string(others.size()) + " other stable fixed point(s))";
     return last_checks(sum, opt, unheld, cycles, t0);
@@ -1555,6 +1570,9 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
 }  // namespace
 
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
+    // Every design is verified in full dynamics before it is reported: no runs, no verification (the
+    // sinks, lines, transports and orienters would otherwise pass on the field alone).
+    if (opt.verify_starts < 1) throw std::invalid_argument("verify_starts must be at least 1 (designs are verified in full dynamics)");
     DesignOptions o = opt;
     if (o.starts <= 0) o.starts = default_starts(part_scene, target);
     DesignSummary sum = dispatch(part_scene, target, o);

@@ -155,8 +155,11 @@ struct DesignStartRun {
     double theta = 0;           // (rigid parts: drawn uniformly over the turn)
     Vec3 end = Vec3::Zero();    // where the run ended
     double end_distance = 0;    // from the target after `seconds` of full dynamics [m] (rigid: the
-                                // larger of the position's and the angle's, 0.05 rad counted as 5 mm)
+                                // larger of the position's and the angle's, 0.05 rad counted as 5 mm;
+                                // transport: from where the target velocity takes it over [from, seconds])
     double seconds = 0;
+    double from = 0;            // transport: the run's second half only, past the start-up's lag [s]
+    Vec3 at_from = Vec3::Zero();   // where the run was at `from`
     std::string stop;           // why the run stopped early, if it did
 };
 
