@@ -835,7 +835,8 @@ struct DesignArgs : Options {
     std::vector<double> limits;
     double period = 0, hold = DesignOptions{}.hold, max_coning = DesignOptions{}.max_coning;
     std::uint64_t seed = 1;
-    int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations;
+    int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations, harmonics = 0;
+    std::string axes;
     explicit DesignArgs(CLI::App* cmd)
         : Options(cmd, "Designs a plate motion for the part of PART_SCENE (its plate block is ignored but for its period)\n"
                        "and verifies it before reporting. Targets:\n"
@@ -854,7 +855,10 @@ struct DesignArgs : Options {
                        "--evaluations each (default 400). Verification: the field's fixed points on a 7x7 grid and full\n"
                        "dynamics from 20 seeded random starts; sinks and fixed points also hold: released at rest at the\n"
                        "target, the part is still within 5 mm after --hold seconds (default 120; coning, rx and ry out of\n"
-                       "phase, turns the field about the plate's centre, so it limits the coning). Writes the designed\n"
+                       "phase, turns the field about the plate's centre, so it limits the coning). --axes and --harmonics\n"
+                       "narrow each target's motion family (sinks x, y, rx, ry at n = 1, 3; line sinks y, rx at n = 1;\n"
+                       "transport and orienters x, y, z at n = 1, 2; rigid fixed points all six at n = 1, 2): the other\n"
+                       "harmonics stay zero. Writes the designed\n"
                        "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
         words("--target", target, 2, 4, "KIND ...",
@@ -868,6 +872,8 @@ struct DesignArgs : Options {
         whole("--evaluations", evaluations, 1, 1'000'000, "evaluations per start");
         number("--hold", hold, "seconds a part released at the target must stay within 5 mm (0: not checked)", "120");
         number("--max-coning", max_coning, "a sink's largest coning rate [rad/s] (negative: from the hold)", "from the hold");
+        text("--axes", axes, "x,y,z,rx,ry,rz", "the axes the motion may use (default: the target's own)");
+        whole("--harmonics", harmonics, 1, 64, "the highest harmonic n the motion may use (default: the target's own)");
     }
 };
 
@@ -918,6 +924,21 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     o.threads = a.threads;
     o.starts = a.starts;
     o.local_evaluations = a.evaluations;
+    if (a.has("--harmonics")) o.max_harmonic = a.harmonics;
+    if (a.has("--axes")) {
+        std::istringstream in(a.axes);
+        std::string name;
+        while (std::getline(in, name, ',')) {
+            bool found = false;
+            for (int k = 0; k < 6; ++k)
+                if (name == axis_name(static_cast<Axis>(k))) {
+                    o.axes.push_back(static_cast<Axis>(k));
+                    found = true;
+                }
+            if (!found) throw UsageError("--axes: expected a comma-separated list of x, y, z, rx, ry, rz, got '" + name + "'");
+        }
+        if (o.axes.empty()) throw UsageError("--axes: expected at least one of x, y, z, rx, ry, rz");
+    }
     // Under mpirun the starts, the verification field's planes and the verification runs are shared
     // over the ranks; every rank follows the same path, rank 0 writes.
     if (cio.farm) o.tasks = sweep::farm_tasks(*cio.farm);
@@ -935,6 +956,11 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     else if (t.kind != DesignTargetKind::Orient) j["target"]["at"] = {t.at.x(), t.at.y()};
     if (rigid) j["target"]["theta"] = t.theta;
     if (t.kind == DesignTargetKind::LineSink) j["target"]["direction"] = t.theta;
+    if (!o.axes.empty()) {   // (the search's freedom, where narrowed)
+        j["axes"] = nlohmann::json::array();
+        for (Axis ax : o.axes) j["axes"].push_back(axis_name(ax));
+    }
+    if (o.max_harmonic > 0) j["max_harmonic"] = o.max_harmonic;
     j["verified"] = d.verified;
     if (!d.verified) j["failure"] = d.failure;
     j["scene"] = a.out;

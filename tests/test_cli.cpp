@@ -504,4 +504,26 @@ TEST_CASE("plate design: a verified sink is a scene whose own field has its one 
                              (d / "y.json").string());
     CHECK(negative.code == 2);
     CHECK(negative.err.find("--hold") != std::string::npos);
+
+    // --axes and --harmonics: the designed scene moves on those alone, and the summary says so; a name
+    // that is no axis, or a target whose motion family they empty, is a usage error with no file.
+    const Run along_x = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target transport 0.02 0 --axes x "
+                            "--harmonics 2 --starts 4 --evaluations 150 --out " + (d / "x_only.json").string());
+    INFO(along_x.err);
+    REQUIRE(along_x.code == 0);
+    const auto jx = nlohmann::json::parse(along_x.out);
+    CHECK(jx["axes"] == nlohmann::json::array({"x"}));
+    CHECK(jx["max_harmonic"] == 2);
+    for (const auto& h : nlohmann::json::parse(slurp(d / "x_only.json"))["plate"]["harmonics"]) {
+        CHECK(h["axis"] == "x");
+        CHECK(h["n"].get<int>() <= 2);
+    }
+    for (const char* axes : {"z,w", "z"}) {
+        INFO(axes);
+        const Run none = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0 0 --axes " + std::string(axes) +
+                             " --out " + (d / "none.json").string());
+        CHECK(none.code == 2);
+        CHECK(none.err.find(std::string(axes) == "z" ? "nothing to move" : "--axes") != std::string::npos);
+        CHECK_FALSE(fs::exists(d / "none.json"));
+    }
 }

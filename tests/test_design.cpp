@@ -473,6 +473,36 @@ TEST_CASE("transport: a translating plate carries a point part at the target vel
     CHECK(fast.failure.find("out of reach within the limits") != std::string::npos);
 }
 
+TEST_CASE("the allowed axes and harmonics narrow the search: the designed motion uses nothing else, and an empty family fails cleanly",
+          "[design]") {
+    const Scene part = scene("fig1_point");
+    DesignTarget t;
+    t.kind = DesignTargetKind::Transport;
+    t.velocity = Vec2(0.02, 0);
+    DesignOptions o = searched(8, 200, 6);
+    o.lin_limit = 15;
+    // Along x alone, with its first two harmonics (a shake whose second harmonic skews it: the part
+    // drifts along the shake), or with x and z at n = 1 only (the heave in phase with the shake).
+    for (const auto& [axes, n_max] : {std::pair<std::vector<Axis>, int>{{Axis::x}, 0}, {{Axis::x, Axis::z}, 1}}) {
+        DesignOptions on = o;
+        on.axes = axes;
+        on.max_harmonic = n_max;
+        const DesignSummary s = design(part, t, on);
+        INFO(s.failure);
+        CHECK(s.verified);
+        CHECK((s.transport_mean - t.velocity).norm() <= 0.02 * t.velocity.norm());
+        REQUIRE(!s.scene.plate.harmonics.empty());
+        for (const Harmonic& h : s.scene.plate.harmonics) {
+            CHECK(std::find(axes.begin(), axes.end(), h.axis) != axes.end());
+            if (n_max > 0) CHECK(h.n <= n_max);
+        }
+    }
+    // A point sink's family is x, y, rx, ry at n = 1, 3: on z alone nothing of it is left.
+    DesignOptions oz = o;
+    oz.axes = {Axis::z};
+    CHECK_THROWS_WITH(design(part, DesignTarget{}, oz), Catch::Contains("x, y, rx, ry at n = 1, 3"));
+}
+
 TEST_CASE("coning: rx and ry out of phase turn the plate about z at the closed-form rate, which the full dynamics shows",
           "[design][coning]") {
     // fig4's 100 rad/s^2 on rx and ry, a quarter period apart: psi' = Im(A_rx conj A_ry) / (2 w^3)

@@ -202,6 +202,14 @@ struct Problem {
     double best_f = std::numeric_limits<double>::infinity();
 
     const Derived& self() const { return static_cast<const Derived&>(*this); }
+    // Is parameter i of a layout over axes x harmonics (motion_from's) free under opt.axes and
+    // opt.max_harmonic? (Derived's is_free(i); multistart holds the others at zero.)
+    bool free(const std::vector<Axis>& axes, const std::vector<int>& harmonics, int i) const {
+        const int H = static_cast<int>(harmonics.size());
+        const Axis a = axes[static_cast<std::size_t>(i / (2 * H))];
+        if (opt.max_harmonic > 0 && harmonics[static_cast<std::size_t>((i / 2) % H)] > opt.max_harmonic) return false;
+        return opt.axes.empty() || std::find(opt.axes.begin(), opt.axes.end(), a) != opt.axes.end();
+    }
     bool feasible(const std::vector<double>& p) const {
         double c[Derived::kConstraints];
         self().constraints(p, c);
@@ -233,6 +241,20 @@ struct Problem {
 template <class P, class Make>
 std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& make, long& evaluations) {
     constexpr int n = P::kParams;
+    // The free parameters (DesignOptions::axes and max_harmonic hold the others at zero, as does a
+    // limit of zero): the local search runs on them alone.
+    std::vector<int> free_idx;
+    {
+        const P probe = make();
+        bool any = false;
+        for (int i = 0; i < n; ++i) {
+            any = any || probe.is_free(i);
+            if (probe.is_free(i) && probe.limit(i) > 0) free_idx.push_back(i);
+        }
+        if (!any) throw std::invalid_argument("the axes and harmonics allowed leave this target's motion family nothing to move (" +
+                                              std::string(P::kFamily) + ")");
+    }
+    const int m = static_cast<int>(free_idx.size());
     const int n_starts = std::max(1, opt.starts);
     std::vector<std::vector<double>> best_p(n_starts);
     std::vector<double> best_f(n_starts, std::numeric_limits<double>::infinity());
@@ -249,23 +271,44 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
         // feasible (the "starting guess").
         if (k == 0 && !prob.guess.empty()) {
             p = prob.guess;
+            for (int i = 0; i < n; ++i)
+                if (!prob.is_free(i)) p[i] = 0;
             ok = prob.feasible(p);
         }
         // (every 100 infeasible draws the box shrinks by 0.7: with z and rx, ry motion most of the full
         // box lets the part fly)
         for (int tries = 0; tries < 1000 && !ok; ++tries) {
             const double box = std::pow(0.7, tries / 100) / std::sqrt(2.0);
-            for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) * box;
+            for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) * box * prob.is_free(i);
             ok = prob.feasible(p);
         }
         if (!ok) return "inf 0 0";
-        for (int i = 0; i < n; ++i) {
-            lo[i] = -prob.limit(i);
-            hi[i] = prob.limit(i);
-            step[i] = std::max(prob.limit(i), 1e-6) / 4;
+        prob.objective(p);   // the feasible start itself
+        if (m == 0) return exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' + std::to_string(own_cycles.load()) +
+                           [&] { std::string t; for (double x : prob.best_p) t += ' ' + exact_text(x); return t; }();
+        // The local search on the free parameters: x (m of them) placed into the full p.
+        struct Reduced {
+            P* prob;
+            const std::vector<int>* idx;
+            std::vector<double> full;
+            const std::vector<double>& place(const double* x) {
+                for (std::size_t j = 0; j < idx->size(); ++j) full[static_cast<std::size_t>((*idx)[j])] = x[j];
+                return full;
+            }
+        } red{&prob, &free_idx, p};
+        std::vector<double> x(m);
+        lo.resize(m);
+        hi.resize(m);
+        step.resize(m);
+        for (int j = 0; j < m; ++j) {
+            const int i = free_idx[j];
+            x[j] = p[i];
+            lo[j] = -prob.limit(i);
+            hi[j] = prob.limit(i);
+            step[j] = prob.limit(i) / 4;
         }
         const bool gradients = opt.local == DesignOptions::Local::SlsqpFiniteDifferences;
-        nlopt::opt local(gradients ? nlopt::LD_SLSQP : nlopt::LN_COBYLA, n);
+        nlopt::opt local(gradients ? nlopt::LD_SLSQP : nlopt::LN_COBYLA, m);
         local.set_lower_bounds(lo);
         local.set_upper_bounds(hi);
         local.set_initial_step(step);
@@ -274,38 +317,37 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
         local.set_maxeval(gradients ? std::max(1, opt.local_evaluations / (n + 1)) : opt.local_evaluations);
         local.set_stopval(stopval);
         local.set_min_objective(
-            [](const std::vector<double>& x, std::vector<double>& g, void* d) {
-                P& pr = *static_cast<P*>(d);
-                const double f = pr.objective(x);
-                for (std::size_t i = 0; i < g.size(); ++i) {
-                    std::vector<double> xp = x;
-                    const double h = 1e-3 * std::max(pr.limit(static_cast<int>(i)), 1e-6);
-                    xp[i] += h;
-                    g[i] = (pr.objective(xp) - f) / h;
+            [](const std::vector<double>& xr, std::vector<double>& g, void* d) {
+                Reduced& r = *static_cast<Reduced*>(d);
+                const double f = r.prob->objective(r.place(xr.data()));
+                for (std::size_t j = 0; j < g.size(); ++j) {
+                    std::vector<double> xp = xr;
+                    const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
+                    xp[j] += h;
+                    g[j] = (r.prob->objective(r.place(xp.data())) - f) / h;
                 }
                 return f;
             },
-            &prob);
+            &red);
         local.add_inequality_mconstraint(
-            [](unsigned, double* c, unsigned, const double* x, double* grad, void* d) {
-                const P& pr = *static_cast<P*>(d);
-                std::vector<double> xv(x, x + P::kParams);
-                pr.constraints(xv, c);
+            [](unsigned, double* c, unsigned mr, const double* xr, double* grad, void* d) {
+                Reduced& r = *static_cast<Reduced*>(d);
+                r.prob->constraints(r.place(xr), c);
                 if (!grad) return;
                 double cp[P::kConstraints];
-                for (int i = 0; i < P::kParams; ++i) {   // grad[k n + i] = d c_k / d x_i
-                    std::vector<double> xp = xv;
-                    const double h = 1e-3 * std::max(pr.limit(i), 1e-6);
-                    xp[i] += h;
-                    pr.constraints(xp, cp);
-                    for (int k = 0; k < P::kConstraints; ++k) grad[k * P::kParams + i] = (cp[k] - c[k]) / h;
+                std::vector<double> xp(xr, xr + mr);
+                for (unsigned j = 0; j < mr; ++j) {   // grad[k m + j] = d c_k / d x_j
+                    const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
+                    xp[j] += h;
+                    r.prob->constraints(r.place(xp.data()), cp);
+                    xp[j] = xr[j];
+                    for (int k = 0; k < P::kConstraints; ++k) grad[k * mr + j] = (cp[k] - c[k]) / h;
                 }
             },
-            &prob, std::vector<double>(P::kConstraints, 1e-9));
-        prob.objective(p);   // the feasible start itself
+            &red, std::vector<double>(P::kConstraints, 1e-9));
         double f = 0;
         try {
-            local.optimize(p, f);
+            local.optimize(x, f);
         } catch (const std::exception&) {
             // (a roundoff-limited stop: the best feasible point found stands)
         }
@@ -536,8 +578,10 @@ struct SinkProblem : Problem<SinkProblem> {
         return part.part.point ? std::vector<double>{0.0} : std::vector<double>{theta, theta + kPi / 2};
     }
     static constexpr int kParams = 16;
+    static constexpr const char* kFamily = "x, y, rx, ry at n = 1, 3";
     static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
     double limit(int i) const { return i < 8 ? opt.lin_limit : opt.ang_limit; }
+    bool is_free(int i) const { return free({Axis::x, Axis::y, Axis::rx, Axis::ry}, {1, 3}, i); }   // (sink_motion's layout)
 
     // Constraints c_k <= 0 on the final (shifted) motion: each harmonic's amplitude within its
     // limit, no flight under the part over the region, and no more coning than the hold allows.
@@ -775,8 +819,10 @@ struct LineSinkProblem : Problem<LineSinkProblem> {
     DesignTarget target;
     double reach = 0;
     static constexpr int kParams = 4;
+    static constexpr const char* kFamily = "y, rx at n = 1";
     static constexpr int kConstraints = 7;   // six amplitudes, the flight margin
     double limit(int i) const { return i < 2 ? opt.lin_limit : opt.ang_limit; }
+    bool is_free(int i) const { return free({Axis::y, Axis::rx}, {1}, i); }
     PlateMotion placed(const std::vector<double>& p) const {
         return shift_motion(rotate_motion(line_motion(p, T), target.theta), target.at);
     }
@@ -878,8 +924,9 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
 // --- the point-part transport --------------------------------------------------------------------
 // Parameters: cosine and sine coefficients of harmonics n = 1, 2 on x, y and z (a plate that only
 // translates). The field is uniform; its value at the centre is driven onto the target.
+const std::vector<Axis> kTranslationAxes = {Axis::x, Axis::y, Axis::z};
 PlateMotion transport_motion(const std::vector<double>& p, double T) {
-    return motion_from(p, {Axis::x, Axis::y, Axis::z}, {1, 2}, T);
+    return motion_from(p, kTranslationAxes, {1, 2}, T);
 }
 
 // c_k <= 0: each of transport_motion's six harmonics within the linear limit, and no flight.
@@ -893,8 +940,10 @@ struct TransportProblem : Problem<TransportProblem> {
         : Problem(part_, opt_, T_, cycles_), target(v_) {}
     Vec2 target;
     static constexpr int kParams = 12;
+    static constexpr const char* kFamily = "x, y, z at n = 1, 2";
     static constexpr int kConstraints = 7;   // six harmonic amplitudes, the flight margin
     double limit(int) const { return opt.lin_limit; }
+    bool is_free(int i) const { return free(kTranslationAxes, {1, 2}, i); }
     void constraints(const std::vector<double>& p, double* c) const { translation_constraints(p, opt, part.g, T, c); }
     double evaluate(const std::vector<double>& p) {
         ++evaluations;
@@ -978,7 +1027,6 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
 // shapes theta'(theta) on a ring of kRing orientations to one stable zero, as steep as it can be,
 // and rotate_motion turns that zero onto THETA.
 constexpr int kRing = 12, kFineRing = 72;
-const std::vector<Axis> kTranslationAxes = {Axis::x, Axis::y, Axis::z};
 
 // theta' at the centre on a ring of n equally spaced orientations from 0 (false if a cycle did not
 // converge); twist receives the whole twists if given.
@@ -1031,8 +1079,10 @@ double turned_amplitude(double xc, double xs, double yc, double ys) {
 struct OrientProblem : Problem<OrientProblem> {
     using Problem::Problem;
     static constexpr int kParams = 12;   // transport_motion's layout: x, y, z; n = 1, 2; cos, sin
+    static constexpr const char* kFamily = "x, y, z at n = 1, 2";
     static constexpr int kConstraints = 5;   // x-y at any turn (n = 1, 2), z (n = 1, 2), the flight margin
     double limit(int) const { return opt.lin_limit; }
+    bool is_free(int i) const { return free(kTranslationAxes, {1, 2}, i); }
     void constraints(const std::vector<double>& p, double* c) const {
         const double L = std::max(opt.lin_limit, 1e-12);
         for (int h = 0; h < 2; ++h) {
@@ -1253,11 +1303,13 @@ struct RigidProblem : Problem<RigidProblem> {
     }
     DesignTarget target;
     static constexpr int kParams = 24;
+    static constexpr const char* kFamily = "x, y, z, rx, ry, rz at n = 1, 2";
     static constexpr int kConstraints = 15;   // twelve amplitudes, the flight margin, coning both ways
     // The search keeps 3% of each limit in hand for the final placement's correction (shifting by the
     // found fixed point's offset, a few mm, adds alpha x offset to the linear amplitudes).
     static constexpr double kRoom = 0.97;
     double limit(int i) const { return i < 12 ? opt.lin_limit : opt.ang_limit; }
+    bool is_free(int i) const { return free(kRigidAxes, {1, 2}, i); }
     void constraints(const std::vector<double>& p, double* c) const {
         placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt,
                            part, 2, kRoom, c);

@@ -397,7 +397,7 @@ PYBIND11_MODULE(_plate, m) {
              std::optional<double> orient, std::optional<std::tuple<double, double, double>> line_sink,
              double lin_limit, double ang_limit, double period,
              std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold,
-             double max_coning) {
+             double max_coning, std::vector<std::string> axes, int max_harmonic) {
               require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() +
                                   line_sink.has_value() == 1,
                       "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta "
@@ -437,6 +437,14 @@ PYBIND11_MODULE(_plate, m) {
               require(hold >= 0, "hold: expected seconds >= 0 (0: not checked)");
               o.hold = hold;
               o.max_coning = max_coning;
+              for (const std::string& name : axes) {
+                  int k = 0;
+                  while (k < 6 && name != axis_name(static_cast<Axis>(k))) ++k;
+                  require(k < 6, "axes: expected names among x, y, z, rx, ry, rz, got '" + name + "'");
+                  o.axes.push_back(static_cast<Axis>(k));
+              }
+              require(max_harmonic >= 0, "max_harmonic: expected >= 0 (0: the target's own)");
+              o.max_harmonic = max_harmonic;
               py::gil_scoped_release free;
               try {
                   return design(part, t, o);
@@ -450,6 +458,7 @@ PYBIND11_MODULE(_plate, m) {
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0, py::arg("local_evaluations") = 400,
           py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0, py::arg("max_coning") = -1.0,
+          py::arg("axes") = std::vector<std::string>{}, py::arg("max_harmonic") = 0,
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
           "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
           "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
@@ -460,7 +469,8 @@ PYBIND11_MODULE(_plate, m) {
           "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
           "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
           "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
-          "pair: theta and theta + pi both stable, unique False; see the README).");
+          "pair: theta and theta + pi both stable, unique False; see the README). axes=['x', ...] and\n"
+          "max_harmonic=n narrow each target's motion family (the others stay zero; an empty family is a ValueError).");
     m.def(
         "orientation_harmonics",
         [](const Scene& sc, std::array<double, 2> at, int n, double tol, double rtol) {

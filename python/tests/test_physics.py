@@ -370,3 +370,18 @@ def test_orientation_harmonics_follow_the_exact_symmetries():
     assert odd["amplitude"][1] < 1e-6 and odd["amplitude"][3] < 1e-6 and odd["amplitude"][2] > 0.05
     with pytest.raises(ValueError):
         plate.orientation_harmonics(fig4, n=3)
+
+
+def test_axes_and_max_harmonic_narrow_a_design_to_those_harmonics():
+    # A transport along x from a plate shaken along x alone (its second harmonic skews the shake):
+    # the designed scene has nothing else, and a family left empty is a ValueError.
+    part = plate.load_scene(scene_path("fig1_point"))
+    d = plate.design(part, transport=(0.02, 0.0), lin_limit=15, starts=4, local_evaluations=150, verify_starts=4,
+                     axes=["x"], max_harmonic=2)
+    assert d.verified, d.failure
+    harmonics = d.scene.to_dict()["plate"]["harmonics"]
+    assert harmonics and all(h["axis"] == "x" and h["n"] <= 2 for h in harmonics)
+    with pytest.raises(ValueError, match="nothing to move"):
+        plate.design(part, sink=(0.0, 0.0), axes=["z"], verify_starts=2)
+    with pytest.raises(ValueError, match="axes"):
+        plate.design(part, sink=(0.0, 0.0), axes=["w"], verify_starts=2)

@@ -140,6 +140,13 @@ struct DesignOptions {
     // (Infinite with a hold: the fastest sink, which the hold then judges.)
     double max_coning = -1;
     double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
+    // The search's freedom (the CLI's --axes and --harmonics): a harmonic on an axis not in `axes`, or
+    // of order n above max_harmonic, is held at zero. Empty / 0: each target's own motion family --
+    // sinks and half-turn pairs x, y, rx, ry at n = 1, 3; line sinks y, rx at n = 1; transport and the
+    // weathervane x, y, z at n = 1, 2; rigid fixed points all six axes at n = 1, 2 -- which these only
+    // narrow (a target whose family is left with nothing to move fails cleanly, naming why).
+    std::vector<Axis> axes;
+    int max_harmonic = 0;
     static LimitCycleOptions cycle_defaults() {
         LimitCycleOptions o;
         o.tol = 1e-6;
