@@ -848,7 +848,8 @@ struct DesignArgs : Options {
                        "  orient THETA      rigid part: every start ends at orientation THETA (position free; a part\n"
                        "                    whose contacts' friction differs: by a plate that only translates)\n"
                        "  line-sink X Y PHI point part: every start ends on the line through (X, Y) along PHI [rad]\n"
-                       "  transport VX VY   point part: a uniform velocity (VX, VY) [m/s] over the plate\n"
+                       "  transport VX VY   a uniform velocity (VX, VY) [m/s] over the plate (a rigid part: one friction\n"
+                       "                    coefficient; OMEGA, a turn, is refused: see the README)\n"
                        "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
                        "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
                        "seeded feasible motions (default 4 for sinks and line sinks, 16 otherwise),\n"
@@ -862,7 +863,7 @@ struct DesignArgs : Options {
                        "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
         words("--target", target, 2, 4, "KIND ...",
-              "sink X Y, fixed-point X Y [THETA], orient THETA, line-sink X Y PHI or transport VX VY; required");
+              "sink X Y, fixed-point X Y [THETA], orient THETA, line-sink X Y PHI or transport VX VY [OMEGA]; required");
         text("--out", out, "SCENE.json", "the designed scene; required");
         numbers("--limits", limits, 2, 2, "LIN ANG", "the largest harmonic amplitudes (default 20 m/s^2, 150 rad/s^2)");
         number("--period", period, "the plate's period [s]", "the part scene's");
@@ -888,8 +889,8 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     for (std::size_t i = 1; i < a.target.size(); ++i) v.push_back(parse_num("--target", a.target[i]));
     const std::size_t want = kind == "orient" ? 1 : (kind == "fixed-point" && !part.part.point) || kind == "line-sink" ? 3 : 2;
     const std::string usage = "expected sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA, "
-                              "line-sink X Y PHI or transport VX VY";
-    if (v.size() != want) throw UsageError("--target " + kind + ": " + usage);
+                              "line-sink X Y PHI or transport VX VY [OMEGA]";
+    if (v.size() != want && !(kind == "transport" && v.size() == 3)) throw UsageError("--target " + kind + ": " + usage);
     if (kind == "sink" || kind == "fixed-point") {
         t.kind = kind == "sink" ? DesignTargetKind::Sink : DesignTargetKind::FixedPoint;
         t.at = Vec2(v[0], v[1]);
@@ -904,6 +905,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     } else if (kind == "transport") {
         t.kind = DesignTargetKind::Transport;
         t.velocity = Vec2(v[0], v[1]);
+        if (v.size() == 3) t.omega = v[2];
     } else {
         throw UsageError("--target: " + usage + ", got '" + kind + "'");
     }
@@ -1001,6 +1003,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
         j["fixed_points_on_grid"] = fixed_points_sentence(d.fixed_points);
     } else {
         j["mean_velocity"] = {d.transport_mean.x(), d.transport_mean.y()};
+        if (rigid) j["largest_turn_rate"] = d.transport_turn;   // (theta' on the grid, rad/s)
         j["spread"] = d.transport_spread;
         j["tolerance"] = d.transport_tolerance;
     }

@@ -389,7 +389,8 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
 
 // With `hold` (sinks and fixed points, opt.hold > 0) one more run starts at rest at *hold, the target,
 // for opt.hold seconds: sum.held (not among sum.runs, nor in the worst distance). With from > 0 each
-// run also records where it was at from * seconds (DesignStartRun::at_from) for end_distance.
+// run also records where it was at about from * seconds, a whole number of periods before its end
+// (DesignStartRun::at_from), for end_distance.
 template <class Seconds, class EndDistance>
 int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& seconds, EndDistance&& end_distance,
                       const Vec3* hold = nullptr, double from = 0) {
@@ -401,7 +402,8 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         r.y = rng.uniform(-opt.region, opt.region);
         if (rigid) r.theta = rng.uniform(-kPi, kPi);   // (drawn after x, y: point parts' starts unchanged)
         r.seconds = seconds(r);
-        r.from = from * r.seconds;
+        // (a whole number of periods from the end: the part's position swings within each period)
+        r.from = r.seconds - std::round((1 - from) * r.seconds / sum.scene.plate.T) * sum.scene.plate.T;
     }
     const bool holding = hold && opt.hold > 0;
     if (holding) {
@@ -960,7 +962,17 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     DesignSummary sum;
     sum.notes.push_back("a plate that only translates (x, y, z): a point part's velocity field is the same everywhere");
     std::atomic<long> cycles{0};
-    const auto make = [&] { return TransportProblem(part_scene, target.velocity, opt, T, &cycles); };
+    // A rigid part with one friction coefficient moves on a translating plate as a point part with
+    // that coefficient (DesignTarget): the search runs on that point part, the verification on the part.
+    Scene point = part_scene;
+    if (!point.part.point) {
+        sum.notes.push_back("a rigid part with one friction coefficient on a plate that only translates: it moves as a point "
+                            "part with that coefficient (no turn; the same velocity at every orientation); designed as that "
+                            "point part, verified as the part itself");
+        point.part.point = true;
+        point.part.mu.setConstant(part_scene.part.mu[0]);
+    }
+    const auto make = [&] { return TransportProblem(point, target.velocity, opt, T, &cycles); };
     // (stop within 0.01% of the target speed)
     const std::vector<double> best = multistart<TransportProblem>(opt, 1e-4, make, sum.evaluations);
     start_summary(sum, part_scene, "_transport", T);
@@ -979,8 +991,13 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     }
     if (undefined < static_cast<int>(f.points.size())) sum.transport_mean /= static_cast<double>(f.points.size() - undefined);
     for (const FieldPoint& p : f.points)
-        if (p.converged) sum.transport_spread = std::max(sum.transport_spread, (p.twist.head<2>() - sum.transport_mean).norm());
+        if (p.converged) {
+            sum.transport_spread = std::max(sum.transport_spread, (p.twist.head<2>() - sum.transport_mean).norm());
+            if (!sum.scene.part.point) sum.transport_turn = std::max(sum.transport_turn, std::abs(p.twist[2]));
+        }
     sum.transport_tolerance = 0.02 * target.velocity.norm();
+    // (a rigid part: theta' within the same 2 %, turned into an angular rate by the part's radius rho)
+    const double turn_tolerance = sum.transport_tolerance / sum.scene.part.rho();
     // Each run for a region's width of travel (1-20 s), judged over its second half: released at rest
     // the part lags the plate's drive while its cycle builds up (about 0.1 s on fig1_point: 9.6 mm at
     // 0.08 m/s, which a check from the start counted against the design; an outside audit found it),
@@ -988,8 +1005,9 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     // field's 2 % over that half (and 5 mm).
     const int stopped = verification_runs(
         sum, opt, [&](const DesignStartRun&) { return std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0); },
-        [&](const DesignStartRun& r, const Vec3& end) {
-            return (end.head<2>() - r.at_from.head<2>() - target.velocity * (r.seconds - r.from)).norm();
+        [&](const DesignStartRun& r, const Vec3& end) {   // (a rigid part's turn over the half: 0.05 rad counts as 5 mm)
+            return std::max((end.head<2>() - r.at_from.head<2>() - target.velocity * (r.seconds - r.from)).norm(),
+                            sum.scene.part.point ? 0.0 : std::abs(end[2] - r.at_from[2]) * opt.verify_distance / 0.05);
         },
         nullptr, 0.5);
     double allowed = opt.verify_distance;
@@ -1001,6 +1019,8 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
                       std::to_string(sum.transport_mean.y()) + ") m/s misses the target by more than 2%: out of reach within the limits";
     else if (!(sum.transport_spread <= sum.transport_tolerance))
         sum.failure = "the field is not uniform over the region";
+    else if (!(sum.transport_turn <= turn_tolerance))
+        sum.failure = "the part turns (theta' up to " + std::to_string(sum.transport_turn) + " rad/s on the grid)";
     else if (stopped)
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
     else if (!(sum.worst_end_distance <= allowed))
@@ -1584,9 +1604,17 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
     const double T = opt.period > 0 ? opt.period : part_scene.plate.T;
     if (!(T > 0)) throw std::invalid_argument("no plate period (give one)");
     if (target.kind == DesignTargetKind::Transport) {
-        if (!part_scene.part.point)
-            throw std::invalid_argument("this version designs transport for point parts only");
         if (!(target.velocity.norm() > 0)) throw std::invalid_argument("a transport target needs a velocity");
+        if (target.omega != 0)
+            throw std::invalid_argument("transport with a turn: a plate that only translates cannot turn a part with one "
+                                        "friction coefficient, and a turning plate's alpha x s makes the twist depend on "
+                                        "position (a whirl), so no uniform twist with OMEGA != 0 is designed (DesignTarget)");
+        if (!part_scene.part.point) {
+            const auto mu = part_scene.part.mu.head(part_scene.part.contacts());
+            if (mu.maxCoeff() > mu.minCoeff() * (1 + 1e-9))
+                throw std::invalid_argument("transport of a part whose contacts' friction differs: a translating plate turns it "
+                                            "(the weathervane) and its velocity with it, so it has no uniform twist (try orient)");
+        }
         return design_transport(part_scene, target, opt, T);
     }
     if (!(std::abs(target.at.x()) <= opt.region && std::abs(target.at.y()) <= opt.region))

@@ -465,7 +465,7 @@ PYBIND11_MODULE(_plate, m) {
           "sink=(x, y) for a rigid part: its position ends at\n"
           "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
           "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
-          "transport=(vx, vy) a uniform velocity over the plate. Rigid parts: orient=theta for a part whose\n"
+          "transport=(vx, vy) a uniform velocity over the plate (also a rigid part with one friction coefficient). Rigid parts: orient=theta for a part whose\n"
           "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
           "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
           "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"

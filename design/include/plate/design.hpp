@@ -88,7 +88,15 @@ struct DesignTarget {
     // Transport: the part moves at the uniform velocity `velocity` everywhere in the region. A plate
     // that only translates (x, y, z harmonics n = 1, 2) gives a point part the same velocity at every
     // position (nothing in its dynamics depends on where it is), so the field is uniform by
-    // construction and the search only sets its value.
+    // construction and the search only sets its value. A rigid part with one friction coefficient on
+    // such a plate is that point part exactly: every contact slides with the centre of mass (nothing
+    // turns it: the torque -(sum_i N_i r_i) x mu u vanishes, sum_i N_i r_i being along u), and friction's
+    // resultant is -mu N u as for the point (measured: fig4's and fig1's parts 0.0200 m/s at every
+    // orientation under a point part's 0.02 m/s design). So it is designed as that point part and
+    // verified as itself (the 7^3 field's twists, theta' included, and full-dynamics runs). `omega`
+    // (transport with a turn) is refused: a translating plate cannot turn such a part, and a turning
+    // plate adds alpha x s, a whirl that makes the twist depend on position (not uniform); a part whose
+    // friction differs turns on any translating plate (the weathervane), its velocity with it.
     // FixedPoint: (at, theta) the unique stable fixed point of the twist field (a rigid part; for a
     // point part the same as Sink). Where no unique one is found, a half-turn pair: (at, theta) and
     // (at, theta + pi) both stable, reported as not unique with each one's basin share. Orient: every start ends at orientation theta, position free (a
@@ -100,6 +108,7 @@ struct DesignTarget {
     Vec2 at = Vec2::Zero();
     double theta = 0;               // [rad]
     Vec2 velocity = Vec2::Zero();   // [m/s]
+    double omega = 0;               // transport's turn [rad/s] (refused unless 0, above)
 };
 
 struct DesignOptions {
@@ -219,8 +228,10 @@ struct DesignSummary {
     // difference between positions on the grid (relative to v_ref and v_ref / rho).
     std::vector<double> ring_theta;
     std::vector<Vec3> ring_twist;
-    // Transport: the field's mean velocity over the verification grid and its largest deviation from it.
+    // Transport: the field's mean velocity over the verification grid and its largest deviation from it
+    // (a rigid part: also its largest |theta'| on the grid, transport_turn [rad/s]).
     Vec2 transport_mean = Vec2::Zero();
+    double transport_turn = 0;
     double transport_spread = 0;       // [m/s]
     double transport_tolerance = 0;    // accepted |mean - target| [m/s]
     double seconds = 0;
