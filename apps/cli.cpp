@@ -966,8 +966,12 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     j["verified"] = d.verified;
     if (!d.verified) j["failure"] = d.failure;
     j["scene"] = a.out;
+    const bool line = t.kind == DesignTargetKind::LineSink, rigid_sink = rigid && t.kind == DesignTargetKind::Sink;
     if (!transport) {
-        j["unique"] = d.unique;
+        // (a line sink has a line of fixed points, not one: there the flag says the line attracts with no
+        // drift along it; a rigid sink's, that the position's field vanishes at the target at every
+        // orientation of the grid -- the design's Newton checks, not a search of the grid for other zeros)
+        j[line ? "line_attracts" : rigid_sink ? "position_zero_at_target_for_every_orientation" : "unique"] = d.unique;
         j["convergence_rate_per_s"] = d.rate;
         if (t.kind == DesignTargetKind::LineSink)   // (the grid's largest speed along the line, and its bound)
             j["speed_along_line"] = {{"largest_on_grid", d.transport_spread}, {"tolerance", d.transport_tolerance}};
@@ -996,11 +1000,11 @@ int cmd_design(const DesignArgs& a, Io& cio) {
                                                  complex_json(c.point.eigenvalues[2])}},
                                 {"basin_share", c.basin_share}});
             j["competing_fixed_points"] = comp;
-        } else {
+        } else if (!line) {
             j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1]};
             j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]), complex_json(d.fixed_point_eigenvalues[1])};
         }
-        j["fixed_points_on_grid"] = fixed_points_sentence(d.fixed_points);
+        if (!rigid_sink) j["fixed_points_on_grid"] = fixed_points_sentence(d.fixed_points);   // (no grid search for those)
     } else {
         j["mean_velocity"] = {d.transport_mean.x(), d.transport_mean.y()};
         if (rigid) j["largest_turn_rate"] = d.transport_turn;   // (theta' on the grid, rad/s)
