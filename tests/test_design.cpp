@@ -205,6 +205,8 @@ TEST_CASE("without the hold a sink cones: released at the target the part walks 
     INFO(s.failure << "; rate " << s.rate << " 1/s, coning " << s.coning << " rad/s");
     REQUIRE(s.verified);   // (verified without a hold)
     CHECK(std::isinf(sink_coning_limit(t.at, o)));
+    // ... and says so: no hold means no coning limit, not a held sink.
+    CHECK(std::any_of(s.notes.begin(), s.notes.end(), [](const std::string& n) { return n.find("coning not limited") != std::string::npos; }));
     CHECK(std::abs(s.coning) > 1e-3);
     const double hold = 120;
     const Trajectory held = simulate(s.scene, Dynamics::Full, Vec3(t.at.x(), t.at.y(), 0), Vec3::Zero(), hold, 10);

@@ -387,6 +387,20 @@ Field verification_field(const Scene& sc, const DesignOptions& opt) {
     return compute_field(sc, g, fo);
 }
 
+// What the grid's fixed-point search could not look at (empty: it searched every cell): cells with an
+// undefined corner, cells left when its budget ran out, cells where the part is stuck all period (a
+// region of fixed configurations, not a point). A fixed point is called unique only without these.
+std::string unsearched(const FixedPoints& f) {
+    std::string gaps;
+    const auto add = [&](int n, const char* what) {
+        if (n > 0) gaps += (gaps.empty() ? "" : ", ") + std::to_string(n) + " cell(s) " + what;
+    };
+    add(f.undefined_cells, "with an undefined corner");
+    add(f.unsearched_cells, "left unsearched (budget)");
+    add(f.stuck_cells, "where the part is stuck all period");
+    return gaps;
+}
+
 // With `hold` (sinks and fixed points, opt.hold > 0) one more run starts at rest at *hold, the target,
 // for opt.hold seconds: sum.held (not among sum.runs, nor in the worst distance). With from > 0 each
 // run also records where it was at about from * seconds, a whole number of periods before its end
@@ -758,6 +772,10 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
         sum.notes.push_back("coning held to " + std::to_string(sink_coning_limit(target.at, opt)) +
                             " rad/s: the plate's second-order turn about z, which the field does not see, turns the "
                             "sink about the plate's centre; at most half the verification distance over the hold");
+    else if (target.at.norm() > 0)   // (an outside audit: --hold 0 lifted the coning limit without a word)
+        sum.notes.push_back("coning not limited (no hold, no --max-coning): the plate's second-order turn about z turns "
+                            "the sink about the plate's centre, so a part held at the target walks off it in time "
+                            "(not checked)");
     std::atomic<long> cycles{0};
     const auto make = [&] { return SinkProblem(part_scene, target.at, opt, T, &cycles); };
     const std::vector<double> best = multistart<SinkProblem>(opt, -HUGE_VAL, make, sum.evaluations);
@@ -792,12 +810,13 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
         stable_at_target += d <= opt.fixed_point_tolerance;
     }
     for (const FixedLine& l : sum.fixed_points.lines) stable += l.stability == Stability::Stable;
-    sum.unique = stable == 1 && stable_at_target == 1;
+    const std::string gaps = unsearched(sum.fixed_points);
+    sum.unique = stable == 1 && stable_at_target == 1 && gaps.empty();
     return sink_verdict(sum, field, target, opt,
                         "the designed field has " + std::to_string(stable) + " stable fixed point(s) or line(s) on the " +
                             std::to_string(opt.verify_grid) + "x" + std::to_string(opt.verify_grid) + " grid, " +
                             std::to_string(stable_at_target) + " within " + std::to_string(opt.fixed_point_tolerance) +
-                            " m of the target",
+                            " m of the target" + (gaps.empty() ? "" : "; not searched: " + gaps),
                         cycles, t0);
 }
 
@@ -1521,7 +1540,9 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
     // A half-turn pair is never unique: its twin exists by the pairing whether or not the grid
     // resolves it (an outside audit: nothing else kept a missed twin from reading unique).
-    sum.unique = !pair && stable == 1 && stable_at_target == 1 && stable_lines == 0;
+    const std::string gaps = unsearched(sum.fixed_points);
+    sum.unique = !pair && stable == 1 && stable_at_target == 1 && stable_lines == 0 && gaps.empty();
+    if (!gaps.empty()) sum.notes.push_back("the grid's fixed-point search did not cover " + gaps + ": not called unique");
     sum.coning = coning_rate(sum.scene.plate);
     const int stopped = verification_runs(
         sum, opt,
