@@ -417,7 +417,7 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         if (rigid) r.theta = rng.uniform(-kPi, kPi);   // (drawn after x, y: point parts' starts unchanged)
         r.seconds = seconds(r);
         // (a whole number of periods from the end: the part's position swings within each period)
-        r.from = r.seconds - std::round((1 - from) * r.seconds / sum.scene.plate.T) * sum.scene.plate.T;
+        r.from = from > 0 ? r.seconds - std::round((1 - from) * r.seconds / sum.scene.plate.T) * sum.scene.plate.T : 0.0;
     }
     const bool holding = hold && opt.hold > 0;
     if (holding) {
