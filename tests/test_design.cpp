@@ -41,6 +41,15 @@ DesignTarget transport(const Vec2& velocity) {
     return t;
 }
 
+// A transport design at `velocity` under 15 m/s^2, which must verify.
+DesignSummary verified_transport(const Scene& part, const Vec2& velocity, DesignOptions o) {
+    o.lin_limit = 15;
+    const DesignSummary s = design(part, transport(velocity), o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    return s;
+}
+
 Vec3 xi(const Scene& sc, const Vec3& q) {
     const LimitCycleSummary lc = limit_cycle(sc, q, tight());
     REQUIRE(lc.converged);
@@ -432,9 +441,7 @@ TEST_CASE("transport: a translating plate carries a point part at the target vel
     DesignTarget t = transport(Vec2(0.02, 0.01));
     DesignOptions o = searched(8, 200, 6);
     o.lin_limit = 15;
-    const DesignSummary s = design(part, t, o);
-    INFO(s.failure);
-    REQUIRE(s.verified);
+    const DesignSummary s = verified_transport(part, t.velocity, o);
     CHECK((s.transport_mean - t.velocity).norm() <= 0.02 * t.velocity.norm());
     // Uniform by construction: what remains is the cycles' tolerance (1e-6 v_ref).
     CHECK(s.transport_spread < 1e-5 * s.scene.v_ref());
@@ -487,12 +494,8 @@ TEST_CASE("transport: a translating plate carries a point part at the target vel
 TEST_CASE("transport of a rigid part with one friction coefficient: the point part's design, verified on the part",
           "[design][rigid]") {
     const Scene part = scene("fig4");
-    DesignTarget t = transport(Vec2(0.02, 0.01));
-    DesignOptions o = searched(4, 150, 6);
-    o.lin_limit = 15;
-    const DesignSummary s = design(part, t, o);
-    INFO(s.failure);
-    REQUIRE(s.verified);
+    const DesignTarget t = transport(Vec2(0.02, 0.01));
+    const DesignSummary s = verified_transport(part, t.velocity, searched(4, 150, 6));
     CHECK(!s.scene.part.point);
     for (const Harmonic& h : s.scene.plate.harmonics) CHECK(static_cast<int>(h.axis) < 3);   // it only translates
     // Independently of the design's own grid: the part's cycles at three configurations, tight, each

@@ -283,9 +283,15 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
             ok = prob.feasible(p);
         }
         if (!ok) return "inf 0 0";
+        // The start's result as text (it may have run in another process): f, evaluations, cycles, p.
+        const auto result = [&] {
+            std::string text = exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' +
+                               std::to_string(own_cycles.load());
+            for (double x : prob.best_p) text += ' ' + exact_text(x);
+            return text;
+        };
         prob.objective(p);   // the feasible start itself
-        if (m == 0) return exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' + std::to_string(own_cycles.load()) +
-                           [&] { std::string t; for (double x : prob.best_p) t += ' ' + exact_text(x); return t; }();
+        if (m == 0) return result();   // (nothing free: the start is the answer)
         // The local search on the free parameters: x (m of them) placed into the full p.
         struct Reduced {
             P* prob;
@@ -351,11 +357,7 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
         } catch (const std::exception&) {
             // (a roundoff-limited stop: the best feasible point found stands)
         }
-        // The start's result as text (it may have run in another process): f, evaluations, cycles, p.
-        std::string text = exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' +
-                           std::to_string(own_cycles.load());
-        for (double x : prob.best_p) text += ' ' + exact_text(x);
-        return text;
+        return result();
     }, [&](int k, const std::string& text) {
         std::istringstream in(text);
         std::string f, x;
@@ -435,8 +437,9 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds,
                                        r.from > 0 ? r.from : r.seconds, io);
         r.end = tr.samples.empty() ? Vec3::Constant(std::numeric_limits<double>::quiet_NaN()) : tr.samples.back().q;
-        for (const Sample& smp : tr.samples)
-            if (r.from > 0 && std::abs(smp.t - r.from) <= 1e-9 * r.seconds) r.at_from = smp.q;
+        if (r.from > 0)
+            for (const Sample& smp : tr.samples)
+                if (std::abs(smp.t - r.from) <= 1e-9 * r.seconds) r.at_from = smp.q;
         const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity() : end_distance(r, r.end);
         // (text: the distance, the end, then why the run stopped early, if it did)
         return exact_text(d) + ' ' + exact_text(r.end[0]) + ' ' + exact_text(r.end[1]) + ' ' + exact_text(r.end[2]) + ' ' +

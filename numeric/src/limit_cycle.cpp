@@ -435,6 +435,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
             break;
         }
         const auto z = e.y();
+        const Vec3 r_now = (model.qd(z) - x).cwiseQuotient(S);   // the residual P(x) - x, scaled
         record_modes(out, e, start_mode, k * T, T);
         const bool switched = start_mode.kind != ModeKind::Slide || !e.events.empty();
         // A period in which the part was stuck as a whole forgets its start: P is constant near x,
@@ -444,7 +445,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
                                 std::any_of(e.events.begin(), e.events.end(),
                                             [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
         if (full_stick) {
-            const double res = (model.qd(z) - x).cwiseQuotient(S).cwiseAbs().maxCoeff();
+            const double res = r_now.cwiseAbs().maxCoeff();
             if (k >= 1 && reset_prev && res <= opt.tol) {
                 // This period ran on a fresh engine from the previous one's end, and returns to its
                 // start within tol: the cycle.
@@ -472,14 +473,13 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         // sides of fig6's 78 sticking cycles in its 7^3 field, by threshold: 3e-4 1.56e6, 1e-3 1.41e6,
         // 3e-2 1.18e6, 1e-1 1.15e6, differences at every start 1.40e6 (the whole field 2.05e6 at
         // 3e-2, 2.29e6 at 1e-3).
-        if (refresh && switched && (model.qd(z) - x).cwiseQuotient(S).cwiseAbs().maxCoeff() > kDifferenceMonodromyNear) {
+        if (refresh && switched && r_now.cwiseAbs().maxCoeff() > kDifferenceMonodromyNear) {
             if (++plain_periods > kPlainPeriodsMax) break;   // slow or alternating: Anderson's
             x = model.qd(z);
             on_curve = true;
             d_prev = std::numeric_limits<double>::infinity();
             continue;
         }
-        const Vec3 r_now = (model.qd(z) - x).cwiseQuotient(S);
         if (refresh) line.setZero();
         const double h = 1e-4;   // the differences' step, relative to the scales
         if (refresh && switched && on_curve && !point && r_now.norm() > 0 &&
