@@ -342,6 +342,13 @@ TEST_CASE("an impossible target fails cleanly, never reported as done", "[design
         const DesignSummary s = design(part, DesignTarget{}, o);
         CHECK_FALSE(s.verified);
         CHECK_FALSE(s.failure.empty());
+        // Stuck all period everywhere: every configuration is fixed, a region and no point; the grid's
+        // search says it did not look there, and nothing is called unique.
+        INFO(s.failure);
+        CHECK(s.fixed_points.stuck_cells > 0);
+        CHECK(s.failure.find("not searched: " + std::to_string(s.fixed_points.stuck_cells) +
+                             " cell(s) where the part is stuck all period") != std::string::npos);
+        CHECK_FALSE(s.unique);
     }
     SECTION("a flight margin no motion can keep") {
         o.flight_margin = 1.1;   // g + a_z >= 1.1 g all period: impossible for zero-mean motion
