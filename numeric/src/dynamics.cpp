@@ -238,9 +238,8 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
         else if (ws.thin) gen::reduced_U_thin_config(ws.in, ws.M38_inv_rowmajor.data(), ws.C.data());
         else gen::reduced_U_thick_config(ws.in, ws.C.data());
     }
-    // A local input: the staged kernels read only the slip directions and u(t), which then stay
-    // in registers.
-    gen::KernelInput k;
+    // The staged kernels read only the slip directions and u(t): those fields are written here.
+    gen::KernelInput& k = ws.staged;
     k.pddx = ps.pdd.x(); k.pddy = ps.pdd.y(); k.pddz = ps.pdd.z();
     k.wdx = ps.wd.x(); k.wdy = ps.wd.y(); k.wdz = ps.wd.z();
     double ux[3], uy[3];

@@ -6,7 +6,53 @@
 
 #include "engine.hpp"
 
+#include <vector>
+
 namespace plate::detail {
+
+// u(t) (eq. 11) and the plate's velocity regrouped by harmonic number: a sin(n w t + phi) =
+// sin(n w t) a cos(phi) + cos(n w t) a sin(phi), so u(t) = sum_n sin(n w t) A_n + cos(n w t) B_n
+// with one sincos per distinct n where PlateMotion::acceleration calls sin once per harmonic
+// (fig6: two harmonics of n = 1; libm's sin took 13 % of its field's time). The velocity's
+// -a/k cos(k t + phi) = -(cos(k t) A_n - sin(k t) B_n)/k with k = n w.
+class Signal {
+public:
+    explicit Signal(const PlateMotion& p) : w_(p.omega()) {
+        for (const auto& h : p.harmonics) {
+            auto it = terms_.begin();
+            while (it != terms_.end() && it->n != h.n) ++it;
+            if (it == terms_.end()) it = terms_.insert(it, Term{h.n, Vec6::Zero(), Vec6::Zero()});
+            it->A[static_cast<int>(h.axis)] += h.amp * std::cos(h.phase);
+            it->B[static_cast<int>(h.axis)] += h.amp * std::sin(h.phase);
+        }
+    }
+    PlateState state(double t, Dynamics level, const Mat3& R1 = Mat3::Identity()) const {
+        PlateState ps;
+        Vec6 u = Vec6::Zero(), v = Vec6::Zero();
+        for (const Term& term : terms_) {
+            const double k = term.n * w_;
+            double s, c;
+            ::sincos(k * t, &s, &c);
+            u += s * term.A + c * term.B;
+            if (level == Dynamics::Full) v -= (c * term.A - s * term.B) / k;
+        }
+        ps.pdd = u.head<3>();
+        ps.wd = u.tail<3>();
+        if (level == Dynamics::Full) {
+            ps.w1 = v.tail<3>();
+            ps.R1 = R1;
+        }
+        return ps;
+    }
+
+private:
+    struct Term {
+        int n;
+        Vec6 A, B;
+    };
+    double w_;
+    std::vector<Term> terms_;
+};
 
 // Scales of the state components: slip speed v_ref, angular rates v_ref / rho, lengths rho.
 struct Scales {
@@ -19,6 +65,7 @@ struct ReducedModel {
     using State = std::array<double, 6>;
     static constexpr bool kStuckFrozen = true;
     const Scene& sc;
+    Signal u{sc.plate};
     Vec3 q0;
     Dynamics level = Dynamics::ReducedU;
     Workspace ws;
@@ -39,8 +86,8 @@ struct ReducedModel {
     Vec3 q(const State&) const { return q0; }
     Vec3 qd(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     void set_qd(State& y, const Vec3& v) const { y[0] = v[0]; y[1] = v[1]; y[2] = v[2]; }
-    PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
-    PlateState plate_at(double t) const { return t == t_last ? ps_last : plate_state(sc.plate, t, level); }
+    PlateState plate(double t, const State&) const { return u.state(t, level); }
+    PlateState plate_at(double t) const { return t == t_last ? ps_last : u.state(t, level); }
     State scale() const {
         const Scales s(sc);
         const double T = sc.plate.T;
@@ -52,6 +99,7 @@ struct UModel {
     using State = std::array<double, 6>;
     static constexpr bool kStuckFrozen = true;
     const Scene& sc;
+    Signal u{sc.plate};
     Dynamics level = Dynamics::U;
     Workspace ws;
     Mode mode;
@@ -64,7 +112,7 @@ struct UModel {
     Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
     void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }
-    PlateState plate(double t, const State&) const { return plate_state(sc.plate, t, level); }
+    PlateState plate(double t, const State&) const { return u.state(t, level); }
     State scale() const {
         const Scales s(sc);
         return {s.L, s.L, 1.0, s.v, s.v, s.w};
@@ -75,6 +123,7 @@ struct FullModel {
     using State = std::array<double, 9>;
     static constexpr bool kStuckFrozen = false;   // the plate's orientation phi moves
     const Scene& sc;
+    Signal u{sc.plate};
     Dynamics level = Dynamics::Full;
     Workspace ws;
     Mode mode;
@@ -90,7 +139,7 @@ struct FullModel {
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
     void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }
     PlateState plate(double t, const State& y) const {
-        return plate_state(sc.plate, t, level, exp_so3(Vec3(y[6], y[7], y[8])));
+        return u.state(t, level, exp_so3(Vec3(y[6], y[7], y[8])));
     }
     State scale() const {
         const Scales s(sc);
