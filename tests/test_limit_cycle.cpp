@@ -71,6 +71,37 @@ TEST_CASE("circular plate translation: the cycle is a circle of speed mu g / w l
     }
 }
 
+TEST_CASE("a circular drive just above mu g: the part slides at the rim from rest, cheaply, its slip bounded",
+          "[trajectory][stick]") {
+    // A w^2 = mu g (1 + 3e-8): the needed friction exceeds the disk from t = 0, so the part never holds,
+    // but its relative speed grows at most as fast as the excess acceleration: d|v|/dt = -a_p . v/|v|
+    // - mu g <= A w^2 - mu g, so |v(t)| <= (A w^2 - mu g) t (8.8e-9 m/s at 0.1 s). Friction pointed
+    // anywhere but against v breaks that by orders (up to 2 mu g t). The slip stays below 1e-9 m/s
+    // for periods while its direction turns with the drive: the engine's creep, spent every third of a
+    // period, restarts after 16, 32, then at most 64 steps below the zero threshold (engine.hpp,
+    // kRecreepMax): 2 061 steps for 0.1 s. Restarts doubling up to 2^20 steps took 1.2e7 (this check
+    // fails on them).
+    const double T = 0.05, mu = 0.3, g = 9.81, excess = mu * g * 3e-8;
+    Scene sc;
+    sc.name = "rim";
+    sc.part.point = true;
+    sc.part.m = 0.02;
+    sc.part.mu.setConstant(mu);
+    sc.plate = circle(mu * g + excess, T);
+    const double duration = 0.1;
+    const Trajectory tr = simulate(sc, Dynamics::U, Vec3::Zero(), Vec3::Zero(), duration, duration / 20);
+    REQUIRE(tr.stop.reason == StopReason::None);
+    INFO("steps " << tr.stats.steps << ", events " << tr.events.size());
+    CHECK(tr.stats.steps < 10000);
+    int sliding = 0;
+    for (const Sample& s : tr.samples) {
+        INFO("t " << s.t << ": |v| " << s.qd.head<2>().norm());
+        CHECK(s.qd.head<2>().norm() <= excess * s.t * (1 + 1e-6) + 1e-15);
+        sliding += s.t > 0 && s.mode.kind == ModeKind::Slide;
+    }
+    CHECK(sliding == 20);
+}
+
 TEST_CASE("Observation 1: very different initial twists reach the same limit cycle on the paper's scenes",
           "[limit_cycle][paper]") {
     struct Case {
