@@ -151,31 +151,31 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
             CHECK(Mc.norm() < 1e-5);          // the period's end forgets its start (measured 1.4e-7)...
             CHECK(sh.monodromy.isZero(0));    // ...and the solver says so
         } else {
-            // The bound follows from the period map's own error e (rtol 1e-8 against 1e-11) at the
-            // points the two difference quotients use: the solver's forward differences at the warm
-            // start w (columns (P(w + h S_j) - P(w)) / h) and the central ones at the cycle c. Each
-            // entry of either is off by at most 2 max|e| / h, so the Frobenius norm of their
-            // difference by 3 (2 + 1) max|e| / h... plus the map's curvature over h/2 + |w - c|
-            // (|P''| from forward against central differences at 10 h). Measured: e up to 1.8e-8,
-            // the difference 1.3e-3 against a bound of ~1.7e-3. A fixed 2e-3 of |M| once passed at
-            // 4.7e-4 and failed at 4.7e-3 after a change of u(t)'s rounding: noise, not the model.
+            // The bound follows from the period map's own errors (against rtol 1e-11) at the points the
+            // two difference quotients use: e_w at the solver's forward differences from the warm start
+            // w (columns (P(w + h S_j) - P(w)) / h, at the solver's rtol 1e-8) and e_c at the central
+            // ones about the cycle c (Mc, at IntegrationOptions{}'s rtol 1e-9). Each entry of the
+            // difference is then off by at most (2 e_w + e_c) / h, its Frobenius norm by 3 times that.
+            // Plus the map's curvature over h/2 + |w - c| -- an estimate, not a bound (|P''| from
+            // forward against central differences at 10 h: diagonal terms only, and P is smooth only
+            // piecewise). A fixed 2e-3 of |M| once passed at 4.7e-4 and failed at 4.7e-3 after a change
+            // of u(t)'s rounding: noise, not the model. (Premise: the solver's M is the one at w -- from
+            // a start this close it takes its three differences on the first period, from w.)
             IntegrationOptions fine;
             fine.rtol = 1e-11;
-            double e = 0;
-            std::vector<Vec3> points{warm, ref.qd_start};
-            for (int j = 0; j < 3; ++j)
-                for (double s : {1.0, -1.0}) {
-                    Vec3 dw = Vec3::Zero(), dc = Vec3::Zero();
-                    dw[j] = 1e-4 * S[j];
-                    dc[j] = s * 1e-4 * S[j];
-                    if (s > 0) points.push_back(warm + dw);
-                    points.push_back(ref.qd_start + dc);
-                }
-            for (const Vec3& x : points) {
+            const IntegrationOptions solver = LimitCycleOptions{}.integration;
+            auto error_at = [&](const Vec3& x, const IntegrationOptions& io) {
                 Vec3 a, b;
-                REQUIRE(period_map(sc, c.q, x, a, IntegrationOptions{}));
+                REQUIRE(period_map(sc, c.q, x, a, io));
                 REQUIRE(period_map(sc, c.q, x, b, fine));
-                e = std::max(e, (a - b).cwiseQuotient(S).cwiseAbs().maxCoeff());
+                return (a - b).cwiseQuotient(S).cwiseAbs().maxCoeff();
+            };
+            double e_w = error_at(warm, solver), e_c = 0;
+            for (int j = 0; j < 3; ++j) {
+                Vec3 d = Vec3::Zero();
+                d[j] = 1e-4 * S[j];
+                e_w = std::max(e_w, error_at(warm + d, solver));
+                e_c = std::max({e_c, error_at(ref.qd_start + d, IntegrationOptions{}), error_at(ref.qd_start - d, IntegrationOptions{})});
             }
             Mat3 Mc10, Mf10;
             REQUIRE(central_monodromy(sc, c.q, ref.qd_start, 1e-3, fine, Mc10));
@@ -187,11 +187,14 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
                 REQUIRE(period_map(sc, c.q, xp, Pp, fine));
                 Mf10.col(j) = (Pp - P0).cwiseQuotient(S) / 1e-3;
             }
-            const double curvature = 2 * (Mf10 - Mc10).norm() / 1e-3;   // |P''|, scaled
-            const double bound = 9 * e / 1e-4 + curvature * (0.5e-4 + 1e-4 * std::sqrt(3.0));
-            INFO("period map error " << e << ", |P''| " << curvature << ", bound " << bound);
+            const double curvature = 2 * (Mf10 - Mc10).norm() / 1e-3;   // |P''|, scaled (estimated)
+            const double bound = 3 * (2 * e_w + e_c) / 1e-4 + curvature * (0.5e-4 + 1e-4 * std::sqrt(3.0));
+            INFO("period map errors e_w " << e_w << ", e_c " << e_c << ", |P''| " << curvature << ", bound " << bound);
             CHECK((sh.monodromy - Mc).norm() <= bound);
-            CHECK(bound < 0.02 * Mc.norm());   // (a bound that says something)
+            // The solver's rtol-1e-8 periods are the noise (e_w 2.0e-7 measured, e_c 1.7e-8): the bound is
+            // 4.5 % of |M| (the difference 0.47 %). It still tells the derivative from what else a
+            // solver could report (a full stick's M = 0 is 100 % off; a monodromy 5 % off fails it).
+            CHECK(bound < 0.06 * Mc.norm());
             CHECK(Mc.eigenvalues().cwiseAbs().maxCoeff() < 1);
             CHECK(Mc.norm() > 0.1);   // not a full stick: the start matters
         }

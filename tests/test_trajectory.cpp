@@ -271,15 +271,17 @@ TEST_CASE("friction never does positive work, in every mode (slide, pivot, stuck
 
 TEST_CASE("a held contact's friction stays in its disk: no stick outlives its break-away", "[trajectory][stick]") {
     // The power test above holds by construction wherever friction opposes the slip; this one tests
-    // the events. While stuck the needed friction wrench must lie in the set the contacts can supply
-    // (gauge gamma <= 1, modes.hpp's friction_gauge over the three disks), and while pivoting the
-    // held contact's force in its own disk (|f_k| <= mu_k N_k): a hold kept past its break-away
-    // breaks them. The break-away is located on the dense output to 1e-13 T, so a sample at most that
-    // far past it exceeds the disk by gamma' 1e-13 T (~1e-10 here): 1e-9 allowed. Where the holds are
-    // sampled densely to their end (fig6's pivots, heave_yaw's sticks: thousands of samples) they reach
-    // the rim (measured 0.99996 and 0.99999), so checked against 0.99 mu (a model with 1 % less
-    // friction than the engine's) those cases fail (measured 1.0101); fig1's brief sticks are sampled
-    // 39 times (their break-away is pinned against an independent root in "fig1 from rest" above).
+    // the hold logic. While stuck the needed friction wrench must lie in the set the contacts can
+    // supply (gauge gamma <= 1, modes.hpp's friction_gauge over the three disks), and while pivoting
+    // the held contact's force in its own disk (|f_k| <= mu_k N_k). Samples every 2e-5 s are step
+    // ends (the engine stops its steps at them), where the hold guards were just evaluated: a sample
+    // outside the disk means a hold kept with its guard negative (a crossing missed, or choose_mode
+    // picking the hold again past the rim); 1e-9 allowed for rounding. It does not time the
+    // break-aways (a late root inside a step would still end the hold before the sample): that is
+    // "fig1 from rest" above, against an independent root. Where the holds are sampled densely to
+    // their end (fig6's pivots, heave_yaw's sticks: thousands of samples) they reach the rim
+    // (measured 0.99996 and 0.99999), so checked against 0.99 mu (a model with 1 % less friction than
+    // the engine's) those cases fail (measured 1.0101); fig1's brief sticks are sampled 39 times.
     struct Case { const char* scene; Vec3 q0; double duration; bool pivots, rim; };
     for (const Case& c : {Case{"fig6", Vec3(-0.05, 0.016666666666666663, 4.487989505128276), 0.2, true, true},
                           Case{"fig1", Vec3(-0.04, 0.03, 1.2), 0.05, false, false},
