@@ -329,11 +329,14 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
     ws.creep_iterations = 0;
     accelerations(sc, level, q, qd, ps, ws);
     if (m == 0) return;
+    // (a_j x u_j + |v_j| rate_j: the slip turns with its direction at the rate the engine measured,
+    // d(v/|v|)/dt = (u x a) / |v|; with rate 0 the slip could not turn with a turning drive, and a
+    // slide at the rim of the disk stayed at the zero threshold, 20x below the exact speed.)
     auto residual = [&](Eigen::Vector3d& c) {
         for (int j = 0; j < m; ++j) {
             const Vec2 a = contact_acceleration(P, level, idx[j], q, qd, ws.qdd);
             const Vec2& u = ws.hint[idx[j]];
-            c[j] = a.x() * u.y() - a.y() * u.x();
+            c[j] = a.x() * u.y() - a.y() * u.x() + ws.slip[idx[j]].norm() * ws.creep_rate[idx[j]];
         }
     };
     auto set_angles = [&](const Eigen::Vector3d& phi) {
@@ -402,6 +405,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
     const Part& P = sc.part;
     const int nc = P.contacts();
     ws.creep = 0;   // every slide below has its directions set here
+    ws.creep_rate = {};
     ws.creep_twist.setZero();
     ModeChoice out;
     int count = 0, k = -1;

@@ -103,6 +103,10 @@ struct Workspace {
     // slip exceeds creep_speed or the lag this ignores could matter (engine.hpp).
     unsigned creep = 0;
     double creep_speed = 0;
+    // The turning rate [rad/s, counter-clockwise] of creeping contact i's direction over the engine's
+    // last step: the direction is then solved so that the slip turns with it, u_i x a_i = |v_i| rate_i
+    // (its lag behind the consistent direction to first order; zero: a_i along u_i).
+    std::array<double, 3> creep_rate{};
     // When every contact creeps (a break-away from rest relative to the plate, or an approach to it)
     // the slips are those of one twist: its unit direction (s_x', s_y', rho theta'), solved instead of
     // the contacts' angles (zero: none yet -- taken from the twist, or set by choose_mode).
