@@ -436,9 +436,7 @@ private:
                 if (recreep || (sn > 0 && sn < zero_abs_ && sn < std::abs(g0_[3 + i]) && !(creep_spent_ >> i & 1u))) {
                     ws.creep |= 1u << i;
                     ws.hint[i] = slip[i] / sn;
-                    creep_err_[i] = 0;
-                    creep_dir_[i] = Vec2::Zero();
-                    ws.creep_rate[i] = 0;
+                    new_creep(i);
                     creep_h_ = std::min(creep_h_, kCreepFirst * scene_.plate.T);
                     changed = true;
                 }
@@ -488,6 +486,12 @@ private:
         }
         return off;
     }
+    // A creep of contact i begins: its budget, last direction and turning rate start afresh.
+    void new_creep(int i) {
+        creep_err_[i] = 0;
+        creep_dir_[i] = Vec2::Zero();
+        model_.ws.creep_rate[i] = 0;
+    }
     // Contact i slides on along v/|v| (spent: not to creep again before its next event); the twist's
     // direction no longer describes every contact.
     void stop_creep(int i, bool spent) {
@@ -514,9 +518,7 @@ private:
         for (int i = 0; i < scene_.part.contacts(); ++i)
             if (v[i].norm() <= ws.hint_speed && ws.hint[i].norm() > 0) {
                 ws.creep |= 1u << i;
-                creep_err_[i] = 0;
-                creep_dir_[i] = Vec2::Zero();   // (the direction is solved at the first evaluation)
-                ws.creep_rate[i] = 0;
+                new_creep(i);   // (the direction is solved at the first evaluation)
                 creep_h_ = kCreepFirst * scene_.plate.T;
             }
     }
