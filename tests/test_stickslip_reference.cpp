@@ -386,38 +386,54 @@ TEST_CASE("tight tolerances through a rim-sliding stick: converged, cheap, and c
 
 TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same at every tight tolerance",
           "[stick][reference]") {
-    // heave_yaw at (0, 0.02, 0): stuck, slides, pivots, ... -- ten mode changes a period. Right after a
-    // reversal (a slip reaching zero that static friction cannot hold) the slips sit at the
-    // integrator's noise, and each crossing of zero used to be taken as a new reversal: 91, 1 519 and
-    // 117 mode changes at rtol 1e-8, 1e-9, 1e-10 for the same cycle (engine.hpp: fresh_). The physical
-    // sequence cannot depend on the tolerance, nor can the stick fractions (within 1e-3 of the period).
+    // heave_yaw at (0, 0.02, 0): held about contact 2, sliding, held about 2 again, stuck; then the same
+    // about contact 3 -- eight changes of held contacts a period. Right after a reversal (a slip
+    // reaching zero that static friction cannot hold) the slips sit at the integrator's noise, and each
+    // crossing of zero used to be taken as a new reversal: 91, 1 519 and 117 mode changes at rtol 1e-8,
+    // 1e-9, 1e-10 for the same cycle (engine.hpp: fresh_). The holds and their times cannot depend on
+    // the tolerance, nor can the stick fractions (within 1e-3 of the period).
+    // Reversals (slide -> slide) are counted, not matched: the second one comes 1e-6-1e-5 T after
+    // contact 3's pivot breaks away at the rim of its disk, where that contact slides on at the
+    // noise floor (2e-11 m/s = 1.5e-9 v_ref at rtol 1e-10, 2e-10 m/s at 1e-9) and the other two at
+    // 1e-8 and 2e-9 m/s, all inside the zero band (3e2 rtol v_ref) of rtol 1e-8: whether that slip
+    // touches zero is noise (measured: at 0.85776 T at rtol 1e-8, 0.857757 T at 1e-10, not at all at
+    // 1e-9 once rigid parts' creeps carry their direction's turn). One or two a cycle (measured 2, 1,
+    // 2); chattering gives hundreds.
     const Scene sc = scene("heave_yaw");
     std::vector<LimitCycleSummary> c;
+    std::vector<std::vector<ModeEvent>> holds;   // the events that are not reversals
     for (double rtol : {1e-8, 1e-9, 1e-10}) {
         LimitCycleOptions o;
         o.tol = 1e-9;
         o.integration.rtol = rtol;
         c.push_back(limit_cycle(sc, Vec3(0, 0.02, 0), o));
         REQUIRE(c.back().converged);
+        holds.emplace_back();
+        int reversals = 0;
+        for (const ModeEvent& e : c.back().mode_events) {
+            if (e.from.kind == ModeKind::Slide && e.to.kind == ModeKind::Slide) ++reversals;
+            else holds.back().push_back(e);
+        }
+        INFO("rtol " << rtol);
+        CHECK(reversals >= 1);
+        CHECK(reversals <= 2);
     }
     for (std::size_t k = 1; k < c.size(); ++k) {
         INFO("rtol 1e-" << 8 + k << " against 1e-8");
-        REQUIRE(c[k].mode_events.size() == c[0].mode_events.size());
-        for (std::size_t e = 0; e < c[0].mode_events.size(); ++e) {
-            CHECK(c[k].mode_events[e].to == c[0].mode_events[e].to);
-            CHECK(std::abs(c[k].mode_events[e].t - c[0].mode_events[e].t) < 1e-3 * sc.plate.T);
+        REQUIRE(holds[k].size() == holds[0].size());
+        for (std::size_t e = 0; e < holds[0].size(); ++e) {
+            CHECK(holds[k][e].to == holds[0][e].to);
+            CHECK(std::abs(holds[k][e].t - holds[0][e].t) < 1e-3 * sc.plate.T);
         }
         for (int i = 0; i < 3; ++i) CHECK(std::abs(c[k].stick_fraction[i] - c[0].stick_fraction[i]) < 1e-3);
     }
     // And the sequence is the physical one, not merely the same at each tolerance (with stick detection
-    // off there would be no events at all, and the comparisons above would hold): held about contact 2,
-    // sliding, held about 2 again, stuck; then the same about contact 3 (measured at all three).
-    const std::vector<Mode> expected = {{ModeKind::Pivot, 1}, {ModeKind::Slide, -1}, {ModeKind::Slide, -1},
-                                        {ModeKind::Pivot, 1}, {ModeKind::Stuck, -1}, {ModeKind::Pivot, 2},
-                                        {ModeKind::Slide, -1}, {ModeKind::Slide, -1}, {ModeKind::Pivot, 2},
-                                        {ModeKind::Stuck, -1}};
-    REQUIRE(c[0].mode_events.size() == expected.size());
-    for (std::size_t e = 0; e < expected.size(); ++e) CHECK(c[0].mode_events[e].to == expected[e]);
+    // off there would be no events at all, and the comparisons above would hold) (measured at all three).
+    const std::vector<Mode> expected = {{ModeKind::Pivot, 1}, {ModeKind::Slide, -1}, {ModeKind::Pivot, 1},
+                                        {ModeKind::Stuck, -1}, {ModeKind::Pivot, 2}, {ModeKind::Slide, -1},
+                                        {ModeKind::Pivot, 2}, {ModeKind::Stuck, -1}};
+    REQUIRE(holds[0].size() == expected.size());
+    for (std::size_t e = 0; e < expected.size(); ++e) CHECK(holds[0][e].to == expected[e]);
     // Each contact has zero slip about three quarters of the period (measured 0.747, 0.782, 0.784).
     for (int i = 0; i < 3; ++i) CHECK(c[0].stick_fraction[i] == Approx(std::array<double, 3>{0.747, 0.782, 0.784}[i]).margin(1e-3));
 }

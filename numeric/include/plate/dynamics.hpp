@@ -111,6 +111,9 @@ struct Workspace {
     // the slips are those of one twist: its unit direction (s_x', s_y', rho theta'), solved instead of
     // the contacts' angles (zero: none yet -- taken from the twist, or set by choose_mode).
     Vec3 creep_twist = Vec3::Zero();
+    // ... and that direction's angular velocity over the engine's last step [rad/s]: the direction x is
+    // solved so that the twist turns with it, q''_perp = |q'| rate x x (zero: q'' along x).
+    Vec3 creep_twist_rate = Vec3::Zero();
     int creep_iterations = 0;              // Newton iterations of the last creep solve (diagnostics)
     std::array<Vec2, 3> f_held = zeros<Vec2>();          // static friction of held contacts (pivot, stuck) [N], P frame
     Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate
