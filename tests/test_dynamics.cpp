@@ -85,8 +85,10 @@ TEST_CASE("the engine's u(t), regrouped by harmonic number, is PlateMotion's to 
     // a sin(n w t + phi) per harmonic; the velocity likewise. Several harmonics share an n and an axis
     // here, on every axis, at times up to 540 periods. The two differ by the rounding of the arguments
     // n w t (+ phi): 4 ulp of the largest, times the amplitudes' sum (measured 3.2e-11 at t = 20 s,
-    // where the arguments reach 1e4 rad). With the velocity's sign flipped, or B_n built from cos(phi),
-    // it fails by the amplitude itself.
+    // where the arguments reach 1e4 rad; 0.010 of that allowance at most). With the velocity's sign
+    // flipped, or B_n built from cos(phi), it fails by the amplitude itself; with the table's rotation
+    // turned the wrong way (sin(j pi/8 - x)) by 3e12 allowances. (Too coarse for the Taylor terms: sin x
+    // without its x^11 term, 4e-16 off at pi/16, still passes.)
     PlateMotion p;
     p.T = 0.037;
     const Axis axes[] = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
@@ -98,7 +100,11 @@ TEST_CASE("the engine's u(t), regrouped by harmonic number, is PlateMotion's to 
     }
     const detail::Signal u(p);
     double worst_a = 0, worst_v = 0;
-    for (double t : {0.0, 0.0123, 0.5, 3.21, 19.999}) {
+    // (Signal reduces n w t to a multiple of pi/8 and a remainder within pi/16: 4 001 times over the
+    // 20 s, an irrational step apart, cover every table entry and remainders to the edges.)
+    std::vector<double> times = {0.0, 0.0123, 0.5, 3.21, 19.999};
+    for (int k = 0; k <= 4000; ++k) times.push_back(k * 20.0 / 4000 * (1 - 1 / (1000 * kPi)));
+    for (double t : times) {
         const double ulps = 4 * 2.2e-16 * (1 + 3 * p.omega() * t + 2);   // (n <= 3, |phi| <= 3)
         const PlateState ps = plate_state(p, t, Dynamics::Full), s = u.state(t, Dynamics::Full);
         worst_a = std::max({worst_a, (ps.pdd - s.pdd).cwiseAbs().maxCoeff() / (ulps * amp),

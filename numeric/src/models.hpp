@@ -12,9 +12,15 @@ namespace plate::detail {
 
 // u(t) (eq. 11) and the plate's velocity regrouped by harmonic number: a sin(n w t + phi) =
 // sin(n w t) a cos(phi) + cos(n w t) a sin(phi), so u(t) = sum_n sin(n w t) A_n + cos(n w t) B_n
-// with one sincos per distinct n where PlateMotion::acceleration calls sin once per harmonic
+// with one sine and cosine per distinct n where PlateMotion::acceleration calls sin once per harmonic
 // (fig6: two harmonics of n = 1; libm's sin took 13 % of its field's time). The velocity's
 // -a/k cos(k t + phi) = -(cos(k t) A_n - sin(k t) B_n)/k with k = n w.
+// The sine and cosine of phi = n w t: phi = j pi/8 + x with j the nearest multiple (Cody-Waite, pi/8
+// split so that j times its head is exact for |j| < 2^20) and |x| <= pi/16, then sin(j pi/8 + x) from
+// a table of sixteen and Taylor polynomials in x (truncation below 1.1e-19 and 1.5e-21 there) -- the
+// same argument fl(n w t) libm's sincos takes, to a few ulp, and deterministic in t (a cache of the
+// last call would make u(t) depend on the order of calls, and a field on its threads). libm's sincos
+// took 17 % of fig6's field (perf); tests/test_dynamics.cpp compares it with PlateMotion.
 class Signal {
 public:
     explicit Signal(const PlateMotion& p) : w_(p.omega()) {
@@ -25,6 +31,11 @@ public:
             it->A[static_cast<int>(h.axis)] += h.amp * std::cos(h.phase);
             it->B[static_cast<int>(h.axis)] += h.amp * std::sin(h.phase);
         }
+        for (int m = 0; m < 16; ++m) {
+            sin_[m] = std::sin(m * kPi / 8);
+            cos_[m] = std::cos(m * kPi / 8);
+        }
+        sin_[0] = sin_[8] = cos_[4] = cos_[12] = 0;   // (exact zeros)
     }
     PlateState state(double t, Dynamics level, const Mat3& R1 = Mat3::Identity()) const {
         PlateState ps;
@@ -32,7 +43,7 @@ public:
         for (const Term& term : terms_) {
             const double k = term.n * w_;
             double s, c;
-            ::sincos(k * t, &s, &c);
+            sincos_of(k * t, s, c);
             u += s * term.A + c * term.B;
             if (level == Dynamics::Full) v -= (c * term.A - s * term.B) / k;
         }
@@ -44,6 +55,24 @@ public:
         }
         return ps;
     }
+    // sin and cos of phi (above); libm's for |phi| beyond the exact range of the reduction.
+    void sincos_of(double phi, double& s, double& c) const {
+        constexpr double kInvStep = 8 / kPi;
+        // pi/8 = kStep1 + kStep2 + kStep3: kStep1 has 33 significant bits (j kStep1 exact for |j| < 2^20)
+        constexpr double kStep1 = 0x1.921fb544p-2, kStep2 = 0x1.0b4611a6p-36, kStep3 = 0x1.3198a2e037073p-71;
+        const double jd = std::nearbyint(phi * kInvStep);
+        if (!(std::abs(jd) < 1048576.0)) {
+            ::sincos(phi, &s, &c);
+            return;
+        }
+        const double x = ((phi - jd * kStep1) - jd * kStep2) - jd * kStep3;
+        const double x2 = x * x;
+        const double sx = x + x * x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 + x2 * (-1.0 / 39916800)))));
+        const double cx = 1 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 + x2 * (-1.0 / 3628800)))));
+        const int m = static_cast<int>(static_cast<long long>(jd) & 15);
+        s = sin_[m] * cx + cos_[m] * sx;
+        c = cos_[m] * cx - sin_[m] * sx;
+    }
 
 private:
     struct Term {
@@ -52,6 +81,7 @@ private:
     };
     double w_;
     std::vector<Term> terms_;
+    double sin_[16], cos_[16];
 };
 
 // Scales of the state components: slip speed v_ref, angular rates v_ref / rho, lengths rho.
