@@ -993,6 +993,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
                                             complex_json(d.fixed_point_eigenvalues[1]),
                                             complex_json(d.fixed_point_eigenvalues[2])};
             j["basin_share"] = d.basin_share;
+            if (d.basin_share_bound < 1) j["basin_share_bound"] = d.basin_share_bound;
             nlohmann::json comp = nlohmann::json::array();
             for (const auto& c : d.competitors)
                 comp.push_back({{"at", {c.point.q[0], c.point.q[1], c.point.q[2]}},

@@ -884,6 +884,10 @@ TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair,
     }
     CHECK(s.basin_share == Approx(at_target / 10.0));
     CHECK(s.competitors[0].basin_share == Approx(at_twin / 10.0));
+    // The pairing's cap on the share, about the centre halfway between the target and its twin:
+    // (0.1 - 0.04)(0.1 - 0.02) of the 0.01 m^2 square is its own image, so at most 1 - 0.48 / 2.
+    CHECK(s.basin_share_bound == Approx(pair_basin_bound(0.5 * (t.at + twin.q.head<2>()), o.region)).margin(1e-3));
+    CHECK(s.basin_share_bound == Approx(0.76).margin(1e-3));
     CHECK(at_target > 0);
     CHECK(at_twin > 0);   // (each basin half the starts in expectation; 10 runs)
     CHECK(std::abs(s.coning) <= 1e-4);
@@ -892,4 +896,17 @@ TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair,
     CHECK(s.held.end_distance <= o.verify_distance);
     CHECK(s.starts == 4);   // two searches of two starts
     CHECK(s.notes.front().find("unique fixed point failed") != std::string::npos);
+}
+
+TEST_CASE("a half-turn pair's basin cap: of the region's part that is its own image, at most half",
+          "[design][rigid]") {
+    // Closed forms for |s_x|, |s_y| <= a: about the region's centre the whole region is its own image
+    // (1/2); about a point on its edge nothing is (1); in between (2a - 2|D_x|)(2a - 2|D_y|) / (4 a^2)
+    // of it is, half of which may go to the target.
+    const double a = 0.05;
+    CHECK(pair_basin_bound(Vec2(0, 0), a) == Approx(0.5));
+    CHECK(pair_basin_bound(Vec2(a, 0), a) == Approx(1.0));
+    CHECK(pair_basin_bound(Vec2(0, -2 * a), a) == Approx(1.0));
+    CHECK(pair_basin_bound(Vec2(0.02, -0.01), a) == Approx(1 - 0.06 * 0.08 / (2 * 0.01)));
+    CHECK(pair_basin_bound(Vec2(-0.02, 0.01), a) == Approx(pair_basin_bound(Vec2(0.02, -0.01), a)));
 }

@@ -1573,6 +1573,15 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     // A half-turn pair: exactly one competitor, the target's image under the pairing about the design's
     // centre D = target - s_turned, i.e. at (2 D - target, THETA + pi).
     const Vec2 twin_at = at - 2 * s_turned;
+    if (pair) {
+        sum.basin_share_bound = pair_basin_bound(at - s_turned, opt.region);
+        std::ostringstream note;
+        note.precision(2);
+        note << "the pairing caps the target's basin share at " << sum.basin_share_bound
+             << " of starts uniform over the region: the twin's basin is the image of the target's under the half turn about "
+                "the design's centre, so where the region is its own image at most half of it can go to the target";
+        sum.notes.push_back(note.str());
+    }
     const bool twin_ok = others.size() == 1 && (others[0].q.head<2>() - twin_at).norm() <= opt.fixed_point_tolerance &&
                          std::abs(wrap_angle(others[0].q[2] - goal[2] - kPi)) <= 0.02;
     if (stable_at_target != 1)
@@ -1596,6 +1605,13 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
 }
 
 }  // namespace
+
+double pair_basin_bound(const Vec2& D, double region) {
+    // R = [-a, a]^2 and its image 2 D - R = [2 D - a, 2 D + a]^2 overlap over (2 a - 2 |D_i|) per axis.
+    double overlap = 1;
+    for (int i = 0; i < 2; ++i) overlap *= std::max(0.0, 2 * region - 2 * std::abs(D[i]));
+    return 1 - overlap / (2 * 4 * region * region);
+}
 
 double coning_rate(const PlateMotion& u) {
     // sum_n Im(A_rx,n conj(A_ry,n)) / (2 (n w)^3) over the phasors amp e^{i phase} of each (axis, n).

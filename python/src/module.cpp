@@ -372,6 +372,8 @@ PYBIND11_MODULE(_plate, m) {
         }, "orient by transport: (theta, twist) at the centre on the verification's ring of orientations")
         .def_readonly("basin_share", &DesignSummary::basin_share,
                       "rigid parts: the share of the verification runs that end at the target")
+        .def_readonly("basin_share_bound", &DesignSummary::basin_share_bound,
+                      "the largest share the design's symmetry allows (a half-turn pair: below 1)")
         .def_property_readonly("competitors", [](const DesignSummary& s) {
             std::vector<std::tuple<Vec3, double>> r;
             for (const auto& c : s.competitors) r.emplace_back(c.point.q, c.basin_share);

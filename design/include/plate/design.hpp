@@ -201,6 +201,11 @@ struct DesignSummary {
     // Rigid parts: the share of the runs below that end at the target, and the other stable fixed
     // points on the grid with the share that ends at each (a design that is not unique says so).
     double basin_share = 0;
+    // The largest share the design's symmetry allows (1: none known). A half-turn pair's twin basin is
+    // the image of the target's under sigma: (s, theta) -> (2 D - s, theta + pi), D the design's centre,
+    // so of the region R the part O = R and sigma(R) that is its own image goes at most half to the
+    // target: share <= 1 - |O| / (2 |R|) for starts uniform over R and the turn (pair_basin_bound).
+    double basin_share_bound = 1;
     struct Competitor {
         FixedPoint point;
         double basin_share = 0;
@@ -251,6 +256,10 @@ double sink_coning_limit(const Vec2& at, const DesignOptions& opt);
 // mass (they stand on plate points up to that far beyond it).
 double vertical_margin(const PlateMotion& u, double g, double half_width);
 double flight_region(const Scene& part, const DesignOptions& opt);
+
+// The basin-share bound of a half-turn pair about D over the region |s_x|, |s_y| <= region (above):
+// 1 - |R and (2 D - R)| / (2 |R|). fig4's pair at (0.02, -0.01): 0.76.
+double pair_basin_bound(const Vec2& D, double region);
 
 // The starts a design makes when DesignOptions::starts is 0: 4 for sinks and line sinks (16 and 4
 // parameters: a point part's sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
