@@ -85,7 +85,7 @@ TEST_CASE("the engine's u(t), regrouped by harmonic number, is PlateMotion's to 
     // a sin(n w t + phi) per harmonic; the velocity likewise. Several harmonics share an n and an axis
     // here, on every axis, at times up to 540 periods. The two differ by the rounding of the arguments
     // n w t (+ phi): 4 ulp of the largest, times the amplitudes' sum (measured 3.2e-11 at t = 20 s,
-    // where the arguments reach 1e4 rad; 0.010 of that allowance at most). With the velocity's sign
+    // where the arguments reach 1e4 rad; 0.014 of that allowance at most). With the velocity's sign
     // flipped, or B_n built from cos(phi), it fails by the amplitude itself; with the table's rotation
     // turned the wrong way (sin(j pi/8 - x)) by 3e12 allowances. (Too coarse for the Taylor terms: sin x
     // without its x^11 term, 4e-16 off at pi/16, still passes.)

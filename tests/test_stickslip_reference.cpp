@@ -392,16 +392,17 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
     // crossing of zero used to be taken as a new reversal: 91, 1 519 and 117 mode changes at rtol 1e-8,
     // 1e-9, 1e-10 for the same cycle (engine.hpp: fresh_). The holds and their times cannot depend on
     // the tolerance, nor can the stick fractions (within 1e-3 of the period).
-    // Reversals (slide -> slide) are counted, not matched: the second one comes 1e-6-1e-5 T after
-    // contact 3's pivot breaks away at the rim of its disk, where that contact slides on at the
-    // noise floor (2e-11 m/s = 1.5e-9 v_ref at rtol 1e-10, 2e-10 m/s at 1e-9) and the other two at
-    // 1e-8 and 2e-9 m/s, all inside the zero band (3e2 rtol v_ref) of rtol 1e-8: whether that slip
-    // touches zero is noise (measured: at 0.85776 T at rtol 1e-8, 0.857757 T at 1e-10, not at all at
-    // 1e-9 once rigid parts' creeps carry their direction's turn). One or two a cycle (measured 2, 1,
-    // 2); chattering gives hundreds.
+    // Reversals (slide -> slide) come right after a pivot breaks away: 1e-6 T after contact 2's at
+    // every tolerance, and 1e-6-1e-5 T after contact 3's at rtol 1e-8 and 1e-10 but not at 1e-9. There
+    // contact 3 slides on at the noise floor (its slip scales with rtol: 2e-10 m/s at 1e-9, 2e-11 =
+    // 1.5e-9 v_ref at 1e-10: it stays at the rim of its disk), the other two at 1e-8 and 2e-9 m/s, all
+    // inside rtol 1e-8's zero band (3e2 rtol v_ref), so whether it touches zero is noise. So: the first
+    // reversal matched (time within 1e-3 T at every tolerance), every reversal within 1e-5 T after a
+    // break-away, and one or two a cycle (chattering gave hundreds; with the reversal band off 100).
     const Scene sc = scene("heave_yaw");
     std::vector<LimitCycleSummary> c;
     std::vector<std::vector<ModeEvent>> holds;   // the events that are not reversals
+    std::vector<double> first_reversal;
     for (double rtol : {1e-8, 1e-9, 1e-10}) {
         LimitCycleOptions o;
         o.tol = 1e-9;
@@ -410,14 +411,23 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
         REQUIRE(c.back().converged);
         holds.emplace_back();
         int reversals = 0;
+        double broke = -HUGE_VAL;   // the last break-away of a pivot
         for (const ModeEvent& e : c.back().mode_events) {
-            if (e.from.kind == ModeKind::Slide && e.to.kind == ModeKind::Slide) ++reversals;
-            else holds.back().push_back(e);
+            if (e.from.kind == ModeKind::Slide && e.to.kind == ModeKind::Slide) {
+                INFO("rtol " << rtol << ": a reversal at " << e.t / sc.plate.T << " T, the last break-away at " << broke / sc.plate.T);
+                CHECK(e.t - broke <= 1e-5 * sc.plate.T);
+                if (reversals++ == 0) first_reversal.push_back(e.t);
+            } else {
+                holds.back().push_back(e);
+                if (e.from.kind == ModeKind::Pivot && e.to.kind == ModeKind::Slide) broke = e.t;
+            }
         }
         INFO("rtol " << rtol);
         CHECK(reversals >= 1);
         CHECK(reversals <= 2);
     }
+    REQUIRE(first_reversal.size() == 3u);
+    for (double t : first_reversal) CHECK(std::abs(t - first_reversal[0]) < 1e-3 * sc.plate.T);
     for (std::size_t k = 1; k < c.size(); ++k) {
         INFO("rtol 1e-" << 8 + k << " against 1e-8");
         REQUIRE(holds[k].size() == holds[0].size());

@@ -462,8 +462,8 @@ private:
             // (the turn less the last rate's), times the slip.
             const double turn = creep_dir_[i].isZero() ? 0.0 : std::atan2(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x(), creep_dir_[i].dot(u));
             const double sn = slip[i].norm(), inc = std::abs(turn - ws.creep_rate[i] * h) * sn;
-            // Rigid parts too: fig6's field 1.86e6 -> 1.67e6 right-hand sides, heave_yaw's 1.90e6 ->
-            // 1.47e6. (heave_yaw's cycle at (0, 0.02, 0) then shows no reversal 1e-6 T after contact 3's
+            // Rigid parts too: fig6's field 1.86e6 -> 1.69e6 right-hand sides, heave_yaw's 1.90e6 ->
+            // 1.56e6 (with the twist creep's turn, modes.cpp). (heave_yaw's cycle at (0, 0.02, 0) then shows no reversal 1e-6 T after contact 3's
             // pivot breaks away at rtol 1e-9, where rtol 1e-8 and 1e-10 show one: that contact slides
             // on at the noise floor, 2e-10 and 2e-11 m/s, and whether it touches zero is noise; the
             // mode-sequence test counts such reversals instead of matching them.)

@@ -16,8 +16,9 @@ namespace plate::detail {
 // (fig6: two harmonics of n = 1; libm's sin took 13 % of its field's time). The velocity's
 // -a/k cos(k t + phi) = -(cos(k t) A_n - sin(k t) B_n)/k with k = n w.
 // The sine and cosine of phi = n w t: phi = j pi/8 + x with j the nearest multiple (Cody-Waite, pi/8
-// split so that j times its head is exact for |j| < 2^20) and |x| <= pi/16, then sin(j pi/8 + x) from
-// a table of sixteen and Taylor polynomials in x (truncation below 1.1e-19 and 1.5e-21 there) -- the
+// split so that j times its head, 31 significant bits, is exact for |j| < 2^20) and |x| <= pi/16, then
+// sin(j pi/8 + x) from a table of sixteen and Taylor polynomials in x (the first terms left out,
+// x^13/13! and x^12/12!, below 1.1e-19 and 6.9e-18 = 0.03 ulp of 1 there) -- the
 // same argument fl(n w t) libm's sincos takes, to a few ulp, and deterministic in t (a cache of the
 // last call would make u(t) depend on the order of calls, and a field on its threads). libm's sincos
 // took 17 % of fig6's field (perf); tests/test_dynamics.cpp compares it with PlateMotion.
@@ -58,7 +59,8 @@ public:
     // sin and cos of phi (above); libm's for |phi| beyond the exact range of the reduction.
     void sincos_of(double phi, double& s, double& c) const {
         constexpr double kInvStep = 8 / kPi;
-        // pi/8 = kStep1 + kStep2 + kStep3: kStep1 has 33 significant bits (j kStep1 exact for |j| < 2^20)
+        // pi/8 = kStep1 + kStep2 + kStep3: kStep1 and kStep2 have at most 33 significant bits (j times
+        // them exact for |j| < 2^20)
         constexpr double kStep1 = 0x1.921fb544p-2, kStep2 = 0x1.0b4611a6p-36, kStep3 = 0x1.3198a2e037073p-71;
         const double jd = std::nearbyint(phi * kInvStep);
         if (!(std::abs(jd) < 1048576.0)) {

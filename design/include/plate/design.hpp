@@ -204,7 +204,8 @@ struct DesignSummary {
     // The largest share the design's symmetry allows (1: none known). A half-turn pair's twin basin is
     // the image of the target's under sigma: (s, theta) -> (2 D - s, theta + pi), D the design's centre,
     // so of the region R the part O = R and sigma(R) that is its own image goes at most half to the
-    // target: share <= 1 - |O| / (2 |R|) for starts uniform over R and the turn (pair_basin_bound).
+    // target: share <= 1 - |O| / (2 |R|) for starts uniform over R and the turn, in the field's flow
+    // (pair_basin_bound; the runs' basin_share is a finite sample from phase 0 and may exceed it).
     double basin_share_bound = 1;
     struct Competitor {
         FixedPoint point;
