@@ -232,6 +232,49 @@ TEST_CASE("shooting fields: predicted warm starts, the same field on any number 
     CHECK(periods / g.size() < 3.5);
 }
 
+TEST_CASE("a plate moving only along and about z: the field turns with the part, and its predicted starts keep it "
+          "the same on any number of threads", "[field][shooting][stick]") {
+    // fig6 (z and rz harmonics) looks the same turned about the plate's origin, so the cycle at
+    // (R_a s, theta + a) is the one at (s, theta) turned: twist (R_a v, theta'). Checked on cycles solved
+    // from rest (no predictor) at a sliding and a sticking configuration, turned by 1 and 2.5 rad: within
+    // the two cycles' accuracy, 2 (tol + 3e2 rtol) v_ref (the zero band counts where it sticks).
+    // A sign error in the turn, or a turn about the wrong point, is off by the twist itself.
+    const Scene sc = scene("fig6");
+    LimitCycleOptions lo;
+    const double v = sc.v_ref(), rho = sc.part.rho();
+    for (const Vec3& q : {Vec3(0.03, -0.01, 0.4), Vec3(-0.05, 0.0167, 4.49)}) {
+        const LimitCycleSummary a = limit_cycle(sc, q, lo);
+        REQUIRE(a.converged);
+        CHECK((*std::max_element(a.stick_fraction.begin(), a.stick_fraction.end()) > 0) == (q[0] < 0));   // (the second sticks)
+        for (double turn : {1.0, 2.5}) {
+            const Vec2 s = Eigen::Rotation2Dd(turn) * Vec2(q[0], q[1]);
+            const LimitCycleSummary b = limit_cycle(sc, Vec3(s[0], s[1], q[2] + turn), lo);
+            REQUIRE(b.converged);
+            const Vec2 va = Eigen::Rotation2Dd(turn) * Vec2(a.twist[0], a.twist[1]);
+            const double allowed = 2 * (lo.tol + 3e2 * lo.integration.rtol);
+            INFO("at (" << q.transpose() << ") turned by " << turn << "; sticks " << a.stick_fraction[0] << ", " << a.stick_fraction[1] << ", " << a.stick_fraction[2]);
+            CHECK((Vec2(b.twist[0], b.twist[1]) - va).norm() / v <= allowed);
+            CHECK(std::abs(b.twist[2] - a.twist[2]) * rho / v <= allowed);
+        }
+    }
+    // The field predicts each start from this symmetry (field.cpp): from points solved before it in
+    // every schedule, so the field is the same on one thread and on two, bit for bit.
+    GridSpec g;
+    g.nx = g.ny = g.nth = 5;
+    FieldOptions o1, o2;
+    o1.threads = 1;
+    o2.threads = 2;
+    const Field f1 = compute_field(sc, g, o1), f2 = compute_field(sc, g, o2);
+    int sticking = 0;
+    for (int i = 0; i < g.size(); ++i) {
+        REQUIRE(f1.points[i].converged);
+        CHECK(f1.points[i].twist == f2.points[i].twist);
+        CHECK(f1.points[i].rhs_evals == f2.points[i].rhs_evals);
+        sticking += *std::max_element(f1.points[i].stick_fraction.begin(), f1.points[i].stick_fraction.end()) > 0;
+    }
+    CHECK(sticking > 0);
+}
+
 TEST_CASE("fixed points: regions where the part is stuck all period are not refined, and work is bounded",
           "[field][stick]") {
     // heave_yaw_point: the point part is stuck all period at 9 of 49 configurations (twist exactly 0:
