@@ -193,6 +193,10 @@ public:
                 continue;
             }
             if (ev < 0) {
+                // A creep's directions are read from the workspace (creep_step): if the event search
+                // evaluated inside the step since, evaluate the step's end again so that they are its.
+                if (model_.ws.creep && !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
+                    sys(ys1_, fs1_, t1);
                 account(t1);
                 t_ = t1;
                 ys_ = ys1_;
