@@ -782,7 +782,7 @@ private:
     // at mu g (1 + 3e-8): the slip under 1e-9 m/s for periods, the creep's budget spent every third
     // of a period) took 1.2e7 steps for 0.1 s with a cap of 2^20 -- stiff stretches of up to 2^20
     // steps between creeps -- and 2 061 with 64 (its slip 2e-10 m/s apart, ~rtol v_ref); measured before
-    // a point part's creep carried the slip's turn (creep_rate: 26 steps since), it still bounds rigid parts'.
+    // the creeps carried the slip's turn (creep_rate: 26 steps since, point and rigid parts).
     static constexpr int kRecreepMax = 64;
     std::array<int, 3> recreep_need_{kRecreep, kRecreep, kRecreep};
     std::array<int, 3> slow_{};
