@@ -429,8 +429,7 @@ private:
                                       : Vec3(axis / sn * (std::atan2(sn, creep_xi_.dot(ws.creep_twist)) / h));
             creep_xi_ = ws.creep_twist;
         } else {
-            ws.creep_twist_rate.setZero();
-            creep_xi_.setZero();
+            forget_twist_turn();
         }
         for (int i = 0; i < scene_.part.contacts(); ++i) {
             if (!(ws.creep >> i & 1u)) {
@@ -467,10 +466,11 @@ private:
             const double turn = creep_dir_[i].isZero() ? 0.0 : std::atan2(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x(), creep_dir_[i].dot(u));
             const double sn = slip[i].norm(), inc = std::abs(turn - ws.creep_rate[i] * h) * sn;
             // Rigid parts too: fig6's field 1.86e6 -> 1.69e6 right-hand sides, heave_yaw's 1.90e6 ->
-            // 1.56e6 (with the twist creep's turn, modes.cpp). (heave_yaw's cycle at (0, 0.02, 0) then shows no reversal 1e-6 T after contact 3's
-            // pivot breaks away at rtol 1e-9, where rtol 1e-8 and 1e-10 show one: that contact slides
-            // on at the noise floor, 2e-10 and 2e-11 m/s, and whether it touches zero is noise; the
-            // mode-sequence test counts such reversals instead of matching them.)
+            // 1.56e6 (with the twist creep's turn, modes.cpp). (heave_yaw's cycle at (0, 0.02, 0) then
+            // shows no reversal 1e-6 T after contact 3's pivot breaks away at rtol 1e-9, where rtol
+            // 1e-8 and 1e-10 show one: that contact slides on at the noise floor, 2e-10 and 2e-11 m/s,
+            // and whether it touches zero is noise; the mode-sequence test ties reversals to
+            // break-aways instead of matching each.)
             ws.creep_rate[i] = creep_dir_[i].isZero() || !(h > 0) ? 0.0 : turn / h;
             creep_err_[i] += inc;
             creep_dir_[i] = u;
@@ -510,6 +510,10 @@ private:
         creep_err_[i] = 0;
         creep_dir_[i] = Vec2::Zero();
         model_.ws.creep_rate[i] = 0;
+        forget_twist_turn();
+    }
+    // The twist creep's turn is measured afresh (a creep started or stopped, or a new mode).
+    void forget_twist_turn() {
         model_.ws.creep_twist_rate.setZero();
         creep_xi_.setZero();
     }
@@ -519,8 +523,7 @@ private:
         model_.ws.creep &= ~(1u << i);
         model_.ws.creep_rate[i] = 0;
         model_.ws.creep_twist.setZero();
-        model_.ws.creep_twist_rate.setZero();
-        creep_xi_.setZero();
+        forget_twist_turn();
         if (spent) creep_spent_ |= 1u << i;
     }
     // Entering a mode at state y: in a slide, the contacts at zero slip (just broken away) creep.
@@ -529,8 +532,7 @@ private:
         fresh_ = 0;
         ws.creep = 0;
         ws.creep_rate = {};
-        ws.creep_twist_rate.setZero();
-        creep_xi_.setZero();
+        forget_twist_turn();
         creep_spent_ = 0;
         linger_need_ = {kLinger, kLinger, kLinger};
         recreep_need_ = {kRecreep, kRecreep, kRecreep};
