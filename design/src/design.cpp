@@ -1580,7 +1580,7 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         note << "the pairing caps the target's basin share in the field's flow at " << sum.basin_share_bound
              << " of starts uniform over the region: the twin's basin is the image of the target's under the half turn about "
                 "the design's centre, so where the region is its own image at most half of it can go to the target (the "
-                "full-dynamics runs' share is a sample of 20 from phase 0 and can exceed it by chance)";
+                "full-dynamics runs' share is a sample of " << sum.runs.size() << " from phase 0 and can exceed it by chance)";
         sum.notes.push_back(note.str());
     }
     const bool twin_ok = others.size() == 1 && (others[0].q.head<2>() - twin_at).norm() <= opt.fixed_point_tolerance &&
