@@ -62,15 +62,22 @@ public:
         // pi/8 = kStep1 + kStep2 + kStep3: kStep1 and kStep2 have at most 33 significant bits (j times
         // them exact for |j| < 2^20)
         constexpr double kStep1 = 0x1.921fb544p-2, kStep2 = 0x1.0b4611a6p-36, kStep3 = 0x1.3198a2e037073p-71;
-        const double jd = std::nearbyint(phi * kInvStep);
+        // (round to nearest by adding and taking away 1.5 * 2^52, exact for |phi kInvStep| < 2^51 in the
+        // default rounding mode: std::nearbyint is a library call without SSE4.1)
+        constexpr double kRound = 0x1.8p52;
+        const double jd = (phi * kInvStep + kRound) - kRound;
         if (!(std::abs(jd) < 1048576.0)) {
             ::sincos(phi, &s, &c);
             return;
         }
         const double x = ((phi - jd * kStep1) - jd * kStep2) - jd * kStep3;
         const double x2 = x * x;
-        const double sx = x + x * x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 + x2 * (-1.0 / 39916800)))));
-        const double cx = 1 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 + x2 * (-1.0 / 3628800)))));
+        // (Estrin's scheme in x^2: a shorter chain of dependent operations than Horner's)
+        const double x4 = x2 * x2, x8 = x4 * x4;
+        const double sx = x + x * x2 * ((-1.0 / 6 + x2 * (1.0 / 120)) + x4 * (-1.0 / 5040 + x2 * (1.0 / 362880)) +
+                                        x8 * (-1.0 / 39916800));
+        const double cx = 1 + x2 * ((-0.5 + x2 * (1.0 / 24)) + x4 * (-1.0 / 720 + x2 * (1.0 / 40320)) +
+                                    x8 * (-1.0 / 3628800));
         const int m = static_cast<int>(static_cast<long long>(jd) & 15);
         s = sin_[m] * cx + cos_[m] * sx;
         c = cos_[m] * cx - sin_[m] * sx;
