@@ -60,7 +60,9 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     std::atomic<long> spent{0};
     bool report_progress = true;   // (with a task runner, the runner's done reports)
     std::atomic<bool> over{false};
-    auto solve = [&](int i, int j, int k, const Vec3& warm, double& h0) {
+    // `tight`: the point solved before it in its line changed mode, so this one likely does too -- no loose
+    // large-slip steps (LimitCycleOptions::integration; a sticking cycle's accepted period must be tight).
+    auto solve = [&](int i, int j, int k, const Vec3& warm, double& h0, bool tight) {
         const int idx = grid.index(i, j, k);
         FieldPoint& p = f.points[idx];
         p.q = grid.at(i, j, k);
@@ -76,6 +78,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         }
         LimitCycleOptions o = opt.cycle;
         if (opt.warm_start) o.integration.h0 = h0;
+        if (tight) o.integration.large_slip_factor = 1;
         LimitCycleSummary lc = limit_cycle(sc, p.q, o, warm);
         if (!lc.converged && !warm.isZero()) {
             const long spent = lc.stats.rhs_evals;
@@ -219,6 +222,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     // quarter of the 7^3 grid), a task runner gets the planes {C_ik, k >= 1} after every process has
     // solved the A and B lines.
     std::vector<double> hint(grid.size(), 0.0);
+    std::vector<char> switching(grid.size(), 0);   // the point's cycle changes mode (or failed)
     struct Line { char kind; int i, k; };   // 'A': k; 'B': i; 'C': i, k
     auto line_points = [&](const Line& l) {
         std::vector<int> idx;
@@ -229,14 +233,18 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     auto run_line = [&](const Line& l) {
         const std::vector<int> idx = line_points(l);
         if (idx.empty()) return;
-        double h0 = l.kind == 'A' ? (l.k > 0 ? hint[grid.index(0, 0, l.k - 1)] : 0.0)
-                                  : hint[grid.index(l.i, 0, l.kind == 'B' ? 0 : l.k)];
+        const int before = l.kind == 'A' ? (l.k > 0 ? grid.index(0, 0, l.k - 1) : -1)
+                                         : grid.index(l.i, 0, l.kind == 'B' ? 0 : l.k);
+        double h0 = before >= 0 ? hint[before] : 0.0;
+        bool tight = before >= 0 && switching[before];
         for (int id : idx) {
             const int i = id / (grid.ny * grid.nth), j = (id / grid.nth) % grid.ny, k = id % grid.nth;
             Vec3 w;
             if (!(rotation_invariant && turned_warm(i, j, k, w))) w = warm(i, j, k);
-            solve(i, j, k, w, h0);
+            const LimitCycleSummary lc = solve(i, j, k, w, h0, tight);
             hint[id] = h0;
+            switching[id] = !lc.converged || lc.start_mode.kind != ModeKind::Slide || !lc.mode_events.empty();
+            tight = switching[id];
         }
     };
     std::vector<Line> lines;   // in an order that respects the predecessors
@@ -278,7 +286,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
             double h0 = 0;
             Vec3 w = Vec3::Zero();
             for (int k = 0; k < grid.nth; ++k) {
-                const LimitCycleSummary lc = solve(t / grid.ny, t % grid.ny, k, opt.warm_start ? w : Vec3::Zero(), h0);
+                const LimitCycleSummary lc = solve(t / grid.ny, t % grid.ny, k, opt.warm_start ? w : Vec3::Zero(), h0, true);
                 w = lc.converged ? lc.qd_start : Vec3::Zero();
             }
         }

@@ -392,11 +392,16 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     int fd_periods = 0;
     int plain_periods = 0;
     Mat3 M = Mat3::Zero(), Pa = Mat3::Zero();
+    bool loose = opt.integration.large_slip_factor != 1;
     bool on_curve = false;   // x is the previous period's end (on the period map's image)
     Vec3 line = Vec3::Zero();   // with a rank-one M: its range, along which the iterates stay
     double d_prev = std::numeric_limits<double>::infinity();
     for (int k = 0; k < opt.max_periods; ++k) {
         const detail::ReducedModel::State y{x[0], x[1], x[2], 0, 0, 0};
+        IntegrationOptions io = opt.integration;
+        if (!loose) io.large_slip_factor = 1;
+        const bool io_tight = io.large_slip_factor == 1;
+        e.set_large_slip_factor(io.large_slip_factor);
         bool ok = true;
         // After a full stick the next period starts on a fresh engine (its first step small again):
         // one carried over from a far start can step over a brief pivot (an outside audit found a
@@ -438,6 +443,9 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         const Vec3 r_now = (model.qd(z) - x).cwiseQuotient(S);   // the residual P(x) - x, scaled
         record_modes(out, e, start_mode, k * T, T);
         const bool switched = start_mode.kind != ModeKind::Slide || !e.events.empty();
+        // A period that changed mode is accepted only if it ran tight, and so are the ones after it.
+        const bool accept = !(switched && !io_tight);
+        if (switched) loose = false;
         // A period in which the part was stuck as a whole forgets its start: P is constant near x,
         // so M = 0 exactly and P(x) is the cycle's start (to the integration's noise). The period
         // after it, from P(x), is then the cycle: when it sticks fully too, it is converged.
@@ -446,7 +454,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
                                             [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
         if (full_stick) {
             const double res = r_now.cwiseAbs().maxCoeff();
-            if (k >= 1 && reset_prev && res <= opt.tol) {
+            if (k >= 1 && reset_prev && res <= opt.tol && accept) {
                 // This period ran on a fresh engine from the previous one's end, and returns to its
                 // start within tol: the cycle.
                 out.twist = Vec3(z[3], z[4], z[5]) / T;
@@ -487,7 +495,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
              std::any_of(e.events.begin(), e.events.end(), [](const ModeEvent& m) { return m.to.kind == ModeKind::Pivot; }))) {
             // The rank-one monodromy (above): one difference along the residual.
             const Vec3 u = r_now.normalized();
-            const PeriodResult pu = one_period(sc, q0, x + h * u.cwiseProduct(S), opt.integration, fd_stats);
+            const PeriodResult pu = one_period(sc, q0, x + h * u.cwiseProduct(S), io, fd_stats);
             ++fd_periods;
             ++out.periods;
             if (!pu.ok) break;
@@ -509,7 +517,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
             for (int j = 0; j < (point ? 2 : 3) && fd_ok; ++j) {
                 Vec3 xj = x;
                 xj[j] += h * S[j];
-                const PeriodResult pj = one_period(sc, q0, xj, opt.integration, fd_stats);
+                const PeriodResult pj = one_period(sc, q0, xj, io, fd_stats);
                 fd_ok = pj.ok;
                 M.col(j) = (pj.end - end).cwiseQuotient(S) / h;
                 Pa.col(j) = (pj.average - avg).cwiseQuotient(S) / h;
@@ -566,7 +574,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         // nothing is accepted before r_perp is below a tenth of tol. It falls quadratically (the map
         // puts every start on its image curve; r_perp is that curve's bend over the last step).
         const bool on_line = line.isZero() || (r - line * line.dot(r)).norm() <= 0.1 * opt.tol;
-        if (was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol && kPaError * dn <= opt.tol) {
+        if (accept && was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol && kPaError * dn <= opt.tol) {
             out.error_estimate = 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn;
             out.converged = true;
             break;
@@ -584,9 +592,12 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
                 // chord-accepted twist 1e-6 v_ref off with an estimate of 7e-8.
                 const double dist = 2 * theta / (1 - 2 * theta) * dn;
                 out.error_estimate = Pa.cwiseAbs().rowwise().sum().maxCoeff() * (dist + kPaError * dn);
-                if (on_line && out.error_estimate <= opt.tol) { out.converged = true; break; }
+                if (accept && on_line && out.error_estimate <= opt.tol) { out.converged = true; break; }
             }
-            if (theta > 0.5) {
+            if (theta > 0.5 && loose) {
+                loose = false;
+                refresh = true;
+            } else if (theta > 0.5) {
                 if (was_fresh) break;   // even a fresh monodromy does not contract: give up
                 refresh = true;         // a stale chord: refresh M at this start
             }
@@ -610,6 +621,10 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     // Within one period the engine's own budget applies: no more than the cycle's.
     LimitCycleOptions opt = opt_in;
     opt.integration.max_steps = std::min(opt.integration.max_steps, std::max(1L, opt.max_rhs_evaluations / 10));
+    // Only the shooting loosens the large-slip steps (it watches its own contraction); Anderson and
+    // plain periods keep one tolerance.
+    LimitCycleOptions shooting_opt = opt;
+    opt.integration.large_slip_factor = 1;
     if (sc.part.mu.head(sc.part.contacts()).maxCoeff() <= 0) {
         // Without friction q'' = -(p'' + omega1' x s)_xy is periodic with zero mean: every initial
         // twist is periodic and none attracts the others, so the asymptotic twist is undefined.
@@ -629,7 +644,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
             a.solver = CycleSolver::Anderson;
             return limit_cycle(sc, q0, a, qd0);
         }
-        LimitCycleSummary fast = shoot ? shooting_cycle(sc, q0, opt, qd0)
+        LimitCycleSummary fast = shoot ? shooting_cycle(sc, q0, shooting_opt, qd0)
                                  : opt.solver == CycleSolver::Newton ? newton_cycle(sc, q0, opt, qd0)
                                                                      : one_start(sc, q0, opt, qd0);
         if (fast.converged || fast.periods >= opt.max_periods || fast.stats.rhs_evals >= opt.max_rhs_evaluations ||

@@ -39,8 +39,17 @@ enum class CycleSolver { PeriodByPeriod, Anderson, Newton, Shooting };
 const char* cycle_solver_name(CycleSolver s);
 CycleSolver parse_cycle_solver(const std::string& name);   // throws std::invalid_argument
 
+// The cycles' integration: rtol 1e-8, and ten times that on steps where every slip is large
+// (IntegrationOptions::large_slip_factor).
+inline IntegrationOptions cycle_integration() {
+    IntegrationOptions io;
+    io.rtol = 1e-8;
+    io.large_slip_factor = 10;
+    return io;
+}
+
 struct LimitCycleOptions {
-    IntegrationOptions integration{1e-8};
+    IntegrationOptions integration = cycle_integration();
     double tol = 1e-7;          // accepted distance to the cycle, relative to v_ref
     int max_periods = 400;      // then "not converged"
     bool record = false;        // keep every accepted step (for plots and tests)

@@ -30,6 +30,12 @@ struct IntegrationOptions {
     // The work budget of one run: accepted steps, and right-hand sides (rejected tries, event
     // location, creep solves) at ten per step; then StepLimit.
     long max_steps = 20'000'000;
+    // Steps that start with every contact sliding at more than 3e-2 v_ref (no creep, no held
+    // contact) take large_slip_factor * rtol, up to 1e-6 (never less than rtol). There the dynamics are smooth and contract (friction
+    // damps the relative motion), so a local error only shifts the path; near zero slip it also
+    // shifts when a contact sticks, breaks away or reverses, which is where the sticking cycles' error
+    // comes from. 1: one tolerance everywhere (trajectories); limit cycles use 10 (LimitCycleOptions).
+    double large_slip_factor = 1;
 };
 
 enum class StopReason { None, ContactLost, Sticking, StepCollapse, StepLimit, NotConverged, EventAccumulation };
