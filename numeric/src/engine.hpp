@@ -789,8 +789,8 @@ private:
     // A step whose slips all exceed this (relative to v_ref) may take IntegrationOptions::large_slip_factor
     // rtol: three times the creep speed (fig6's field, factor 10: 1e-2 and 3e-2 save alike, 1e-1 a third less).
     static constexpr double kLargeSlip = 3e-2;
-    // ... but no looser than 1e-6: at rtol 1e-3 such steps (1e-2) were long enough to pass over a
-    // tenth of a period's stick, fig6's cycle at (-0.0333, 0.0167, 4.488) 55 rtol v_ref off.
+    // ... but no looser than 1e-6 (and never tighter than rtol): fig4's cycle at (0.02, -0.01, 0.5),
+    // shot at rtol 1e-6 from 0.05 v_ref off, 8.9 cycle tolerances off without the cap, 0.27 with it.
     static constexpr double kLargeSlipRtolCap = 1e-6;
     std::array<int, 3> low_{};
     std::array<double, 3> slip_prev_{}, slip_prev2_{};

@@ -60,8 +60,9 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     std::atomic<long> spent{0};
     bool report_progress = true;   // (with a task runner, the runner's done reports)
     std::atomic<bool> over{false};
-    // `tight`: the point solved before it in its line changed mode, so this one likely does too -- no loose
-    // large-slip steps (LimitCycleOptions::integration; a sticking cycle's accepted period must be tight).
+    // `tight`: the point solved before it in its line changed mode, so this one likely does too: its
+    // first period at one tolerance (LimitCycleOptions::first_period_tight; a cycle that changes mode
+    // goes on tight, and a loose period that changed mode would be one spent in vain).
     auto solve = [&](int i, int j, int k, const Vec3& warm, double& h0, bool tight) {
         const int idx = grid.index(i, j, k);
         FieldPoint& p = f.points[idx];
@@ -78,7 +79,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         }
         LimitCycleOptions o = opt.cycle;
         if (opt.warm_start) o.integration.h0 = h0;
-        if (tight) o.integration.large_slip_factor = 1;
+        o.first_period_tight = tight;
         LimitCycleSummary lc = limit_cycle(sc, p.q, o, warm);
         if (!lc.converged && !warm.isZero()) {
             const long spent = lc.stats.rhs_evals;

@@ -399,7 +399,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     for (int k = 0; k < opt.max_periods; ++k) {
         const detail::ReducedModel::State y{x[0], x[1], x[2], 0, 0, 0};
         IntegrationOptions io = opt.integration;
-        if (!loose) io.large_slip_factor = 1;
+        if (!loose || (k == 0 && opt.first_period_tight)) io.large_slip_factor = 1;
         const bool io_tight = io.large_slip_factor == 1;
         e.set_large_slip_factor(io.large_slip_factor);
         bool ok = true;
@@ -594,10 +594,7 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
                 out.error_estimate = Pa.cwiseAbs().rowwise().sum().maxCoeff() * (dist + kPaError * dn);
                 if (accept && on_line && out.error_estimate <= opt.tol) { out.converged = true; break; }
             }
-            if (theta > 0.5 && loose) {
-                loose = false;
-                refresh = true;
-            } else if (theta > 0.5) {
+            if (theta > 0.5) {
                 if (was_fresh) break;   // even a fresh monodromy does not contract: give up
                 refresh = true;         // a stale chord: refresh M at this start
             }

@@ -63,6 +63,10 @@ struct LimitCycleOptions {
     // The work budget of one cycle, all its periods, restarts and fallbacks together: right-hand
     // sides (a cycle takes 10^3 to 10^5; 2e7 is about 3 s). Then StepLimit ("work budget").
     long max_rhs_evaluations = 20'000'000;
+    // Shooting: the first period at one tolerance (integration.large_slip_factor then applies from the
+    // second period on, if the first did not change mode): a field sets it where the point before
+    // this one changed mode.
+    bool first_period_tight = false;
 };
 
 struct LimitCycleSummary {

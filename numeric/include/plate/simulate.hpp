@@ -31,10 +31,12 @@ struct IntegrationOptions {
     // location, creep solves) at ten per step; then StepLimit.
     long max_steps = 20'000'000;
     // Steps that start with every contact sliding at more than 3e-2 v_ref (no creep, no held
-    // contact) take large_slip_factor * rtol, up to 1e-6 (never less than rtol). There the dynamics are smooth and contract (friction
-    // damps the relative motion), so a local error only shifts the path; near zero slip it also
+    // contact) take large_slip_factor * rtol, up to 1e-6 (never less than rtol). There the dynamics
+    // are smooth and contract (friction damps the relative motion), so a local error only shifts the
+    // path; near zero slip it also
     // shifts when a contact sticks, breaks away or reverses, which is where the sticking cycles' error
-    // comes from. 1: one tolerance everywhere (trajectories); limit cycles use 10 (LimitCycleOptions).
+    // comes from. 1: one tolerance everywhere (trajectories); the shooting of limit cycles uses 10
+    // (cycle_integration(), limit_cycle.hpp; Anderson and plain periods take 1 whatever is set).
     double large_slip_factor = 1;
 };
 
