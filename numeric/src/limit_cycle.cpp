@@ -618,8 +618,9 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     // Within one period the engine's own budget applies: no more than the cycle's.
     LimitCycleOptions opt = opt_in;
     opt.integration.max_steps = std::min(opt.integration.max_steps, std::max(1L, opt.max_rhs_evaluations / 10));
-    // Only the shooting loosens the large-slip steps (it watches its own contraction); Anderson and
-    // plain periods keep one tolerance.
+    // Only the shooting loosens the large-slip steps, until its cycle changes mode (shooting_cycle);
+    // Anderson and plain periods keep one tolerance (with it, fig1_point's slowly contracting cycles
+    // stalled at the loose map's noise).
     LimitCycleOptions shooting_opt = opt;
     opt.integration.large_slip_factor = 1;
     if (sc.part.mu.head(sc.part.contacts()).maxCoeff() <= 0) {

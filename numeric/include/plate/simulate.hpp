@@ -33,10 +33,10 @@ struct IntegrationOptions {
     // Steps that start with every contact sliding at more than 3e-2 v_ref (no creep, no held
     // contact) take large_slip_factor * rtol, up to 1e-6 (never less than rtol). There the dynamics
     // are smooth and contract (friction damps the relative motion), so a local error only shifts the
-    // path; near zero slip it also
-    // shifts when a contact sticks, breaks away or reverses, which is where the sticking cycles' error
-    // comes from. 1: one tolerance everywhere (trajectories); the shooting of limit cycles uses 10
-    // (cycle_integration(), limit_cycle.hpp; Anderson and plain periods take 1 whatever is set).
+    // path; near zero slip it also shifts when a contact sticks, breaks away or reverses, which is
+    // where the sticking cycles' error comes from. 1: one tolerance everywhere (trajectories); the
+    // shooting of limit cycles uses 10 (cycle_integration(), limit_cycle.hpp; Anderson and plain
+    // periods take 1 whatever is set).
     double large_slip_factor = 1;
 };
 
