@@ -360,10 +360,13 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
         for (const Job& j : jobs) {
             fs::remove(j.result);
             fs::remove(j.result.string() + ".tmp");
+            // The previous job's line must not be there when the loop first looks: the shell truncates the
+            // file in the child, which may not have run yet (a fast machine signalled a job before it started).
+            fs::remove(err);
             // bash: start, wait (up to 10 min) for the pause, signal, reap; prints the exit status.
             const std::string script =
                 "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " " + j.args + " > /dev/null 2> " +
-                err.string() + " & p=$!; for i in $(seq 6000); do grep -q 'paused before rename' " + err.string() +
+                err.string() + " & p=$!; for i in $(seq 6000); do grep -qs 'paused before rename' " + err.string() +
                 " && break; sleep 0.1; done; kill -" + sig + " $p; wait $p; echo $?";
             const fs::path status = tmpdir() / "status", sh = tmpdir() / "interrupt.sh";
             std::ofstream(sh) << script << "\n";
@@ -380,9 +383,10 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
     // A report interrupted after an earlier one completed does not leave the old page beside new figures.
     REQUIRE(run("report --quick --sections fig3 --out " + (d / "report").string()).code == 0);
     REQUIRE(fs::exists(d / "report" / "index.html"));
+    fs::remove(err);
     const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " report --quick --sections fig3 --out " +
                                (d / "report").string() + " > /dev/null 2> " + err.string() +
-                               " & p=$!; for i in $(seq 6000); do grep -q paused " + err.string() +
+                               " & p=$!; for i in $(seq 6000); do grep -qs paused " + err.string() +
                                " && break; sleep 0.1; done; kill -KILL $p; wait $p";
     std::ofstream(tmpdir() / "interrupt.sh") << script << "\n";
     CHECK(std::system(("bash " + (tmpdir() / "interrupt.sh").string()).c_str()) != -1);
