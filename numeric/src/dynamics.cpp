@@ -130,6 +130,7 @@ gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const
 void Workspace::prepare(const Scene& sc) {
     const Part& P = sc.part;
     prepared = &sc;
+    pivot_k = -1;   // (the part's parameters are in the pivot's matrix)
     in = gen::KernelInput{};
     in.m = P.m;
     in.g = sc.g;

@@ -56,6 +56,19 @@ public:
         }
         return ps;
     }
+    // u(t) alone into ps.pdd, ps.wd (the rest of ps untouched): what the reduced U- and U-dynamics
+    // read, without building a PlateState per evaluation (state() above took 11 % of fig6's field's
+    // instructions, most of them in the struct's construction and copies).
+    void acceleration(double t, PlateState& ps) const {
+        double u[6] = {0, 0, 0, 0, 0, 0};
+        for (const Term& term : terms_) {
+            double s, c;
+            sincos_of(term.n * w_ * t, s, c);
+            for (int i = 0; i < 6; ++i) u[i] += s * term.A[i] + c * term.B[i];
+        }
+        ps.pdd = Vec3(u[0], u[1], u[2]);
+        ps.wd = Vec3(u[3], u[4], u[5]);
+    }
     // sin and cos of phi (above); libm's for |phi| beyond the exact range of the reduction.
     void sincos_of(double phi, double& s, double& c) const {
         constexpr double kInvStep = 8 / kPi;
@@ -117,7 +130,7 @@ struct ReducedModel {
 
     void rhs(double t, const State& y, State& dy) {
         const Vec3 qd(y[0], y[1], y[2]);
-        ps_last = plate(t, y);
+        u.acceleration(t, ps_last);   // (R1 and w1 stay identity and zero: unused at this level)
         t_last = t;
         mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
@@ -145,9 +158,11 @@ struct UModel {
     explicit UModel(const Scene& s) : sc(s) {}
 
     void rhs(double t, const State& y, State& dy) {
-        mode_accelerations(sc, level, q(y), qd(y), plate(t, y), mode, ws);
+        u.acceleration(t, ps_);   // (R1 and w1 stay identity and zero: unused at this level)
+        mode_accelerations(sc, level, q(y), qd(y), ps_, mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; }
     }
+    PlateState ps_;
     Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
     void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }

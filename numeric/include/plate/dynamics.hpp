@@ -118,6 +118,13 @@ struct Workspace {
     std::array<Vec2, 3> f_held = zeros<Vec2>();          // static friction of held contacts (pivot, stuck) [N], P frame
     Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate
     double tau_needed = 0;                 // stuck: its moment about s (z)
+    // Pivot about contact pivot_k: the factorised matrix of its system (modes.cpp), which depends on
+    // theta (cos, sin), the held contact and the sliding contacts' directions only -- constant along a
+    // pivot of the reduced U-dynamics, whose configuration is frozen (-1: none yet).
+    int pivot_k = -1;
+    double pivot_ct = 0, pivot_st = 0;
+    std::array<Vec2, 3> pivot_u = zeros<Vec2>();
+    Eigen::PartialPivLU<Eigen::Matrix<double, 8, 8, Eigen::RowMajor>> pivot_lu{8};
 };
 
 // Solves for q''_part and n at configuration q = (s_x, s_y, theta) and twist qd: the production
