@@ -189,9 +189,9 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
         vx[i] = qd[0] - w * ws.r[i].y();
         vy[i] = qd[1] + w * ws.r[i].x();
     }
+    double sp[3];   // |v_i|^2 (Coulomb's directions and the hints below)
+    for (int i = 0; i < nc; ++i) sp[i] = vx[i] * vx[i] + vy[i] * vy[i];
     if (ws.law == FrictionLaw::Coulomb) {
-        double sp[3];
-        for (int i = 0; i < nc; ++i) sp[i] = vx[i] * vx[i] + vy[i] * vy[i];
         int packed = 0;
 #if defined(__SSE2__)
         if (nc == 3) {
@@ -215,7 +215,7 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
     if (ws.use_hints) {
         const double hs2 = ws.hint_speed * ws.hint_speed;
         for (int i = 0; i < nc; ++i) {
-            const double s2 = vx[i] * vx[i] + vy[i] * vy[i];
+            const double s2 = sp[i];
             const double along = vx[i] * ws.hint[i].x() + vy[i] * ws.hint[i].y();
             const bool past_zero = s2 < 0.01 * ws.hint_from[i] * ws.hint_from[i] && (along <= 0 || along * along <= 0.25 * s2);
             if (s2 <= hs2 || past_zero || (ws.creep >> i & 1u)) { ux[i] = ws.hint[i].x(); uy[i] = ws.hint[i].y(); }
@@ -297,6 +297,18 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
 }
 
 }  // namespace
+
+namespace detail {
+// The engine's most frequent evaluation (models.hpp): a slide without creep in the reduced
+// U-dynamics, straight to the staged kernels -- what mode_accelerations and accelerations do for it,
+// without their dispatch (7 % of fig6's field's instructions). False where that path declines (an
+// unprepared workspace, a near-singular thick part): the caller then takes mode_accelerations.
+bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
+    if (ws.prepared != &sc || !accelerations_reduced_U(sc.part, q, qd, ps, ws)) return false;
+    ++ws.evals;
+    return true;
+}
+}  // namespace detail
 
 void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                    Workspace& ws) {

@@ -10,6 +10,10 @@
 
 namespace plate::detail {
 
+// dynamics.cpp: the reduced U-dynamics' slide without creep, without the mode dispatch (false: not
+// taken, call mode_accelerations).
+bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws);
+
 // u(t) (eq. 11) and the plate's velocity regrouped by harmonic number: a sin(n w t + phi) =
 // sin(n w t) a cos(phi) + cos(n w t) a sin(phi), so u(t) = sum_n sin(n w t) A_n + cos(n w t) B_n
 // with one sine and cosine per distinct n where PlateMotion::acceleration calls sin once per harmonic
@@ -132,7 +136,8 @@ struct ReducedModel {
         const Vec3 qd(y[0], y[1], y[2]);
         u.acceleration(t, ps_last);   // (R1 and w1 stay identity and zero: unused at this level)
         t_last = t;
-        mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
+        if (!(mode.kind == ModeKind::Slide && !ws.creep && reduced_U_slide(sc, q0, qd, ps_last, ws)))
+            mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
     }
     Vec3 q(const State&) const { return q0; }
