@@ -44,34 +44,27 @@ public:
     }
     PlateState state(double t, Dynamics level, const Mat3& R1 = Mat3::Identity()) const {
         PlateState ps;
-        Vec6 u = Vec6::Zero(), v = Vec6::Zero();
+        acceleration(t, ps, level == Dynamics::Full);
+        if (level == Dynamics::Full) ps.R1 = R1;
+        return ps;
+    }
+    // u(t) into ps.pdd, ps.wd, and with `velocity` the plate's angular velocity into ps.w1; the rest of
+    // ps untouched. The reduced U- and U-dynamics call it on a PlateState of their own, which saves
+    // building one per evaluation (state() doing so took 11 % of fig6's field's instructions, most of
+    // them in the struct's construction and copies).
+    void acceleration(double t, PlateState& ps, bool velocity = false) const {
+        double u[6] = {0, 0, 0, 0, 0, 0}, w[3] = {0, 0, 0};
         for (const Term& term : terms_) {
             const double k = term.n * w_;
             double s, c;
             sincos_of(k * t, s, c);
-            u += s * term.A + c * term.B;
-            if (level == Dynamics::Full) v -= (c * term.A - s * term.B) / k;
-        }
-        ps.pdd = u.head<3>();
-        ps.wd = u.tail<3>();
-        if (level == Dynamics::Full) {
-            ps.w1 = v.tail<3>();
-            ps.R1 = R1;
-        }
-        return ps;
-    }
-    // u(t) alone into ps.pdd, ps.wd (the rest of ps untouched): what the reduced U- and U-dynamics
-    // read, without building a PlateState per evaluation (state() above took 11 % of fig6's field's
-    // instructions, most of them in the struct's construction and copies).
-    void acceleration(double t, PlateState& ps) const {
-        double u[6] = {0, 0, 0, 0, 0, 0};
-        for (const Term& term : terms_) {
-            double s, c;
-            sincos_of(term.n * w_ * t, s, c);
             for (int i = 0; i < 6; ++i) u[i] += s * term.A[i] + c * term.B[i];
+            if (velocity)
+                for (int i = 0; i < 3; ++i) w[i] -= (c * term.A[3 + i] - s * term.B[3 + i]) / k;
         }
         ps.pdd = Vec3(u[0], u[1], u[2]);
         ps.wd = Vec3(u[3], u[4], u[5]);
+        if (velocity) ps.w1 = Vec3(w[0], w[1], w[2]);
     }
     // sin and cos of phi (above); libm's for |phi| beyond the exact range of the reduction.
     void sincos_of(double phi, double& s, double& c) const {

@@ -261,10 +261,16 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     return g;
 }
 
+namespace {
+// A rigid part's contact at r = R2 c_i: s'' + theta'' e_z x r - kappa theta'^2 r.
+Vec2 contact_acceleration_at(const Vec2& r, Dynamics level, const Vec3& qd, const Vec3& qdd) {
+    return qdd.head<2>() + qdd[2] * perp(r) - kappa(level) * qd[2] * qd[2] * r;
+}
+}  // namespace
+
 Vec2 contact_acceleration(const Part& P, Dynamics level, int i, const Vec3& q, const Vec3& qd, const Vec3& qdd) {
     if (P.point) return qdd.head<2>();
-    const Vec2 r = horizontal_offset(P, q[2], i);
-    return qdd.head<2>() + qdd[2] * perp(r) - kappa(level) * qd[2] * qd[2] * r;
+    return contact_acceleration_at(horizontal_offset(P, q[2], i), level, qd, qdd);
 }
 
 namespace {
@@ -351,13 +357,12 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
     // (a_j x u_j + |v_j| rate_j: the slip turns with its direction at the rate the engine measured,
     // d(v/|v|)/dt = (u x a) / |v|; with rate 0 the slip could not turn with a turning drive, and a
     // slide at the rim of the disk stayed at the zero threshold, 20x below the exact speed.)
-    // (contact_acceleration with r_i from the workspace's cache when it holds this theta: the same
-    // products, without a cosine and sine per contact and evaluation)
+    // (r_i from the workspace's cache when it holds this theta: no cosine and sine per contact and
+    // evaluation)
     const bool cached = !P.point && q[2] == ws.theta;
     auto residual = [&](Eigen::Vector3d& c) {
         for (int j = 0; j < m; ++j) {
-            const Vec2& r = ws.r[idx[j]];
-            const Vec2 a = cached ? Vec2(ws.qdd.head<2>() + ws.qdd[2] * perp(r) - kappa(level) * qd[2] * qd[2] * r)
+            const Vec2 a = cached ? contact_acceleration_at(ws.r[idx[j]], level, qd, ws.qdd)
                                   : contact_acceleration(P, level, idx[j], q, qd, ws.qdd);
             const Vec2& u = ws.hint[idx[j]];
             c[j] = a.x() * u.y() - a.y() * u.x() + ws.slip[idx[j]].norm() * ws.creep_rate[idx[j]];
