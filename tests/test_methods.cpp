@@ -280,7 +280,10 @@ TEST_CASE("a-priori auto picks the cheaper rung where it is exact by constructio
         REQUIRE(c.verified);
         CHECK(c.measured <= 1e-2);
         CHECK(c.predicted <= 1e-2);
-        CHECK(c.measured <= c.predicted);
+        // The picked rung is exact here, so what is measured is the two runs' integration error (rtol
+        // 1e-9 each, at most about 10 rtol over the 20 s: "a loose tolerance does not invent sticks";
+        // fig1's 9.7e-9, 1.8e-11 at rtol 1e-10), which the prediction of the model's error leaves out.
+        CHECK(c.measured <= c.predicted + 2 * 10 * IntegrationOptions{}.rtol);
         CHECK(c.estimate.work < 0.5 * c.reference_work);
     }
     // Where nothing simpler is predicted within tol the scene's own model runs, and alone.

@@ -611,3 +611,50 @@ TEST_CASE("a pivot's break-away inside one step is not missed (random scene 132 
     CHECK(std::abs(l.stick_fraction[1] - t.stick_fraction[1]) < 0.02);
     CHECK(twist_distance(sc, l.twist, t.twist) <= 10 * 1e-5);
 }
+
+TEST_CASE("a slip reversing along a line is not overrun: fig1_point's period map and field at rtol 1e-8",
+          "[stick][reference]") {
+    // fig1_point at (0, -0.05): the plate drives the point part along x, so its slip passes through
+    // zero along a line twice a period (a reversal: static friction cannot hold it). Steps that
+    // overran the zero put reversed friction into their later stages; the error estimate jumped by
+    // 10^3-10^5 and the step was cut down to the zero, where one was accepted at an error near 1 while
+    // straddling the reversed friction. One period from the cycle's start at rtol 1e-8 was then 3e-7 to
+    // 5e-7 v_ref from the rtol-1e-11 period, depending on the first step; with the steps ending just
+    // past a slip's predicted zero (engine.hpp, zero_cap) at most 2e-9. Bound: 10 rtol v_ref, what a
+    // period of local errors below rtol leaves where the flow contracts (measured 0.2 rtol).
+    const Scene sc = scene("fig1_point");
+    const Vec3 q(0, -0.05, 0);
+    LimitCycleOptions ro;
+    ro.integration.rtol = 1e-11;
+    ro.tol = 1e-11;
+    ro.solver = CycleSolver::Anderson;
+    const LimitCycleSummary ref = limit_cycle(sc, q, ro);
+    REQUIRE(ref.converged);
+    IntegrationOptions fine;
+    fine.rtol = 1e-11;
+    for (double h0 : {0.0, 1e-4, 1e-3, 3e-3})
+        for (double off : {0.0, 1e-6, -1e-6, 1e-5}) {
+            const Vec3 x = ref.qd_start + Vec3(off * sc.v_ref(), 0, 0);
+            IntegrationOptions io;
+            io.rtol = 1e-8;
+            io.h0 = h0;
+            Vec3 p, pr;
+            REQUIRE(period_map(sc, q, x, p, io));
+            REQUIRE(period_map(sc, q, x, pr, fine));
+            INFO("first step " << h0 << " T, start " << off << " v_ref off the cycle");
+            CHECK(twist_distance(sc, p, pr) <= 10 * 1e-8);
+        }
+    // The field at its defaults against the same field at rtol 1e-11 (its shooting's twists): within the
+    // cycle tolerance, 1e-7 v_ref (1.07e-6 before, 8.4e-9 now).
+    FieldOptions fo, fr;
+    fr.cycle.integration.rtol = 1e-11;
+    fr.cycle.integration.large_slip_factor = 1;
+    fr.cycle.tol = 1e-10;
+    const Field f = compute_field(sc, GridSpec{}, fo), r = compute_field(sc, GridSpec{}, fr);
+    double worst = 0;
+    for (std::size_t i = 0; i < f.points.size(); ++i) {
+        REQUIRE(f.points[i].converged);
+        worst = std::max(worst, twist_distance(sc, f.points[i].twist, r.points[i].twist));
+    }
+    CHECK(worst <= LimitCycleOptions{}.tol);
+}

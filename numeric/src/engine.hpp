@@ -129,7 +129,8 @@ public:
             const bool stuck = model_.mode.kind == ModeKind::Stuck;
             frozen_ = stuck && Model::kStuckFrozen;
             const double cap = stuck ? T / 200 : std::numeric_limits<double>::infinity();
-            const double want = frozen_ ? cap : std::min({dt_, cap, creep_h_});
+            double want = frozen_ ? cap : std::min({dt_, cap, creep_h_});
+            if (!frozen_ && model_.mode.kind == ModeKind::Slide) want = std::min(want, std::max(zero_cap(), h_min_));
             const bool clamp = t_ + want >= t_end;
             double dt = clamp ? t_end - t_ : want;
             double t1 = t_;
@@ -331,6 +332,44 @@ private:
         return g[i];
     }
 
+    // The step that ends just past the first zero of a slip heading for it: kZeroOvershoot times the
+    // time at which a slip's component along its reference direction (the slide guard, g0_ at the
+    // step's start) reaches zero at its present rate (from the state's derivative: slips are linear in
+    // the twist, so a difference over any small time gives it). Without it a slip that crosses zero
+    // along a line -- a point part's reversal, or a contact of a part sliding straight -- is overrun:
+    // stages far past zero take the reversed friction, the error estimate jumps by 10^3-10^5 and the
+    // step is rejected, and so on down to the zero, where a step accepted at an error near 1 straddles
+    // the reversed friction (dynamics.cpp keeps the start's direction only for stage slips below a
+    // tenth of the start's). fig1_point's cycle at (0, -0.05), one period from the cycle's start at rtol
+    // 1e-8 against 1e-11: 3e-7 to 5e-7 v_ref off depending on the first step, 2e-9 with the cap; its
+    // field 277 520 -> 63 287 right-hand sides, the largest error 1.07e-6 -> 8.4e-9 v_ref (README).
+    // Ending 5 % past the predicted zero keeps the stages past it inside that tenth.
+    double zero_cap() {
+        const int nc = scene_.part.contacts();
+        const double d = 1e-6 * scene_.plate.T;
+        State yd;
+        for (std::size_t i = 0; i < yd.size(); ++i) yd[i] = (ys_[i] + d * fs_[i]) * scale_[i];
+        std::array<Vec2, 3> v;
+        slip_velocities(scene_.part, model_.q(yd), model_.qd(yd), v);
+        double c = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < nc; ++i) {
+            // Only a slip outside the zero band (inside it the lingering and creeping rules decide; and
+            // a slip sliding on from a reversal, or creeping, has no zero event) ...
+            const double s0 = model_.ws.hint_from[i];
+            if ((fresh_ >> i & 1u) || (model_.ws.creep >> i & 1u) || !(g0_[3 + i] > 0) || s0 <= zero_abs_) continue;
+            const Vec2 a = (v[i] - slip0_[i]) / d;
+            const double rate = a.dot(ref_[i]);
+            if (!(rate < 0)) continue;
+            // ... heading for zero, not turning past it: at the predicted time the slip itself is within
+            // a tenth of its start (a swing's component along ref vanishes while the slip stays large).
+            const double tc = g0_[3 + i] / -rate;
+            if ((slip0_[i] + tc * a).norm() <= 0.1 * s0) c = std::min(c, kZeroOvershoot * tc);
+        }
+        return c;
+    }
+    static constexpr double kZeroOvershoot = 1.05;
+    std::array<Vec2, 3> slip0_ = zeros<Vec2>();   // the slips at the step's start (reference_directions)
+
     double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
 
     // Sets the state (physical units) and evaluates there; the guards' baseline follows.
@@ -386,6 +425,7 @@ private:
 
     // The unit slip directions at the step's start, against which the slide guards are measured.
     void reference_directions(const std::array<Vec2, 3>& slip) {
+        slip0_ = slip;
         for (int i = 0; i < 3; ++i) {
             const double s = slip[i].norm();
             const bool creeping = model_.ws.creep >> i & 1u;
