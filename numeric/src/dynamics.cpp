@@ -71,19 +71,26 @@ PlateState plate_state(const PlateMotion& plate, double t, Dynamics level, const
     return ps;
 }
 
-void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v) {
+void contact_offsets(const Part& part, double theta, std::array<Vec2, 3>& r) {
+    const double c = std::cos(theta), s = std::sin(theta);
+    for (int i = 0; i < 3; ++i)
+        r[i] = Vec2(c * part.c[i].x() - s * part.c[i].y(), s * part.c[i].x() + c * part.c[i].y());   // R2 c_i
+}
+
+void slip_velocities_at(const Part& part, const std::array<Vec2, 3>& r, const Vec3& qd, std::array<Vec2, 3>& v) {
     if (part.point) {
         v[0] = qd.head<2>();
         v[1].setZero();
         v[2].setZero();
         return;
     }
-    const double c = std::cos(q[2]), s = std::sin(q[2]);
-    for (int i = 0; i < 3; ++i) {
-        const double rx = c * part.c[i].x() - s * part.c[i].y();   // R2 c_i
-        const double ry = s * part.c[i].x() + c * part.c[i].y();
-        v[i] = Vec2(qd[0] - qd[2] * ry, qd[1] + qd[2] * rx);       // s' + w2^ R2 c_i
-    }
+    for (int i = 0; i < 3; ++i) v[i] = Vec2(qd[0] - qd[2] * r[i].y(), qd[1] + qd[2] * r[i].x());   // s' + w2^ R2 c_i
+}
+
+void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v) {
+    std::array<Vec2, 3> r;
+    if (!part.point) contact_offsets(part, q[2], r);
+    slip_velocities_at(part, r, qd, v);
 }
 
 Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {

@@ -342,15 +342,21 @@ private:
     // the reversed friction (dynamics.cpp keeps the start's direction only for stage slips below a
     // tenth of the start's). fig1_point's cycle at (0, -0.05), one period from the cycle's start at rtol
     // 1e-8 against 1e-11: 3e-7 to 5e-7 v_ref off depending on the first step, 2e-9 with the cap; its
-    // field 277 520 -> 63 287 right-hand sides, the largest error 1.07e-6 -> 8.4e-9 v_ref (README).
+    // field 277 520 -> 64 469 right-hand sides, the largest error 1.07e-6 -> 8.4e-9 v_ref (README).
     // Ending 5 % past the predicted zero keeps the stages past it inside that tenth.
     double zero_cap() {
         const int nc = scene_.part.contacts();
         const double d = 1e-6 * scene_.plate.T;
         State yd;
         for (std::size_t i = 0; i < yd.size(); ++i) yd[i] = (ys_[i] + d * fs_[i]) * scale_[i];
+        // (the offsets R2 c_i kept while theta stays: it does all period in the reduced U-dynamics)
+        const double theta = model_.q(yd)[2];
+        if (!(theta == cap_theta_)) {
+            if (!scene_.part.point) contact_offsets(scene_.part, theta, cap_r_);
+            cap_theta_ = theta;
+        }
         std::array<Vec2, 3> v;
-        slip_velocities(scene_.part, model_.q(yd), model_.qd(yd), v);
+        slip_velocities_at(scene_.part, cap_r_, model_.qd(yd), v);
         double c = std::numeric_limits<double>::infinity();
         for (int i = 0; i < nc; ++i) {
             // Only a slip outside the zero band (inside it the lingering and creeping rules decide; and
@@ -369,6 +375,8 @@ private:
     }
     static constexpr double kZeroOvershoot = 1.05;
     std::array<Vec2, 3> slip0_ = zeros<Vec2>();   // the slips at the step's start (reference_directions)
+    double cap_theta_ = std::numeric_limits<double>::quiet_NaN();
+    std::array<Vec2, 3> cap_r_ = zeros<Vec2>();
 
     double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
 

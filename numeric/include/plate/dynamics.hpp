@@ -151,6 +151,10 @@ void accelerations_reference(const Scene& scene, Dynamics level, const Vec3& q, 
 
 // Sliding velocity of each contact: s' + omega2^ R2 c_i (horizontal; P frame).
 void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v);
+// The same in two parts, for callers that keep the offsets r_i = R2 c_i of an orientation (a point
+// part's are not read).
+void contact_offsets(const Part& part, double theta, std::array<Vec2, 3>& r);
+void slip_velocities_at(const Part& part, const std::array<Vec2, 3>& r, const Vec3& qd, std::array<Vec2, 3>& v);
 
 // Would contact k stay stuck if its sliding velocity were zero now? The pivot mode's dynamics
 // (modes.hpp: Newton-Euler with contact k carrying an unknown tangential force F, the others sliding,
