@@ -415,17 +415,13 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
     // crossing of zero used to be taken as a new reversal: 91, 1 519 and 117 mode changes at rtol 1e-8,
     // 1e-9, 1e-10 for the same cycle (engine.hpp: fresh_). The holds and their times cannot depend on
     // the tolerance, nor can the stick fractions (within 1e-3 of the period).
-    // Reversals (slide -> slide) come right after a pivot breaks away, while the slips sit at the noise
-    // floor: 1e-6 T after contact 2's at every tolerance, and 1e-6-1e-5 T after contact 3's at rtol 1e-8
-    // and 1e-10 but not at 1e-9. There contact 3 slides on at the noise floor (its slip scales with
-    // rtol: 2e-10 m/s at 1e-9, 2e-11 = 1.5e-9 v_ref at 1e-10: it stays at the rim of its disk), the
-    // other two at 1e-8 and 2e-9 m/s, all inside rtol 1e-8's zero band (3e2 rtol v_ref), so whether it
-    // touches zero is noise. With the cycles' predictive step control (stepper.hpp) rtol 1e-8's
-    // reversals come 4e-4 T and 3e-5 T after the break-aways instead: contact 2's slip stays at 1e-7 v_ref
-    // after its break-away and leaves the zero band only 4.6e-3 T later (measured with either step
-    // control), so those are the same noise. So: the first reversal matched (time within 1e-3 T at every
-    // tolerance), every reversal after a break-away within that stretch (5e-3 T), and one or two a cycle
-    // (chattering gave hundreds; with the reversal band off 100).
+    // Reversals (slide -> slide) come right after a pivot breaks away: 1e-6 T after contact 2's at
+    // every tolerance, and 1e-6-1e-5 T after contact 3's at rtol 1e-8 and 1e-10 but not at 1e-9. There
+    // contact 3 slides on at the noise floor (its slip scales with rtol: 2e-10 m/s at 1e-9, 2e-11 =
+    // 1.5e-9 v_ref at 1e-10: it stays at the rim of its disk), the other two at 1e-8 and 2e-9 m/s, all
+    // inside rtol 1e-8's zero band (3e2 rtol v_ref), so whether it touches zero is noise. So: the first
+    // reversal matched (time within 1e-3 T at every tolerance), every reversal within 1e-5 T after a
+    // break-away, and one or two a cycle (chattering gave hundreds; with the reversal band off 100).
     const Scene sc = scene("heave_yaw");
     std::vector<LimitCycleSummary> c;
     std::vector<std::vector<ModeEvent>> holds;   // the events that are not reversals
@@ -442,7 +438,7 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
         for (const ModeEvent& e : c.back().mode_events) {
             if (e.from.kind == ModeKind::Slide && e.to.kind == ModeKind::Slide) {
                 INFO("rtol " << rtol << ": a reversal at " << e.t / sc.plate.T << " T, the last break-away at " << broke / sc.plate.T);
-                CHECK(e.t - broke <= 5e-3 * sc.plate.T);
+                CHECK(e.t - broke <= 1e-5 * sc.plate.T);
                 if (reversals++ == 0) first_reversal.push_back(e.t);
             } else {
                 holds.back().push_back(e);

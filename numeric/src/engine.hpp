@@ -52,7 +52,6 @@ public:
         for (std::size_t i = 0; i < scale_.size(); ++i) inv_scale_[i] = 1 / scale_[i];
         v_ref_ = scene_.v_ref();
         h_min_ = opt_.h_min * scene_.plate.T;
-        stepper_.set_predictive(opt_.predictive_steps);
         // Below hint_speed (ten times the integration error of a slip) a sliding contact's friction
         // keeps its last direction: v/|v| of a slip that small is rounding noise (just after a
         // break-away its direction is the hint choose_mode set).
@@ -62,9 +61,6 @@ public:
         // counted as zero and fig4's never-sticking part stuck 797 times in 20 s (3 rad off).
         model_.ws.hint_speed = std::clamp(10 * opt_.rtol, 1e-12, 1e-4) * v_ref_;
         zero_abs_ = std::clamp(3e2 * opt_.rtol, 1e-9, 3e-3) * v_ref_;
-        // A slip lingering below hold_abs_ is taken as zero (advance): a third of zero_abs_, which
-        // stays the zero band's width and the creep's trigger (see there for why and what it bought).
-        hold_abs_ = std::clamp(1e2 * opt_.rtol, 1e-9, 1e-3) * v_ref_;
         // A contact that breaks away creeps (Workspace::creep: its friction along the consistent
         // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
         // the error that leaves stays below creep_budget_ (creep_step), 100 rtol v_ref: about the
@@ -217,14 +213,9 @@ public:
                 rebase(g1, slip1);
                 // A slip that lingers just above zero (near a grazing stick, where the deceleration
                 // vanishes with the slip, it need not cross zero) makes v/|v| stiff and the steps tiny:
-                // after kLinger steps below hold_abs_ it is taken as zero. The error is below that
-                // threshold: at 1e3 rtol v_ref 4 of fig6's 78 sticking cycles were 1.4-2.1e-6 v_ref
-                // from the regularised limit at rtol 1e-8; at 3e2 rtol (zero_abs_, until 2026-11-27)
-                // 800 seeded random sticking cycles were up to 7.7e-7 from the rtol-1e-11 ones (99 % within
-                // 1.4e-7); at 1e2 rtol, with the predictive step control (stepper.hpp), 2.3e-7 (6.4e-8)
-                // in 12 % fewer right-hand sides. At 3e1 rtol the threshold meets the chatter of an
-                // explicit step on v/|v| (the slips alternate about 1e-6 v_ref at rtol 1e-8) and fig6's
-                // field took 4.5e6 right-hand sides.
+                // after kLinger steps below zero_abs_ it is taken as zero (the error is below zero_abs_,
+                // i.e. 3e2 rtol v_ref; measured on fig6's sticking cycles, about a fifth of it: 1e3 rtol
+                // v_ref left 4 of 78 at 1.4-2.1e-6 v_ref from the regularised limit at rtol 1e-8).
                 unsigned linger = 0;
                 if (model_.mode.kind == ModeKind::Slide)
                     for (int i = 0; i < nc; ++i) {
@@ -232,14 +223,14 @@ public:
                         // that alternates between two values -- an explicit step unstable on the
                         // direction's relaxation -- does: it is compared with the larger of the last two)
                         const double sn = slip1[i].norm();
-                        low_[i] = sn < hold_abs_ && sn <= 1.01 * std::max(slip_prev_[i], slip_prev2_[i]) ? low_[i] + 1 : 0;
+                        low_[i] = sn < zero_abs_ && sn <= 1.01 * std::max(slip_prev_[i], slip_prev2_[i]) ? low_[i] + 1 : 0;
                         slip_prev2_[i] = slip_prev_[i];
                         slip_prev_[i] = sn;
                         if (low_[i] >= linger_need_[i]) linger |= 1u << i;
                     }
                 if (linger) {
                     for (int i = 0; i < nc; ++i)
-                        if (slip1[i].norm() < hold_abs_) linger |= 1u << i;
+                        if (slip1[i].norm() < zero_abs_) linger |= 1u << i;
                     if (!try_hold(linger)) return false;
                 }
                 on_step(t_, y(), n_);
@@ -872,7 +863,7 @@ private:
     Dopri5Controller<State> stepper_;
     State scale_{}, inv_scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, last_y_{};
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
-    double v_ref_ = 0, h_min_ = 0, zero_abs_ = 0, hold_abs_ = 0;
+    double v_ref_ = 0, h_min_ = 0, zero_abs_ = 0;
     bool frozen_ = false;
     Guards g0_{};
     unsigned fresh_ = 0;   // contacts sliding on from a reversal, still inside the zero band

@@ -39,13 +39,12 @@ enum class CycleSolver { PeriodByPeriod, Anderson, Newton, Shooting };
 const char* cycle_solver_name(CycleSolver s);
 CycleSolver parse_cycle_solver(const std::string& name);   // throws std::invalid_argument
 
-// The cycles' integration: rtol 1e-8, ten times that on steps where every slip is large
-// (IntegrationOptions::large_slip_factor), predictive step-size control (predictive_steps).
+// The cycles' integration: rtol 1e-8, and ten times that on steps where every slip is large
+// (IntegrationOptions::large_slip_factor).
 inline IntegrationOptions cycle_integration() {
     IntegrationOptions io;
     io.rtol = 1e-8;
     io.large_slip_factor = 10;
-    io.predictive_steps = true;
     return io;
 }
 

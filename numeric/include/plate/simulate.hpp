@@ -38,12 +38,6 @@ struct IntegrationOptions {
     // shooting of limit cycles uses 10 (cycle_integration(), limit_cycle.hpp; Anderson and plain
     // periods take 1 whatever is set).
     double large_slip_factor = 1;
-    // Gustafsson's predictive step-size control on top of the PI controller (stepper.hpp): the next
-    // step shrinks ahead where the accepted steps' errors grow. On limit cycles (cycle_integration())
-    // it cut fig6's field's right-hand sides 13 % and the rejected tries from 21 % to 7 %, at equal or
-    // better accuracy (README, Speed); on trajectories it is off: fig4's 20 s run at rtol 1e-3, whose
-    // steps are held by stability, came out 16x less accurate for half the work.
-    bool predictive_steps = false;
 };
 
 enum class StopReason { None, ContactLost, Sticking, StepCollapse, StepLimit, NotConverged, EventAccumulation };
