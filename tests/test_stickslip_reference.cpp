@@ -536,15 +536,16 @@ TEST_CASE("slips at the rim of the disk and grazing contacts: two random scenes 
         Vec3 q0;
         const Scene sc = sticking_random_scene(c.seed, q0);
         const LimitCycleSummary ref = limit_cycle(sc, q0, tight);
-        REQUIRE(ref.converged);
         LimitCycleOptions o;
         o.integration.rtol = c.rtol;
         o.tol = 10 * c.rtol;
         const LimitCycleSummary lc = limit_cycle(sc, q0, o);
         INFO("seed " << c.seed << " at rtol " << c.rtol << ": " << lc.report());
+        CHECK(ref.converged);
         CHECK(lc.stop.reason != StopReason::ContactLost);
-        REQUIRE(lc.converged);
-        CHECK(twist_distance(sc, lc.twist, ref.twist) <= 3e2 * c.rtol + o.tol + tight.tol);
+        CHECK(lc.converged);
+        if (ref.converged && lc.converged)
+            CHECK(twist_distance(sc, lc.twist, ref.twist) <= 3e2 * c.rtol + o.tol + tight.tol);
     }
 }
 
