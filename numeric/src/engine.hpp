@@ -205,7 +205,6 @@ public:
                 // evaluated inside the step since, evaluate the step's end again so that they are its.
                 if (model_.ws.creep && !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
                     sys(ys1_, fs1_, t1);
-                if (!clamp) dt_ *= shrink_factor(slip1);
                 account(t1);
                 t_ = t1;
                 ys_ = ys1_;
@@ -289,27 +288,6 @@ private:
             stage_min_[i] = g;
             stage_t_[i] = t;
         }
-    }
-
-    // The factor on the step the controller proposes after an accepted slide step whose smallest slip
-    // fell from s0 (its start) to s1 (its end): s1/s0, at least 1/2. The PI controller proposes from
-    // the last step's error as if the error constant stayed put, but on a slide it grows as the
-    // smallest slip s shrinks -- the friction direction v/|v| has k-th derivatives ~ (|a|/s)^k, so
-    // the error goes as (h |a| / s)^5 and the step that keeps it is proportional to s. Without the
-    // factor, where a slip decelerates every other step was tried at about the last one's size and
-    // rejected (fig6's field: 22 % of the right-hand sides went to rejected tries, 89 % of those
-    // with the smallest slip shrinking). Only while s1 is above the creep speed (1e-2 v_ref): below
-    // it the creeps, the lingering test and the zero band decide as before (with the factor there
-    // too, foot's sticking cycle moved from 7.9e-7 to 1.0e-6 v_ref off its rtol-1e-11 cycle: the
-    // hold's entry follows the steps' history). Not while a contact creeps. Measured (README, Speed).
-    double shrink_factor(const std::array<Vec2, 3>& slip1) const {
-        if (model_.mode.kind != ModeKind::Slide || model_.ws.creep) return 1;
-        int k = 0;
-        double s1 = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < scene_.part.contacts(); ++i)
-            if (slip1[i].norm() < s1) { s1 = slip1[i].norm(); k = i; }
-        const double s0 = model_.ws.hint_from[k];
-        return s1 > model_.ws.creep_speed && s1 < s0 ? std::max(s1 / s0, 0.5) : 1.0;
     }
 
     // One step of size dt from (t_, ys_) into ys1_, fs1_ (stepper.hpp); t1 and dt as there.
