@@ -519,7 +519,7 @@ TEST_CASE("stick-slip on scenes nobody tuned: 36 seeded random sticking scenes a
     CHECK(errors[errors.size() / 2] <= tol);
 }
 
-TEST_CASE("slips at the rim of the disk and grazing contacts: two random scenes that broke a faster step control",
+TEST_CASE("slips at the rim of the disk and grazing contacts: random scenes that broke a faster step control or spent the budget",
           "[stick][random]") {
     // An outside audit of a predictive step control with a lower hold threshold (README, Speed,
     // *Measured and reverted*) found, among 3 000 sticking_random_scene seeds: seed 2512 (a thin part
@@ -528,11 +528,17 @@ TEST_CASE("slips at the rim of the disk and grazing contacts: two random scenes 
     // grazes, smallest normal force about 1e-3 m g) was reported losing contact in the transient from
     // rest at rtol 1e-9 and 1e-10. The engine as it stands finds both cycles, and the tight cycle (rtol
     // 1e-11) is the reference for their twists: within the zero band plus both cycle tolerances.
+    // Seed 2512 at rtol 1e-9 and seed 3121 at the default rtol 1e-8 (a later audit): after the stuck
+    // part breaks away next to a pivot one contact slides at its disk's rim while the two others grow
+    // from zero, and their repeated creeps, each completing a creep of the whole twist (which reversed
+    // the slips at once), spent the whole 2e7 budget until a growing slip no longer restarts such a
+    // creep (engine.hpp, creep_step); without that rule this case fails on both. (2512 still spends
+    // it at rtol 5e-9, 5e-10, 2e-10 and 1e-10: README, Reliability.)
     LimitCycleOptions tight;
     tight.integration.rtol = 1e-11;
     tight.tol = 1e-10;
     struct Case { std::uint64_t seed; std::vector<double> rtols; };
-    for (const Case& c : {Case{2512, {1e-8}}, Case{495, {1e-9, 1e-10}}}) {
+    for (const Case& c : {Case{2512, {1e-8, 1e-9}}, Case{3121, {1e-8}}, Case{495, {1e-9, 1e-10}}}) {
         Vec3 q0;
         const Scene sc = sticking_random_scene(c.seed, q0);
         const LimitCycleSummary ref = limit_cycle(sc, q0, tight);
