@@ -521,7 +521,7 @@ TEST_CASE("stick-slip on scenes nobody tuned: 36 seeded random sticking scenes a
 
 TEST_CASE("slips at the rim of the disk and grazing contacts: random scenes that broke a faster step control or spent the budget",
           "[stick][random]") {
-    // An outside audit of a predictive step control with a lower hold threshold (README, Speed,
+    // An outside audit of a predictive step control with a lower hold threshold (docs/speed.md,
     // *Measured and reverted*) found, among 3 000 sticking_random_scene seeds: seed 2512 (a thin part
     // with a contact sliding at its disk's rim, its slip chattering between 3e-8 and 1.5e-6 v_ref at
     // rtol 1e-8) spent the whole 2e7 budget without a cycle at the default options; seed 495 (its cycle
@@ -634,7 +634,7 @@ TEST_CASE("a pivot's break-away inside one step is not missed (random scene 132 
     // within one step of 0.075 T at loose tolerances (an outside review's probe of the dense output);
     // both ends positive, the break-away was missed and the cycle held its contact 0.82 of the period
     // instead of 0.72, with 4 mode changes instead of 6, 1.75e-4 v_ref off. The step's stages see the
-    // negative margin (engine.hpp, note_stage). Bound: the loose-tolerance cycles' 10 rtol v_ref (README).
+    // negative margin (engine.hpp, note_stage). Bound: the loose-tolerance cycles' 10 rtol v_ref (docs/stick-slip.md).
     Vec3 q0;
     const Scene sc = sticking_random_scene(132, q0);
     LimitCycleOptions tight, loose;

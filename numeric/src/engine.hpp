@@ -342,7 +342,7 @@ private:
     // the reversed friction (dynamics.cpp keeps the start's direction only for stage slips below a
     // tenth of the start's). fig1_point's cycle at (0, -0.05), one period from the cycle's start at rtol
     // 1e-8 against 1e-11: 3e-7 to 5e-7 v_ref off depending on the first step, 2e-9 with the cap; its
-    // field 277 520 -> 64 469 right-hand sides, the largest error 1.07e-6 -> 8.4e-9 v_ref (README).
+    // field 277 520 -> 64 469 right-hand sides, the largest error 1.07e-6 -> 8.4e-9 v_ref (docs/speed.md).
     // Ending 5 % past the predicted zero keeps the stages past it inside that tenth.
     double zero_cap() {
         const int nc = scene_.part.contacts();
