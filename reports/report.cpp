@@ -730,9 +730,10 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
            std::to_string(d.runs.size()) + " end within 0.05 rad of the target.", "800,420");
 }
 
-// A rigid part's fixed point (design.cpp): fig4's part at (0.02, -0.01, 0.5). Where the search for a
-// unique one fails, the design returns the half-turn pair; the table and the runs' theta(t) show what
-// the verification found (the target's share of the random starts and any competitor's).
+// A rigid part's fixed point (design.cpp): fig4's part at (0.02, -0.01, 0.5). The design starts from a
+// half-turn pair and breaks it with rz about its centre where that verifies (break_pair); the table and
+// the runs' theta(t) show what the verification found (the target's share of the random starts and any
+// competitor's).
 void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     const Scene part = load_scene((src / "scenes" / "fig4.json").string());
     const DesignOptions o = report_design_options(opt, 2, 150, 10);

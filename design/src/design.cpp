@@ -13,6 +13,7 @@
 #include <cmath>
 #include <complex>
 #include <map>
+#include <mutex>
 #include <stdexcept>
 #include <sstream>
 #include <thread>
@@ -1307,14 +1308,15 @@ const std::vector<Axis> kRigidAxes = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis:
 PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion_from(p, kRigidAxes, {1, 2}, T); }
 
 // Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
-// `room`, no flight under the part's contacts over the region, and no coning beyond kConingLimit either
-// way (6 n_max + 3 entries).
+// `room`, no flight under the part's contacts over the region, no coning beyond kConingLimit either
+// way and no more tilt drift than that (6 n_max + 4 entries).
 void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
                         double* c) {
     const int k = amplitude_constraints(fin, opt, part, n_max, room, c);
     const double cone = coning_rate(fin) / kConingLimit;
     c[k] = cone - 1;
     c[k + 1] = -cone - 1;
+    c[k + 2] = tilt_drift_rate(fin).norm() / kConingLimit - 1;
 }
 
 // The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
@@ -1346,7 +1348,7 @@ struct RigidProblem : Problem<RigidProblem> {
     DesignTarget target;
     static constexpr int kParams = 24;
     static constexpr const char* kFamily = "x, y, z, rx, ry, rz at n = 1, 2";
-    static constexpr int kConstraints = 15;   // twelve amplitudes, the flight margin, coning both ways
+    static constexpr int kConstraints = 16;   // twelve amplitudes, the flight margin, coning both ways, tilt drift
     // The search keeps 3% of each limit in hand for the final placement's correction (shifting by the
     // found fixed point's offset, a few mm, adds alpha x offset to the linear amplitudes).
     static constexpr double kRoom = 0.97;
@@ -1394,7 +1396,8 @@ struct RigidProblem : Problem<RigidProblem> {
 
 DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
-                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair = false);
+                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair = false,
+                                      double run_seconds = 0, double theta_offset = 0);
 
 // --- the rigid part's fixed point as a half-turn pair ----------------------------------------------
 // Where no unique fixed point is found (fig4's part: its first harmonic in theta stays below the rest
@@ -1404,6 +1407,220 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
 // (-s*, THETA + pi) are both stable fixed points, at the centre (s* ~ 0) the same position: the part
 // is brought to the target's position from everywhere and to its orientation up to a half turn --
 // reported as not unique, with the twin and each one's share of the random starts.
+// --- the half-turn pair broken: rz about its centre ---------------------------------------------------
+// (Measured on fig4's pair, 2026-11-28: docs/inverse-design.md.) At the pair's fixed point theta' has a
+// mean M and a second harmonic B_2 (0.007 and 0.088 rad/s) and no first. rz at n = 2 about the design's
+// centre keeps the pairing (a half turn leaves rz, half a period leaves n = 2) but moves M and B_2 (with
+// 50 rad/s^2: 0.030 and 0.035), so the pair's two stable orientations, at theta''s two minima, come
+// near a saddle-node; rz at n = 1 breaks the pairing (half a period reverses it) and adds a first
+// harmonic of 0.005-0.015 rad/s -- ten times what x, y, rx and ry gave there -- which lifts one minimum
+// above zero and leaves one stable orientation. First rx and ry at n = 1 are made parallel (the pair's
+// are a few degrees apart) and rz at n = 1 takes their direction: rotations about two axes a quarter
+// period apart turn the plate steadily (tilt_drift_rate; a trial with rz out of line drifted 1e-3 rad/s
+// and every full-dynamics run left the plate after 36 s). A grid over rz's amplitudes, its phase at n =
+// 2 and its sense at n = 1 is screened by theta' on a ring of orientations at the pair's fixed point
+// (exactly one stable zero), the survivors refined to their fixed point (stable, near the centre) and
+// verified in order of rate like every rigid design, and the first that verifies as unique is returned.
+constexpr int kBreakRing = 24;      // orientations of the screening ring
+constexpr int kBreakVerified = 3;   // candidates verified at most
+
+// The pair's motion with rx and ry at n = 1 turned onto one line (each keeps its amplitude; the line
+// halves the angle between them), and that line's phase psi.
+PlateMotion aligned_tilts(const PlateMotion& u, double& psi) {
+    auto ph = phasors(u);
+    const std::pair<int, int> kx{static_cast<int>(Axis::rx), 1}, ky{static_cast<int>(Axis::ry), 1};
+    const std::complex<double> a = ph.count(kx) ? ph[kx] : 0.0, b = ph.count(ky) ? ph[ky] : 0.0;
+    const double sense = std::real(a * std::conj(b)) < 0 ? -1.0 : 1.0;
+    const std::complex<double> line = b + sense * a;
+    psi = std::abs(line) > 0 ? std::arg(line) : 0.0;
+    PlateMotion r;
+    r.T = u.T;
+    for (const auto& [k, z] : ph) {
+        double amp = std::abs(z), phase = std::arg(z);
+        if (k == kx) phase = psi + (sense < 0 ? kPi : 0.0);
+        if (k == ky) phase = psi;
+        if (amp > 0) r.harmonics.push_back({static_cast<Axis>(k.first), k.second, amp, phase});
+    }
+    return r;
+}
+
+DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion, double theta, const DesignTarget& target,
+                         const DesignOptions& opt, double T, std::atomic<long>& cycles, Clock::time_point t0) {
+    DesignSummary best;
+    best.failure = "no rz about the pair's centre left one stable orientation there";
+    double psi = 0;
+    const PlateMotion aligned0 = aligned_tilts(pair_motion, psi);
+    PlateMotion aligned = aligned0;
+    struct Candidate {
+        PlateMotion u;
+        Vec3 q;
+        double rate;
+        std::string what;
+        double passage;   // [s] the slowest start's way round the ring to the stable orientation
+    };
+    std::vector<Candidate> found;
+    std::mutex m;
+    std::vector<std::array<double, 4>> grid;   // (rz amplitude at n = 1, its sense, at n = 2, its phase)
+    const double room = 0.97 * opt.ang_limit;
+    for (double a1 : {2.0 / 3, 1.0})
+        for (double s1 : {1.0, -1.0})
+            for (double a2 : {0.4, 0.5, 0.6, 0.7, 0.8, 1.0})
+                for (int k = 0; k < 24; ++k) grid.push_back({a1 * room, s1, a2 * room, -kPi + k * kPi / 12});
+    std::atomic<int> next{0};
+    // The placement turns the motion by THETA less the orientation found, and a pair searched at the
+    // flight margin turned that far tilts its corners beyond it (fig4: 0.04-0.09 g over): the sink's
+    // harmonics scaled down by `scale` until candidates fit.
+    double scale = 1;
+    auto worker = [&] {
+        for (int i; (i = next.fetch_add(1)) < static_cast<int>(grid.size());) {
+            const auto& g = grid[i];
+            Scene sc = part_scene;
+            sc.plate = aligned;
+            sc.plate.harmonics.push_back({Axis::rz, 1, g[0], psi + (g[1] < 0 ? kPi : 0.0)});
+            sc.plate.harmonics.push_back({Axis::rz, 2, g[2], g[3]});
+            // theta' on the ring at the centre: exactly one stable zero (and its one unstable)
+            double w[kBreakRing];
+            Vec3 warm = Vec3::Zero();
+            bool ok = true;
+            for (int k = 0; k < kBreakRing && ok; ++k) {
+                const LimitCycleSummary c = limit_cycle(sc, Vec3(0, 0, -kPi + 2 * kPi * k / kBreakRing), opt.cycle, warm);
+                ++cycles;
+                ok = c.converged;
+                warm = c.qd_start;
+                w[k] = c.twist[2];
+            }
+            if (!ok) continue;
+            int stable = 0, at = -1;
+            for (int k = 0; k < kBreakRing; ++k)
+                if (w[k] > 0 && w[(k + 1) % kBreakRing] <= 0) ++stable, at = k;
+            if (stable != 1) continue;
+            // its fixed point: Newton from the zero, stable and within 5 mm of the centre
+            Vec3 q(0, 0, -kPi + 2 * kPi * (at + 0.5) / kBreakRing);
+            Vec3 xi;
+            Mat3 J;
+            bool conv = false;
+            for (int it = 0; it < 8 && !conv; ++it) {
+                if (!twist_and_jacobian(sc, q, opt.cycle, xi, J, cycles)) break;
+                const Vec3 step = J.fullPivLu().solve(xi);
+                if (!step.allFinite()) break;
+                q -= step;
+                conv = step.head<2>().norm() < 1e-6 && std::abs(step[2]) < 1e-4;
+            }
+            if (!conv || q.head<2>().norm() > 0.005) continue;
+            const Eigen::Vector3cd ev = J.eigenvalues();
+            const double rate = -std::max({ev[0].real(), ev[1].real(), ev[2].real()});
+            if (!(rate > 0)) continue;
+            {   // placed as place_and_verify_rigid will place it, within the limits and the flight margin
+                const double turn = target.theta - q[2];
+                const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
+                const PlateMotion placed = combined(shift_motion(rotate_motion(sc.plate, turn), target.at - s_turned));
+                double c[6 * 3 + 4];
+                placed_constraints(placed, opt, part_scene, 3, 1.0, c);
+                if (*std::max_element(c, c + 6 * 3 + 4) > 0) continue;
+            }
+            std::ostringstream what;
+            what.precision(3);
+            what << "rz " << g[0] << " rad/s^2 at n = 1 along the tilts (" << (g[1] > 0 ? "+" : "-") << "), " << g[2]
+                 << " rad/s^2 at n = 2, phase " << g[3] << ", the sink's harmonics scaled by " << scale;
+            // theta' = w(theta) round the ring (linear between its points) from just past the unstable
+            // zero, both ways, to within 0.05 rad of the stable one: the slowest start's time, which the
+            // bottleneck where the twin was sets (the linear rate alone says nothing of it)
+            int unstable = 0;
+            for (int k = 0; k < kBreakRing; ++k)
+                if (w[k] < 0 && w[(k + 1) % kBreakRing] >= 0) unstable = k;
+            const double h = 2 * kPi / kBreakRing;
+            const double th_s = -kPi + h * (at + w[at] / (w[at] - w[(at + 1) % kBreakRing]));
+            const double th_u = -kPi + h * (unstable + w[unstable] / (w[unstable] - w[(unstable + 1) % kBreakRing]));
+            auto w_at = [&](double th) {
+                const double x = (wrap_angle(th) + kPi) / h;
+                const int k = static_cast<int>(std::floor(x)) % kBreakRing;
+                const double f = x - std::floor(x);
+                return (1 - f) * w[k] + f * w[(k + 1) % kBreakRing];
+            };
+            double passage = 0;
+            for (double dir : {1.0, -1.0}) {
+                double th = th_u + dir * h, t = 0;
+                while (std::abs(wrap_angle(th - th_s)) > 0.05 && t < 1000) {
+                    const double v = w_at(th);
+                    const double dt = std::min(1.0, 0.01 / std::max(std::abs(v), 1e-6));
+                    th += v * dt;
+                    t += dt;
+                }
+                passage = std::max(passage, t);
+            }
+            std::lock_guard<std::mutex> lock(m);
+            found.push_back({sc.plate, q, rate, what.str(), passage});
+        }
+    };
+    int tried = 0;
+    for (double f : {1.0, 0.95, 0.9, 0.85, 0.8}) {
+        scale = f;
+        aligned = aligned0;
+        for (Harmonic& h : aligned.harmonics) h.amp *= f;
+        next = 0;
+        const int threads = std::max(1, std::min(opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency()),
+                                                 static_cast<int>(grid.size())));
+        std::vector<std::thread> pool;
+        for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+        worker();
+        for (auto& t : pool) t.join();
+        tried += static_cast<int>(grid.size());
+        if (!found.empty()) break;
+    }
+    best.evaluations = tried;
+    // (threads finish in any order: ranked by the slowest start's passage -- the runs' length and the
+    // design's real speed -- ties by the grid's order through `what`)
+    std::sort(found.begin(), found.end(), [](const Candidate& a, const Candidate& b) {
+        return a.passage != b.passage ? a.passage < b.passage : a.what < b.what;
+    });
+    DesignSummary kept;   // the best verified so far: unique, else the largest share of the runs
+    for (std::size_t i = 0; i < found.size() && static_cast<int>(i) < kBreakVerified; ++i) {
+        DesignSummary sum;
+        start_summary(sum, part_scene, "_fixed_point", T);
+        sum.evaluations = best.evaluations;
+        // Where the full dynamics settles: from the field's fixed point, as placed, until the slow mode
+        // has decayed; the field's fixed point is then placed half that offset short of THETA, so that
+        // both lie within their tolerances of it (0.02 and 0.05 rad) where the offset allows.
+        const Candidate& c = found[i];
+        const double settle = settle_time(2 * opt.region, c.rate, opt);
+        double offset = 0;
+        {
+            const double turn = target.theta - c.q[2];
+            Scene placed = part_scene;
+            placed.plate = combined(shift_motion(rotate_motion(c.u, turn), target.at - Eigen::Rotation2Dd(turn) * Vec2(c.q.head<2>())));
+            IntegrationOptions io;
+            io.rtol = 1e-7;
+            const Trajectory tr = simulate(placed, Dynamics::Full, Vec3(target.at.x(), target.at.y(), target.theta), Vec3::Zero(),
+                                           settle, settle, io);
+            if (tr.stop.reason == StopReason::None && !tr.samples.empty())
+                offset = wrap_angle(tr.samples.back().q[2] - target.theta);
+        }
+        place_and_verify_rigid(sum, part_scene, c.u, c.q, target, opt, cycles, t0, false, 1.5 * c.passage + settle, 0.5 * offset);
+        sum.notes.push_back("the half-turn pair broken by " + found[i].what +
+                            " about its centre (rx and ry at n = 1 made parallel first: no tilt drift)");
+        if (offset != 0) {
+            std::ostringstream note;
+            note.precision(2);
+            note << "the full dynamics settles " << offset << " rad past the field's fixed point: the field's is placed "
+                 << 0.5 * offset << " rad short of THETA, the full dynamics' as far past it";
+            sum.notes.push_back(note.str());
+        }
+        if (sum.verified && sum.unique) return sum;
+        if (sum.verified && (!kept.verified || sum.basin_share > kept.basin_share)) kept = sum;
+        best.failure = "the first " + std::to_string(i + 1) + " of " + std::to_string(found.size()) +
+                       " candidates with one stable orientation at the centre did not verify as unique (the last: " +
+                       (sum.failure.empty() ? "a competing stable fixed point on the grid" : sum.failure) + ")";
+        if (kept.verified && kept.basin_share >= 0.9) break;
+    }
+    if (kept.verified) {
+        kept.notes.push_back("not unique: " + best.failure);
+        return kept;
+    }
+    if (found.empty()) best.failure += " within the flight margin (" + std::to_string(tried) + " tried)";
+    (void)theta;
+    return best;
+}
+
 DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
@@ -1425,7 +1642,23 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
     }
     // (the search's motion is centred: the placement shifts it by the target less the small offset of
     // the fixed point found)
-    return place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0, true);
+    place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0, true);
+    if (!sum.verified || !opt.break_pair) return sum;
+    DesignSummary broken = break_pair(part_scene, sink_motion(best, T), theta, target, opt, T, cycles, t0);
+    if (broken.verified && (broken.unique || broken.basin_share > sum.basin_share)) {
+        std::ostringstream note;
+        note.precision(2);
+        note << "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA a stable zero of theta'; verified, "
+                "the target's share of the runs "
+             << sum.basin_share << ", which its pairing caps at " << sum.basin_share_bound << ")";
+        broken.notes.insert(broken.notes.begin(), note.str());
+        broken.evaluations += sum.evaluations;
+        broken.starts = sum.starts;
+        return finished(broken, cycles, t0);
+    }
+    sum.notes.push_back("breaking the pairing with rz about its centre: " + broken.failure);
+    sum.evaluations += broken.evaluations;
+    return finished(sum, cycles, t0);
 }
 
 DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
@@ -1459,7 +1692,10 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
 // dynamics from random starts (the target's basin share and each competing stable point's), the hold.
 DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
-                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair) {
+                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair,
+                                      double run_seconds, double theta_offset) {
+    // (run_seconds: the verification runs last at least this long; theta_offset: the field's fixed point
+    // is placed this far short of THETA -- break_pair's, where the full dynamics settles past it)
     const bool orient = target.kind == DesignTargetKind::Orient;
     Scene centred = part_scene;
     centred.plate = centred_motion;
@@ -1504,17 +1740,17 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         sum.failure = "the search's best motion has no fixed point near the design's centre";
         return finished(sum, cycles, t0);
     }
-    const double turn = target.theta - q[2];
+    const double turn = target.theta - theta_offset - q[2];
     const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
     const Vec2 at = orient ? Vec2::Zero() : target.at;
     sum.scene.plate = combined(shift_motion(rotate_motion(centred.plate, turn), at - s_turned));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     int n_max = 1;
     for (const Harmonic& h : sum.scene.plate.harmonics) n_max = std::max(n_max, h.n);
-    std::vector<double> c(6 * n_max + 3);
+    std::vector<double> c(6 * n_max + 4);
     placed_constraints(sum.scene.plate, opt, sum.scene, n_max, 1.0, c.data());
     if (*std::max_element(c.begin(), c.end()) > 1e-9) {
-        sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning limit";
+        sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning (or tilt drift) limit";
         return finished(sum, cycles, t0);
     }
     const Vec3 goal(at.x(), at.y(), wrap_angle(target.theta));
@@ -1549,7 +1785,7 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     sum.coning = coning_rate(sum.scene.plate);
     const int stopped = verification_runs(
         sum, opt,
-        [&](const DesignStartRun&) { return settle_time(2 * opt.region, sum.rate, opt); },   // (from across the region)
+        [&](const DesignStartRun&) { return std::max(settle_time(2 * opt.region, sum.rate, opt), run_seconds); },   // (from across the region)
         [&](const DesignStartRun&, const Vec3& end) {
             return std::max(orient ? 0.0 : (end.head<2>() - at).norm(),
                             std::abs(wrap_angle(end[2] - goal[2])) * opt.verify_distance / 0.05);
@@ -1628,6 +1864,23 @@ double coning_rate(const PlateMotion& u) {
     return r;
 }
 
+Vec2 tilt_drift_rate(const PlateMotion& u) {
+    // (coning_rate's sum for the pairs (ry, rz) -> x and (rz, rx) -> y: the cross product's cyclic order)
+    const auto ph = phasors(u);
+    auto pair_sum = [&](Axis a, Axis b) {
+        double r = 0;
+        for (const auto& [k, za] : ph) {
+            if (k.first != static_cast<int>(a)) continue;
+            const auto zb = ph.find({static_cast<int>(b), k.second});
+            if (zb == ph.end()) continue;
+            const double nw = k.second * 2 * kPi / u.T;
+            r += std::imag(za * std::conj(zb->second)) / (2 * nw * nw * nw);
+        }
+        return r;
+    };
+    return Vec2(pair_sum(Axis::ry, Axis::rz), pair_sum(Axis::rz, Axis::rx));
+}
+
 double sink_coning_limit(const Vec2& at, const DesignOptions& opt) {
     if (opt.max_coning >= 0) return opt.max_coning;
     const double walk = at.norm() * opt.hold;   // [m s]: the sink's walk per unit coning rate
@@ -1669,20 +1922,23 @@ DesignSummary dispatch(const Scene& part_scene, const DesignTarget& target, cons
         if (target.kind == DesignTargetKind::LineSink)
             throw std::invalid_argument("a line sink is built for point parts only");
         if (target.kind == DesignTargetKind::Sink) return design_sink(part_scene, target, opt, T);
-        DesignSummary unique = design_rigid(part_scene, target, opt, T);
-        if (unique.verified || target.kind != DesignTargetKind::FixedPoint) return unique;
-        // No unique fixed point: the half-turn pair, which says so (design_rigid_pair).
+        if (target.kind != DesignTargetKind::FixedPoint) return design_rigid(part_scene, target, opt, T);
+        // The half-turn pair first, broken where rz about its centre leaves one stable fixed point
+        // (design_rigid_pair, break_pair); where the pair itself fails (no sink for this part), the
+        // general search over all six axes at n = 1, 2 (design_rigid).
         DesignSummary pair = design_rigid_pair(part_scene, target, opt, T);
+        if (pair.verified) return pair;
+        DesignSummary general = design_rigid(part_scene, target, opt, T);
         std::ostringstream note;
         note.precision(3);
-        note << "the search for a unique fixed point failed (" << unique.failure << "; " << unique.evaluations
-             << " evaluations, " << unique.seconds << " s, counted below)";
-        pair.notes.insert(pair.notes.begin(), note.str());
-        pair.evaluations += unique.evaluations;
-        pair.cycles += unique.cycles;
-        pair.starts += opt.starts;   // (both searches')
-        pair.seconds += unique.seconds;
-        return pair;
+        note << "the half-turn pair failed (" << pair.failure << "; " << pair.evaluations << " evaluations, " << pair.seconds
+             << " s, counted below)";
+        general.notes.insert(general.notes.begin(), note.str());
+        general.evaluations += pair.evaluations;
+        general.cycles += pair.cycles;
+        general.starts += pair.starts;   // (both searches')
+        general.seconds += pair.seconds;
+        return general;
     }
     if (target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");
     if (target.kind == DesignTargetKind::LineSink) return design_line_sink(part_scene, target, opt, T);

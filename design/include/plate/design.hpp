@@ -51,6 +51,13 @@ PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& a
 // sink and fixed point is verified by a part released at the target staying within verify_distance
 // over DesignOptions::hold seconds of full dynamics.
 double coning_rate(const PlateMotion& u);
+// The same second-order drift about the horizontal axes, (ry with rz, rz with rx): the components
+// of (1/2) <theta x theta'> along x and y, sum_n Im(A_ry,n conj(A_rz,n)) / (2 (n w)^3) and
+// sum_n Im(A_rz,n conj(A_rx,n)) / (2 (n w)^3) [rad/s]. Where it is not zero the plate's tilt grows
+// steadily and gravity pulls every part downhill: a trial design with rz at n = 1 a quarter period
+// off the tilts' drifted 1e-3 rad/s, and all 20 of its full-dynamics runs left the plate after 36 s
+// (docs/inverse-design.md). Rigid designs hold it to the coning limit; a motion without rz has none.
+Vec2 tilt_drift_rate(const PlateMotion& u);
 
 // ORIENTATION HARMONICS. At a position s the twist's theta' is a function of theta alone,
 //     theta'(theta) = M + sum_k B_k sin(k theta + phi_k)
@@ -148,6 +155,10 @@ struct DesignOptions {
     // The coning a point-part sink may have [rad/s]; negative: sink_coning_limit (from the hold).
     // (Infinite with a hold: the fastest sink, which the hold then judges.)
     double max_coning = -1;
+    // A rigid fixed point that comes out as a half-turn pair (design_rigid_pair) is offered rz about
+    // its centre -- at n = 2 to bring theta''s two minima near a saddle-node, at n = 1 to lift one of
+    // them -- and reported unique where one such motion verifies; false: the pair as found.
+    bool break_pair = true;
     double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
     // The search's freedom (the CLI's --axes and --harmonics): a harmonic on an axis not in `axes`, or
     // of order n above max_harmonic, is held at zero. Empty / 0: each target's own motion family --
