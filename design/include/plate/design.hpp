@@ -53,7 +53,9 @@ PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& a
 double coning_rate(const PlateMotion& u);
 // The same second-order drift about the horizontal axes, (ry with rz, rz with rx): the components
 // of (1/2) <theta x theta'> along x and y, sum_n Im(A_ry,n conj(A_rz,n)) / (2 (n w)^3) and
-// sum_n Im(A_rz,n conj(A_rx,n)) / (2 (n w)^3) [rad/s]. Where it is not zero the plate's tilt grows
+// sum_n Im(A_rz,n conj(A_rx,n)) / (2 (n w)^3) [rad/s], signed as coning_rate is: the plate itself
+// turns about x and y at minus these (a test: a part on such a plate slides downhill that way, in
+// full dynamics). Where it is not zero the plate's tilt grows
 // steadily and gravity pulls every part downhill: a trial design with rz at n = 1 a quarter period
 // off the tilts' drifted 1e-3 rad/s, and all 20 of its full-dynamics runs left the plate after 36 s
 // (docs/inverse-design.md). Rigid designs hold it to the coning limit; a motion without rz has none.
@@ -105,8 +107,10 @@ struct DesignTarget {
     // plate adds alpha x s, a whirl that makes the twist depend on position (not uniform); a part whose
     // friction differs turns on any translating plate (the weathervane), its velocity with it.
     // FixedPoint: (at, theta) the unique stable fixed point of the twist field (a rigid part; for a
-    // point part the same as Sink). Where no unique one is found, a half-turn pair: (at, theta) and
-    // (at, theta + pi) both stable, reported as not unique with each one's basin share. Orient: every start ends at orientation theta, position free (a
+    // point part the same as Sink). Designed as a half-turn pair ((at, theta) and (at, theta + pi) both
+    // stable), then broken by rz about its centre (DesignOptions::break_pair); what verifies is reported
+    // with the target's basin share and each competing stable fixed point's, unique only where the grid
+    // finds no other. Orient: every start ends at orientation theta, position free (a
     // part whose contacts' friction differs: by a plate that only translates, a weathervane; else
     // designed as a fixed point at the region's centre and verified on the orientation).
     // LineSink (point parts): every start ends on the line through `at` along direction `theta`, and
@@ -155,9 +159,10 @@ struct DesignOptions {
     // The coning a point-part sink may have [rad/s]; negative: sink_coning_limit (from the hold).
     // (Infinite with a hold: the fastest sink, which the hold then judges.)
     double max_coning = -1;
-    // A rigid fixed point that comes out as a half-turn pair (design_rigid_pair) is offered rz about
-    // its centre -- at n = 2 to bring theta''s two minima near a saddle-node, at n = 1 to lift one of
-    // them -- and reported unique where one such motion verifies; false: the pair as found.
+    // A rigid fixed point designed as a half-turn pair (design_rigid_pair) is offered rz about its
+    // centre -- at n = 2 to bring theta''s two minima near a saddle-node, at n = 1 to lift one of them.
+    // A motion that verifies as unique replaces the pair; else the verified one whose runs end at the
+    // target most often, where that beats the pair's share. false: the pair as found.
     bool break_pair = true;
     double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
     // The search's freedom (the CLI's --axes and --harmonics): a harmonic on an axis not in `axes`, or
