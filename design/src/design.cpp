@@ -13,7 +13,6 @@
 #include <cmath>
 #include <complex>
 #include <map>
-#include <mutex>
 #include <stdexcept>
 #include <sstream>
 #include <thread>
@@ -1403,6 +1402,14 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
                                       std::atomic<long>& cycles, Clock::time_point t0, bool pair = false,
                                       double run_seconds = 0, double theta_offset = 0);
 
+// A centred motion whose fixed point is q, placed so that it lands on (at, THETA - theta_offset): turned
+// by THETA - theta_offset - q_theta about the origin (the field turns), then shifted by `at` less the
+// turned s (the field shifts).
+PlateMotion placed_motion(const PlateMotion& centred, const Vec3& q, const Vec2& at, double theta, double theta_offset = 0) {
+    const double turn = theta - theta_offset - q[2];
+    return combined(shift_motion(rotate_motion(centred, turn), at - Eigen::Rotation2Dd(turn) * Vec2(q.head<2>())));
+}
+
 // --- the half-turn pair broken: rz about its centre ---------------------------------------------------
 // (Measured on fig4's pair, 2026-11-28: docs/inverse-design.md.) At the pair's fixed point theta' has a
 // mean M and a second harmonic B_2 (0.007 and 0.088 rad/s) and no first. rz at n = 2 about the design's
@@ -1508,9 +1515,7 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         const double rate = -std::max({ev[0].real(), ev[1].real(), ev[2].real()});
         if (!(rate > 0)) return "";
         {   // placed as place_and_verify_rigid will place it: within the limits and the flight margin
-            const double turn = target.theta - q[2];
-            const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
-            const PlateMotion placed = combined(shift_motion(rotate_motion(sc.plate, turn), target.at - s_turned));
+            const PlateMotion placed = placed_motion(sc.plate, q, target.at, target.theta);
             double c[6 * 3 + 4];
             placed_constraints(placed, opt, part_scene, 3, 1.0, c);
             if (*std::max_element(c, c + 6 * 3 + 4) > 0) return "";
@@ -1594,9 +1599,8 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         const double settle = std::ceil(settle_time(2 * opt.region, c.rate, opt) / T) * T;
         double offset = 0;
         {
-            const double turn = target.theta - c.q[2];
             Scene placed = part_scene;
-            placed.plate = combined(shift_motion(rotate_motion(c.u, turn), target.at - Eigen::Rotation2Dd(turn) * Vec2(c.q.head<2>())));
+            placed.plate = placed_motion(c.u, c.q, target.at, target.theta);
             IntegrationOptions io;
             io.rtol = 1e-7;
             const Trajectory tr = simulate(placed, Dynamics::Full, Vec3(target.at.x(), target.at.y(), target.theta), Vec3::Zero(),
@@ -1764,10 +1768,9 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         sum.failure = "the search's best motion has no fixed point near the design's centre";
         return finished(sum, cycles, t0);
     }
-    const double turn = target.theta - theta_offset - q[2];
-    const Vec2 s_turned = Eigen::Rotation2Dd(turn) * Vec2(q.head<2>());
     const Vec2 at = orient ? Vec2::Zero() : target.at;
-    sum.scene.plate = combined(shift_motion(rotate_motion(centred.plate, turn), at - s_turned));
+    const Vec2 s_turned = Eigen::Rotation2Dd(target.theta - theta_offset - q[2]) * Vec2(q.head<2>());
+    sum.scene.plate = placed_motion(centred.plate, q, at, target.theta, theta_offset);
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     int n_max = 1;
     for (const Harmonic& h : sum.scene.plate.harmonics) n_max = std::max(n_max, h.n);
@@ -1874,36 +1877,26 @@ double pair_basin_bound(const Vec2& D, double region) {
     return 1 - overlap / (2 * 4 * region * region);
 }
 
-double coning_rate(const PlateMotion& u) {
-    // sum_n Im(A_rx,n conj(A_ry,n)) / (2 (n w)^3) over the phasors amp e^{i phase} of each (axis, n).
+namespace {
+// sum_n Im(A_a,n conj(A_b,n)) / (2 (n w)^3) over the phasors amp e^{i phase} of each (axis, n): the
+// second-order drift about the third axis of (a, b) in the cross product's cyclic order.
+double drift_sum(const PlateMotion& u, Axis a, Axis b) {
     const auto ph = phasors(u);
     double r = 0;
-    for (const auto& [k, a] : ph) {
-        if (k.first != static_cast<int>(Axis::rx)) continue;
-        const auto b = ph.find({static_cast<int>(Axis::ry), k.second});
-        if (b == ph.end()) continue;
+    for (const auto& [k, za] : ph) {
+        if (k.first != static_cast<int>(a)) continue;
+        const auto zb = ph.find({static_cast<int>(b), k.second});
+        if (zb == ph.end()) continue;
         const double nw = k.second * 2 * kPi / u.T;
-        r += std::imag(a * std::conj(b->second)) / (2 * nw * nw * nw);
+        r += std::imag(za * std::conj(zb->second)) / (2 * nw * nw * nw);
     }
     return r;
 }
+}  // namespace
 
-Vec2 tilt_drift_rate(const PlateMotion& u) {
-    // (coning_rate's sum for the pairs (ry, rz) -> x and (rz, rx) -> y: the cross product's cyclic order)
-    const auto ph = phasors(u);
-    auto pair_sum = [&](Axis a, Axis b) {
-        double r = 0;
-        for (const auto& [k, za] : ph) {
-            if (k.first != static_cast<int>(a)) continue;
-            const auto zb = ph.find({static_cast<int>(b), k.second});
-            if (zb == ph.end()) continue;
-            const double nw = k.second * 2 * kPi / u.T;
-            r += std::imag(za * std::conj(zb->second)) / (2 * nw * nw * nw);
-        }
-        return r;
-    };
-    return Vec2(pair_sum(Axis::ry, Axis::rz), pair_sum(Axis::rz, Axis::rx));
-}
+double coning_rate(const PlateMotion& u) { return drift_sum(u, Axis::rx, Axis::ry); }
+
+Vec2 tilt_drift_rate(const PlateMotion& u) { return Vec2(drift_sum(u, Axis::ry, Axis::rz), drift_sum(u, Axis::rz, Axis::rx)); }
 
 double sink_coning_limit(const Vec2& at, const DesignOptions& opt) {
     if (opt.max_coning >= 0) return opt.max_coning;

@@ -58,7 +58,8 @@ double coning_rate(const PlateMotion& u);
 // full dynamics). Where it is not zero the plate's tilt grows
 // steadily and gravity pulls every part downhill: a trial design with rz at n = 1 a quarter period
 // off the tilts' drifted 1e-3 rad/s, and all 20 of its full-dynamics runs left the plate after 36 s
-// (docs/inverse-design.md). Rigid designs hold it to the coning limit; a motion without rz has none.
+// (docs/inverse-design.md). Rigid designs hold it to 2e-6 rad/s (design.cpp, kTiltDriftLimit); a
+// motion without rz has none.
 Vec2 tilt_drift_rate(const PlateMotion& u);
 
 // ORIENTATION HARMONICS. At a position s the twist's theta' is a function of theta alone,
