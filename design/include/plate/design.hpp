@@ -165,6 +165,12 @@ struct DesignOptions {
     // A motion that verifies as unique replaces the pair; else the verified one whose runs end at the
     // target most often, where that beats the pair's share. false: the pair as found.
     bool break_pair = true;
+    // break_pair's candidates with theta''s other wells lifted clear of zero along the curve s*(theta)
+    // where the position's twist vanishes (the field's fixed points lie on it; the screen looks at the
+    // centre only): rz's settings moved until the shallowest other well clears 0.003 rad/s. false: the
+    // screen's candidates as they are (fig4: verified, every run at the target, but a second stable
+    // fixed point on the grid, 1 mm off the target at the twin's orientation).
+    bool lift_wells = true;
     double fixed_point_tolerance = 0.002;   // the field's stable fixed point within this of the target [m]
     // The search's freedom (the CLI's --axes and --harmonics): a harmonic on an axis not in `axes`, or
     // of order n above max_harmonic, is held at zero. Empty / 0: each target's own motion family --
