@@ -1486,22 +1486,30 @@ bool reduced_ring(const Scene& sc, const Vec2& base, int n, const LimitCycleOpti
     return true;
 }
 
-// The second-lowest local minimum of theta' round a ring of n (a parabola through each minimum and its
-// neighbours): where the ring has one stable orientation, how far its shallowest other well stays
-// above zero -- negative where that well holds a second stable orientation; the ring's largest value
-// where it has one well only.
-double second_well(const double* w, int n) {
-    std::vector<double> minima;
+// The shallowest well of theta' round a ring of n other than the target's: the target's well is the arc
+// where theta' < 0 from the stable zero nearest theta_target (theta' falls through it) to the unstable
+// one; every local minimum outside that arc (a parabola through it and its neighbours) is another well,
+// and the lowest of them is returned -- negative where it holds a second stable orientation, the
+// ring's largest value where there is none, -infinity without a stable zero.
+double other_well(const double* w, int n, double theta_target) {
+    const double h = 2 * kPi / n;
+    int at = -1;
+    for (int k = 0; k < n; ++k)
+        if (w[k] > 0 && w[(k + 1) % n] <= 0 &&
+            (at < 0 || std::abs(wrap_angle(-kPi + h * (k + 0.5) - theta_target)) <
+                           std::abs(wrap_angle(-kPi + h * (at + 0.5) - theta_target))))
+            at = k;
+    if (at < 0) return -HUGE_VAL;
+    std::vector<bool> own(n, false);
+    for (int k = (at + 1) % n; w[k] <= 0 && !own[k]; k = (k + 1) % n) own[k] = true;
+    double lowest = *std::max_element(w, w + n);
     for (int k = 0; k < n; ++k) {
         const double a = w[(k + n - 1) % n], b = w[k], c = w[(k + 1) % n];
-        if (b <= a && b < c) {
-            const double curv = a - 2 * b + c;
-            minima.push_back(curv > 0 ? b - (c - a) * (c - a) / (8 * curv) : b);
-        }
+        if (own[k] || !(b <= a && b < c)) continue;
+        const double curv = a - 2 * b + c;
+        lowest = std::min(lowest, curv > 0 ? b - (c - a) * (c - a) / (8 * curv) : b);
     }
-    if (minima.size() < 2) return *std::max_element(w, w + n);
-    std::sort(minima.begin(), minima.end());
-    return minima[1];
+    return lowest;
 }
 
 // theta' = w(theta) round a ring of n (linear between its points), with exactly one stable zero: the
@@ -1683,7 +1691,7 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
             if (*std::max_element(con, con + 6 * 3 + 4) > 0) return sc0;
             double w[kWellRing];
             if (!reduced_ring(sc, c.q.head<2>(), kWellRing, opt.cycle, own, w)) return sc0;
-            return Score{second_well(w, kWellRing), ring_passage(w, kWellRing)};
+            return Score{other_well(w, kWellRing, c.q[2]), ring_passage(w, kWellRing)};
         };
         std::array<double, 4> g = c.g;
         long own0 = 0;
@@ -1727,12 +1735,15 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         }
         std::ostringstream note;
         note.precision(2);
-        note << "theta' along the position's fixed points (" << kWellRing << " orientations): its shallowest other well "
-             << start.well << " rad/s";
+        note << "theta' along the position's fixed points (" << kWellRing << " orientations, linearised): its shallowest "
+             << "other well " << start.well << " rad/s";
         if (now.well != start.well) note << ", lifted to " << now.well << " rad/s";
         note << " (" << kWellMargin << " needed), the slowest passage round it " << std::min(now.passage, 1e9) << " s";
         lift = note.str();
-        if (now.well < kWellMargin) return false;
+        if (now.well < kWellMargin) {
+            lift += " -- not applied: the margin not reached";
+            return false;
+        }
         if (g == c.g) return true;
         Scene sc = part_scene;
         sc.plate = with_rz(c.base, g);
@@ -1743,7 +1754,10 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         cycles += own;
         std::istringstream in(r);
         std::string x[5];
-        if (!(in >> x[0] >> x[1] >> x[2] >> x[3] >> x[4])) return false;
+        if (!(in >> x[0] >> x[1] >> x[2] >> x[3] >> x[4])) {
+            lift += " -- not applied: the lifted motion's fixed point not found again within the limits";
+            return false;
+        }
         c.u = sc.plate;
         c.g = g;
         c.q = Vec3(exact_value(x[0]), exact_value(x[1]), exact_value(x[2]));
@@ -1816,8 +1830,11 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
 // loses the position's pull, README), the sink's motion (odd harmonics on x, y, rx, ry; n = 1, 3) with
 // theta' at THETA made a stable zero as well, coning held to kConingLimit. Turning such a motion by pi is shifting it by half a period, so (s*, THETA) and
 // (-s*, THETA + pi) are both stable fixed points, at the centre (s* ~ 0) the same position: the part
-// is brought to the target's position from everywhere and to its orientation up to a half turn --
-// reported as not unique, with the twin and each one's share of the random starts.
+// is brought to the target's position from everywhere and to its orientation up to a half turn.
+// Then broken (break_pair, where DesignOptions::break_pair): the pair's field checked first (no runs),
+// and where the broken motion verifies as unique it is returned without the pair's own runs; else the
+// pair is verified in full and reported as not unique, with the twin and each one's share of the
+// random starts, unless a verified broken motion has the larger share.
 DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
@@ -1849,6 +1866,7 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
         DesignSummary probe = sum;
         place_and_verify_rigid(probe, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, quick, cycles, t0, true);
         if (probe.verified) broken = break_pair(part_scene, sink_motion(best, T), target, opt, T, cycles, t0);
+        else broken.failure = "not tried: the pair's field does not hold the target (" + probe.failure + ")";
         if (broken.verified && broken.unique) {
             broken.notes.insert(broken.notes.begin(),
                                 "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA a stable zero of theta'; "
@@ -1860,7 +1878,7 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
     }
     place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0, true);
     if (!opt.break_pair) return sum;
-    if (broken.verified && broken.basin_share > sum.basin_share) {
+    if (sum.verified && broken.verified && broken.basin_share > sum.basin_share) {
         std::ostringstream note;
         note.precision(2);
         note << "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA a stable zero of theta'; verified, "
@@ -1945,8 +1963,8 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
                  << oh.first() << " rad/s against " << oh.rest() << " for the mean and the others ("
                  << (oh.one_stable()            ? "enough for exactly one stable orientation"
                      : oh.first() > oh.rest() ? "the zeros lie in two arcs, but more than one may be stable"
-                                              : "too small for one orientation: stable ones pair about a half turn apart "
-                                                "unless the mean is tuned onto a saddle-node")
+                                              : "below the rest: not enough by itself for one orientation, whose stable ones pair "
+                                                "about a half turn apart unless the mean is tuned near a saddle-node")
                  << "; orientation_harmonics, design.hpp)";
             sum.notes.push_back(note.str());
         }
@@ -2047,7 +2065,7 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         sum.failure = "of " + std::to_string(sum.runs.size()) + " full-dynamics runs, " +
                       std::to_string(static_cast<int>(sum.runs.size()) - accounted) +
                       " ended at neither the target nor a competing stable fixed point";
-    else if (!sum.unique && ended[0] == 0 && !sum.runs.empty())   // (no runs asked: the field's checks only)
+    else if (!sum.unique && ended[0] == 0 && opt.verify_starts > 0)   // (0, design_rigid_pair's probe: the field only)
         sum.failure = "no full-dynamics run ended at the target";
     else if (pair && !twin_ok)
         sum.failure = "the half-turn pair's stable fixed points are not the target and its twin alone (" +

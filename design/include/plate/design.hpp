@@ -162,8 +162,10 @@ struct DesignOptions {
     double max_coning = -1;
     // A rigid fixed point designed as a half-turn pair (design_rigid_pair) is offered rz about its
     // centre -- at n = 2 to bring theta''s two minima near a saddle-node, at n = 1 to lift one of them.
-    // A motion that verifies as unique replaces the pair; else the verified one whose runs end at the
-    // target most often, where that beats the pair's share. false: the pair as found.
+    // A motion that verifies as unique replaces the pair (whose own full-dynamics runs are then not
+    // made; its field is checked first); else the pair is verified in full, and the verified broken one
+    // whose runs end at the target most often replaces it where that beats the pair's share. false: the
+    // pair as found.
     bool break_pair = true;
     // break_pair's candidates with theta''s other wells lifted clear of zero along the curve s*(theta)
     // where the position's twist vanishes (the field's fixed points lie on it; the screen looks at the
