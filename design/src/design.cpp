@@ -1574,6 +1574,13 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         u.harmonics.push_back({Axis::rz, 2, g[2], g[3]});
         return u;
     };
+    // The motion with fixed point q, placed as place_and_verify_rigid will place it: within the limits,
+    // the flight margin, and the coning and tilt-drift limits.
+    auto fits = [&](const PlateMotion& u, const Vec3& q) {
+        double con[6 * 3 + 4];
+        placed_constraints(placed_motion(u, q, target.at, target.theta), opt, part_scene, 3, 1.0, con);
+        return *std::max_element(con, con + 6 * 3 + 4) <= 0;
+    };
     // A ring of n values of theta' with exactly one stable zero: its fixed point by Newton from q (not
     // finite: the middle of the zero's cell at the centre), stable and within `reach` of the centre
     // (the screen's 5 mm; 10 mm once lifted, its fixed point found again along s*), the placed motion
@@ -1600,13 +1607,7 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         if (!conv || q.head<2>().norm() > reach) return "";
         const Eigen::Vector3cd ev = J.eigenvalues();
         const double rate = -std::max({ev[0].real(), ev[1].real(), ev[2].real()});
-        if (!(rate > 0)) return "";
-        {   // placed as place_and_verify_rigid will place it: within the limits and the flight margin
-            const PlateMotion placed = placed_motion(sc.plate, q, target.at, target.theta);
-            double c[6 * 3 + 4];
-            placed_constraints(placed, opt, part_scene, 3, 1.0, c);
-            if (*std::max_element(c, c + 6 * 3 + 4) > 0) return "";
-        }
+        if (!(rate > 0) || !fits(sc.plate, q)) return "";
         const double passage = ring_passage(w, n);
         return exact_text(q[0]) + ' ' + exact_text(q[1]) + ' ' + exact_text(q[2]) + ' ' + exact_text(rate) + ' ' +
                exact_text(passage);
@@ -1686,9 +1687,7 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
             if (g[0] < 0 || g[0] > room || g[2] < 0 || g[2] > room) return sc0;
             Scene sc = part_scene;
             sc.plate = with_rz(c.base, g);
-            double con[6 * 3 + 4];
-            placed_constraints(placed_motion(sc.plate, c.q, target.at, target.theta), opt, part_scene, 3, 1.0, con);
-            if (*std::max_element(con, con + 6 * 3 + 4) > 0) return sc0;
+            if (!fits(sc.plate, c.q)) return sc0;
             double w[kWellRing];
             if (!reduced_ring(sc, c.q.head<2>(), kWellRing, opt.cycle, own, w)) return sc0;
             return Score{other_well(w, kWellRing, c.q[2]), ring_passage(w, kWellRing)};
@@ -1859,6 +1858,14 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
     // a pair that does not hold the target is not broken); else the pair verified in full and the better kept.
     DesignSummary broken;
     broken.failure = "not tried";
+    // (the broken pair returned, saying what the pair was)
+    auto adopt = [&](const std::string& pair_was) -> DesignSummary {
+        broken.notes.insert(broken.notes.begin(), "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA "
+                                                  "a stable zero of theta'; " + pair_was + ")");
+        broken.evaluations += sum.evaluations;
+        broken.starts = sum.starts;
+        return finished(broken, cycles, t0);
+    };
     if (opt.break_pair) {
         DesignOptions quick = opt;
         quick.verify_starts = 0;
@@ -1867,27 +1874,17 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
         place_and_verify_rigid(probe, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, quick, cycles, t0, true);
         if (probe.verified) broken = break_pair(part_scene, sink_motion(best, T), target, opt, T, cycles, t0);
         else broken.failure = "not tried: the pair's field does not hold the target (" + probe.failure + ")";
-        if (broken.verified && broken.unique) {
-            broken.notes.insert(broken.notes.begin(),
-                                "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA a stable zero of theta'; "
-                                "its field checked, its own full-dynamics runs not needed once the broken pair verified as unique)");
-            broken.evaluations += sum.evaluations;
-            broken.starts = sum.starts;
-            return finished(broken, cycles, t0);
-        }
+        if (broken.verified && broken.unique)
+            return adopt("its field checked, its own full-dynamics runs not needed once the broken pair verified as unique");
     }
     place_and_verify_rigid(sum, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, opt, cycles, t0, true);
     if (!opt.break_pair) return sum;
     if (sum.verified && broken.verified && broken.basin_share > sum.basin_share) {
         std::ostringstream note;
         note.precision(2);
-        note << "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA a stable zero of theta'; verified, "
-                "the target's share of the runs "
-             << sum.basin_share << ", which its pairing caps at " << sum.basin_share_bound << ")";
-        broken.notes.insert(broken.notes.begin(), note.str());
-        broken.evaluations += sum.evaluations;
-        broken.starts = sum.starts;
-        return finished(broken, cycles, t0);
+        note << "verified, the target's share of the runs " << sum.basin_share << ", which its pairing caps at "
+             << sum.basin_share_bound;
+        return adopt(note.str());
     }
     sum.notes.push_back("breaking the pairing with rz about its centre: " + broken.failure);
     sum.evaluations += broken.evaluations;
