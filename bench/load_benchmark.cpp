@@ -42,7 +42,7 @@ int main() {
     for (int block = 0; block < 10; ++block) {
         const auto t0 = std::chrono::steady_clock::now();
         int converged = 0;
-        for (int i = 0; i < 1000; ++i) converged += limit_cycle(sc, Vec3(u(rng), u(rng), th(rng))).converged;
+        for (int i = 0; i < 1000; ++i) converged += limit_cycle(sc, Vec3{u(rng), u(rng), th(rng)}).converged;
         const double s = since(t0);
         (block == 0 ? first : last) = s;
         if (block == 0) hwm_first = status_kb("VmHWM:");

@@ -205,8 +205,8 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
     const DynamicsUnderTest dyn = dynamics ? dynamics : production_dynamics();
     Rng r(seed * 2654435761u + 3);
     for (int k = 0; k < samples; ++k) {
-        const Vec3 q(q0[0] + r.uniform(-0.005, 0.005), q0[1] + r.uniform(-0.005, 0.005), q0[2] + r.uniform(-0.5, 0.5));
-        const Vec3 qd(r.uniform(-v, v), r.uniform(-v, v), r.uniform(-v, v) / rho);
+        const Vec3 q{q0[0] + r.uniform(-0.005, 0.005), q0[1] + r.uniform(-0.005, 0.005), q0[2] + r.uniform(-0.5, 0.5)};
+        const Vec3 qd{r.uniform(-v, v), r.uniform(-v, v), r.uniform(-v, v) / rho};
         const PlateState ps = plate_state(sc.plate, r.uniform(0, sc.plate.T), Dynamics::U);
         Vec3 qdd, n;
         dyn(sc, q, qd, ps, qdd, n);
@@ -245,8 +245,8 @@ ContractionCase contraction_random_case(const ContractionOptions& opt, int k) {
     if (opt.modify) opt.modify(sc);
     Rng r(seed * 0x9E3779B97F4A7C15ull + 17);
     const double v = sc.v_ref(), w = v / sc.part.rho();
-    const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
-    auto twist = [&] { return Vec3(r.uniform(-v, v), r.uniform(-v, v), r.uniform(-w, w)); };
+    const Vec3 q0{r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)};
+    auto twist = [&] { return Vec3{r.uniform(-v, v), r.uniform(-v, v), r.uniform(-w, w)}; };
     const Vec3 a = twist(), b = twist();
     ContractionCase c = contraction_case(sc, q0, a, b, opt.periods, opt.rtol);
     c.seed = seed;
@@ -413,7 +413,7 @@ LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const D
     for (int k = 0; k < parts; ++k) {
         const Scene sc = random_scene(seed + 90'000'000 + static_cast<std::uint64_t>(k), RandomSceneOptions{true});
         double scale = 0;
-        const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
+        const Vec3 q0{r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)};
         const double t = r.uniform(0, sc.plate.T);
         const WrenchMap w = thin_wrench_map(sc, q0, t, &scale);
         c.tie.merge(check_dynamics_tie(sc, q0, 10, seed + 90'000'000 + static_cast<std::uint64_t>(k), dynamics));
@@ -443,8 +443,8 @@ Conditioning condition_of_A(const Scene& sc, int samples, std::uint64_t seed) {
     De << m * g, m * g, m * g, m * g * rho, m * g * rho, m * g * rho;
     Workspace ws;
     for (int k = 0; k < samples; ++k) {
-        const Vec3 q(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
-        const Vec3 qd(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30));
+        const Vec3 q{r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)};
+        const Vec3 qd{r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30)};
         accelerations_reference(sc, Dynamics::U, q, qd, PlateState{}, ws);
         const Mat6 As = De.cwiseInverse().asDiagonal() * ws.A * Dz.asDiagonal();
         const Vec6 sv = Eigen::JacobiSVD<Mat6>(As).singularValues();

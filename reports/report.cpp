@@ -69,8 +69,8 @@ void section_kernels(Ctx& c, std::uint64_t seed) {
         Rng r(seed + s);
         Workspace g, f;
         for (int k = 0; k < 100; ++k, ++n) {
-            const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
-            const Vec3 qd(r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-20, 20));
+            const Vec3 q{r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi)};
+            const Vec3 qd{r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-20, 20)};
             const PlateState ps = plate_state(sc.plate, r.uniform(0, sc.plate.T), Dynamics::U);
             accelerations(sc, Dynamics::U, q, qd, ps, g);
             accelerations_reference(sc, Dynamics::U, q, qd, ps, f);

@@ -131,11 +131,11 @@ TEST_CASE("plate at rest, thin part: normal forces solve (38) and sum to m g, wh
         const Scene sc = resting(random_scene(seed, ro));
         REQUIRE(sc.part.thin());
         Rng r(seed + 1000);
-        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const Vec3 q{r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi)};
         const Vec3 n38 = normal_forces_38(sc.part, Vec3(0, 0, sc.part.m * sc.g));
         Workspace ws;
         for (int k = 0; k < 5; ++k) {
-            const Vec3 qd(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30));
+            const Vec3 qd{r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30)};
             accelerations(sc, Dynamics::U, q, qd, PlateState{}, ws);
             for (int i = 0; i < 3; ++i) CHECK(rel(ws.n[i], n38[i]) < 1e-11);
             CHECK(rel(ws.n.sum(), sc.part.m * sc.g) < 1e-13);
@@ -149,7 +149,7 @@ TEST_CASE("thin part on a moving plate: (38) with the U-dynamics right-hand side
         ro.thin = true;
         const Scene sc = random_scene(seed, ro);
         Rng r(seed + 7);
-        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const Vec3 q{r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi)};
         const double t = r.uniform(0, sc.plate.T);
         const PlateState ps = plate_state(sc.plate, t, Dynamics::U);
         const Mat3 R2 = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix();
@@ -159,7 +159,7 @@ TEST_CASE("thin part on a moving plate: (38) with the U-dynamics right-hand side
         const Vec3 n38 = normal_forces_38(sc.part, rhs);
         Workspace ws;
         for (int k = 0; k < 3; ++k) {
-            const Vec3 qd(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30));
+            const Vec3 qd{r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-30, 30)};
             accelerations(sc, Dynamics::ReducedU, q, qd, ps, ws);
             for (int i = 0; i < 3; ++i) CHECK(std::abs(ws.n[i] - n38[i]) < 1e-11 * sc.part.m * sc.g);
         }
@@ -274,10 +274,10 @@ WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, con
 // A random tilted, turning plate state for the full dynamics.
 PlateState random_plate(Rng& r) {
     PlateState ps;
-    ps.R1 = detail::exp_so3(Vec3(r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)));
-    ps.w1 = Vec3(r.uniform(-5, 5), r.uniform(-5, 5), r.uniform(-5, 5));
-    ps.pdd = Vec3(r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(-3, 3));
-    ps.wd = Vec3(r.uniform(-50, 50), r.uniform(-50, 50), r.uniform(-100, 100));
+    ps.R1 = detail::exp_so3(Vec3{r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)});
+    ps.w1 = Vec3{r.uniform(-5, 5), r.uniform(-5, 5), r.uniform(-5, 5)};
+    ps.pdd = Vec3{r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(-3, 3)};
+    ps.wd = Vec3{r.uniform(-50, 50), r.uniform(-50, 50), r.uniform(-100, 100)};
     return ps;
 }
 
@@ -289,8 +289,8 @@ TEST_CASE("full dynamics (31) satisfy Newton-Euler in the world frame", "[dynami
     for (std::uint64_t seed = 1; seed <= 40; ++seed) {
         const Scene sc = random_scene(seed);
         Rng r(seed * 31);
-        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
-        const Vec3 qd(r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-30, 30));
+        const Vec3 q{r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi)};
+        const Vec3 qd{r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-30, 30)};
         const PlateState ps = random_plate(r);
         Workspace ws;
         accelerations(sc, Dynamics::Full, q, qd, ps, ws);
@@ -309,11 +309,11 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
     // has zero second derivative (central differences, h = 1e-4 s: truncation
     // h^2/12 |x^(4)| ~ 1e-9 theta'^4 |c| ~ 4e-5 m/s^2 at theta' = 30 rad/s; rounding 1e-9). Bound: 1e-4.
     int pivots = 0, stucks = 0;
-    for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+    for (std::uint64_t seed = 1; seed <= 40; ++seed) {
         const Scene sc = random_scene(seed);
         const Part& P = sc.part;
         Rng r(seed * 57);
-        const Vec3 q(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
+        const Vec3 q{r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi)};
         const PlateState ps = random_plate(r);
         Workspace ws;
         for (int k = 0; k < 3; ++k) {
@@ -367,7 +367,7 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
         CHECK(std::abs(dw / h / g.gamma - 1) < 1e-9);
         ++stucks;
     }
-    CHECK(pivots == 90);
+    CHECK(pivots == 120);
     CHECK(stucks >= 20);
 }
 
@@ -409,8 +409,8 @@ TEST_CASE("U-dynamics are the full dynamics with R1 = I and products of x and u 
 TEST_CASE("exponential coordinates: phi' = dexp^-1(phi) omega1 follows R1' = omega1^ R1", "[dynamics][so3]") {
     Rng r(99);
     for (int k = 0; k < 50; ++k) {
-        const Vec3 phi(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
-        const Vec3 w(r.uniform(-3, 3), r.uniform(-3, 3), r.uniform(-3, 3));
+        const Vec3 phi{r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1)};
+        const Vec3 w{r.uniform(-3, 3), r.uniform(-3, 3), r.uniform(-3, 3)};
         const double h = 1e-6;
         const Vec3 phid = detail::dexp_inv(phi * (k == 0 ? 1e-5 : 1.0), w);
         const Vec3 p0 = phi * (k == 0 ? 1e-5 : 1.0);
@@ -523,4 +523,45 @@ TEST_CASE("the friction gauge is the support function's optimum: brute force, an
         }
     }
     CHECK(checked >= 200);
+    // A certificate of optimality that no search can fake, where the part is held near its break-away
+    // (gamma near 1, where holds are decided): the distribution supplies (F, tau) with no disk
+    // used beyond gamma (so the gauge is at most gamma) and the direction d gives (d . w) / h(d) = gamma
+    // (at least gamma, by weak duality). heave_yaw with z 2 m/s^2 and rz 60 rad/s^2 at (0, 0.02, 0),
+    // held over its period: there Newton stalls next to a kink, and the pattern search that decided
+    // before stopped on kinks short of the minimum, its distribution's wrench up to 0.31 |w| off and
+    // its gauge up to 6e-6 low (1 / 1.03699388 for 1 / 1.0369874).
+    {
+        Scene sc = load_scene(PLATE_SOURCE_DIR "/scenes/heave_yaw.json");
+        sc.plate.harmonics[0].amp = 2;
+        sc.plate.harmonics[1].amp = 60;
+        ws.prepare(sc);
+        const Part& P = sc.part;
+        const Vec3 q(0, 0.02, 0);
+        int near_one = 0;
+        for (int k = 0; k < 4000; ++k) {
+            const PlateState ps = plate_state(sc.plate, sc.plate.T * k / 4000, Dynamics::ReducedU);
+            mode_accelerations(sc, Dynamics::ReducedU, q, Vec3::Zero(), ps, Mode{ModeKind::Stuck, -1, 0}, ws);
+            if ((ws.n.array() <= 0).any()) continue;
+            const FrictionGauge g = friction_gauge(P, q[2], ws.n, ws.F_needed, ws.tau_needed);
+            if (!(g.gamma > 0.5 && g.gamma < 2)) continue;
+            ++near_one;
+            Vec2 F = Vec2::Zero();
+            double tau = 0, h = 0;
+            for (int i = 0; i < 3; ++i) {
+                const Vec2 r = Eigen::Rotation2Dd(q[2]) * P.c[i].head<2>();
+                F += g.f[i];
+                tau += r.x() * g.f[i].y() - r.y() * g.f[i].x();
+                CHECK(g.f[i].norm() <= g.gamma * P.mu[i] * ws.n[i] * (1 + 1e-9));
+                h += P.mu[i] * ws.n[i] * (g.direction.head<2>() + g.direction[2] * Vec2(-r.y(), r.x())).norm();
+            }
+            const double scale = ws.F_needed.norm() + std::abs(ws.tau_needed) / P.rho();
+            INFO("t / T = " << k / 4000.0 << ", gamma " << g.gamma);
+            // (Newton stops where the gradient in the plane is below 1e-7 h |w|, which leaves the wrench
+            // within 1e-7 |w| (measured 8.7e-8); a stalled search is repaired beyond 1e-6 |w|.)
+            CHECK((F - ws.F_needed).norm() + std::abs(tau - ws.tau_needed) / P.rho() < 1e-6 * scale);
+            const double dw = g.direction.head<2>().dot(ws.F_needed) + g.direction[2] * ws.tau_needed;
+            CHECK(std::abs(dw / h / g.gamma - 1) < 1e-9);
+        }
+        CHECK(near_one >= 100);
+    }
 }

@@ -21,13 +21,13 @@ struct RandomState {
 
 RandomState random_state(Rng& r, bool tilt) {
     RandomState s;
-    s.q = Vec3(r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi));
-    s.qd = Vec3(r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-20, 20));
-    s.ps.pdd = Vec3(r.uniform(-25, 25), r.uniform(-25, 25), r.uniform(-3, 3));
-    s.ps.wd = Vec3(r.uniform(-60, 60), r.uniform(-60, 60), r.uniform(-150, 150));
+    s.q = Vec3{r.uniform(-0.03, 0.03), r.uniform(-0.03, 0.03), r.uniform(-kPi, kPi)};
+    s.qd = Vec3{r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(-20, 20)};
+    s.ps.pdd = Vec3{r.uniform(-25, 25), r.uniform(-25, 25), r.uniform(-3, 3)};
+    s.ps.wd = Vec3{r.uniform(-60, 60), r.uniform(-60, 60), r.uniform(-150, 150)};
     if (tilt) {
-        s.ps.R1 = detail::exp_so3(Vec3(r.uniform(-0.1, 0.1), r.uniform(-0.1, 0.1), r.uniform(-0.5, 0.5)));
-        s.ps.w1 = Vec3(r.uniform(-3, 3), r.uniform(-3, 3), r.uniform(-3, 3));
+        s.ps.R1 = detail::exp_so3(Vec3{r.uniform(-0.1, 0.1), r.uniform(-0.1, 0.1), r.uniform(-0.5, 0.5)});
+        s.ps.w1 = Vec3{r.uniform(-3, 3), r.uniform(-3, 3), r.uniform(-3, 3)};
     }
     return s;
 }
@@ -130,7 +130,7 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
             set(*w[i], S.w[i], r.uniform(-3, 3));
             set(*wd[i], S.wd[i], r.uniform(-100, 100));
         }
-        const Mat3 R1 = detail::exp_so3(Vec3(r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)));
+        const Mat3 R1 = detail::exp_so3(Vec3{r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)});
         double* Rf[9] = {&in.R11, &in.R12, &in.R13, &in.R21, &in.R22, &in.R23, &in.R31, &in.R32, &in.R33};
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) set(*Rf[3 * i + j], S.R[i][j], R1(i, j));

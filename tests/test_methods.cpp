@@ -242,7 +242,7 @@ TEST_CASE("a-priori auto: the error estimates bound the measured errors on seede
         ro.thin = k % 3 == 0;
         const Scene sc = random_scene(5000 + static_cast<std::uint64_t>(k), ro);
         Rng r(77 + k);
-        const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi));
+        const Vec3 q0{r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-kPi, kPi)};
         const ModelChoice mc = choose_model(sc, q0, 1.0, 1e-2);
         const ModelEstimate est = estimate_model_errors(sc, q0, 1.0);
         if (!est.ok || mc.rungs.size() < 2) continue;
@@ -316,9 +316,10 @@ TEST_CASE("every method gets the engine's start and restart rule (issue 15's fai
     // transient (it would tip), while its sliding cycle keeps all three: the engine starts again
     // from another twist (limit_cycle's rule). A general method given the same rule reaches the same
     // cycle instead of being charged with a contact loss the engine also met.
+    // (The configuration was drawn by Rng(226) when g++ evaluated Vec3's arguments last to first; the
+    // draws are now in order on every compiler, so it is written out.)
     const Scene sc = random_scene(226);
-    Rng r(226);
-    const Vec3 q0(r.uniform(-0.02, 0.02), r.uniform(-0.02, 0.02), r.uniform(-3, 3));
+    const Vec3 q0(-0.012930818368603558, -0.0022664680119125584, 0.6638159462880342);
     const LimitCycleSummary lc = limit_cycle(sc, q0);
     REQUIRE(lc.converged);
     REQUIRE(lc.restarts > 0);
