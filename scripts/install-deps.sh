@@ -4,6 +4,7 @@ set -euo pipefail
 pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-dev libcln-dev
       catch2 nlohmann-json3-dev libcli11-dev gnuplot-nox libjs-katex valgrind chromium
       python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev
+      clang libclang-rt-dev   # (the sanitizer build, scripts/test-sanitizers.sh)
       libopenmpi-dev openmpi-bin
       libbullet-dev libode-dev libmujoco-dev)   # (the last three: the peer engines, optional to the build)
 missing=()

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -71,7 +72,14 @@ struct Mutator {
                 if (n.is_object()) n["extra"] = 1;
                 else if (n.is_array() && !n.empty()) n.push_back(n[pick(n.size())]);
                 break;
-            case 7: if (n.is_number_integer()) n = static_cast<long long>(special(n.get<double>())); break;
+            case 7:   // an integer field gets a special value, saturated to long long's range: a cast of
+                      // 1.7e308 to it is undefined behaviour (clang's UBSan, float-cast-overflow)
+                if (n.is_number_integer()) {
+                    const double v = special(n.get<double>());
+                    constexpr double lim = 9.2e18;   // below 2^63
+                    n = v >= lim ? LLONG_MAX : v <= -lim ? LLONG_MIN : static_cast<long long>(v);
+                }
+                break;
             case 8: if (n.is_number()) n = n.get<double>() * (coin(0.5) ? -1 : 1) * std::pow(10.0, static_cast<int>(pick(13)) - 6); break;
         }
     }
