@@ -63,6 +63,8 @@ memcheck() {
   done
 }
 echo "sanitizers: $ncases cases ($tags) in two halves, the fuzz replay and valgrind, side by side" >&2
+# (a stop of this script stops the four runs too, rather than leaving them running)
+trap 'kill $(jobs -p) 2>/dev/null' INT TERM
 run cases1 build-asan/tests/plate_tests -f "$work/half1" --warn NoTests &
 run cases2 build-asan/tests/plate_tests -f "$work/half2" --warn NoTests &
 run fuzz fuzz &

@@ -116,13 +116,15 @@ bool vanishes_on_rotations(const ex& e, const Symbols& S, int trials, unsigned s
     std::mt19937 rng(seed);
     auto rat = [&](int lo, int hi) {
         std::uniform_int_distribution<int> num(lo, hi), den(1, 7);
-        return numeric(num(rng), den(rng));
+        const int a = num(rng);   // (drawn in order: a call's arguments are evaluated in no set order)
+        return numeric(a, den(rng));
     };
     for (int t = 0; t < trials; ++t) {
         exmap sub;
         for (const auto& s : all_symbols(S)) sub[s] = rat(-9, 9);
         // R1 = (I - K)^-1 (I + K), K = k^: exactly orthogonal with rational entries.
-        const matrix K = hat(col(rat(-3, 3), rat(-3, 3), rat(-3, 3)));
+        const ex k1 = rat(-3, 3), k2 = rat(-3, 3), k3 = rat(-3, 3);
+        const matrix K = hat(col(k1, k2, k3));
         const matrix I = ex_to<matrix>(unit_matrix(3));
         const matrix R = I.sub(K).inverse().mul(I.add(K));
         for (int i = 0; i < 3; ++i)

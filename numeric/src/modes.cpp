@@ -220,8 +220,8 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     // Hessian unbounded): drawn there, the line search stalled with the gradient far from zero and
     // the gauge came out low (fig6 at (0.0167, 0, 2.693), t = 0.01759: 0.967 where the minimum gives
     // 0.992 -- the part was held 0.13 ms too long, its cycle's twist 1.8e-4 v_ref off the regularised
-    // reference). Then the kinks and a pattern search in the plane decide (h is convex: one of 16
-    // directions descends until the step is at rounding).
+    // reference). Then the kinks and a pattern search in the plane decide (16 directions; h is convex,
+    // but next to a kink its descent cone can be narrower than their spacing: repaired below).
     const bool stalled = last_gy > 1e-7 * h * wn;
     if (stalled) {
         // (the minimum may sit at a kink whose test above failed by rounding: h there first)
@@ -254,14 +254,17 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
         d = d0 + B * y;
     }
     // At the optimum the distribution f_i = gamma cap_i v_i / |v_i| (v_i = G_i^T d) supplies w exactly.
-    // Where the pattern search's does not (by more than 1e-6 of |w|: its own stopping leaves less), it stopped at a kink that is not the optimum (its descent cone
+    // Where the pattern search's does not (by more than 1e-6 of |w|; its own stopping leaves less away
+    // from kinks, and next to one the repair below only refines a correct optimum), it stopped at a kink that is not the optimum (its descent cone
     // narrower than the 16 directions: random scene 15 of the held-modes test, the wrench 0.22 N off
     // and the gauge 4.7997 for 4.8008), or at the optimum on a kink whose test failed by rounding (the
     // kink's force, inside its disk, is then missing). Then h is smoothed, h_delta(d) = sum cap_i
     // sqrt(|v_i|^2 + delta^2) (convex and smooth for delta > 0, within 3 cap delta of h), and minimised
-    // by Newton while delta falls from 1e-2 to 1e-12 of |d0|, each stage from the last. Its stationary
-    // point gives f_i = cap_i v_i / (s_i h~), s_i = sqrt(|v_i|^2 + delta^2), h~ = sum cap_i |v_i|^2 /
-    // s_i, whose wrench is w (grad h_delta = h~ w there), a contact at the kink included.
+    // by Newton while delta falls from 1e-2 to 1e-12 of |d0| = 1/|w|, each stage from the last. Its
+    // stationary point gives f_i = cap_i v_i / (s_i h~), s_i = sqrt(|v_i|^2 + delta^2), h~ = sum cap_i
+    // |v_i|^2 / s_i, whose wrench is w (grad h_delta = h~ w there), a contact at the kink included: its
+    // force is then inside its disk, and it is the pivot (choose_mode breaks away about it). The repair
+    // is kept only where it is at least as low as the search's h (it always was where measured).
     Vec3 supplied = Vec3::Zero();
     for (int i = 0; i < 3 && stalled; ++i) {
         const Vec2 v = Gt(i, d);
@@ -310,8 +313,19 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
             }
         }
         delta *= 10;   // the last stage's
-        d = d0 + B * y;
-        h = h_at(d);
+        const Vec3 dr = d0 + B * y;
+        const double hr = h_at(dr);
+        if (!(hr <= h * (1 + 1e-12))) {   // (a repair that did not descend: the search's result stands)
+            finish(d, h);
+            for (int i = 0; i < 3; ++i) {
+                const Vec2 v = Gt(i, d);
+                const double nv = v.norm();
+                g.f[i] = nv > 0 ? Vec2(g.gamma * cap[i] * v / nv) : Vec2::Zero();
+            }
+            return g;
+        }
+        d = dr;
+        h = hr;
         finish(d, h);
         double ht = 0;
         std::array<Vec2, 3> v;
@@ -321,7 +335,15 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
             si[i] = std::sqrt(v[i].squaredNorm() + delta * delta);
             if (cap[i] > 0) ht += cap[i] * v[i].squaredNorm() / si[i];
         }
-        for (int i = 0; i < 3; ++i) g.f[i] = cap[i] > 0 && ht > 0 ? Vec2(cap[i] * v[i] / (si[i] * ht)) : Vec2::Zero();
+        double least = 1 - 1e-3;   // (a sliding contact's force is at its rim to within (delta/|v|)^2)
+        for (int i = 0; i < 3; ++i) {
+            g.f[i] = cap[i] > 0 && ht > 0 ? Vec2(cap[i] * v[i] / (si[i] * ht)) : Vec2::Zero();
+            const double used = cap[i] > 0 ? g.f[i].norm() / (g.gamma * cap[i]) : 1.0;
+            if (used < least) {
+                least = used;
+                g.pivot = i;
+            }
+        }
         return g;
     }
     finish(d, h);

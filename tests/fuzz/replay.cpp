@@ -80,7 +80,12 @@ struct Mutator {
                     n = v >= lim ? LLONG_MAX : v <= -lim ? LLONG_MIN : static_cast<long long>(v);
                 }
                 break;
-            case 8: if (n.is_number()) n = n.get<double>() * (coin(0.5) ? -1 : 1) * std::pow(10.0, static_cast<int>(pick(13)) - 6); break;
+            case 8:   // (the two draws in order: operands of * are evaluated in no set order)
+                if (n.is_number()) {
+                    const double sign = coin(0.5) ? -1 : 1;
+                    n = n.get<double>() * sign * std::pow(10.0, static_cast<int>(pick(13)) - 6);
+                }
+                break;
         }
     }
     void mutate_args(std::vector<std::string>& a) {

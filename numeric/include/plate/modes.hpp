@@ -65,8 +65,9 @@ std::string mode_name(const Mode& m);
 // the friction set (G_i^T d = the velocity of contact i under the twist d, in the paper's scaled
 // coordinates: w = (F, tau/rho), d = (d_x, d_y, rho d_theta)); we minimise the convex h over the
 // plane d . w = 1 -- at a kink G_k^T d = 0 (a rotation about contact k, tested in closed form) or
-// by Newton's method where h is smooth. The optimal distribution is unique at a smooth boundary
-// point: f_i = gamma mu_i N_i G_i^T d/|G_i^T d|.
+// by Newton's method where h is smooth; where Newton stalls next to a kink, a pattern search, and
+// where that stops short (its distribution misses the wrench), Newton on h smoothed by delta -> 0.
+// The optimal distribution is unique at a smooth boundary point: f_i = gamma mu_i N_i G_i^T d/|G_i^T d|.
 struct FrictionGauge {
     double gamma = 0;               // 0 for w = 0; inf if no friction can supply w
     std::array<Vec2, 3> f = zeros<Vec2>();        // the optimal friction distribution [N], P frame
