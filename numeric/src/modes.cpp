@@ -315,36 +315,29 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
         delta *= 10;   // the last stage's
         const Vec3 dr = d0 + B * y;
         const double hr = h_at(dr);
-        if (!(hr <= h * (1 + 1e-12))) {   // (a repair that did not descend: the search's result stands)
+        if (hr <= h * (1 + 1e-12)) {   // (else the repair did not descend: the search's result stands)
+            d = dr;
+            h = hr;
             finish(d, h);
+            double ht = 0;
+            std::array<Vec2, 3> v;
+            std::array<double, 3> si{};
             for (int i = 0; i < 3; ++i) {
-                const Vec2 v = Gt(i, d);
-                const double nv = v.norm();
-                g.f[i] = nv > 0 ? Vec2(g.gamma * cap[i] * v / nv) : Vec2::Zero();
+                v[i] = Gt(i, d);
+                si[i] = std::sqrt(v[i].squaredNorm() + delta * delta);
+                if (cap[i] > 0) ht += cap[i] * v[i].squaredNorm() / si[i];
+            }
+            double least = 1 - 1e-3;   // (a sliding contact's force is at its rim to within (delta/|v|)^2)
+            for (int i = 0; i < 3; ++i) {
+                g.f[i] = cap[i] > 0 && ht > 0 ? Vec2(cap[i] * v[i] / (si[i] * ht)) : Vec2::Zero();
+                const double used = cap[i] > 0 ? g.f[i].norm() / (g.gamma * cap[i]) : 1.0;
+                if (used < least) {
+                    least = used;
+                    g.pivot = i;
+                }
             }
             return g;
         }
-        d = dr;
-        h = hr;
-        finish(d, h);
-        double ht = 0;
-        std::array<Vec2, 3> v;
-        std::array<double, 3> si{};
-        for (int i = 0; i < 3; ++i) {
-            v[i] = Gt(i, d);
-            si[i] = std::sqrt(v[i].squaredNorm() + delta * delta);
-            if (cap[i] > 0) ht += cap[i] * v[i].squaredNorm() / si[i];
-        }
-        double least = 1 - 1e-3;   // (a sliding contact's force is at its rim to within (delta/|v|)^2)
-        for (int i = 0; i < 3; ++i) {
-            g.f[i] = cap[i] > 0 && ht > 0 ? Vec2(cap[i] * v[i] / (si[i] * ht)) : Vec2::Zero();
-            const double used = cap[i] > 0 ? g.f[i].norm() / (g.gamma * cap[i]) : 1.0;
-            if (used < least) {
-                least = used;
-                g.pivot = i;
-            }
-        }
-        return g;
     }
     finish(d, h);
     for (int i = 0; i < 3; ++i) {
