@@ -264,7 +264,9 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     // stationary point gives f_i = cap_i v_i / (s_i h~), s_i = sqrt(|v_i|^2 + delta^2), h~ = sum cap_i
     // |v_i|^2 / s_i, whose wrench is w (grad h_delta = h~ w there), a contact at the kink included: its
     // force is then inside its disk, and it is the pivot (choose_mode breaks away about it). The repair
-    // is kept only where it is at least as low as the search's h (it always was where measured).
+    // is kept only where it is at least as low as the search's h (it always was where measured). (Where
+    // measured -- fig6's, heave_yaw's, fig1's and foot's fields, the [stick] and [dynamics] tests -- the
+    // repair ran over a hundred times and never ended at a kink: its pivot is a guard, not a path seen.)
     Vec3 supplied = Vec3::Zero();
     for (int i = 0; i < 3 && stalled; ++i) {
         const Vec2 v = Gt(i, d);
