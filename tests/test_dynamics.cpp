@@ -568,19 +568,27 @@ TEST_CASE("the friction gauge is the support function's optimum: brute force, an
             // near-one gauges here; all named by the closed-form kink test. Naming none there, or the
             // next contact, fails 1 684 and 3 384 checks. The repair's pivot -- a kink whose closed-form
             // test failed by rounding -- was not reached in any field or test measured.)
-            int inside = -1;
+            // (At most one such contact: complementary slackness puts every force with G_i^T d != 0 at its
+            // rim, and d != 0 turns about one point. The velocity is compared with the twist's own scale,
+            // |v| + rho |omega|: exactly zero at a kink up to rounding, measured below 1e-15 of it.)
+            int inside = -1, n_inside = 0;
             for (int i = 0; i < 3; ++i)
-                if (g.f[i].norm() < (1 - 1e-3) * g.gamma * P.mu[i] * ws.n[i]) inside = i;
+                if (g.f[i].norm() < (1 - 1e-3) * g.gamma * P.mu[i] * ws.n[i]) {
+                    inside = i;
+                    ++n_inside;
+                }
+            CHECK(n_inside <= 1);
             if (inside >= 0) {
                 ++pivots;
                 CHECK(g.pivot == inside);
             }
             if (g.pivot >= 0) {
                 const Vec2 r = Eigen::Rotation2Dd(q[2]) * P.c[g.pivot].head<2>();
-                CHECK((g.direction.head<2>() + g.direction[2] * Vec2(-r.y(), r.x())).norm() < 1e-6 * g.direction.norm());
+                const double scale = g.direction.head<2>().norm() + P.rho() * std::abs(g.direction[2]);
+                CHECK((g.direction.head<2>() + g.direction[2] * Vec2(-r.y(), r.x())).norm() < 1e-9 * scale);
             }
         }
         CHECK(near_one >= 100);
-        CHECK(pivots >= 1);
+        CHECK(pivots >= 1000);   // (1 684 measured: a gauge that never names a kink fails here)
     }
 }
