@@ -36,6 +36,10 @@
 
 namespace plate::detail {
 
+// The zero band, relative to v_ref: a slip below it counts as zero (a lingering slip is offered to
+// static friction), so it bounds the engine's error in a slip -- and in a cycle's start after a stick.
+inline double zero_band(double rtol) { return std::clamp(3e2 * rtol, 1e-9, 3e-3); }
+
 // Model concept: State, level, ws, mode; rhs(t, y, dy) in physical units, in the model's mode (fills
 // ws); q(y), qd(y), set_qd(y, qd); plate(t, y) -> PlateState; scale() -> State of characteristic
 // magnitudes; kStuckFrozen: nothing in the state moves while the part is stuck.
@@ -60,7 +64,7 @@ public:
         // creep speed (1e-2 v_ref) at any tolerance: uncapped, at rtol 1e-2 every slip below 3 v_ref
         // counted as zero and fig4's never-sticking part stuck 797 times in 20 s (3 rad off).
         model_.ws.hint_speed = std::clamp(10 * opt_.rtol, 1e-12, 1e-4) * v_ref_;
-        zero_abs_ = std::clamp(3e2 * opt_.rtol, 1e-9, 3e-3) * v_ref_;
+        zero_abs_ = zero_band(opt_.rtol) * v_ref_;
         // A contact that breaks away creeps (Workspace::creep: its friction along the consistent
         // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
         // the error that leaves stays below creep_budget_ (creep_step), 100 rtol v_ref: about the
