@@ -46,6 +46,19 @@ CycleSolver parse_cycle_solver(const std::string& name) {
 
 namespace {
 
+// Did the part stick as a whole during the period (a mode change into Stuck)? It then forgets the
+// period's start.
+bool stuck_during(const std::vector<ModeEvent>& events) {
+    return std::any_of(events.begin(), events.end(), [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
+}
+
+// After two periods in a row that stuck as a whole, the second on a fresh engine: is its return r at
+// the integration's floor -- within tol plus the zero band, and no smaller than half the previous such
+// return r_floor (one that still halves is a transient)? More periods do not shrink it (one_start).
+bool at_stuck_floor(double r, double r_floor, const LimitCycleOptions& opt) {
+    return r <= opt.tol + detail::zero_band(opt.integration.rtol) && r >= 0.5 * r_floor;
+}
+
 // Anderson extrapolation (type II) from the history of starts x_j and images f_j = P(x_j), in
 // scaled coordinates: minimise |g_k - dG gamma| over the differences of residuals g = f - x,
 // then x_new = f_k - dF gamma.
@@ -161,8 +174,7 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
             // Stuck as a whole during this period: it forgets its start. (Not a period that starts
             // stuck without sticking again, as from rest: taking that one too put random scene 132's
             // loose cycle, rtol 1e-5, a period later and 11 rtol v_ref off its tight cycle for 8.)
-            const bool reset = std::any_of(e.events.begin(), e.events.end(),
-                                           [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
+            const bool reset = stuck_during(e.events);
             if (k >= 2 && r_prev > 0) {
                 // With Anderson the ratio r/r_prev measures the acceleration, not the map: keep the
                 // map's contraction from the first plain periods for the error estimate.
@@ -186,7 +198,7 @@ LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOpt
                 // estimate at least r.
                 if (began_fresh) {
                     out.error_estimate = std::max(out.error_estimate, r);
-                    if (reset && r <= opt.tol + detail::zero_band(opt.integration.rtol) && r >= 0.5 * r_floor) {
+                    if (reset && at_stuck_floor(r, r_floor, opt)) {
                         out.converged = true;
                         break;
                     }
@@ -496,13 +508,11 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
         // A period in which the part was stuck as a whole forgets its start: P is constant near x,
         // so M = 0 exactly and P(x) is the cycle's start (to the integration's noise). The period
         // after it, from P(x), is then the cycle: when it sticks fully too, it is converged.
-        const bool full_stick = start_mode.kind == ModeKind::Stuck ||
-                                std::any_of(e.events.begin(), e.events.end(),
-                                            [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
+        const bool full_stick = start_mode.kind == ModeKind::Stuck || stuck_during(e.events);
         if (full_stick) {
             const double res = r_now.cwiseAbs().maxCoeff();
             if (k >= 1 && reset_prev && accept &&
-                (res <= opt.tol || (res <= opt.tol + detail::zero_band(opt.integration.rtol) && res >= 0.5 * res_floor))) {
+                (res <= opt.tol || at_stuck_floor(res, res_floor, opt))) {
                 // This period ran on a fresh engine from the previous one's end, and returns to its
                 // start within tol, or within tol plus the zero band where the return has stopped
                 // halving (the integration's error, which more periods do not shrink: one_start
