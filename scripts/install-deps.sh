@@ -6,7 +6,8 @@ pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-d
       python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev
       clang libclang-rt-dev   # (the sanitizer build, scripts/test-sanitizers.sh)
       libopenmpi-dev openmpi-bin
-      libbullet-dev libode-dev libmujoco-dev)   # (the last three: the peer engines, optional to the build)
+      libbullet-dev libode-dev libmujoco-dev   # (these three: the peer engines, optional to the build)
+      libsiconos-numerics-dev)   # (the Moreau-Jean stick-slip reference, tests/test_siconos.cpp; optional)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
