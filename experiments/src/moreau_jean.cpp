@@ -32,12 +32,18 @@ struct Fc3d {
         options->iparam[SICONOS_IPARAM_MAX_ITER] = opt.max_iterations;
     }
     ~Fc3d() {
-        // Siconos 4.4's solver_options_delete frees the members, not the structures themselves
-        // (valgrind: the options' and their NSGS local solver's 120 bytes each were lost).
+#if PLATE_SICONOS_OPTIONS_LEAK
+        // Siconos 4.4/4.5's solver_options_delete frees the members, not the structures themselves
+        // (valgrind: the options' and their NSGS local solver's 120 bytes each were lost; fixed
+        // after 4.5, where freeing them here would free them twice: CMakeLists.txt sets this by
+        // the library's soname).
         SolverOptions* local = options->numberOfInternalSolvers > 0 ? options->internalSolvers[0] : nullptr;
         solver_options_delete(options);
         std::free(local);
         std::free(options);
+#else
+        solver_options_delete(options);
+#endif
         frictionContactProblem_free(problem);
     }
     Fc3d(const Fc3d&) = delete;

@@ -3,20 +3,22 @@
 // problem solved by Siconos' fc3d solver (Debian libsiconos-numerics-dev). Built only where Siconos
 // is found (the target plate_siconos); nothing else depends on it.
 //
-// It shares none of the engine's equations. The part is a free rigid body (point part: a particle)
-// in the plate's frame, written from Newton-Euler alone: in the U-dynamics the frame is level
-// (R1 = I) and its angular velocity is dropped (products of x and u, Section III-G), so the frame's
-// motion enters as the fictitious force -m (p'' + omega1' x x) at the centre of mass x (the frame's
-// origin at the plate's) and the torque -J omega1' about it (that force's moment about the centre
-// of mass), with gravity -m g e_z; the part's own gyroscopic term -w x J w stays.
+// It shares none of the engine's equations (only its inputs: the Scene, u(t) from PlateMotion). The
+// part is a free rigid body (point part: a particle) in the plate's frame, written from Newton-Euler
+// alone: in the U-dynamics the frame is level (R1 = I) and its angular velocity is dropped (products
+// of x and u, Section III-G), so the frame's motion enters as the fictitious force
+// -m (p'' + omega1' x x) with x the centre of mass (the frame's origin at the plate's) and, the
+// fictitious forces being spread over the body, the torque -J omega1' about x; gravity -m g e_z. The
+// part's own gyroscopic term -w x J w is kept, which the engine's U-dynamics drop (dynamics.hpp,
+// DERIVATION NOTES): the two are the same model where J_xz = J_yz = 0, as for the scenes the tests use.
 // The contacts are three unilateral points with Coulomb cones (Siconos' local frames: normal e_z,
 // tangents e_x, e_y; the disk, not a pyramid), the plate's points at rest in its frame. Per step h:
 //   V+ = V + h M^-1 F(t + h/2, x, R) + M^-1 H^T P,   U = H V+,  (P, U) Coulomb (De Saxce's cone
 //   complementarity, Siconos' FrictionContactProblem with W = H M^-1 H^T, q = H V_free),
 //   x += h v+,  R = exp(h w+) R,
 // so each step is one contact solve, no events: sticking, pivoting and sliding are all the solver's
-// answer, with no mode logic of ours. The scheme is first-order (errors shrink as h where the
-// motion sticks and slips), which the tests check before they extrapolate (Richardson) to h -> 0.
+// answer, with no mode logic of ours. The scheme is first order; where a stick starts or ends inside
+// a step its error's size and sign jump from one h to the next (tests/test_siconos.cpp).
 // Three contacts give nine impulses against six velocities: a stuck part's friction distribution is
 // indeterminate (as in the engine's gauge, modes.hpp), its velocities are not.
 #pragma once
@@ -37,7 +39,8 @@ struct MoreauJeanSummary {
     long steps = 0;
     double mean_iterations = 0;     // NSGS sweeps per step
     long solver_failures = 0;       // steps whose solve did not reach solver_tol
-    double max_residual = 0;        // the largest of Siconos' error measures at the end of a step's solve
+    double max_residual = 0;        // the largest final error of a step's solve (Siconos' natural-map residual
+                                    // over max(|q|, |r|, |u|))
     double max_gap = 0;             // largest height of a contact above the plate [m] (lift-off)
     double max_tilt = 0;            // largest angle of the part's z axis from the plate's [rad]
 };

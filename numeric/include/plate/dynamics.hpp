@@ -190,6 +190,7 @@ gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const
 //  (38) third row prints g e_z^T inside a sum of column vectors; it is g e_z.
 //  (33) writes s_0; in U-dynamics it is the current s (in reduced U-dynamics the frozen s_0).
 //  U-dynamics drop the part's own gyroscopic term w2^ J w2 of (30) (a product of states);
-//  it vanishes for J_xz = J_yz = 0, so for every part of the paper.
+//  it vanishes for J_xz = J_yz = 0: the parts of fig1, fig4-fig6 and the stick-slip scenes, not
+//  fig3_random's random part (its theta'^2 (-J_yz, J_xz, 0) is then left to the full dynamics).
 
 }  // namespace plate
