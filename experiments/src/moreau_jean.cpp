@@ -72,6 +72,7 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
     Eigen::VectorXd r = Eigen::VectorXd::Zero(n), u = Eigen::VectorXd::Zero(n);   // warm start: last step's
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, dof), Minv = Eigen::MatrixXd::Zero(dof, dof), W(n, n);
     Eigen::VectorXd Vf(dof), V(dof);
+    Minv.topLeftCorner<3, 3>() = Mat3::Identity() / P.m;   // the rotational block follows R below
 
     MoreauJeanSummary out;
     long sweeps = 0;
@@ -81,7 +82,6 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
         // The free motion over the step: gravity and the frame's fictitious force and torque.
         const Vec3 F = -P.m * sc.g * Vec3::UnitZ() - P.m * (pdd + wd.cross(x));
         Vf.head<3>() = v + h / P.m * F;
-        Minv.topLeftCorner<3, 3>() = Mat3::Identity() / P.m;
         if (!P.point) {
             const Mat3 JP = R * P.J * R.transpose();
             const Mat3 JPi = JP.inverse();
@@ -112,7 +112,6 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
         theta += std::remainder(std::atan2(R(1, 0), R(0, 0)) - theta, 2 * kPi);
         for (int i = 0; i < nc; ++i)
             out.max_gap = std::max(out.max_gap, (x + R * (P.point ? Vec3::Zero() : P.c[i])).z());
-        out.max_tilt = std::max(out.max_tilt, std::acos(std::clamp(R(2, 2), -1.0, 1.0)));
     }
     out.q = Vec3(x.x(), x.y(), P.point ? 0.0 : theta);
     out.qd = Vec3(v.x(), v.y(), P.point ? 0.0 : w.z());

@@ -42,7 +42,6 @@ struct MoreauJeanSummary {
     double max_residual = 0;        // the largest final error of a step's solve (Siconos' natural-map residual
                                     // over max(|q|, |r|, |u|))
     double max_gap = 0;             // largest height of a contact above the plate [m] (lift-off)
-    double max_tilt = 0;            // largest angle of the part's z axis from the plate's [rad]
 };
 
 // The part at rest relative to the plate at q0 at t = 0, for `duration` seconds.
