@@ -33,6 +33,7 @@ if j is not None:
     # design runs keep "seconds" as the run's simulated length: only top-level timings are wall clock
     if isinstance(j, dict) and "full_dynamics_runs" in j:
         j.pop("seconds", None)
+        j.pop("scene", None)   # (the --out path given)
         print(json.dumps(j, sort_keys=True))
     else:
         print(json.dumps(strip(j), sort_keys=True))
@@ -76,7 +77,11 @@ for scene in scenes/*.json; do
     run "$s.field.json" "$plate" field "$scene" --threads 2
     run "$s.field.csv" "$plate" field "$scene" --format csv --threads 2
     run "$s.fixed-points.json" "$plate" fixed-points "$scene" --threads 2
-    if grep -q '"point": *true' "$scene"; then at=(0.01 -0.015); else at=(0.01 -0.015 0.7); fi
+    if python3 -c 'import json, sys; sys.exit(0 if json.load(open(sys.argv[1]))["part"].get("point") else 1)' "$scene"; then
+        at=(0.01 -0.015)
+    else
+        at=(0.01 -0.015 0.7)
+    fi
     run "$s.twist.json" "$plate" twist "$scene" --at "${at[@]}"
 done
 run fig4.full.csv "$plate" simulate scenes/fig4.json --dynamics full --from 0.04 -0.04 1.0 --time 3
