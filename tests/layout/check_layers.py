@@ -9,7 +9,11 @@ Every #include, quoted or <angled>, is resolved to the file it names (beside the
 the layers' include folders; angled ones that resolve to no project file are system headers), and
 the layer of the resolved file -- its top-level folder -- is compared with the includer's. C++
 sources in a top-level folder that is no layer fail too (their layer would be unknown).
-Exit 1 with the offending lines.
+Within numeric/ the same holds between its internal levels (NUMERIC_LEVELS below, lowest first: what
+needs nothing of plate < the model < dynamics and friction < the contact modes < the engine < simulate and
+limit cycles < fields, fixed points and output): no numeric file includes a numeric header of a higher
+level, and every numeric source has a level (a new file gets a line in NUMERIC_LEVELS).
+Exit 1 with the offending lines, also when no file at all was found to check (a wrong SOURCE_DIR).
     check_layers.py SOURCE_DIR
 """
 import pathlib
@@ -25,13 +29,38 @@ INCLUDE_DIRS = ["symbolic", "numeric/include", "numeric/generated", "numeric/src
 include = re.compile(r'^\s*#\s*include\s+(["<])([^">]+)[">]', re.M)
 SOURCES = (".cpp", ".hpp", ".h", ".cc", ".hh")
 
+# numeric's internal levels, lowest first, each with its files (relative to numeric/). A file may include
+# headers of its own level or of a lower one, never of a higher one.
+NUMERIC_LEVELS = [
+    ("needs nothing of plate", ["include/plate/tasks.hpp", "src/tasks.cpp", "src/stepper.hpp", "src/events.hpp",
+                                "src/lsan_suppressions.cpp"]),
+    ("model", ["include/plate/model.hpp", "src/model.cpp", "src/so3.hpp", "include/plate/scene_io.hpp",
+               "src/scene_io.cpp", "include/plate/random_scene.hpp", "src/random_scene.cpp"]),
+    ("dynamics/friction", ["generated/plate_kernels.hpp", "include/plate/dynamics.hpp", "src/dynamics.cpp",
+                           # friction's one home (issue 57), listed ahead of the files
+                           "include/plate/friction.hpp", "src/friction.hpp", "src/friction.cpp"]),
+    ("modes", ["include/plate/modes.hpp", "src/modes.cpp",
+               "src/models.hpp"]),            # the state layouts the engine integrates, with their modes
+    ("engine", ["src/engine.hpp",
+                "include/plate/simulate.hpp"]),   # the options, stops and samples the engine fills
+    ("simulate/limit_cycle", ["src/simulate.cpp", "include/plate/limit_cycle.hpp", "src/limit_cycle.cpp"]),
+    ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp",
+                            "include/plate/output.hpp", "src/output.cpp"]),
+]
+NUMERIC_LEVEL = {name: (rank, level) for rank, (level, names) in enumerate(NUMERIC_LEVELS) for name in names}
+
 
 def layer_of(path):
     rel = path.relative_to(root)
     return rel.parts[0] if len(rel.parts) > 1 else None
 
 
-problems, checked = [], 0
+def numeric_level(path):
+    """(rank, level name) of a file under numeric/, None if it has no level."""
+    return NUMERIC_LEVEL.get(path.relative_to(root / "numeric").as_posix())
+
+
+problems, checked, files, numeric_files, numeric_checked = [], 0, 0, 0, 0
 for f in sorted(root.rglob("*")):
     if f.suffix not in SOURCES or not f.is_file():
         continue
@@ -42,6 +71,14 @@ for f in sorted(root.rglob("*")):
         problems.append(f"{f.relative_to(root)}: C++ source in '{top}/', which is no layer (see check_layers.py)")
         continue
     rank = RANK[top]
+    files += 1
+    own_level = None
+    if top == "numeric":
+        numeric_files += 1
+        own_level = numeric_level(f)
+        if own_level is None:
+            problems.append(f"{f.relative_to(root)}: a numeric source with no level (add it to NUMERIC_LEVELS in "
+                            f"tests/layout/check_layers.py)")
     for kind, name in include.findall(f.read_text(errors="replace")):
         candidates = ([f.parent / name] if kind == '"' else []) + [root / d / name for d in INCLUDE_DIRS]
         target = next((c.resolve() for c in candidates if c.is_file()), None)
@@ -60,7 +97,18 @@ for f in sorted(root.rglob("*")):
         elif RANK[owner] > rank or (RANK[owner] == rank and owner != top):
             problems.append(f"{f.relative_to(root)} ({top}) includes \"{name}\" from {owner}, "
                             f"{'a layer above' if RANK[owner] > rank else 'a sibling layer'}")
+        elif owner == "numeric" and top == "numeric" and own_level is not None:
+            numeric_checked += 1
+            target_level = numeric_level(target)
+            if target_level is not None and target_level[0] > own_level[0]:
+                problems.append(f"{f.relative_to(root)} (numeric level '{own_level[1]}') includes \"{name}\" of the "
+                                f"higher level '{target_level[1]}'")
+if files == 0 or checked == 0 or numeric_files == 0 or numeric_checked == 0:
+    problems.append(f"no files to check under {root}: {files} sources, {checked} project includes, "
+                    f"{numeric_files} numeric sources, {numeric_checked} includes within numeric (a wrong SOURCE_DIR?)")
 if problems:
     print("\n".join(problems))
     sys.exit(1)
-print(f"layers: {checked} project includes checked, none reaches above its layer")
+print(f"layers: {files} sources, {checked} project includes checked, none reaches above its layer; numeric: "
+      f"{numeric_files} sources in {len(NUMERIC_LEVELS)} levels, {numeric_checked} includes within numeric checked, "
+      f"none reaches a higher level")

@@ -1,0 +1,78 @@
+// The Python module's compiled half, plate._plate, in pieces by topic (python/src/): module.cpp's
+// PYBIND11_MODULE calls the bind_* functions below in order, each defined in the file named beside it;
+// the conversions and result holders more than one of them uses are declared here.
+#pragma once
+
+#include "plate/design.hpp"
+#include "plate/field.hpp"
+#include "plate/output.hpp"
+#include "plate/scene_io.hpp"
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace plate::python {
+
+namespace py = pybind11;
+
+// --- the module's classes and functions, registered in this order --------------------------------
+
+void bind_scene(py::module_& m);          // scene.cpp:    Scene, load_scene, parse_scene, Stop
+void bind_twist(py::module_& m);          // twist.cpp:    Cycle, twist
+void bind_field(py::module_& m);          // field.cpp:    Field, field
+void bind_fixed_points(py::module_& m);   // field.cpp:    FixedPoint, FixedLine, FixedPoints, fixed_points
+void bind_design(py::module_& m);         // design.cpp:   Design, design, orientation_harmonics, coning_rate
+void bind_simulate(py::module_& m);       // simulate.cpp: Trajectory, simulate
+
+// --- conversions (conversions.cpp) ---------------------------------------------------------------
+
+py::object json_to_python(const nlohmann::json& j);
+
+// A configuration or twist: 3 numbers for a rigid part, 2 for a point part (theta meaningless).
+Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name);
+
+// ValueError(message) unless ok.
+void require(bool ok, const std::string& message);
+
+// A numpy array of the given shape holding data (row-major).
+py::array_t<double> array(const std::vector<double>& data, std::vector<py::ssize_t> shape);
+
+// The limit-cycle options of the keywords tol, rtol, max_periods, solver, max_rhs (ValueError if out of range).
+LimitCycleOptions cycle_options(double tol, double rtol, int max_periods, const std::string& solver, long max_rhs);
+
+// --- results more than one topic holds ------------------------------------------------------------
+
+struct PyStop {
+    std::string reason;     // "none", "contact_lost", ... (stop_name)
+    int contact = 0;        // 1-based, 0 if none
+    double t = 0;
+    std::string message;    // StopEvent::describe()
+};
+PyStop to_py(const StopEvent& e);
+
+// plate.field's result; plate.fixed_points takes it.
+struct PyField {
+    Scene scene;
+    Field f;
+};
+
+// --- the design target (design.cpp) ----------------------------------------------------------------
+
+// plate.design's target keywords -- exactly one of sink=(x, y), transport=(vx, vy), fixed_point=(x, y,
+// theta), orient=theta, line_sink=(x, y, phi) -- as a DesignTarget (ValueError if not exactly one). The
+// one place the module reads a target.
+DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, double>>& sink,
+                                       const std::optional<std::pair<double, double>>& transport,
+                                       const std::optional<std::tuple<double, double, double>>& fixed_point,
+                                       const std::optional<double>& orient,
+                                       const std::optional<std::tuple<double, double, double>>& line_sink);
+
+}  // namespace plate::python
