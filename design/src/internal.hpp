@@ -456,6 +456,9 @@ struct SinkProblem : Problem<SinkProblem> {
 
 // --- the targets (one file each; design.cpp's dispatch picks one) ---------------------------------
 
+// A registered kind of target by name (nullptr if none; design_target.cpp).
+const DesignTargetType* registered(const std::string& name);
+
 DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T);
 DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T);
 DesignSummary design_transport(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T);

@@ -67,12 +67,14 @@ struct PyField {
 // --- the design target (design.cpp) ----------------------------------------------------------------
 
 // plate.design's target keywords -- exactly one of sink=(x, y), transport=(vx, vy), fixed_point=(x, y,
-// theta), orient=theta, line_sink=(x, y, phi) -- as a DesignTarget (ValueError if not exactly one). The
-// one place the module reads a target.
+// theta), orient=theta, line_sink=(x, y, phi), target='KIND NUMBERS' -- as a DesignTarget through the
+// library's parse_design_target (ValueError with its message if not exactly one, or refused). The one
+// place the module reads a target.
 DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, double>>& sink,
                                        const std::optional<std::pair<double, double>>& transport,
                                        const std::optional<std::tuple<double, double, double>>& fixed_point,
                                        const std::optional<double>& orient,
-                                       const std::optional<std::tuple<double, double, double>>& line_sink);
+                                       const std::optional<std::tuple<double, double, double>>& line_sink,
+                                       const std::optional<std::string>& target, bool point_part);
 
 }  // namespace plate::python

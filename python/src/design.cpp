@@ -3,40 +3,62 @@
 #include "bindings.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <sstream>
 
 namespace plate::python {
+
+namespace {
+
+// "KIND NUMBERS...", as the command line's --target takes it.
+DesignTarget target_from_words(const std::string& words, bool point_part) {
+    std::istringstream in(words);
+    std::string kind, w;
+    in >> kind;
+    std::vector<double> values;
+    while (in >> w) {
+        std::size_t used = 0;
+        double x = 0;
+        try {
+            x = std::stod(w, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        require(used == w.size() && std::isfinite(x), "target: expected KIND and numbers, got '" + w + "'");
+        values.push_back(x);
+    }
+    return parse_design_target(kind, values, point_part);
+}
+
+}  // namespace
 
 DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, double>>& sink,
                                        const std::optional<std::pair<double, double>>& transport,
                                        const std::optional<std::tuple<double, double, double>>& fixed_point,
                                        const std::optional<double>& orient,
-                                       const std::optional<std::tuple<double, double, double>>& line_sink) {
+                                       const std::optional<std::tuple<double, double, double>>& line_sink,
+                                       const std::optional<std::string>& target, bool point_part) {
     require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() +
-                    line_sink.has_value() == 1,
-            "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta "
-            "or line_sink=(x, y, phi)");
-    DesignTarget t;
-    if (sink) t.at = Vec2(sink->first, sink->second);
-    if (transport) {
-        t.kind = DesignTargetKind::Transport;
-        t.velocity = Vec2(transport->first, transport->second);
+                    line_sink.has_value() + target.has_value() == 1,
+            "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta, "
+            "line_sink=(x, y, phi) or target='KIND NUMBERS' as the command line's --target");
+    // Every form goes through the library's parser (the command line's and campaigns' too).
+    try {
+        if (target) return target_from_words(*target, point_part);
+        if (sink) return parse_design_target("sink", {sink->first, sink->second}, point_part);
+        if (transport) return parse_design_target("transport", {transport->first, transport->second}, point_part);
+        if (fixed_point) {
+            const auto& [x, y, theta] = *fixed_point;   // (a point part's fixed point has no orientation)
+            return parse_design_target("fixed-point", point_part ? std::vector<double>{x, y} : std::vector<double>{x, y, theta},
+                                       point_part);
+        }
+        if (orient) return parse_design_target("orient", {*orient}, point_part);
+        const auto& [x, y, phi] = *line_sink;
+        return parse_design_target("line-sink", {x, y, phi}, point_part);
+    } catch (const std::invalid_argument& e) {
+        throw py::value_error(e.what());
     }
-    if (fixed_point) {
-        t.kind = DesignTargetKind::FixedPoint;
-        t.at = Vec2(std::get<0>(*fixed_point), std::get<1>(*fixed_point));
-        t.theta = std::get<2>(*fixed_point);
-    }
-    if (orient) {
-        t.kind = DesignTargetKind::Orient;
-        t.theta = *orient;
-    }
-    if (line_sink) {
-        t.kind = DesignTargetKind::LineSink;
-        t.at = Vec2(std::get<0>(*line_sink), std::get<1>(*line_sink));
-        t.theta = std::get<2>(*line_sink);
-    }
-    return t;
 }
 
 void bind_design(py::module_& m) {
@@ -92,12 +114,10 @@ void bind_design(py::module_& m) {
              std::optional<double> orient, std::optional<std::tuple<double, double, double>> line_sink,
              double lin_limit, double ang_limit, double period,
              std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold,
-             double max_coning, std::vector<std::string> axes, int max_harmonic) {
-              const DesignTarget t = design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink);
-              DesignOptions o;
-              require(lin_limit >= 0 && ang_limit >= 0, "limits: expected amplitudes >= 0");
-              require(starts >= 0 && local_evaluations >= 1 && verify_starts >= 1,
-                      "starts: expected >= 0 (0: the target's default); local_evaluations, verify_starts: expected >= 1");
+             double max_coning, std::vector<std::string> axes, int max_harmonic, std::optional<std::string> target) {
+              const DesignTarget t =
+                  design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink, target, part.part.point);
+              DesignOptions o;   // (judged in the library: validate_design_options, as for the CLI and campaigns)
               o.lin_limit = lin_limit;
               o.ang_limit = ang_limit;
               o.period = period;
@@ -106,7 +126,6 @@ void bind_design(py::module_& m) {
               o.local_evaluations = local_evaluations;
               o.verify_starts = verify_starts;
               o.threads = threads;
-              require(hold >= 0, "hold: expected seconds >= 0 (0: not checked)");
               o.hold = hold;
               o.max_coning = max_coning;
               for (const std::string& name : axes) {
@@ -115,7 +134,6 @@ void bind_design(py::module_& m) {
                   require(k < 6, "axes: expected names among x, y, z, rx, ry, rz, got '" + name + "'");
                   o.axes.push_back(static_cast<Axis>(k));
               }
-              require(max_harmonic >= 0, "max_harmonic: expected >= 0 (0: the target's own)");
               o.max_harmonic = max_harmonic;
               py::gil_scoped_release free;
               try {
@@ -130,7 +148,7 @@ void bind_design(py::module_& m) {
           py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
           py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0, py::arg("local_evaluations") = 400,
           py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0, py::arg("max_coning") = -1.0,
-          py::arg("axes") = std::vector<std::string>{}, py::arg("max_harmonic") = 0,
+          py::arg("axes") = std::vector<std::string>{}, py::arg("max_harmonic") = 0, py::arg("target") = py::none(),
           "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
           "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
           "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
@@ -142,7 +160,9 @@ void bind_design(py::module_& m) {
           "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
           "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
           "pair: theta and theta + pi both stable, unique False; see the README). axes=['x', ...] and\n"
-          "max_harmonic=n narrow each target's motion family (the others stay zero; an empty family is a ValueError).");
+          "max_harmonic=n narrow each target's motion family (the others stay zero; an empty family is a ValueError).\n"
+          "target='KIND NUMBERS' is any target as the command line's --target writes it (e.g. 'sink 0.02 -0.01'),\n"
+          "judged by the same parser: what one refuses, the other refuses with the same message.");
     m.def(
         "orientation_harmonics",
         [](const Scene& sc, std::array<double, 2> at, int n, double tol, double rtol) {

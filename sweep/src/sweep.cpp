@@ -236,24 +236,19 @@ Campaign campaign_from_json(const json& file, const std::string& source) {
     if (comp.contains("design")) {
         const json& g = comp["design"];
         r.only(g, "compute.design", {"target", "limits", "starts", "evaluations", "seed"});
+        // [KIND, numbers...]: the library's parser and judgement, as the CLI's --target and Python's target=
         const json& t = r.need(g, "compute.design", "target");
-        if (!t.is_array() || t.size() != 3 || !t[0].is_string())
-            r.fail("compute.design.target", "expected [\"sink\", X, Y], [\"fixed-point\", X, Y] or [\"transport\", VX, VY]");
-        DesignTarget target;
-        const std::string kind = t[0].get<std::string>();
-        const Vec2 ab(r.number(t[1], "compute.design.target[1]"), r.number(t[2], "compute.design.target[2]"));
-        if (kind == "sink" || kind == "fixed-point") target.at = ab;
-        else if (kind == "transport") {
-            target.kind = DesignTargetKind::Transport;
-            target.velocity = ab;
-        } else {
-            r.fail("compute.design.target[0]", "expected sink, fixed-point or transport, got '" + kind + "'");
+        if (!t.is_array() || t.size() < 2 || t.size() > 5 || !t[0].is_string())
+            r.fail("compute.design.target", "expected [KIND, numbers...]: " + design_target_usage());
+        std::vector<double> values;
+        for (std::size_t i = 1; i < t.size(); ++i) values.push_back(r.number(t[i], "compute.design.target[" + std::to_string(i) + "]"));
+        try {
+            c.design = parse_design_target(t[0].get<std::string>(), values, base.part.point);
+        } catch (const std::invalid_argument& e) {
+            r.fail("compute.design.target", e.what());
         }
-        c.design = target;
         if (g.contains("limits")) {
             const auto l = r.numbers(g["limits"], "compute.design.limits", 2, 2);
-            if (!(l[0] >= 0 && l[1] >= 0 && l[0] <= kMaxAmplitude && l[1] <= kMaxAmplitude))
-                r.fail("compute.design.limits", "expected amplitudes from 0 to 1e6");
             c.design_options.lin_limit = l[0];
             c.design_options.ang_limit = l[1];
         }
@@ -262,6 +257,12 @@ Campaign campaign_from_json(const json& file, const std::string& source) {
             c.design_options.local_evaluations = static_cast<int>(r.whole(g["evaluations"], "compute.design.evaluations", 1, 1'000'000));
         if (g.contains("seed")) c.design_options.seed = static_cast<std::uint64_t>(r.whole(g["seed"], "compute.design.seed", 0, 1L << 52));
         c.design_options.threads = 1;   // one case, one thread: the farm shares the cases
+        try {   // (the limits and the target judged once, in the library, on the base scene)
+            validate_design_options(c.design_options);
+            validate_design_target(*c.design, base, c.design_options);
+        } catch (const std::invalid_argument& e) {
+            r.fail("compute.design", e.what());
+        }
     }
     c.cycle.max_rhs_evaluations = 2'000'000;   // as the command line's (about 0.3 s per cycle)
     if (comp.contains("cycle")) {

@@ -19,6 +19,7 @@
 // (-s, theta + pi) with the same stability -- a unique one cannot exist with such motions.
 #pragma once
 
+#include "plate/design_target.hpp"
 #include "plate/field.hpp"
 
 #include <cstdint>
@@ -89,39 +90,6 @@ struct OrientationHarmonics {
 // theta' on the ring theta_k = 2 pi k / n (n >= 4) as harmonics.
 OrientationHarmonics harmonics_of(const std::vector<double>& theta_dot);
 OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n = 12);
-
-enum class DesignTargetKind { Sink, FixedPoint, Transport, Orient, LineSink };
-struct DesignTarget {
-    // Sink: every start in the region ends at position `at`: for a point part the unique stable
-    // fixed point of its velocity field ("fixed-point X Y" is the same target); for a rigid part
-    // whatever its orientation, which is left free (it may turn on at the sink: the summary's pulls).
-    // Transport: the part moves at the uniform velocity `velocity` everywhere in the region. A plate
-    // that only translates (x, y, z harmonics n = 1, 2) gives a point part the same velocity at every
-    // position (nothing in its dynamics depends on where it is), so the field is uniform by
-    // construction and the search only sets its value. A rigid part with one friction coefficient on
-    // such a plate is that point part exactly: every contact slides with the centre of mass (nothing
-    // turns it: the torque -(sum_i N_i r_i) x mu u vanishes, sum_i N_i r_i being along u), and friction's
-    // resultant is -mu N u as for the point (measured: fig4's and fig1's parts 0.0200 m/s at every
-    // orientation under a point part's 0.02 m/s design). So it is designed as that point part and
-    // verified as itself (the 7^3 field's twists, theta' included, and full-dynamics runs). `omega`
-    // (transport with a turn) is refused: a translating plate cannot turn such a part, and a turning
-    // plate adds alpha x s, a whirl that makes the twist depend on position (not uniform); a part whose
-    // friction differs turns on any translating plate (the weathervane), its velocity with it.
-    // FixedPoint: (at, theta) the unique stable fixed point of the twist field (a rigid part; for a
-    // point part the same as Sink). Designed as a half-turn pair ((at, theta) and (at, theta + pi) both
-    // stable), then broken by rz about its centre (DesignOptions::break_pair); what verifies is reported
-    // with the target's basin share and each competing stable fixed point's, unique only where the grid
-    // finds no other. Orient: every start ends at orientation theta, position free (a
-    // part whose contacts' friction differs: by a plate that only translates, a weathervane; else
-    // designed as a fixed point at the region's centre and verified on the orientation).
-    // LineSink (point parts): every start ends on the line through `at` along direction `theta`, and
-    // stays where it arrives (a line of fixed points: no drift along it).
-    DesignTargetKind kind = DesignTargetKind::Sink;
-    Vec2 at = Vec2::Zero();
-    double theta = 0;               // [rad]
-    Vec2 velocity = Vec2::Zero();   // [m/s]
-    double omega = 0;               // transport's turn [rad/s] (refused unless 0, above)
-};
 
 struct DesignOptions {
     double lin_limit = 20;     // largest amplitude of a linear-acceleration harmonic [m/s^2]
