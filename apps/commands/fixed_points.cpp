@@ -1,0 +1,50 @@
+// plate fixed-points: the zeros of the field, refined and classified (stable, unstable, saddle; lines).
+#include "commands.hpp"
+
+#include "plate/output.hpp"
+
+#include <algorithm>
+#include <string>
+
+namespace plate::cli {
+namespace {
+
+struct FixedPointsArgs : Options {
+    std::string scene, out = "-";
+    GridArgs grid;
+    CycleArgs cycle;
+    long max_work = 2'000'000'000L;
+    explicit FixedPointsArgs(CLI::App& app)
+        : Options(app, "fixed-points", "zeros of the field, refined and classified (stable, unstable, saddle; lines)",
+                  "Computes the field, finds cells where every component changes sign, refines the zeros\n"
+                  "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
+                  "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field;\n"
+                  "the refinement's own budget is the smaller of it and 2e7 right-hand sides.\n") {
+        scene_file(scene);
+        add_grid_options(*this, grid);
+        text("--out", out, "FILE", "the output file (default: standard output)");
+        whole("--max-work", max_work, 1000, kMaxWorkLimit, "work budget of the field, right-hand sides");
+        add_cycle_options(*this, cycle);
+    }
+};
+
+int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
+    launched_farm(cio, a.grid.threads);
+    const Scene sc = scene_arg(a.scene, cio);
+    const LimitCycleOptions cycle = cycle_opts(a, a.cycle);
+    const GridSpec g = grid_opts(a, a.grid);
+    const Field f = bounded_field(sc, g, cycle, a.grid.threads, a.max_work, cio);
+    if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 refines the zeros and writes)
+    FixedPointOptions fpo;   // (the refinement has its own budget)
+    fpo.cycle = cycle;
+    if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.max_work);
+    const FixedPoints fp = find_fixed_points(sc, f, fpo);
+    write_file_atomic(a.out, [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
+    return 0;
+}
+
+}  // namespace
+
+Command add_fixed_points(CLI::App& app) { return make_command<FixedPointsArgs>(app, cmd_fixed_points); }
+
+}  // namespace plate::cli

@@ -1,0 +1,309 @@
+// The shared layer of the plate command line: see options.hpp.
+#include "options.hpp"
+
+#include "plate/output.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <utility>
+
+namespace plate::cli {
+
+// ---- errors and values -------------------------------------------------------------------------
+
+double parse_num(const std::string& k, const std::string& s) {
+    char* end = nullptr;
+    const double x = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !std::isfinite(x))
+        throw UsageError("option " + k + ": expected a finite number, got '" + s + "'");
+    return x;
+}
+
+long parse_whole(const std::string& k, const std::string& s, long lo, long hi) {
+    char* end = nullptr;
+    const long x = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || *end != '\0' || x < lo || x > hi)
+        throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " +
+                         std::to_string(hi) + ", got '" + s + "'");
+    return x;
+}
+
+std::string fmt(double x) {
+    std::ostringstream s;
+    s.precision(3);
+    s << x;
+    return s.str();
+}
+
+std::string data_root() {
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+        const std::filesystem::path share = exe.parent_path().parent_path() / "share" / "plate";
+        if (std::filesystem::exists(share / "scenes", ec)) return share.string();
+    }
+    return PLATE_SOURCE_DIR;
+}
+
+// ---- a command's options -----------------------------------------------------------------------
+
+Options::Options(CLI::App& app, const std::string& name, const std::string& about, const std::string& footer)
+    : cmd_(app.add_subcommand(name, about)) {
+    cmd_->group("commands")->footer(footer);
+}
+
+bool Options::given() const { return cmd_->parsed(); }
+
+void Options::reject(const std::vector<std::string>& leftovers) const {
+    for (const std::string& s : leftovers) {
+        char* end = nullptr;
+        std::strtod(s.c_str(), &end);
+        if (s.size() > 1 && s[0] == '-' && *end != '\0') throw UsageError("unknown option " + s);
+    }
+    if (leftovers.empty()) return;
+    throw UsageError(takes_scene_ ? "expected exactly one SCENE file" : cmd_->get_name() + " takes no SCENE argument");
+}
+
+void Options::scene_file(std::string& file, const std::string& name) {
+    takes_scene_ = true;
+    cmd_->add_option(name, file, "the scene file (JSON, see scenes/)")->required()->option_text(" ");
+}
+
+void Options::number(const std::string& name, double& x, const std::string& help, const char* def) {
+    std::ostringstream value;
+    value << x;
+    add(name, "X", help + in_parentheses("", def ? def : value.str()),
+        [name, &x](const std::string& s) { x = parse_num(name, s); });
+}
+
+void Options::numbers(const std::string& name, std::vector<double>& v, std::size_t lo, std::size_t hi,
+                      const std::string& names, const std::string& help) {
+    const std::string count = std::to_string(lo) + (lo < hi ? " or " + std::to_string(hi) : "");
+    add(name, static_cast<int>(hi), names, help, [name, &v, lo, hi, count](const std::vector<std::string>& s) {
+        if (s.size() < lo || s.size() > hi) throw UsageError(name + ": expected " + count + " numbers");
+        v.clear();
+        for (const std::string& x : s) v.push_back(parse_num(name, x));
+    });
+}
+
+void Options::words(const std::string& name, std::vector<std::string>& v, std::size_t n, const std::string& names,
+                    const std::string& help) {
+    add(name, static_cast<int>(n), names, help, [name, &v, n](const std::vector<std::string>& s) {
+        if (s.size() != n)
+            throw UsageError("option " + name + " expects " + std::to_string(n) + " value(s)");
+        v = s;
+    });
+}
+
+void Options::words(const std::string& name, std::vector<std::string>& v, std::size_t lo, std::size_t hi,
+                    const std::string& names, const std::string& help) {
+    add(name, static_cast<int>(hi), names, help, [name, &v, lo, hi](const std::vector<std::string>& s) {
+        if (s.size() < lo || s.size() > hi)
+            throw UsageError("option " + name + " expects " + std::to_string(lo) + " to " + std::to_string(hi) +
+                             " values");
+        v = s;
+    });
+}
+
+void Options::text(const std::string& name, std::string& s, const std::string& value, const std::string& help) {
+    add(name, value, help, [&s](const std::string& t) { s = t; });
+}
+
+void Options::flag(const std::string& name, bool& b, const std::string& help) {
+    cmd_->add_flag_function(name, [this, name, &b](std::int64_t) { once(name); b = true; }, help)
+        ->disable_flag_override()
+        ->trigger_on_parse();
+}
+
+namespace {
+
+// Declares option `name` of `cmd`, taking 1 to max_values values of type T (std::string or a vector
+// of them), each occurrence passed through `once` to `store` as it is parsed.
+template <class T>
+void add_option(CLI::App* cmd, const std::string& name, int max_values, const std::string& names,
+                const std::string& help, std::function<void(const std::string&)> once,
+                std::function<void(const T&)> store) {
+    cmd->add_option_function<T>(name, [name, once, store](const T& v) { once(name); store(v); }, help)
+        ->expected(1, max_values)
+        ->allow_extra_args(false)                   // (a vector's default: eat every value that follows)
+        ->option_text(names)
+        ->type_name(names.substr(0, names.find(' ')))   // "--at: 1 required SX missing"
+        ->trigger_on_parse();
+}
+
+}  // namespace
+
+void Options::add(const std::string& name, const std::string& names, const std::string& help,
+                  std::function<void(const std::string&)> store) {
+    add_option<std::string>(cmd_, name, 1, names, help, [this](const std::string& n) { once(n); }, std::move(store));
+}
+
+void Options::add(const std::string& name, int max_values, const std::string& names, const std::string& help,
+                  std::function<void(const std::vector<std::string>&)> store) {
+    add_option<std::vector<std::string>>(cmd_, name, max_values, names, help,
+                                         [this](const std::string& n) { once(n); }, std::move(store));
+}
+
+void Options::once(const std::string& name) {
+    if (!seen_.insert(name).second) throw UsageError("option " + name + " given twice");
+}
+
+std::string Options::in_parentheses(const std::string& range, const std::string& def) {
+    std::string s = range;
+    if (!def.empty()) s += (s.empty() ? "default " : "; default ") + def;
+    return s.empty() ? s : " (" + s + ")";
+}
+
+// ---- the scene and a configuration -------------------------------------------------------------
+
+Scene scene_arg(const std::string& file, Io& cio) {
+    if (!cio.farm || cio.farm->ranks() == 1) {
+        Scene sc = load_scene(file);
+        for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
+        return sc;
+    }
+    std::string text;
+    if (cio.farm->root()) {
+        std::ifstream in(file, std::ios::binary);
+        std::stringstream buf;
+        buf << in.rdbuf();
+        text = in ? "S" + buf.str() : "E";
+    }
+    cio.farm->broadcast(text);
+    if (text.empty() || text[0] != 'S') throw InputError(file + ": cannot open scene file");
+    Scene sc = parse_scene(text.substr(1), file);
+    if (cio.farm->root())
+        for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
+    return sc;
+}
+
+Vec3 config_arg(const Options& a, const std::string& k, const std::vector<double>& v, const Scene& sc, bool required) {
+    if (!a.has(k)) {
+        if (required) throw UsageError("missing " + k + (sc.part.point ? " SX SY" : " SX SY THETA"));
+        return Vec3::Zero();
+    }
+    Vec3 q = Vec3::Zero();
+    const std::size_t need = sc.part.point ? 2 : 3;
+    if (v.size() != need) throw UsageError(k + ": expected " + std::to_string(need) + " numbers");
+    for (std::size_t i = 0; i < need; ++i) q[i] = v[i];
+    return q;
+}
+
+// ---- the limit cycle's and the grid's options --------------------------------------------------
+
+void add_cycle_options(Options& p, CycleArgs& c) {
+    p.number("--tol", c.o.tol, "accepted distance to the cycle, relative to the slip-speed scale");
+    p.number("--rtol", c.o.integration.rtol, "integrator tolerance, in (0, 1e-2)");
+    p.whole("--max-periods", c.o.max_periods, 2, 100000, "periods before the cycle counts as not converged");
+    p.whole("--max-rhs", c.o.max_rhs_evaluations, 1000, 1'000'000'000'000L,
+            "work budget of one cycle, right-hand sides");
+    p.text("--cycle-solver", c.solver, "NAME", "period-by-period, anderson, newton or shooting (default shooting)");
+}
+
+LimitCycleOptions cycle_opts(const Options& a, const CycleArgs& c) {
+    LimitCycleOptions o = c.o;
+    if (a.has("--cycle-solver")) {
+        try {
+            o.solver = parse_cycle_solver(c.solver);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(std::string("--cycle-solver: ") + e.what());
+        }
+    }
+    if (!(o.tol > 0) || !(o.integration.rtol > 0 && o.integration.rtol < 1e-2))
+        throw UsageError("--tol must be > 0 and --rtol in (0, 1e-2)");
+    return o;
+}
+
+void add_grid_options(Options& p, GridArgs& a) {
+    p.whole("--grid", a.n, 1, 201, "grid points on each axis");
+    p.whole("--nx", a.g.nx, 1, 201, "points along s_x", "--grid");
+    p.whole("--ny", a.g.ny, 1, 201, "points along s_y", "--grid");
+    p.whole("--ntheta", a.g.nth, 1, 720, "points along theta", "--grid");
+    p.numbers("--x", a.x, 2, 2, "MIN MAX", "the range of s_x [m] (default -0.05 0.05)");
+    p.numbers("--y", a.y, 2, 2, "MIN MAX", "the range of s_y [m] (default -0.05 0.05)");
+    p.number("--theta0", a.g.th0, "the first theta of the full turn");
+    p.whole("--threads", a.threads, 0, 256, "threads (0: all cores)");
+}
+
+GridSpec grid_opts(const Options& a, const GridArgs& ga) {
+    GridSpec g = ga.g;
+    if (!a.has("--nx")) g.nx = ga.n;
+    if (!a.has("--ny")) g.ny = ga.n;
+    if (!a.has("--ntheta")) g.nth = ga.n;
+    if (a.has("--x")) {
+        g.x0 = ga.x[0];
+        g.x1 = ga.x[1];
+    }
+    if (a.has("--y")) {
+        g.y0 = ga.y[0];
+        g.y1 = ga.y[1];
+    }
+    if (!(g.x1 >= g.x0) || !(g.y1 >= g.y0)) throw UsageError("--x and --y take MIN MAX with MIN <= MAX");
+    return g;
+}
+
+// ---- work budgets and MPI ranks ----------------------------------------------------------------
+
+long check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, long budget) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double dth = 2 * kPi / 5;
+    const Vec3 samples[] = {{(g.x0 + g.x1) / 2, (g.y0 + g.y1) / 2, g.th0},
+                            {g.x0 + 0.25 * (g.x1 - g.x0), g.y0 + 0.25 * (g.y1 - g.y0), g.th0 + dth},
+                            {g.x0 + 0.75 * (g.x1 - g.x0), g.y0 + 0.25 * (g.y1 - g.y0), g.th0 + 2 * dth},
+                            {g.x0 + 0.25 * (g.x1 - g.x0), g.y0 + 0.75 * (g.y1 - g.y0), g.th0 + 3 * dth},
+                            {g.x0 + 0.75 * (g.x1 - g.x0), g.y0 + 0.75 * (g.y1 - g.y0), g.th0 + 4 * dth}};
+    double total = 0;
+    for (const Vec3& q : samples) total += std::max<double>(limit_cycle(sc, q, lo).stats.rhs_evals, 1);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double per = total / 5, n = static_cast<double>(g.size());
+    if (per * n > static_cast<double>(budget))
+        throw UsageError("a " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" + std::to_string(g.nth) +
+                         " grid would take about " + fmt(per * n) + " right-hand sides (" + fmt(per) +
+                         " per configuration, the mean of five cycles run first: about " + fmt(secs / 5 * n) +
+                         " s on one core here), above the budget of " + fmt(static_cast<double>(budget)) +
+                         ": raise it with --max-work or use a coarser grid");
+    return budget;
+}
+
+void require_within_budget(const Field& f, long budget) {
+    if (!f.budget_spent) return;
+    int left = 0;
+    for (const auto& p : f.points) left += p.stop == StopReason::StepLimit && p.rhs_evals == 0;
+    throw std::runtime_error("the work budget of " + fmt(static_cast<double>(budget)) + " right-hand sides was spent with " +
+                             std::to_string(left) + " of " + std::to_string(f.points.size()) +
+                             " configurations not started (the up-front estimate was low): raise --max-work");
+}
+
+sweep::Farm* launched_farm(Io& cio, int threads) {
+    if (!sweep::mpi_launched()) return nullptr;
+    if (!sweep::mpi_built())
+        throw UsageError("started by an MPI launcher with several ranks, but this plate was built without MPI: "
+                         "every process would do the whole job (rebuild with libopenmpi-dev, or run it alone)");
+    cio.farm = sweep::mpi_farm(threads);
+    return cio.farm.get();
+}
+
+Field bounded_field(const Scene& sc, const GridSpec& g, const LimitCycleOptions& cycle, int threads, long max_work, Io& cio) {
+    FieldOptions fo;
+    fo.cycle = cycle;
+    fo.threads = threads;
+    if (cio.farm) fo.tasks = sweep::farm_tasks(*cio.farm);
+    fo.max_rhs_evaluations = check_field_work(sc, g, fo.cycle, max_work);
+    ProgressPrinter prog{"field"};
+    prog.to = &cio.err == &std::cerr && progress_wanted() && (!cio.farm || cio.farm->root()) ? &cio.err : nullptr;
+    fo.progress = std::ref(prog);
+    Field f = compute_field(sc, g, fo);
+    require_within_budget(f, fo.max_rhs_evaluations);
+    return f;
+}
+
+}  // namespace plate::cli
