@@ -64,7 +64,7 @@ DesignTarget parse_design_target(const std::string& kind, const std::vector<doub
                 return t;
             }
     }
-    if (!b) throw std::invalid_argument("expected " + design_target_usage() + ", got '" + kind + "'");
+    if (!b) throw std::invalid_argument(kind + ": expected " + design_target_usage());
     const std::size_t want = b->kind == DesignTargetKind::Orient                                          ? 1
                              : (b->kind == DesignTargetKind::FixedPoint && !point_part) ||
                                        b->kind == DesignTargetKind::LineSink                              ? 3

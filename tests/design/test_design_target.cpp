@@ -132,7 +132,7 @@ TEST_CASE("A kind of target registered outside the library is parsed, dispatched
     // is (gravity is balanced by the normal forces, friction has nothing to hold), in full dynamics.
     const Scene part = load_scene(kScenes + "fig1_point.json");
     const Words still{"still", {0.01, -0.02}};
-    CHECK_THROWS_WITH(parse_design_target(still.kind, still.values, true), Catch::Contains("got 'still'"));
+    CHECK_THROWS_WITH(parse_design_target(still.kind, still.values, true), Catch::Contains("still: expected sink X Y"));
     DesignTargetType type;
     type.name = "still";
     type.numbers = "X Y";

@@ -62,8 +62,8 @@ struct DesignTarget {
 
 // The kinds and their numbers, as the messages below state them.
 std::string design_target_usage();
-// KIND and its numbers as a target; throws std::invalid_argument naming the kind and what it expects
-// ("sink: expected sink X Y, ...", "unknown target 'spin': expected ...").
+// KIND and its numbers as a target; throws std::invalid_argument naming the kind and what the kinds
+// expect ("sink: expected sink X Y, ...", also for a KIND that is none of them).
 DesignTarget parse_design_target(const std::string& kind, const std::vector<double>& values, bool point_part);
 // The target's KIND word and its numbers (parse_design_target's inverse).
 std::string design_target_kind(const DesignTarget& t);
