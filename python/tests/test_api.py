@@ -56,6 +56,27 @@ def test_a_bad_scene_raises_InputError_with_the_command_lines_message(tmp_path, 
     assert isinstance(err.value, ValueError)
 
 
+@pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
+@pytest.mark.parametrize("scene, words", [
+    ("fig1_point", "wobble 0 0"), ("fig1_point", "sink 0.02"), ("fig4", "fixed-point 0.02 -0.01"),
+    ("fig1_point", "transport 1 2 3 4"), ("fig1_point", "sink 0.2 0"), ("fig4", "line-sink 0 0 0.5"),
+    ("fig1_point", "orient 1"), ("fig1_point", "transport 0.01 0 0.5"),
+])
+def test_a_target_the_command_line_refuses_python_refuses_with_the_same_message(tmp_path, scene, words):
+    # One parser, in the library: target='KIND NUMBERS' and the keywords alike.
+    part = plate.load_scene(scene_path(scene))
+    with pytest.raises(ValueError) as err:
+        plate.design(part, target=words, verify_starts=1)
+    message = str(err.value)
+    cli = subprocess.run([EXE, "design", scene_path(scene), "--target", *words.split(), "--out",
+                          str(tmp_path / "x.json")], capture_output=True, text=True)
+    assert cli.returncode == 2 and not (tmp_path / "x.json").exists()
+    assert message and message in cli.stderr
+    if words == "sink 0.2 0":   # (the keyword form is the same target)
+        with pytest.raises(ValueError, match="outside the plate region"):
+            plate.design(part, sink=(0.2, 0), verify_starts=1)
+
+
 def test_bad_options_raise_ValueError_naming_the_option():
     sc = plate.load_scene(scene_path("fig4"))
     for call, name in [(lambda: plate.twist(sc, at=(0, 0)), "at"),
