@@ -3,6 +3,7 @@
 #   scripts/golden.sh [--quick] BUILD_DIR OUT_DIR     runs BUILD_DIR/plate on the shipped inputs into OUT_DIR
 #                                                     and writes OUT_DIR/checksums.txt
 #   scripts/golden.sh --compare A B                   compares two OUT_DIRs' checksums (exit 1 on a difference)
+#   scripts/golden.sh --sums OUT_DIR                  OUT_DIR's checksums again (after a change of this script)
 # What is checked: the field (JSON and CSV) and fixed points of every shipped scene, twists at a
 # configuration, full / U / averaged trajectories, random scenes, Theorem 1's proofs JSON, the point sink,
 # line sink, transport, orienter and fig4 fixed-point designs (summary and scene) and a campaign's table.
@@ -11,12 +12,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-normalise() {   # FILE: its content without wall-clock figures, on stdout
-    python3 - "$1" <<'EOF'
+normalise() {   # FILE OUT: its content without wall-clock figures or OUT's own path, on stdout
+    python3 - "$1" "$2" <<'EOF'
 import json, re, sys
-path = sys.argv[1]
-text = open(path).read()
-TIMING = {"seconds", "threads", "machine", "wall_seconds", "elapsed", "decision_seconds", "cpu_seconds"}
+path, out = sys.argv[1], sys.argv[2]
+text = open(path).read().replace(out, "OUT")
+TIMING = {"seconds", "threads", "machine", "wall_seconds", "elapsed", "decision_seconds", "cpu_seconds",
+          "busy_seconds", "load_balance_efficiency"}
 def strip(x, key=None):
     if isinstance(x, dict):
         return {k: strip(v, k) for k, v in x.items() if k not in TIMING}
@@ -37,9 +39,9 @@ if j is not None:
         print(json.dumps(j, sort_keys=True))
     else:
         print(json.dumps(strip(j), sort_keys=True))
-elif path.endswith(".jsonl"):
-    for line in text.splitlines():
-        print(json.dumps(strip(json.loads(line)), sort_keys=True))
+elif path.endswith(".jsonl"):   # (a journal's lines come in the order the cases finished)
+    for line in sorted(json.dumps(strip(json.loads(l)), sort_keys=True) for l in text.splitlines()):
+        print(line)
 else:
     # CSV and text: lines that name a wall-clock figure are dropped
     for line in text.splitlines():
@@ -49,6 +51,22 @@ else:
 EOF
 }
 
+sums() {   # OUT: OUT/checksums.txt from what is in OUT
+    local out=$1
+    (
+        abs=$(cd "$out" && pwd)
+        cd "$out"
+        for f in $(find . -type f ! -name 'checksums.txt*' ! -name timing.csv ! -name '*.svg' | sort); do
+            printf '%s  %s\n' "$(normalise "$f" "$abs" | sha256sum | cut -c1-16)" "$f"
+        done
+    ) >"$out/checksums.txt.tmp"
+    mv "$out/checksums.txt.tmp" "$out/checksums.txt"
+}
+
+if [[ ${1:-} == --sums ]]; then   # OUT: the checksums again (after a change of this script)
+    sums "$(realpath "$2")"
+    exit 0
+fi
 if [[ ${1:-} == --compare ]]; then
     a=$2 b=$3
     if diff <(sort "$a/checksums.txt") <(sort "$b/checksums.txt"); then
@@ -61,7 +79,7 @@ fi
 
 quick=0
 if [[ ${1:-} == --quick ]]; then quick=1; shift; fi
-build=$1 out=$2
+build=$1 out=$(realpath -m "$2")
 plate="$build/plate"
 mkdir -p "$out"
 run() {   # NAME COMMAND...: stdout to OUT/NAME (exit code kept in OUT/NAME.rc)
@@ -106,11 +124,5 @@ if ((quick == 0)); then
     run campaign.json "$plate" sweep campaigns/heave_yaw_stick_slip.json --out "$out/campaign" --threads 2
 fi
 
-(
-    cd "$out"
-    for f in $(find . -type f ! -name checksums.txt ! -name timing.csv ! -name '*.svg' | sort); do
-        printf '%s  %s\n' "$(normalise "$f" | sha256sum | cut -c1-16)" "$f"
-    done
-) >"$out/checksums.txt.tmp"
-mv "$out/checksums.txt.tmp" "$out/checksums.txt"
+sums "$out"
 echo "golden: $(wc -l <"$out/checksums.txt") outputs in $out/checksums.txt" >&2
