@@ -95,7 +95,7 @@ for scene in scenes/*.json; do
     run "$s.field.json" "$plate" field "$scene" --threads 2
     run "$s.field.csv" "$plate" field "$scene" --format csv --threads 2
     run "$s.fixed-points.json" "$plate" fixed-points "$scene" --threads 2
-    if python3 -c 'import json, sys; sys.exit(0 if json.load(open(sys.argv[1]))["part"].get("point") else 1)' "$scene"; then
+    if python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["part"]; sys.exit(1 if "inertia" in p or "contacts" in p else 0)' "$scene"; then
         at=(0.01 -0.015)
     else
         at=(0.01 -0.015 0.7)
