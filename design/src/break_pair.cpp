@@ -3,16 +3,14 @@
 namespace plate::design_detail {
 
 // --- the half-turn pair broken: rz about its centre ---------------------------------------------------
-// (Measured on fig4's pair, 2026-11-28: docs/inverse-design.md.) At the pair's fixed point theta' has a
-// mean M and a second harmonic B_2 (0.007 and 0.088 rad/s) and no first. rz at n = 2 about the design's
-// centre keeps the pairing (a half turn leaves rz, half a period leaves n = 2) but moves M and B_2 (with
-// 50 rad/s^2: 0.030 and 0.035), so the pair's two stable orientations, at theta''s two minima, come
-// near a saddle-node; rz at n = 1 breaks the pairing (half a period reverses it) and adds a first
-// harmonic of 0.005-0.015 rad/s -- ten times what x, y, rx and ry gave there -- which lifts one minimum
-// above zero and leaves one stable orientation. First rx and ry at n = 1 are made parallel (the pair's
-// are a few degrees apart) and rz at n = 1 takes their direction: rotations about two axes a quarter
-// period apart turn the plate steadily (tilt_drift_rate; a trial with rz out of line drifted 1e-3 rad/s
-// and every full-dynamics run left the plate after 36 s). A grid over rz's amplitudes, its phase at n =
+// At the pair's fixed point theta' has a mean M and a second harmonic B_2 and no first harmonic. rz at
+// n = 2 about the design's centre keeps the pairing (a half turn leaves rz, half a period leaves n = 2)
+// but moves M and B_2, so the pair's two stable orientations, at theta''s two minima, come near a
+// saddle-node; rz at n = 1 breaks the pairing (half a period reverses it) and adds a first harmonic,
+// which lifts one minimum above zero and leaves one stable orientation (fig4's figures:
+// docs/inverse-design.md). First rx and ry at n = 1 are made parallel and rz at n = 1 takes their
+// direction: rotations about two axes a quarter period apart turn the plate steadily (tilt_drift_rate;
+// docs/decisions.md: the trial that left the plate). A grid over rz's amplitudes, its phase at n =
 // 2 and its sense at n = 1 is screened by theta' on a ring of orientations at the pair's fixed point
 // (exactly one stable zero), the survivors refined to their fixed point (stable, near the centre) and
 // verified like every rigid design, the shortest passage round the ring first (it sets the runs'
@@ -138,47 +136,49 @@ double ring_passage(const double* w, int n) {
     return passage;
 }
 
-DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion, const DesignTarget& target,
-                         const DesignOptions& opt, double T, std::atomic<long>& cycles, Clock::time_point t0) {
-    std::string failure = "no rz about the pair's centre left one stable orientation there";
+namespace {
+
+// A candidate of the screen: rz's setting on the pair's motion, with its fixed point near the centre.
+struct Candidate {
+    PlateMotion u;
+    Vec3 q;
+    double rate;
+    double passage;   // [s] the slowest start's way round the ring to the stable orientation
+    int index;        // in the grid (ties)
+    PlateMotion base;             // the motion before rz: the pair's, tilts aligned, scaled
+    std::array<double, 4> g;      // rz's setting
+    double scale;
+};
+
+// break_pair's stages over what they share: the part, the target, the options, the tilts' phase psi,
+// rz's room under the limit, and the cycles counted.
+struct PairBreaker {
+    const Scene& part_scene;
+    const DesignTarget& target;
+    const DesignOptions& opt;
+    std::atomic<long>& cycles;
     double psi = 0;
-    const PlateMotion aligned0 = aligned_tilts(pair_motion, psi);
-    struct Candidate {
-        PlateMotion u;
-        Vec3 q;
-        double rate;
-        double passage;   // [s] the slowest start's way round the ring to the stable orientation
-        int index;        // in the grid (ties)
-        PlateMotion base;             // the motion before rz: the pair's, tilts aligned, scaled
-        std::array<double, 4> g;      // rz's setting
-        double scale;
-    };
-    std::vector<Candidate> found;
-    std::vector<std::array<double, 4>> grid;   // (rz amplitude at n = 1, its sense, at n = 2, its phase)
-    const double room = 0.97 * opt.ang_limit;
-    for (double a1 : {2.0 / 3, 1.0})
-        for (double s1 : {1.0, -1.0})
-            for (double a2 : {0.4, 0.5, 0.6, 0.7, 0.8, 1.0})
-                for (int k = 0; k < 24; ++k) grid.push_back({a1 * room, s1, a2 * room, -kPi + k * kPi / 12});
-    auto with_rz = [&](const PlateMotion& base, const std::array<double, 4>& g) {
+    double room = 0;
+
+    PlateMotion with_rz(const PlateMotion& base, const std::array<double, 4>& g) const {
         PlateMotion u = base;
         u.harmonics.push_back({Axis::rz, 1, g[0], psi + (g[1] < 0 ? kPi : 0.0)});
         u.harmonics.push_back({Axis::rz, 2, g[2], g[3]});
         return u;
-    };
+    }
     // The motion with fixed point q, placed as place_and_verify_rigid will place it: within the limits,
     // the flight margin, and the coning and tilt-drift limits.
-    auto fits = [&](const PlateMotion& u, const Vec3& q) {
+    bool fits(const PlateMotion& u, const Vec3& q) const {
         double con[6 * 3 + 4];
         placed_constraints(placed_motion(u, q, target.at, target.theta), opt, part_scene, 3, 1.0, con);
         return *std::max_element(con, con + 6 * 3 + 4) <= 0;
-    };
+    }
     // A ring of n values of theta' with exactly one stable zero: its fixed point by Newton from q (not
     // finite: the middle of the zero's cell at the centre), stable and within `reach` of the centre
     // (the screen's 5 mm; 10 mm once lifted, its fixed point found again along s*), the placed motion
     // within the limits and the flight margin; "" where it fails, else "q0 q1 q2 rate passage" (exact
     // text: a task may run in another process).
-    auto fixed_point_on = [&](const Scene& sc, const double* w, int n, Vec3 q, double reach, long& own) -> std::string {
+    std::string fixed_point_on(const Scene& sc, const double* w, int n, Vec3 q, double reach, long& own) const {
         int stable = 0, at = -1;
         for (int k = 0; k < n; ++k)
             if (w[k] > 0 && w[(k + 1) % n] <= 0) ++stable, at = k;
@@ -203,9 +203,9 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         const double passage = ring_passage(w, n);
         return exact_text(q[0]) + ' ' + exact_text(q[1]) + ' ' + exact_text(q[2]) + ' ' + exact_text(rate) + ' ' +
                exact_text(passage);
-    };
+    }
     // One setting's screen: theta' on the ring at the centre, then its fixed point.
-    auto screen = [&](const PlateMotion& base, const std::array<double, 4>& g, long& own) -> std::string {
+    std::string screen(const PlateMotion& base, const std::array<double, 4>& g, long& own) const {
         Scene sc = part_scene;
         sc.plate = with_rz(base, g);
         double w[kBreakRing];
@@ -218,11 +218,33 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
             w[k] = c.twist[2];
         }
         return fixed_point_on(sc, w, kBreakRing, Vec3::Constant(NAN), 0.005, own);
-    };
-    // The placement turns the motion by THETA less the orientation found, and a pair searched at the
-    // flight margin turned that far tilts its corners beyond it (fig4: 0.04-0.09 g over): the sink's
-    // harmonics scaled down until some settings fit.
-    int tried = 0;
+    }
+    std::vector<Candidate> screen_grid(const PlateMotion& aligned0, int& tried) const;
+    bool lift_wells(Candidate& c, std::string& lift) const;
+    double settle_offset(const Candidate& c, double settle, double T) const;
+};
+
+std::string describe(const Candidate& c) {
+    std::ostringstream what;
+    what.precision(3);
+    what << "rz " << c.g[0] << " rad/s^2 at n = 1 along the tilts (" << (c.g[1] > 0 ? "+" : "-") << "), " << c.g[2]
+         << " rad/s^2 at n = 2, phase " << c.g[3] << ", the sink's harmonics scaled by " << c.scale;
+    return what.str();
+}
+
+// The grid of rz's settings (amplitude at n = 1, its sense, amplitude at n = 2, its phase) screened on
+// the pair's motion. The placement turns the motion by THETA less the orientation found, and a pair
+// searched at the flight margin turned that far tilts its corners beyond it (fig4: 0.04-0.09 g over):
+// the sink's harmonics scaled down until some settings fit. The candidates ranked by the slowest
+// start's passage (the runs' length and the design's real speed), ties by the grid's order (tasks
+// finish in any order).
+std::vector<Candidate> PairBreaker::screen_grid(const PlateMotion& aligned0, int& tried) const {
+    std::vector<Candidate> found;
+    std::vector<std::array<double, 4>> grid;   // (rz amplitude at n = 1, its sense, at n = 2, its phase)
+    for (double a1 : {2.0 / 3, 1.0})
+        for (double s1 : {1.0, -1.0})
+            for (double a2 : {0.4, 0.5, 0.6, 0.7, 0.8, 1.0})
+                for (int k = 0; k < 24; ++k) grid.push_back({a1 * room, s1, a2 * room, -kPi + k * kPi / 12});
     for (double scale : {1.0, 0.95, 0.9, 0.85, 0.8}) {
         PlateMotion base = aligned0;
         for (Harmonic& hm : base.harmonics) hm.amp *= scale;
@@ -247,143 +269,151 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         tried += n;
         if (!found.empty()) break;
     }
-    // (tasks finish in any order: ranked by the slowest start's passage -- the runs' length and the
-    // design's real speed -- ties by the grid's order)
     std::sort(found.begin(), found.end(), [](const Candidate& a, const Candidate& b) {
         return a.passage != b.passage ? a.passage < b.passage : a.index < b.index;
     });
-    auto describe = [](const Candidate& c) {
-        std::ostringstream what;
-        what.precision(3);
-        what << "rz " << c.g[0] << " rad/s^2 at n = 1 along the tilts (" << (c.g[1] > 0 ? "+" : "-") << "), " << c.g[2]
-             << " rad/s^2 at n = 2, phase " << c.g[3] << ", the sink's harmonics scaled by " << c.scale;
-        return what.str();
+    return found;
+}
+
+// The screen's ring lies at the centre; the field's fixed points lie on the curve s*(theta) where the
+// position's twist vanishes, up to 6 mm away, where a shallow well of theta' can dip below zero
+// (fig4: -0.0016 rad/s, a second stable fixed point the runs never reach). Lifting: rz's three
+// settings (amplitudes, phase at n = 2) moved by a pattern search, each step to the neighbour that
+// lifts the shallowest other well of w* (reduced_ring) the most, steps halved where none does, until
+// it clears kWellMargin; the candidate is replaced where its fixed point is found again within the
+// limits. `lift` says from what to what.
+bool PairBreaker::lift_wells(Candidate& c, std::string& lift) const {
+    // (the well's clearance, and the passage round the ring for the note: the smallest change that
+    // clears the margin keeps the pair's small offset between field and full dynamics; a search for the
+    // shortest passage instead was tried and not kept, docs/decisions.md)
+    struct Score {
+        double well = -HUGE_VAL, passage = HUGE_VAL;
     };
-    // The screen's ring lies at the centre; the field's fixed points lie on the curve s*(theta) where the
-    // position's twist vanishes, up to 6 mm away, where a shallow well of theta' can dip below zero
-    // (fig4: -0.0016 rad/s, a second stable fixed point the runs never reach). Lifting: rz's three
-    // settings (amplitudes, phase at n = 2) moved by a pattern search, each step to the neighbour that
-    // lifts the shallowest other well of w* (reduced_ring) the most, steps halved where none does, until
-    // it clears kWellMargin; the candidate is replaced where its fixed point is found again within the
-    // limits. `lift` says from what to what.
-    auto lift_wells = [&](Candidate& c, std::string& lift) -> bool {
-        // (the well's clearance, and the passage round the ring for the note; a search for the shortest
-        // passage instead, 2026-11-28, went to rz 144 rad/s^2 at n = 1, where the full dynamics settled
-        // 0.12-0.13 rad past the field's fixed point, more than the two tolerances' 0.07 together: the
-        // smallest change that clears the margin keeps the pair's offset, 0.06 rad)
-        struct Score {
-            double well = -HUGE_VAL, passage = HUGE_VAL;
-        };
-        auto score = [&](const std::array<double, 4>& g, long& own) -> Score {
-            Score sc0;
-            if (g[0] < 0 || g[0] > room || g[2] < 0 || g[2] > room) return sc0;
-            Scene sc = part_scene;
-            sc.plate = with_rz(c.base, g);
-            if (!fits(sc.plate, c.q)) return sc0;
-            double w[kWellRing];
-            if (!reduced_ring(sc, c.q.head<2>(), kWellRing, opt.cycle, own, w)) return sc0;
-            return Score{other_well(w, kWellRing, c.q[2]), ring_passage(w, kWellRing)};
-        };
-        std::array<double, 4> g = c.g;
-        long own0 = 0;
-        const Score start = score(g, own0);
-        cycles += own0;
-        Score now = start;
-        double step[3] = {0.05 * room, 0.05 * room, kPi / 48};
-        for (int it = 0; it < kLiftSteps && start.well > -HUGE_VAL && now.well < kWellMargin; ++it) {
-            std::vector<std::array<double, 4>> next;
-            for (int d = 0; d < 3; ++d)
-                for (double sgn : {1.0, -1.0}) {
-                    std::array<double, 4> t = g;
-                    t[d == 0 ? 0 : d == 1 ? 2 : 3] += sgn * step[d];
-                    next.push_back(t);
-                }
-            std::vector<Score> got(next.size());
-            runner(opt)(
-                static_cast<int>(next.size()),
-                [&](int k) -> std::string {
-                    long own = 0;
-                    const Score v = score(next[k], own);
-                    return std::to_string(own) + ' ' + exact_text(v.well) + ' ' + exact_text(v.passage);
-                },
-                [&](int k, const std::string& text) {
-                    std::istringstream in(text);
-                    long own = 0;
-                    std::string a, b;
-                    in >> own >> a >> b;
-                    cycles += own;
-                    got[k] = Score{exact_value(a), exact_value(b)};
-                });
-            std::size_t best = 0;
-            for (std::size_t k = 1; k < got.size(); ++k)
-                if (got[k].well > got[best].well) best = k;
-            if (got[best].well > now.well) {
-                now = got[best];
-                g = next[best];
-            } else {
-                for (double& st : step) st /= 2;
-            }
-        }
-        std::ostringstream note;
-        note.precision(2);
-        note << "theta' along the position's fixed points (" << kWellRing << " orientations, linearised): its shallowest "
-             << "other well " << start.well << " rad/s";
-        if (now.well != start.well) note << ", lifted to " << now.well << " rad/s";
-        note << " (" << kWellMargin << " needed), the slowest passage round it " << std::min(now.passage, 1e9) << " s";
-        lift = note.str();
-        if (now.well < kWellMargin) {
-            lift += " -- not applied: the margin not reached";
-            return false;
-        }
-        if (g == c.g) return true;
+    auto score = [&](const std::array<double, 4>& g, long& own) -> Score {
+        Score sc0;
+        if (g[0] < 0 || g[0] > room || g[2] < 0 || g[2] > room) return sc0;
         Scene sc = part_scene;
         sc.plate = with_rz(c.base, g);
+        if (!fits(sc.plate, c.q)) return sc0;
         double w[kWellRing];
-        long own = 0;
-        const bool ring_ok = reduced_ring(sc, c.q.head<2>(), kWellRing, opt.cycle, own, w);
-        const std::string r = ring_ok ? fixed_point_on(sc, w, kWellRing, c.q, 0.01, own) : "";
-        cycles += own;
-        std::istringstream in(r);
-        std::string x[5];
-        if (!(in >> x[0] >> x[1] >> x[2] >> x[3] >> x[4])) {
-            lift += " -- not applied: the lifted motion's fixed point not found again within the limits";
-            return false;
-        }
-        c.u = sc.plate;
-        c.g = g;
-        c.q = Vec3(exact_value(x[0]), exact_value(x[1]), exact_value(x[2]));
-        c.rate = exact_value(x[3]);
-        c.passage = exact_value(x[4]);
-        return true;
+        if (!reduced_ring(sc, c.q.head<2>(), kWellRing, opt.cycle, own, w)) return sc0;
+        return Score{other_well(w, kWellRing, c.q[2]), ring_passage(w, kWellRing)};
     };
+    std::array<double, 4> g = c.g;
+    long own0 = 0;
+    const Score start = score(g, own0);
+    cycles += own0;
+    Score now = start;
+    double step[3] = {0.05 * room, 0.05 * room, kPi / 48};
+    for (int it = 0; it < kLiftSteps && start.well > -HUGE_VAL && now.well < kWellMargin; ++it) {
+        std::vector<std::array<double, 4>> next;
+        for (int d = 0; d < 3; ++d)
+            for (double sgn : {1.0, -1.0}) {
+                std::array<double, 4> t = g;
+                t[d == 0 ? 0 : d == 1 ? 2 : 3] += sgn * step[d];
+                next.push_back(t);
+            }
+        std::vector<Score> got(next.size());
+        runner(opt)(
+            static_cast<int>(next.size()),
+            [&](int k) -> std::string {
+                long own = 0;
+                const Score v = score(next[k], own);
+                return std::to_string(own) + ' ' + exact_text(v.well) + ' ' + exact_text(v.passage);
+            },
+            [&](int k, const std::string& text) {
+                std::istringstream in(text);
+                long own = 0;
+                std::string a, b;
+                in >> own >> a >> b;
+                cycles += own;
+                got[k] = Score{exact_value(a), exact_value(b)};
+            });
+        std::size_t best = 0;
+        for (std::size_t k = 1; k < got.size(); ++k)
+            if (got[k].well > got[best].well) best = k;
+        if (got[best].well > now.well) {
+            now = got[best];
+            g = next[best];
+        } else {
+            for (double& st : step) st /= 2;
+        }
+    }
+    std::ostringstream note;
+    note.precision(2);
+    note << "theta' along the position's fixed points (" << kWellRing << " orientations, linearised): its shallowest "
+         << "other well " << start.well << " rad/s";
+    if (now.well != start.well) note << ", lifted to " << now.well << " rad/s";
+    note << " (" << kWellMargin << " needed), the slowest passage round it " << std::min(now.passage, 1e9) << " s";
+    lift = note.str();
+    if (now.well < kWellMargin) {
+        lift += " -- not applied: the margin not reached";
+        return false;
+    }
+    if (g == c.g) return true;
+    Scene sc = part_scene;
+    sc.plate = with_rz(c.base, g);
+    double w[kWellRing];
+    long own = 0;
+    const bool ring_ok = reduced_ring(sc, c.q.head<2>(), kWellRing, opt.cycle, own, w);
+    const std::string r = ring_ok ? fixed_point_on(sc, w, kWellRing, c.q, 0.01, own) : "";
+    cycles += own;
+    std::istringstream in(r);
+    std::string x[5];
+    if (!(in >> x[0] >> x[1] >> x[2] >> x[3] >> x[4])) {
+        lift += " -- not applied: the lifted motion's fixed point not found again within the limits";
+        return false;
+    }
+    c.u = sc.plate;
+    c.g = g;
+    c.q = Vec3(exact_value(x[0]), exact_value(x[1]), exact_value(x[2]));
+    c.rate = exact_value(x[3]);
+    c.passage = exact_value(x[4]);
+    return true;
+}
+
+// Where the full dynamics settles: from the field's fixed point, as placed, over whole periods until
+// the slow mode has decayed (`settle`), theta averaged over the last period (it swings within each);
+// its offset from THETA [rad] (0 if the run stopped).
+double PairBreaker::settle_offset(const Candidate& c, double settle, double T) const {
+    double offset = 0;
+    Scene placed = part_scene;
+    placed.plate = placed_motion(c.u, c.q, target.at, target.theta);
+    IntegrationOptions io;
+    io.rtol = 1e-7;
+    const Trajectory tr = simulate(placed, Dynamics::Full, Vec3(target.at.x(), target.at.y(), target.theta), Vec3::Zero(),
+                                   settle, T / 20, io);
+    double sum_off = 0;
+    int count = 0;
+    for (const Sample& smp : tr.samples)
+        if (smp.t > settle - T + 1e-9 * T) sum_off += wrap_angle(smp.q[2] - target.theta), ++count;
+    if (tr.stop.reason == StopReason::None && count > 0) offset = sum_off / count;
+    return offset;
+}
+
+}  // namespace
+
+DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion, const DesignTarget& target,
+                         const DesignOptions& opt, double T, std::atomic<long>& cycles, Clock::time_point t0) {
+    std::string failure = "no rz about the pair's centre left one stable orientation there";
+    PairBreaker pb{part_scene, target, opt, cycles};
+    const PlateMotion aligned0 = aligned_tilts(pair_motion, pb.psi);
+    pb.room = 0.97 * opt.ang_limit;
+    int tried = 0;
+    const std::vector<Candidate> found = pb.screen_grid(aligned0, tried);
     DesignSummary kept;   // the best verified so far: unique, else the largest share of the runs
     for (std::size_t i = 0; i < found.size() && static_cast<int>(i) < kBreakVerified; ++i) {
         Candidate c = found[i];
         std::string lift;
-        if (opt.lift_wells && !lift_wells(c, lift)) c = found[i];
+        if (opt.lift_wells && !pb.lift_wells(c, lift)) c = found[i];
         DesignSummary sum;
         start_summary(sum, part_scene, "_fixed_point", T);
         sum.evaluations = tried;
-        // Where the full dynamics settles: from the field's fixed point, as placed, over whole periods
-        // until the slow mode has decayed, theta averaged over the last period (it swings within each);
-        // the offset is then split in proportion to the two tolerances (the field's fixed point within
-        // 0.02 rad of THETA, the runs within 0.05): the field's placed 2/7 of it short of THETA, the full
-        // dynamics' 5/7 past it.
+        // The full dynamics' offset split in proportion to the two tolerances (the field's fixed point
+        // within 0.02 rad of THETA, the runs within 0.05): the field's placed 2/7 of it short of THETA,
+        // the full dynamics' 5/7 past it.
         const double settle = std::ceil(settle_time(2 * opt.region, c.rate, opt) / T) * T;
-        double offset = 0;
-        {
-            Scene placed = part_scene;
-            placed.plate = placed_motion(c.u, c.q, target.at, target.theta);
-            IntegrationOptions io;
-            io.rtol = 1e-7;
-            const Trajectory tr = simulate(placed, Dynamics::Full, Vec3(target.at.x(), target.at.y(), target.theta), Vec3::Zero(),
-                                           settle, T / 20, io);
-            double sum_off = 0;
-            int count = 0;
-            for (const Sample& smp : tr.samples)
-                if (smp.t > settle - T + 1e-9 * T) sum_off += wrap_angle(smp.q[2] - target.theta), ++count;
-            if (tr.stop.reason == StopReason::None && count > 0) offset = sum_off / count;
-        }
+        const double offset = pb.settle_offset(c, settle, T);
         const double short_of = offset * 0.02 / (0.02 + 0.05);
         place_and_verify_rigid(sum, part_scene, c.u, c.q, target, opt, cycles, t0, false, 1.5 * c.passage + settle, short_of);
         if (!lift.empty()) sum.notes.push_back(lift);
@@ -414,6 +444,5 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
     none.failure = found.empty() ? failure + " within the flight margin (" + std::to_string(tried) + " tried)" : failure;
     return none;
 }
-
 
 }  // namespace plate::design_detail

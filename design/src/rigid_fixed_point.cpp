@@ -292,7 +292,7 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     int stable_lines = 0;
     for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
     // A half-turn pair is never unique: its twin exists by the pairing whether or not the grid
-    // resolves it (an outside audit: nothing else kept a missed twin from reading unique).
+    // resolves it (nothing else keeps a missed twin from reading unique).
     const std::string gaps = unsearched(sum.fixed_points);
     sum.unique = !pair && stable == 1 && stable_at_target == 1 && stable_lines == 0 && gaps.empty();
     if (!gaps.empty()) sum.notes.push_back("the grid's fixed-point search did not cover " + gaps + ": not called unique");

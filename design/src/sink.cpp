@@ -72,7 +72,7 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
         sum.notes.push_back("coning held to " + std::to_string(sink_coning_limit(target.at, opt)) +
                             " rad/s: the plate's second-order turn about z, which the field does not see, turns the "
                             "sink about the plate's centre; at most half the verification distance over the hold");
-    else if (target.at.norm() > 0)   // (an outside audit: --hold 0 lifted the coning limit without a word)
+    else if (target.at.norm() > 0)   // (without a hold nothing limits the coning: say so)
         sum.notes.push_back("coning not limited (no hold, no --max-coning): the plate's second-order turn about z turns "
                             "the sink about the plate's centre, so a part held at the target walks off it in time "
                             "(not checked)");

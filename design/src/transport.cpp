@@ -77,9 +77,8 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     // (a rigid part: theta' within the same 2 %, turned into an angular rate by the part's radius rho)
     const double turn_tolerance = sum.transport_tolerance / sum.scene.part.rho();
     // Each run for a region's width of travel (1-20 s), judged over its second half: released at rest
-    // the part lags the plate's drive while its cycle builds up (about 0.1 s on fig1_point: 9.6 mm at
-    // 0.08 m/s, which a check from the start counted against the design; an outside audit found it),
-    // so the distance is from where the target velocity takes it from the run's midpoint, within the
+    // the part lags the plate's drive while its cycle builds up (about 0.1 s on fig1_point, which a check
+    // from the start would count against the design), so the distance is from where the target velocity takes it from the run's midpoint, within the
     // field's 2 % over that half (and 5 mm).
     const int stopped = verification_runs(
         sum, opt, [&](const DesignStartRun&) { return std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0); },

@@ -56,11 +56,9 @@ double coning_rate(const PlateMotion& u);
 // of (1/2) <theta x theta'> along x and y, sum_n Im(A_ry,n conj(A_rz,n)) / (2 (n w)^3) and
 // sum_n Im(A_rz,n conj(A_rx,n)) / (2 (n w)^3) [rad/s], signed as coning_rate is: the plate itself
 // turns about x and y at minus these (a test: a part on such a plate slides downhill that way, in
-// full dynamics). Where it is not zero the plate's tilt grows
-// steadily and gravity pulls every part downhill: a trial design with rz at n = 1 a quarter period
-// off the tilts' drifted 1e-3 rad/s, and all 20 of its full-dynamics runs left the plate after 36 s
-// (docs/inverse-design.md). Rigid designs hold it to 2e-6 rad/s (design.cpp, kTiltDriftLimit); a
-// motion without rz has none.
+// full dynamics). Where it is not zero the plate's tilt grows steadily and gravity pulls every part
+// downhill (docs/decisions.md: a trial design that left the plate). Rigid designs hold it to 2e-6
+// rad/s (internal.hpp, kTiltDriftLimit); a motion without rz has none.
 Vec2 tilt_drift_rate(const PlateMotion& u);
 
 // ORIENTATION HARMONICS. At a position s the twist's theta' is a function of theta alone,
@@ -70,14 +68,12 @@ Vec2 tilt_drift_rate(const PlateMotion& u);
 // lower ones). What a rigid part's one stable orientation needs: with r = rest() = |M| + B_2 + ...,
 // B_1 > r puts every zero of theta' in the two arcs |sin(theta + phi_1)| <= r / B_1, and if also
 // B_1^2 > r^2 + slope_bound()^2 (slope_bound = sum_{k>=2} k B_k) theta' is monotonic in them: exactly
-// one stable orientation (one_stable()). B_1 > r alone is not enough: scenes/foot.json's weathervane has
-// B_1 = 0.37 rad/s against 0.16 and three stable orientations (measured on a 0.01-rad ring: 0.035 rad
-// either side of the foot-ahead orientation, itself unstable at that scale, and one with a 0.09-rad
-// basin at the foot-behind one). If instead the pi-periodic part (M, B_2, B_4, ...)
-// dominates, stable orientations pair about a half turn apart (with B_2 dominant each basin is near half
-// the turn), and one is unique only with M tuned onto a saddle-node of that part, which leaves a
-// bottleneck of theta' < B_1 where its twin was (README, inverse design). bench_orientation_drive
-// measures how large B_1 can be within the design limits (fig4's part: below rest()).
+// one stable orientation (one_stable()). B_1 > r alone is not enough (scenes/foot.json's weathervane
+// has three stable orientations: docs/inverse-design.md, "What one orientation needs"). If instead the
+// pi-periodic part (M, B_2, B_4, ...) dominates, stable orientations pair about a half turn apart, and
+// one is unique only with M tuned onto a saddle-node of that part, which leaves a bottleneck of
+// theta' < B_1 where its twin was. bench_orientation_drive measures how large B_1 can be within the
+// design limits.
 struct OrientationHarmonics {
     bool defined = false;            // every cycle on the ring converged
     double mean = 0;                 // M [rad/s]
