@@ -1,5 +1,4 @@
 #include "plate/dynamics.hpp"
-#include "plate/modes.hpp"
 
 #include <cmath>
 #include <limits>
@@ -9,53 +8,12 @@
 #include <stdexcept>
 
 namespace plate {
-namespace {
-
-
-// u = factor * v for the regularised friction laws (FrictionLaw).
-inline double regularised_factor(FrictionLaw law, double eps, double speed) {
-    if (law == FrictionLaw::Tanh) return speed > 1e-8 * eps ? std::tanh(speed / eps) / speed : 1.0 / eps;
-    if (law == FrictionLaw::Sqrt) return 1.0 / std::hypot(speed, eps);
-    return 1.0 / std::max(speed, eps);
-}
-
-// d u/d v (2x2) of the friction law at sliding velocity v.
-Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v) {
-    const double s = v.norm();
-    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-    if (law == FrictionLaw::Linear && s < eps) return I / eps;
-    if (law == FrictionLaw::Sqrt) {
-        const double r = std::hypot(s, eps);
-        return I / r - v * v.transpose() / (r * r * r);
-    }
-    if (law == FrictionLaw::Tanh) {
-        if (s < 1e-8 * eps) return I / eps;
-        const Vec2 e = v / s;
-        const double th = std::tanh(s / eps), sech2 = 1 - th * th;
-        return th / s * (I - e * e.transpose()) + sech2 / eps * e * e.transpose();
-    }
-    if (s == 0) return Eigen::Matrix2d::Zero();   // Coulomb at zero slip: undefined; no sliding term
-    const Vec2 e = v / s;
-    return (I - e * e.transpose()) / s;
-}
-
-}  // namespace
 
 const char* dynamics_name(Dynamics d) {
     switch (d) {
         case Dynamics::Full: return "full";
         case Dynamics::U: return "u";
         case Dynamics::ReducedU: return "reduced-u";
-    }
-    return "?";
-}
-
-const char* friction_law_name(FrictionLaw f) {
-    switch (f) {
-        case FrictionLaw::Coulomb: return "coulomb";
-        case FrictionLaw::Tanh: return "tanh";
-        case FrictionLaw::Linear: return "linear";
-        case FrictionLaw::Sqrt: return "sqrt";
     }
     return "?";
 }
@@ -123,17 +81,6 @@ Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const
     return b;
 }
 
-gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho) {
-    gen::WrenchInput in;
-    in.N1 = n[0]; in.N2 = n[1]; in.N3 = n[2];
-    in.r1x = r[0].x(); in.r1y = r[0].y();
-    in.r2x = r[1].x(); in.r2y = r[1].y();
-    in.r3x = r[2].x(); in.r3y = r[2].y();
-    in.mu1 = mu[0]; in.mu2 = mu[1]; in.mu3 = mu[2];
-    in.rho = rho;
-    return in;
-}
-
 void Workspace::prepare(const Scene& sc) {
     const Part& P = sc.part;
     prepared = &sc;
@@ -152,7 +99,8 @@ void Workspace::prepare(const Scene& sc) {
     in.c3x = P.c[2].x(); in.c3y = P.c[2].y();
     in.cz = P.point ? 0.0 : P.c[0].z();
     in.sz = P.s_z();
-    in.mu1 = P.mu[0]; in.mu2 = P.mu[1]; in.mu3 = P.mu[2];
+    const ContactFriction fr = P.friction();   // (the kernels' slides take the kinetic coefficients)
+    in.mu1 = fr.kinetic(0); in.mu2 = fr.kinetic(1); in.mu3 = fr.kinetic(2);
     in.R11 = in.R22 = in.R33 = 1;
     theta = std::numeric_limits<double>::quiet_NaN();
     C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -400,7 +348,7 @@ void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& 
     if (P.point) {
         // s'' = -(mu N u(v) + b_xy)/m with N = b_z independent of the twist.
         Jq.setZero();
-        Jq.topLeftCorner<2, 2>() = -P.mu[0] * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
+        Jq.topLeftCorner<2, 2>() = -P.friction().kinetic(0) * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
         return;
     }
     double A[36], D[36], V[18];
@@ -429,7 +377,7 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
         const double N = ws.b[2];
         const double v = ws.slip[0].norm();
         const Vec2 dir = v > 0 ? Vec2(ws.slip[0] / v) : Vec2::Zero();
-        const Vec2 sdd = (-P.mu[0] * N * dir - ws.b.head<2>()) / P.m;
+        const Vec2 sdd = (-P.friction().kinetic(0) * N * dir - ws.b.head<2>()) / P.m;
         ws.qdd = Vec3(sdd.x(), sdd.y(), 0);
         ws.n = Vec3(N, 0, 0);
         return;
@@ -442,10 +390,11 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
     A(0, 0) = -P.m;
     A(1, 1) = -P.m;
     A.block<3, 1>(3, 2) = -P.J.col(2);
+    const ContactFriction fr = P.friction();
     for (int i = 0; i < 3; ++i) {
         const double v = ws.slip[i].norm();
         const Vec2 u = v > 0 ? Vec2(ws.slip[i] / v) : Vec2::Zero();
-        const Vec3 d(-P.mu[i] * u.x(), -P.mu[i] * u.y(), 1.0);              // (17)
+        const Vec3 d(-fr.kinetic(i) * u.x(), -fr.kinetic(i) * u.y(), 1.0);              // (17)
         const Vec3 dS(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());  // R2^T d_i
         A.block<3, 1>(0, 3 + i) = d;
         A.block<3, 1>(3, 3 + i) = P.c[i].cross(dS);                          // h_i (23)
@@ -454,40 +403,6 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
     ws.z = ws.lu.solve(ws.b);
     ws.qdd = ws.z.head<3>();
     ws.n = ws.z.tail<3>();
-}
-
-StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd,
-                     const PlateState& ps) {
-    const Part& P = sc.part;
-    Workspace ws;
-    StickTest r;
-    if (P.point) {   // s'' = 0: friction must supply f_xy, and N = f_z
-        mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
-        r.friction_needed = ws.F_needed.norm();
-        r.friction_available = P.mu[0] * ws.n[0];
-        r.sticks = ws.n[0] > 0 && r.friction_needed <= r.friction_available;
-        return r;
-    }
-    // The others turn about c_k with theta' (sense 0 at rest: no kinetic friction there).
-    const double sense = qd[2] > 0 ? 1.0 : qd[2] < 0 ? -1.0 : 0.0;
-    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Pivot, k, sense}, ws);
-    r.friction_needed = ws.f_held[k].norm();
-    r.friction_available = P.mu[k] * ws.n[k];
-    r.sticks = ws.n.minCoeff() >= 0 && r.friction_needed <= r.friction_available;
-    return r;
-}
-
-StickTest stick_test_all(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {
-    // The stuck mode's statics and the exact friction-disk gauge (modes.hpp).
-    Workspace ws;
-    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
-    const int nc = sc.part.contacts();
-    StickTest r;
-    r.friction_needed = ws.F_needed.norm();
-    for (int i = 0; i < nc; ++i) r.friction_available += sc.part.mu[i] * std::max(ws.n[i], 0.0);
-    r.sticks = ws.n.head(nc).minCoeff() >= 0 &&
-               friction_gauge(sc.part, q[2], ws.n, ws.F_needed, ws.tau_needed).gamma <= 1;
-    return r;
 }
 
 }  // namespace plate

@@ -283,7 +283,7 @@ private:
         for (int i = 0; i < scene_.part.contacts(); ++i) note_stage_guard(i, t, ws.n[i]);
         if (model_.mode.kind == ModeKind::Pivot) {
             const int k = model_.mode.k;
-            note_stage_guard(3, t, scene_.part.mu[k] * ws.n[k] - ws.f_held[k].norm());
+            note_stage_guard(3, t, scene_.part.friction().hold_margin(k, ws.n[k], ws.f_held[k]));
             note_stage_guard(4, t, model_.qd(y)[2] * model_.mode.sense);
         }
     }
@@ -651,7 +651,7 @@ private:
             case ModeKind::Pivot: {
                 State y;
                 for (std::size_t i = 0; i < y.size(); ++i) y[i] = ys[i] * scale_[i];
-                g[3] = scene_.part.mu[m.k] * ws.n[m.k] - ws.f_held[m.k].norm();
+                g[3] = scene_.part.friction().hold_margin(m.k, ws.n[m.k], ws.f_held[m.k]);
                 g[4] = model_.qd(y)[2] * m.sense;
                 break;
             }

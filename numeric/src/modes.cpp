@@ -62,7 +62,8 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
     ws.b = b;
     ws.qdd = z.head<3>();
     ws.n = z.segment<3>(3);
-    for (int i = 0; i < 3; ++i) ws.f_held[i] = i == k ? Vec2(z[6], z[7]) : Vec2(-P.mu[i] * ws.n[i] * u[i]);
+    const ContactFriction fr = P.friction();
+    for (int i = 0; i < 3; ++i) ws.f_held[i] = i == k ? Vec2(z[6], z[7]) : Vec2(-fr.kinetic(i) * ws.n[i] * u[i]);
 }
 
 // q'' = 0: the needed friction total and moment, and the normal forces (generated stuck_solve).
@@ -93,261 +94,6 @@ std::string mode_name(const Mode& m) {
         case ModeKind::Stuck: return "stuck";
     }
     return "?";
-}
-
-FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const Vec2& F, double tau) {
-    FrictionGauge g;
-    const double inf = std::numeric_limits<double>::infinity();
-    if (P.point) {
-        const double cap = P.mu[0] * std::max(n[0], 0.0);
-        const double need = F.norm();
-        g.gamma = need == 0 ? 0.0 : cap > 0 ? need / cap : inf;
-        g.f[0] = F;
-        if (need > 0) g.direction = Vec3(F.x() / need, F.y() / need, 0);
-        return g;
-    }
-    // Scaled coordinates of the Appendix: w = (F, tau / rho), R_i = r_i / rho.
-    const double rg = P.rho();
-    const Vec3 w(F.x(), F.y(), tau / rg);
-    const double wn = w.norm();
-    if (wn == 0) return g;
-    std::array<Vec2, 3> R;
-    std::array<double, 3> cap;
-    for (int i = 0; i < 3; ++i) {
-        R[i] = horizontal_offset(P, theta, i) / rg;
-        cap[i] = P.mu[i] * std::max(n[i], 0.0);
-    }
-    auto Gt = [&](int i, const Vec3& d) { return Vec2(d.x() - R[i].y() * d.z(), d.y() + R[i].x() * d.z()); };
-    auto Gf = [&](int i, const Vec2& f) { return Vec3(f.x(), f.y(), R[i].x() * f.y() - R[i].y() * f.x()); };
-    auto finish = [&](const Vec3& d, double h) {
-        g.gamma = h > 0 ? 1 / h : inf;
-        g.direction = Vec3(d.x(), d.y(), d.z() / rg);
-        g.direction /= g.direction.norm();
-    };
-    // Kinks: d a rotation about contact k, scaled onto d . w = 1. Optimal iff some g in the unit disk
-    // and c > 0 satisfy sum_{j != k} cap_j G_j u_j + cap_k G_k g = c w (then c = h(d), gamma = 1/c).
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 e(R[k].y(), -R[k].x(), 1);
-        const double s = w.dot(e);
-        if (!(std::abs(s) > 1e-14 * wn * e.norm()) || !(cap[k] > 0)) continue;
-        const Vec3 d = e / s;
-        Vec3 rhs = Vec3::Zero();
-        double h = 0;
-        std::array<Vec2, 3> u = zeros<Vec2>();
-        bool ok = true;
-        for (int j = 0; j < 3 && ok; ++j) {
-            if (j == k) continue;
-            const Vec2 v = Gt(j, d);
-            const double nv = v.norm();
-            if (!(nv > 0)) { ok = false; break; }
-            u[j] = v / nv;
-            rhs -= cap[j] * Gf(j, u[j]);
-            h += cap[j] * nv;
-        }
-        if (!ok) continue;
-        Mat3 A;
-        A.col(0) = cap[k] * Gf(k, Vec2::UnitX());
-        A.col(1) = cap[k] * Gf(k, Vec2::UnitY());
-        A.col(2) = -w;
-        const Eigen::FullPivLU<Mat3> lu(A);
-        if (!lu.isInvertible()) continue;
-        const Vec3 x = lu.solve(rhs);
-        if (!(x[2] > 0) || x.head<2>().norm() > 1 + 1e-12) continue;
-        finish(d, h);
-        for (int j = 0; j < 3; ++j) g.f[j] = g.gamma * cap[j] * (j == k ? Vec2(x.head<2>()) : u[j]);
-        g.pivot = k;
-        return g;
-    }
-    // Smooth optimum: Newton on h(d0 + B y), d0 = w/|w|^2, B an orthonormal basis of w's complement.
-    const Vec3 d0 = w / (wn * wn);
-    const Vec3 a = w / wn;
-    const Vec3 t1 = (std::abs(a.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(a).normalized();
-    Eigen::Matrix<double, 3, 2> B;
-    B.col(0) = t1;
-    B.col(1) = a.cross(t1);
-    // The support function P(d) = sum_i mu_i N_i |G_i^T d| with its gradient and Hessian: the
-    // generated friction_support (a term is left out where its contact is at rest, a kink of P,
-    // where its subgradient 0 is a valid choice).
-    gen::WrenchInput win = wrench_input({R[0] * rg, R[1] * rg, R[2] * rg}, n.cwiseMax(0.0), P.mu, rg);
-    double sp[3], term[3], gr[9], he[18];
-    auto support = [&](const Vec3& d) {
-        win.vx = d.x();
-        win.vy = d.y();
-        win.xith = d.z();
-        gen::friction_support(win, sp, term, gr, he);
-    };
-    auto h_at = [&](const Vec3& d) {
-        support(d);
-        double h = 0;
-        for (int i = 0; i < 3; ++i)
-            if (sp[i] > 0) h += term[i];
-        return h;
-    };
-    Vec2 y = Vec2::Zero();
-    Vec3 d = d0;
-    double h = h_at(d);
-    double last_gy = 0;
-    for (int it = 0; it < 100; ++it) {
-        g.iterations = it + 1;
-        Vec3 grad = Vec3::Zero();
-        Mat3 H = Mat3::Zero();
-        support(d);
-        for (int i = 0; i < 3; ++i) {
-            if (!(sp[i] > 0) || !(cap[i] > 0)) continue;
-            grad += Vec3(gr[3 * i], gr[3 * i + 1], gr[3 * i + 2]);
-            const double* Hi = he + 6 * i;
-            H += (Mat3() << Hi[0], Hi[1], Hi[2], Hi[1], Hi[3], Hi[4], Hi[2], Hi[4], Hi[5]).finished();
-        }
-        const Vec2 gy = B.transpose() * grad;
-        last_gy = gy.norm();
-        const Eigen::Matrix2d Hy = B.transpose() * H * B;
-        Vec2 step = -Hy.ldlt().solve(gy);
-        if (!step.allFinite()) step = -gy;
-        double alpha = 1;
-        const double slope = gy.dot(step);
-        Vec2 y1;
-        double h1 = h;
-        for (int ls = 0; ls < 60; ++ls, alpha *= 0.5) {
-            y1 = y + alpha * step;
-            h1 = h_at(d0 + B * y1);
-            if (h1 <= h + 1e-4 * alpha * slope) break;
-        }
-        const double moved = (alpha * step).norm();
-        if (h1 <= h) { y = y1; d = d0 + B * y; h = h1; }
-        if (moved <= 1e-14 * (1 + y.norm()) || h1 > h) break;
-    }
-    // Newton's quadratic model fails next to a kink of h (a contact's term |G_i^T d| near zero, its
-    // Hessian unbounded): drawn there, the line search stalled with the gradient far from zero and
-    // the gauge came out low (fig6 at (0.0167, 0, 2.693), t = 0.01759: 0.967 where the minimum gives
-    // 0.992 -- the part was held 0.13 ms too long, its cycle's twist 1.8e-4 v_ref off the regularised
-    // reference). Then the kinks and a pattern search in the plane decide (16 directions; h is convex,
-    // but next to a kink its descent cone can be narrower than their spacing: repaired below).
-    const bool stalled = last_gy > 1e-7 * h * wn;
-    if (stalled) {
-        // (the minimum may sit at a kink whose test above failed by rounding: h there first)
-        for (int k = 0; k < 3; ++k) {
-            const Vec3 e(R[k].y(), -R[k].x(), 1);
-            const double s = w.dot(e);
-            if (!(std::abs(s) > 1e-14 * wn * e.norm())) continue;
-            const double hk = h_at(e / s);
-            if (hk < h) {
-                h = hk;
-                y = B.transpose() * (e / s - d0);
-            }
-        }
-        // Pattern search: 16 directions, the step doubled after a success and halved after a failure.
-        double step = 1e-2 / wn;
-        while (step > 1e-9 / wn) {   // (h then within ~1e-18 of its minimum where smooth)
-            bool better = false;
-            for (int k = 0; k < 16; ++k) {
-                const double a = 2 * kPi * k / 16;
-                const Vec2 y1 = y + step * Vec2(std::cos(a), std::sin(a));
-                const double h1 = h_at(d0 + B * y1);
-                if (h1 < h) {
-                    h = h1;
-                    y = y1;
-                    better = true;
-                }
-            }
-            step = better ? std::min(2 * step, 1 / wn) : 0.5 * step;
-        }
-        d = d0 + B * y;
-    }
-    // At the optimum the distribution f_i = gamma cap_i v_i / |v_i| (v_i = G_i^T d) supplies w exactly.
-    // Where the pattern search's does not (by more than 1e-6 of |w|; its own stopping leaves less away
-    // from kinks, and next to one the repair below only refines a correct optimum), it stopped at a kink that is not the optimum (its descent cone
-    // narrower than the 16 directions: random scene 15 of the held-modes test, the wrench 0.22 N off
-    // and the gauge 4.7997 for 4.8008), or at the optimum on a kink whose test failed by rounding (the
-    // kink's force, inside its disk, is then missing). Then h is smoothed, h_delta(d) = sum cap_i
-    // sqrt(|v_i|^2 + delta^2) (convex and smooth for delta > 0, within 3 cap delta of h), and minimised
-    // by Newton while delta falls from 1e-2 to 1e-12 of |d0| = 1/|w|, each stage from the last. Its
-    // stationary point gives f_i = cap_i v_i / (s_i h~), s_i = sqrt(|v_i|^2 + delta^2), h~ = sum cap_i
-    // |v_i|^2 / s_i, whose wrench is w (grad h_delta = h~ w there), a contact at the kink included: its
-    // force is then inside its disk, and it is the pivot (choose_mode breaks away about it). The repair
-    // is kept only where it is at least as low as the search's h (it always was where measured). (Where
-    // measured -- fig6's, heave_yaw's, fig1's and foot's fields, the [stick] and [dynamics] tests -- the
-    // repair ran over a hundred times and never ended at a kink: its pivot is a guard, not a path seen.)
-    Vec3 supplied = Vec3::Zero();
-    for (int i = 0; i < 3 && stalled; ++i) {
-        const Vec2 v = Gt(i, d);
-        const double nv = v.norm();
-        if (nv > 0) supplied += cap[i] * Gf(i, v / nv) / h;
-    }
-    if (stalled && (supplied - w).norm() > 1e-6 * wn) {
-        double delta = 1e-2 / wn;
-        auto h_delta = [&](const Vec2& yy) {
-            const Vec3 dd = d0 + B * yy;
-            double sum = 0;
-            for (int i = 0; i < 3; ++i)
-                if (cap[i] > 0) sum += cap[i] * std::sqrt(Gt(i, dd).squaredNorm() + delta * delta);
-            return sum;
-        };
-        for (int stage = 0; stage < 11; ++stage, delta *= 0.1) {
-            double hy = h_delta(y);
-            for (int it = 0; it < 50; ++it) {
-                const Vec3 dd = d0 + B * y;
-                Vec3 grad = Vec3::Zero();
-                Mat3 H = Mat3::Zero();
-                for (int i = 0; i < 3; ++i) {
-                    if (!(cap[i] > 0)) continue;
-                    Eigen::Matrix<double, 3, 2> G;   // d . G = G_i^T d = Gt(i, d)
-                    G << 1, 0, 0, 1, -R[i].y(), R[i].x();
-                    const Vec2 v = Gt(i, dd);
-                    const double si = std::sqrt(v.squaredNorm() + delta * delta);
-                    grad += cap[i] * G * v / si;
-                    H += cap[i] * G * (Eigen::Matrix2d::Identity() / si - v * v.transpose() / (si * si * si)) * G.transpose();
-                }
-                const Vec2 gy = B.transpose() * grad;
-                Vec2 step = -(B.transpose() * H * B).ldlt().solve(gy);
-                if (!step.allFinite()) step = -gy;
-                double alpha = 1, h1 = hy;
-                Vec2 y1 = y;
-                for (int ls = 0; ls < 60; ++ls, alpha *= 0.5) {
-                    y1 = y + alpha * step;
-                    h1 = h_delta(y1);
-                    if (h1 <= hy + 1e-4 * alpha * gy.dot(step)) break;
-                }
-                if (!(h1 <= hy)) break;
-                const double moved = (y1 - y).norm();
-                y = y1;
-                hy = h1;
-                if (moved <= 1e-15 * (1 + y.norm())) break;
-            }
-        }
-        delta *= 10;   // the last stage's
-        const Vec3 dr = d0 + B * y;
-        const double hr = h_at(dr);
-        if (hr <= h * (1 + 1e-12)) {   // (else the repair did not descend: the search's result stands)
-            d = dr;
-            h = hr;
-            finish(d, h);
-            double ht = 0;
-            std::array<Vec2, 3> v;
-            std::array<double, 3> si{};
-            for (int i = 0; i < 3; ++i) {
-                v[i] = Gt(i, d);
-                si[i] = std::sqrt(v[i].squaredNorm() + delta * delta);
-                if (cap[i] > 0) ht += cap[i] * v[i].squaredNorm() / si[i];
-            }
-            double least = 1 - 1e-3;   // (a sliding contact's force is at its rim to within (delta/|v|)^2)
-            for (int i = 0; i < 3; ++i) {
-                g.f[i] = cap[i] > 0 && ht > 0 ? Vec2(cap[i] * v[i] / (si[i] * ht)) : Vec2::Zero();
-                const double used = cap[i] > 0 ? g.f[i].norm() / (g.gamma * cap[i]) : 1.0;
-                if (used < least) {
-                    least = used;
-                    g.pivot = i;
-                }
-            }
-            return g;
-        }
-    }
-    finish(d, h);
-    for (int i = 0; i < 3; ++i) {
-        const Vec2 v = Gt(i, d);
-        const double nv = v.norm();
-        g.f[i] = nv > 0 ? Vec2(g.gamma * cap[i] * v / nv) : Vec2::Zero();
-    }
-    return g;
 }
 
 namespace {
@@ -570,7 +316,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
         else {
             Mode pivot{ModeKind::Pivot, k, qd[2] > 0 ? 1.0 : -1.0};
             mode_accelerations(sc, level, q, qd, ps, pivot, ws);
-            const double cap = P.mu[k] * std::max(ws.n[k], 0.0), need = ws.f_held[k].norm();
+            const double cap = P.friction().disk(k, ws.n[k]), need = ws.f_held[k].norm();
             out.gamma = cap > 0 ? need / cap : std::numeric_limits<double>::infinity();
             if (need <= cap * (1 + 1e-12)) {
                 // Held; a negative normal force elsewhere then means the part would tip.
@@ -607,7 +353,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
             for (double sense : {1.0, -1.0}) {
                 const Mode pv{ModeKind::Pivot, kk, sense};
                 mode_accelerations(sc, level, q, qd, ps, pv, ws);
-                if (ws.n.minCoeff() >= 0 && ws.f_held[kk].norm() <= P.mu[kk] * ws.n[kk] && sense * ws.qdd[2] > 0) {
+                if (ws.n.minCoeff() >= 0 && ws.f_held[kk].norm() <= P.friction().static_(kk) * ws.n[kk] && sense * ws.qdd[2] > 0) {
                     out.mode = pv;
                     return out;
                 }
@@ -666,6 +412,41 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
     }
     out.mode = Mode{};
     return out;
+}
+
+StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd,
+                     const PlateState& ps) {
+    const Part& P = sc.part;
+    Workspace ws;
+    StickTest r;
+    if (P.point) {   // s'' = 0: friction must supply f_xy, and N = f_z
+        mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+        r.friction_needed = ws.F_needed.norm();
+        r.friction_available = P.friction().static_(0) * ws.n[0];
+        r.sticks = ws.n[0] > 0 && r.friction_needed <= r.friction_available;
+        return r;
+    }
+    // The others turn about c_k with theta' (sense 0 at rest: no kinetic friction there).
+    const double sense = qd[2] > 0 ? 1.0 : qd[2] < 0 ? -1.0 : 0.0;
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Pivot, k, sense}, ws);
+    r.friction_needed = ws.f_held[k].norm();
+    r.friction_available = P.friction().static_(k) * ws.n[k];
+    r.sticks = ws.n.minCoeff() >= 0 && r.friction_needed <= r.friction_available;
+    return r;
+}
+
+StickTest stick_test_all(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {
+    // The stuck mode's statics and the exact friction-disk gauge (friction.hpp).
+    Workspace ws;
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+    const int nc = sc.part.contacts();
+    StickTest r;
+    r.friction_needed = ws.F_needed.norm();
+    const ContactFriction fr = sc.part.friction();
+    for (int i = 0; i < nc; ++i) r.friction_available += fr.disk(i, ws.n[i]);
+    r.sticks = ws.n.head(nc).minCoeff() >= 0 &&
+               friction_gauge(sc.part, q[2], ws.n, ws.F_needed, ws.tau_needed).gamma <= 1;
+    return r;
 }
 
 }  // namespace plate
