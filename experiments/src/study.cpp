@@ -1,5 +1,6 @@
 #include "plate/study.hpp"
 
+#include "engine.hpp"
 #include "models.hpp"
 
 #include "plate/field.hpp"

@@ -1,5 +1,6 @@
 #include "plate/limit_cycle.hpp"
 
+#include "engine.hpp"
 #include "models.hpp"
 
 #include <gsl/gsl_errno.h>

@@ -1,11 +1,16 @@
-// Internal: the three state layouts integrated by the engine.
+// Internal: the three state layouts integrated by the engine (engine.hpp drives any of them).
 //   ReducedU (35): y = [q'(3), Q(3)], Q = integral of q' (for the average (36)); q frozen.
 //   U (32):        y = [q(3), q'(3)]
 //   Full (31):     y = [q(3), q'(3), phi(3)], R1 = exp(phi^)
 #pragma once
 
-#include "engine.hpp"
+#include "plate/modes.hpp"
+#include "so3.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 namespace plate::detail {
