@@ -9,6 +9,7 @@
 
 #include "models.hpp"   // Signal
 #include "so3.hpp"   // dexp_inv, exp_so3, hat
+#include "workspace.hpp"   // detail::StickSlipState
 
 #include <catch2/catch.hpp>
 
@@ -69,9 +70,11 @@ TEST_CASE("default model and workspace members are zero, not what the memory hel
         for (int i = 0; i < 3; ++i) {
             CHECK(ws.r[i] == Vec2::Zero());
             CHECK(ws.slip[i] == Vec2::Zero());
-            CHECK(ws.hint[i] == Vec2::Zero());
             CHECK(ws.f_held[i] == Vec2::Zero());
         }
+    });
+    on_poisoned_storage<detail::StickSlipState>([](const detail::StickSlipState& s) {
+        for (const Vec2& h : s.hint) CHECK(h == Vec2::Zero());
     });
     on_poisoned_storage<FrictionGauge>([](const FrictionGauge& g) {
         for (const Vec2& f : g.f) CHECK(f == Vec2::Zero());

@@ -32,6 +32,7 @@
 #include "plate/modes.hpp"
 #include "plate/simulate.hpp"
 #include "stepper.hpp"
+#include "workspace.hpp"
 
 #include <algorithm>
 #include <array>
@@ -123,6 +124,8 @@ private:
         void operator()(const State& ys, State& dys, double t) const { e->sys(ys, dys, t); }
     };
     Sys sysref() { return Sys{this}; }
+    // The stick-slip state the engine keeps in the model's workspace (hints, creep; workspace.hpp).
+    StickSlipState& stick_slip() { return detail::stick_slip(model_.ws); }
 
     // --- the loop (engine_step.hxx) ---
     // The model's right-hand side on the scaled state ys at t (counts it; in a step, notes the hold

@@ -1,5 +1,5 @@
 // Engine (engine.hpp), creep: a contact that has just broken away slides along its consistent
-// direction (Workspace::creep) while the error that leaves stays within a budget. Included by
+// direction (StickSlipState::creep) while the error that leaves stays within a budget. Included by
 // engine.cpp only.
 #pragma once
 
@@ -18,7 +18,7 @@ namespace plate::detail {
 // creeping (the state is then evaluated again).
 template <class Model>
 bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
-    Workspace& ws = model_.ws;
+    StickSlipState& ss = stick_slip();
     if (model_.mode.kind != ModeKind::Slide) return false;
     bool changed = false;
     const double h = t_ - creep_t_;
@@ -26,20 +26,20 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
     const double h_cap = creep_h_ == std::numeric_limits<double>::infinity() ? kCreepFirst * scene_.plate.T : 5 * h;
     creep_h_ = std::numeric_limits<double>::infinity();
     // Every contact creeping (a rigid part's twist direction solved, modes.cpp): its turn too.
-    if ((ws.creep & 7u) == 7u && !scene_.part.point && !ws.creep_twist.isZero()) {
+    if ((ss.creep & 7u) == 7u && !scene_.part.point && !ss.creep_twist.isZero()) {
         // (as an angular velocity, the turn about the normal of the last and the new direction,
         // so that within a step it turns the direction where the Newton puts it)
-        const Vec3 axis = creep_xi_.cross(ws.creep_twist);
+        const Vec3 axis = creep_xi_.cross(ss.creep_twist);
         const double sn = axis.norm();
-        ws.creep_twist_rate = creep_xi_.isZero() || !(h > 0) || sn == 0
+        ss.creep_twist_rate = creep_xi_.isZero() || !(h > 0) || sn == 0
                                   ? Vec3::Zero()
-                                  : Vec3(axis / sn * (std::atan2(sn, creep_xi_.dot(ws.creep_twist)) / h));
-        creep_xi_ = ws.creep_twist;
+                                  : Vec3(axis / sn * (std::atan2(sn, creep_xi_.dot(ss.creep_twist)) / h));
+        creep_xi_ = ss.creep_twist;
     } else {
         forget_twist_turn();
     }
     for (int i = 0; i < scene_.part.contacts(); ++i) {
-        if (!(ws.creep >> i & 1u)) {
+        if (!(ss.creep >> i & 1u)) {
             // A slip falling below zero_abs_ creeps on to zero along its consistent direction
             // (where the deceleration vanishes with the slip, near a grazing stick, it need not
             // reach zero soon, and v/|v| would make the steps collapse meanwhile). Its direction
@@ -63,7 +63,7 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
             if (sn > 0 && sn < zero_abs_) {
                 if (slow_[i] == 0) slow_from_[i] = sn;
                 ++slow_[i];
-                const bool whole_twist = !scene_.part.point && ((ws.creep | 1u << i) & 7u) == 7u;
+                const bool whole_twist = !scene_.part.point && ((ss.creep | 1u << i) & 7u) == 7u;
                 if (whole_twist && sn > 2 * slow_from_[i]) {
                     slow_[i] = 1;
                     slow_from_[i] = sn;
@@ -78,35 +78,35 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
                 slow_[i] = 0;
             }
             if (recreep || (sn > 0 && sn < zero_abs_ && sn < std::abs(g0_[3 + i]) && !(creep_spent_ >> i & 1u))) {
-                ws.creep |= 1u << i;
-                ws.hint[i] = slip[i] / sn;
+                ss.creep |= 1u << i;
+                ss.hint[i] = slip[i] / sn;
                 new_creep(i);
                 creep_h_ = std::min(creep_h_, kCreepFirst * scene_.plate.T);
                 changed = true;
             }
             continue;
         }
-        const Vec2& u = ws.hint[i];
+        const Vec2& u = ss.hint[i];
         // The direction's signed turn over the step: its rate is followed in the next steps
-        // (Workspace::creep_rate), so what the creep leaves out is the rate's change over a step
+        // (StickSlipState::creep_rate), so what the creep leaves out is the rate's change over a step
         // (the turn less the last rate's), times the slip.
         const double turn = creep_dir_[i].isZero() ? 0.0 : std::atan2(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x(), creep_dir_[i].dot(u));
-        const double sn = slip[i].norm(), inc = std::abs(turn - ws.creep_rate[i] * h) * sn;
+        const double sn = slip[i].norm(), inc = std::abs(turn - ss.creep_rate[i] * h) * sn;
         // Rigid parts too: fig6's field 1.86e6 -> 1.69e6 right-hand sides, heave_yaw's 1.90e6 ->
         // 1.56e6 (with the twist creep's turn, modes.cpp). (heave_yaw's cycle at (0, 0.02, 0) then
         // shows no reversal 1e-6 T after contact 3's pivot breaks away at rtol 1e-9, where rtol
         // 1e-8 and 1e-10 show one: that contact slides on at the noise floor, 2e-10 and 2e-11 m/s,
         // and whether it touches zero is noise; the mode-sequence test ties reversals to
         // break-aways instead of matching each.)
-        ws.creep_rate[i] = creep_dir_[i].isZero() || !(h > 0) ? 0.0 : turn / h;
+        ss.creep_rate[i] = creep_dir_[i].isZero() || !(h > 0) ? 0.0 : turn / h;
         creep_err_[i] += inc;
         creep_dir_[i] = u;
         // The step the rest of the budget affords; where that is not even the last step's size,
         // the creep ends (a budget shrinking the steps towards zero would never be spent).
         const double afford = inc > 0 && h > 0 ? h * std::sqrt(std::max(creep_budget_ - creep_err_[i], 0.0) / inc)
                                                : std::numeric_limits<double>::infinity();
-        if (creep_err_[i] > creep_budget_ || sn > ws.creep_speed || afford < h) {
-            stop_creep(i, sn <= ws.creep_speed);
+        if (creep_err_[i] > creep_budget_ || sn > ss.creep_speed || afford < h) {
+            stop_creep(i, sn <= ss.creep_speed);
             changed = true;
         } else {
             creep_h_ = std::min({creep_h_, h_cap, afford});
@@ -122,12 +122,12 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
 // stops creeping until its next event, and true is returned (the step is retried).
 template <class Model>
 bool Engine<Model>::creep_inconsistent(const std::array<Vec2, 3>& slip) {
-    Workspace& ws = model_.ws;
-    if (!ws.creep || model_.mode.kind != ModeKind::Slide) return false;
+    StickSlipState& ss = stick_slip();
+    if (!ss.creep || model_.mode.kind != ModeKind::Slide) return false;
     bool off = false;
     for (int i = 0; i < scene_.part.contacts(); ++i) {
         const double sn = slip[i].norm();
-        if ((ws.creep >> i & 1u) && sn > kCreepJudged * ws.hint_speed && slip[i].dot(ws.hint[i]) < 0.9 * sn) {
+        if ((ss.creep >> i & 1u) && sn > kCreepJudged * ss.hint_speed && slip[i].dot(ss.hint[i]) < 0.9 * sn) {
             stop_creep(i, true);
             off = true;
         }
@@ -140,14 +140,14 @@ template <class Model>
 void Engine<Model>::new_creep(int i) {
     creep_err_[i] = 0;
     creep_dir_[i] = Vec2::Zero();
-    model_.ws.creep_rate[i] = 0;
+    stick_slip().creep_rate[i] = 0;
     forget_twist_turn();
 }
 
 // The twist creep's turn is measured afresh (a creep started or stopped, or a new mode).
 template <class Model>
 void Engine<Model>::forget_twist_turn() {
-    model_.ws.creep_twist_rate.setZero();
+    stick_slip().creep_twist_rate.setZero();
     creep_xi_.setZero();
 }
 
@@ -155,9 +155,9 @@ void Engine<Model>::forget_twist_turn() {
 // direction no longer describes every contact.
 template <class Model>
 void Engine<Model>::stop_creep(int i, bool spent) {
-    model_.ws.creep &= ~(1u << i);
-    model_.ws.creep_rate[i] = 0;
-    model_.ws.creep_twist.setZero();
+    stick_slip().creep &= ~(1u << i);
+    stick_slip().creep_rate[i] = 0;
+    stick_slip().creep_twist.setZero();
     forget_twist_turn();
     if (spent) creep_spent_ |= 1u << i;
 }
@@ -165,10 +165,10 @@ void Engine<Model>::stop_creep(int i, bool spent) {
 // Entering a mode at state y: in a slide, the contacts at zero slip (just broken away) creep.
 template <class Model>
 void Engine<Model>::start_creep(const State& y) {
-    Workspace& ws = model_.ws;
+    StickSlipState& ss = stick_slip();
     fresh_ = 0;
-    ws.creep = 0;
-    ws.creep_rate = {};
+    ss.creep = 0;
+    ss.creep_rate = {};
     forget_twist_turn();
     creep_spent_ = 0;
     linger_need_ = {kLinger, kLinger, kLinger};
@@ -180,8 +180,8 @@ void Engine<Model>::start_creep(const State& y) {
     std::array<Vec2, 3> v;
     slip_velocities(scene_.part, model_.q(y), model_.qd(y), v);
     for (int i = 0; i < scene_.part.contacts(); ++i)
-        if (v[i].norm() <= ws.hint_speed && ws.hint[i].norm() > 0) {
-            ws.creep |= 1u << i;
+        if (v[i].norm() <= ss.hint_speed && ss.hint[i].norm() > 0) {
+            ss.creep |= 1u << i;
             new_creep(i);   // (the direction is solved at the first evaluation)
             creep_h_ = kCreepFirst * scene_.plate.T;
         }

@@ -108,7 +108,7 @@ bool Engine<Model>::event(int ev) {
                 std::array<Vec2, 3> v;
                 slip_velocities(scene_.part, q, qd, v);
                 qd.head<2>() -= v[from.k];
-                ws.hint[from.k] = f.norm() > 0 ? Vec2(-f / f.norm()) : Vec2::Zero();
+                stick_slip().hint[from.k] = f.norm() > 0 ? Vec2(-f / f.norm()) : Vec2::Zero();
                 return enter(Mode{}, y, qd);
             }
             return switch_mode(7, true);   // theta' reached zero: every slip is zero
@@ -124,20 +124,20 @@ bool Engine<Model>::try_hold(unsigned zero) {
     low_ = {0, 0, 0};
     const State y = this->y();
     Vec3 qd = model_.qd(y);
-    const unsigned creep = model_.ws.creep;
-    const Vec3 creep_twist = model_.ws.creep_twist, creep_twist_rate = model_.ws.creep_twist_rate;
-    const std::array<double, 3> creep_rate = model_.ws.creep_rate;
-    const std::array<Vec2, 3> hint = model_.ws.hint;
+    const unsigned creep = stick_slip().creep;
+    const Vec3 creep_twist = stick_slip().creep_twist, creep_twist_rate = stick_slip().creep_twist_rate;
+    const std::array<double, 3> creep_rate = stick_slip().creep_rate;
+    const std::array<Vec2, 3> hint = stick_slip().hint;
     const ModeChoice c = choose_mode(scene_, model_.level, model_.q(y), qd, model_.plate(t_, y), zero, model_.ws);
     if (!c.lost && c.mode.kind != ModeKind::Slide) return enter(c.mode, y, qd);
     // Not held: wait twice as long before the next try (each costs a mode choice).
     for (int i = 0; i < 3; ++i)
         if (zero >> i & 1u) linger_need_[i] = std::min(2 * linger_need_[i], 1 << 20);
-    model_.ws.creep = creep;
-    model_.ws.creep_twist = creep_twist;
-    model_.ws.creep_twist_rate = creep_twist_rate;
-    model_.ws.creep_rate = creep_rate;
-    model_.ws.hint = hint;
+    stick_slip().creep = creep;
+    stick_slip().creep_twist = creep_twist;
+    stick_slip().creep_twist_rate = creep_twist_rate;
+    stick_slip().creep_rate = creep_rate;
+    stick_slip().hint = hint;
     set(y);   // nothing changes: restore the workspace
     return true;
 }

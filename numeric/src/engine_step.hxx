@@ -19,13 +19,13 @@ Engine<Model>::Engine(Model& model, const Scene& scene, const IntegrationOptions
     // Below hint_speed (ten times the integration error of a slip) a sliding contact's friction
     // keeps its last direction: v/|v| of a slip that small is rounding noise (just after a
     // break-away its direction is the hint choose_mode set).
-    model_.ws.use_hints = true;
+    stick_slip().use_hints = true;
     // Both grow with rtol only up to rtol 1e-5's values, so that hint_speed < zero_abs_ < the
     // creep speed (1e-2 v_ref) at any tolerance: uncapped, at rtol 1e-2 every slip below 3 v_ref
     // counted as zero and fig4's never-sticking part stuck 797 times in 20 s (3 rad off).
-    model_.ws.hint_speed = std::clamp(10 * opt_.rtol, 1e-12, 1e-4) * v_ref_;
+    stick_slip().hint_speed = std::clamp(10 * opt_.rtol, 1e-12, 1e-4) * v_ref_;
     zero_abs_ = zero_band(opt_.rtol) * v_ref_;
-    // A contact that breaks away creeps (Workspace::creep: its friction along the consistent
+    // A contact that breaks away creeps (StickSlipState::creep: its friction along the consistent
     // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
     // the error that leaves stays below creep_budget_ (creep_step), 100 rtol v_ref: about the
     // integration's own error over the stretch the creep replaces (the local error's allowance,
@@ -33,7 +33,7 @@ Engine<Model>::Engine(Model& model, const Scene& scene, const IntegrationOptions
     // against 10 rtol v_ref: 7 % fewer right-hand sides, the same largest error against the rtol-1e-11
     // field (2.4e-7 v_ref sliding, 6.5e-7 sticking), the sticking median 4.1e-8 -> 5.1e-8;
     // heave_yaw's 15 % fewer, its largest 3.4e-7 -> 2.6e-7.
-    model_.ws.creep_speed = 1e-2 * v_ref_;
+    stick_slip().creep_speed = 1e-2 * v_ref_;
     creep_budget_ = 100 * opt_.rtol * v_ref_;
 }
 
@@ -97,7 +97,7 @@ bool Engine<Model>::advance(double t_end, OnStep on_step) {
         }
         if (swing && ev < 0) {
             // A swing within one step: the step kept the start's friction direction past the
-            // turn (ws.hint_from), so retry it shorter until the turn is resolved.
+            // turn (StickSlipState::hint_from), so retry it shorter until the turn is resolved.
             ++stats.rejected;
             dt_ = 0.5 * (t1 - t_);
             if (dt_ < h_min_) {
@@ -152,7 +152,7 @@ bool Engine<Model>::accept_step(double t1, const Guards& g1, const Vec3& n1, con
     const int nc = scene_.part.contacts();
     // A creep's directions are read from the workspace (creep_step): if the event search
     // evaluated inside the step since, evaluate the step's end again so that they are its.
-    if (model_.ws.creep && !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
+    if (stick_slip().creep && !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
         sys(ys1_, fs1_, t1);
     account(t1);
     t_ = t1;
@@ -205,9 +205,9 @@ bool Engine<Model>::try_step(double& t1, double& dt) {
     // Where every contact slides faster than kLargeSlip v_ref the step's tolerance is
     // large_slip_factor rtol (IntegrationOptions); the slips' speeds at the step's start.
     double r = opt_.rtol;
-    if (opt_.large_slip_factor != 1 && model_.mode.kind == ModeKind::Slide && !model_.ws.creep) {
+    if (opt_.large_slip_factor != 1 && model_.mode.kind == ModeKind::Slide && !stick_slip().creep) {
         double slowest = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < scene_.part.contacts(); ++i) slowest = std::min(slowest, model_.ws.hint_from[i]);
+        for (int i = 0; i < scene_.part.contacts(); ++i) slowest = std::min(slowest, stick_slip().hint_from[i]);
         if (slowest > kLargeSlip * v_ref_) r = std::max(r, std::min(r * opt_.large_slip_factor, kLargeSlipRtolCap));
     }
     const bool ok = stepper_.try_step(sysref(), ys_, fs_, t1, ys1_, fs1_, dt, r);
@@ -245,8 +245,8 @@ double Engine<Model>::zero_cap() {
     for (int i = 0; i < nc; ++i) {
         // Only a slip outside the zero band (inside it the lingering and creeping rules decide; and
         // a slip sliding on from a reversal, or creeping, has no zero event) ...
-        const double s0 = model_.ws.hint_from[i];
-        if ((fresh_ >> i & 1u) || (model_.ws.creep >> i & 1u) || !(g0_[3 + i] > 0) || s0 <= zero_abs_) continue;
+        const double s0 = stick_slip().hint_from[i];
+        if ((fresh_ >> i & 1u) || (stick_slip().creep >> i & 1u) || !(g0_[3 + i] > 0) || s0 <= zero_abs_) continue;
         const Vec2 a = (v[i] - slip0_[i]) / d;
         const double rate = a.dot(ref_[i]);
         if (!(rate < 0)) continue;
@@ -264,12 +264,12 @@ void Engine<Model>::reference_directions(const std::array<Vec2, 3>& slip) {
     slip0_ = slip;
     for (int i = 0; i < 3; ++i) {
         const double s = slip[i].norm();
-        const bool creeping = model_.ws.creep >> i & 1u;
-        ref_[i] = s > model_.ws.hint_speed && !creeping ? Vec2(slip[i] / s) : model_.ws.hint[i];
+        const bool creeping = stick_slip().creep >> i & 1u;
+        ref_[i] = s > stick_slip().hint_speed && !creeping ? Vec2(slip[i] / s) : stick_slip().hint[i];
         // The friction direction a slip keeps near zero within the next step (dynamics.hpp).
         if (model_.mode.kind == ModeKind::Slide) {
-            model_.ws.hint[i] = ref_[i];
-            model_.ws.hint_from[i] = s;
+            stick_slip().hint[i] = ref_[i];
+            stick_slip().hint_from[i] = s;
         }
     }
 }
@@ -282,7 +282,7 @@ void Engine<Model>::rebase(const Guards& g, const std::array<Vec2, 3>& slip) {
     // fell below a tenth of its speed at that step's start, evaluate it again with the new ones.
     bool again = false;
     if (model_.mode.kind == ModeKind::Slide)
-        for (int i = 0; i < scene_.part.contacts(); ++i) again |= slip[i].norm() < 0.1 * model_.ws.hint_from[i];
+        for (int i = 0; i < scene_.part.contacts(); ++i) again |= slip[i].norm() < 0.1 * stick_slip().hint_from[i];
     again |= creep_step(slip);
     reference_directions(slip);
     if (again) sys(ys_, fs_, t_);

@@ -6,6 +6,7 @@
 
 #include "plate/modes.hpp"
 #include "so3.hpp"
+#include "workspace.hpp"
 
 #include <algorithm>
 #include <array>
@@ -134,7 +135,7 @@ struct ReducedModel {
         const Vec3 qd(y[0], y[1], y[2]);
         u.acceleration(t, ps_last);   // (R1 and w1 stay identity and zero: unused at this level)
         t_last = t;
-        if (!(mode.kind == ModeKind::Slide && !ws.creep && reduced_U_slide(sc, q0, qd, ps_last, ws)))
+        if (!(mode.kind == ModeKind::Slide && !stick_slip(ws).creep && reduced_U_slide(sc, q0, qd, ps_last, ws)))
             mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
     }

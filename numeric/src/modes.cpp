@@ -1,5 +1,7 @@
 #include "plate/modes.hpp"
 
+#include "workspace.hpp"
+
 #include <cmath>
 #include <limits>
 
@@ -15,8 +17,9 @@ inline double kappa(Dynamics level) { return level == Dynamics::ReducedU ? 0.0 :
 
 // The generated kernels' inputs for the current configuration and twist (ws prepared).
 gen::KernelInput mode_input(const Vec3& q, const Vec3& qd, const Workspace& ws) {
-    gen::KernelInput in = ws.in;
-    if (q[2] != ws.theta) {   // (else in holds them: the workspace's cache of theta's cos and sin)
+    const detail::KernelScratch& ks = detail::kernels(ws);
+    gen::KernelInput in = ks.in;
+    if (q[2] != ks.theta) {   // (else in holds them: the workspace's cache of theta's cos and sin)
         in.ct = std::cos(q[2]);
         in.st = std::sin(q[2]);
     }
@@ -32,6 +35,7 @@ gen::KernelInput mode_input(const Vec3& q, const Vec3& qd, const Workspace& ws) 
 // system pivotK_system (symbolic/derivation.cpp), unknowns [s_x'', s_y'', theta'', N1, N2, N3, f_kx, f_ky].
 void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd, const PlateState& ps,
                  const std::array<Vec2, 3>& u, Workspace& ws) {
+    detail::KernelScratch& ks = detail::kernels(ws);
     const Part& P = sc.part;
     const Vec6 b = rhs_b(sc, level, q, qd, ps);
     gen::KernelInput in = mode_input(q, qd, ws);
@@ -45,20 +49,20 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
     // The matrix depends on theta, k and u only (the generated code reads no twist there): factorised
     // once per pivot of the reduced U-dynamics (fig6's field: the 8 x 8 factorisation was 6 % of its
     // instructions). c (theta'^2 r_k) only where kappa is not 0.
-    const bool same = ws.pivot_k == k && ws.pivot_ct == in.ct && ws.pivot_st == in.st && ws.pivot_u == u;
+    const bool same = ks.pivot_k == k && ks.pivot_ct == in.ct && ks.pivot_st == in.st && ks.pivot_u == u;
     if (!same || kappa(level) != 0) system[k](in, M.data(), c);
     if (!same) {
-        ws.pivot_lu.compute(M);
-        ws.pivot_k = k;
-        ws.pivot_ct = in.ct;
-        ws.pivot_st = in.st;
-        ws.pivot_u = u;
+        ks.pivot_lu.compute(M);
+        ks.pivot_k = k;
+        ks.pivot_ct = in.ct;
+        ks.pivot_st = in.st;
+        ks.pivot_u = u;
     }
     Eigen::Matrix<double, 8, 1> rhs;
     rhs.head<6>() = b;
     rhs[6] = kappa(level) * c[0];   // theta'^2 r_k; the reduced U-dynamics' frozen configuration has none
     rhs[7] = kappa(level) * c[1];
-    const Eigen::Matrix<double, 8, 1> z = ws.pivot_lu.solve(rhs);
+    const Eigen::Matrix<double, 8, 1> z = ks.pivot_lu.solve(rhs);
     ws.b = b;
     ws.qdd = z.head<3>();
     ws.n = z.segment<3>(3);
@@ -112,11 +116,12 @@ namespace {
 
 // The unit slip directions of the twist xi (scaled: s_x', s_y', rho theta') as the contacts' hints.
 void set_twist_hints(const Part& P, double theta, const Vec3& xi, Workspace& ws) {
+    detail::StickSlipState& ss = detail::stick_slip(ws);
     const double rho = P.rho();
     for (int i = 0; i < P.contacts(); ++i) {
         const Vec2 r = horizontal_offset(P, theta, i);
         const Vec2 v(xi[0] - xi[2] / rho * r.y(), xi[1] + xi[2] / rho * r.x());
-        ws.hint[i] = v.norm() > 0 ? Vec2(v / v.norm()) : Vec2::Zero();
+        ss.hint[i] = v.norm() > 0 ? Vec2(v / v.norm()) : Vec2::Zero();
     }
 }
 Vec3 scaled_qdd(const Part& P, const Workspace& ws) { return Vec3(ws.qdd[0], ws.qdd[1], P.rho() * ws.qdd[2]); }
@@ -127,13 +132,14 @@ void tangent_basis(const Vec3& xi, Vec3& e1, Vec3& e2) {
 
 // Every contact creeping: the unknown is the direction xi of the twist, the contacts' directions are its
 // slips', and it is consistent when q'' (scaled) is parallel to xi, less the turn the engine measured
-// (Workspace::creep_twist_rate; Newton on two angles about xi,
+// (StickSlipState::creep_twist_rate; Newton on two angles about xi,
 // forward-difference Jacobian). Three independent angles would also admit directions no rigid motion
 // has (a contact decelerating while the twist grows).
 void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                                Workspace& ws) {
+    detail::StickSlipState& ss = detail::stick_slip(ws);
     const Part& P = sc.part;
-    Vec3& xi = ws.creep_twist;
+    Vec3& xi = ss.creep_twist;
     const Vec3 qs(qd[0], qd[1], P.rho() * qd[2]);
     if (xi.isZero()) xi = qs.norm() > 0 ? Vec3(qs.normalized()) : Vec3::UnitX();
     Vec3 e1, e2;
@@ -147,7 +153,7 @@ void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, c
         // part's contact, u x a = |v| rate: with no turn a slide at the rim of the disk is held at the
         // zero threshold -- fig4's part under a circular drive at mu g (1 + 1e-6), 9.2e5 steps and 5.5x
         // the threshold off)
-        const Vec3 D = Q - qs.norm() * ws.creep_twist_rate.cross(x);
+        const Vec3 D = Q - qs.norm() * ss.creep_twist_rate.cross(x);
         const Vec3 r = D - x.dot(D) * x;
         return Eigen::Vector2d(r.dot(e1), r.dot(e2));
     };
@@ -170,22 +176,24 @@ void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, c
     xi = at(a, b);
 }
 
-// Slide with creeping contacts (Workspace::creep): the direction u_j = (cos phi_j, sin phi_j) of each
+// Slide with creeping contacts (StickSlipState::creep): the direction u_j = (cos phi_j, sin phi_j) of each
 // creeping contact j is the one along which it then accelerates, c_j = a_j x u_j = 0 (the consistent
 // slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
 // first order at the rim's direction). Newton's method on the angles, from the last solution
-// (ws.hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
+// (StickSlipState::hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
 void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                          Workspace& ws) {
+    detail::KernelScratch& ks = detail::kernels(ws);
+    detail::StickSlipState& ss = detail::stick_slip(ws);
     const Part& P = sc.part;
-    if (!P.point && (ws.creep & 7u) == 7u) {
+    if (!P.point && (ss.creep & 7u) == 7u) {
         ws.creep_iterations = 0;
         twist_creep_accelerations(sc, level, q, qd, ps, ws);
         return;
     }
     int idx[3], m = 0;
     for (int i = 0; i < P.contacts(); ++i)
-        if ((ws.creep >> i & 1u) && ws.hint[i].norm() > 0) idx[m++] = i;
+        if ((ss.creep >> i & 1u) && ss.hint[i].norm() > 0) idx[m++] = i;
     ws.creep_iterations = 0;
     accelerations(sc, level, q, qd, ps, ws);
     if (m == 0) return;
@@ -194,20 +202,20 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
     // slide at the rim of the disk stayed at the zero threshold, 20x below the exact speed.)
     // (r_i from the workspace's cache when it holds this theta: no cosine and sine per contact and
     // evaluation)
-    const bool cached = !P.point && q[2] == ws.theta;
+    const bool cached = !P.point && q[2] == ks.theta;
     auto residual = [&](Eigen::Vector3d& c) {
         for (int j = 0; j < m; ++j) {
             const Vec2 a = cached ? contact_acceleration_at(ws.r[idx[j]], level, qd, ws.qdd)
                                   : contact_acceleration(P, level, idx[j], q, qd, ws.qdd);
-            const Vec2& u = ws.hint[idx[j]];
-            c[j] = a.x() * u.y() - a.y() * u.x() + ws.slip[idx[j]].norm() * ws.creep_rate[idx[j]];
+            const Vec2& u = ss.hint[idx[j]];
+            c[j] = a.x() * u.y() - a.y() * u.x() + ws.slip[idx[j]].norm() * ss.creep_rate[idx[j]];
         }
     };
     auto set_angles = [&](const Eigen::Vector3d& phi) {
-        for (int j = 0; j < m; ++j) ws.hint[idx[j]] = Vec2(std::cos(phi[j]), std::sin(phi[j]));
+        for (int j = 0; j < m; ++j) ss.hint[idx[j]] = Vec2(std::cos(phi[j]), std::sin(phi[j]));
     };
     Eigen::Vector3d phi, c, cj;
-    for (int j = 0; j < m; ++j) phi[j] = std::atan2(ws.hint[idx[j]].y(), ws.hint[idx[j]].x());
+    for (int j = 0; j < m; ++j) phi[j] = std::atan2(ss.hint[idx[j]].y(), ss.hint[idx[j]].x());
     residual(c);
     constexpr double dphi = 1e-7;
     for (int it = 0; it < 8; ++it) {
@@ -238,11 +246,13 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
 
 void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                         const Mode& mode, Workspace& ws) {
+    detail::KernelScratch& ks = detail::kernels(ws);
+    detail::StickSlipState& ss = detail::stick_slip(ws);
     const Part& P = sc.part;
-    if (ws.prepared != &sc) ws.prepare(sc);
+    if (ks.prepared != &sc) ws.prepare(sc);
     switch (mode.kind) {
         case ModeKind::Slide:
-            if (ws.creep) creep_accelerations(sc, level, q, qd, ps, ws);
+            if (ss.creep) creep_accelerations(sc, level, q, qd, ps, ws);
             else accelerations(sc, level, q, qd, ps, ws);
             return;
         case ModeKind::Stuck:
@@ -267,12 +277,13 @@ void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Ve
 
 ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& ps, unsigned zero,
                        Workspace& ws, bool hold) {
+    detail::StickSlipState& ss = detail::stick_slip(ws);
     const Part& P = sc.part;
     const int nc = P.contacts();
-    ws.creep = 0;   // every slide below has its directions set here
-    ws.creep_rate = {};
-    ws.creep_twist.setZero();
-    ws.creep_twist_rate.setZero();
+    ss.creep = 0;   // every slide below has its directions set here
+    ss.creep_rate = {};
+    ss.creep_twist.setZero();
+    ss.creep_twist_rate.setZero();
     ModeChoice out;
     int count = 0, k = -1;
     for (int i = 0; i < nc; ++i)
@@ -300,13 +311,13 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
                 const Vec2 a = contact_acceleration(P, level, i, q, qd, ws.qdd);
                 if (!(a.norm() > 0)) continue;
                 const Vec2 u = a / a.norm();
-                change = std::max(change, (u - ws.hint[i]).norm());
-                ws.hint[i] = u;
+                change = std::max(change, (u - ss.hint[i]).norm());
+                ss.hint[i] = u;
             }
             if (change < 1e-12) break;
         }
     };
-    ws.use_hints = true;
+    ss.use_hints = true;
     if (count == 1 && !P.point) {
         // One contact at zero slip: project onto v_k = 0 (s' -= v_k), then can contact k pivot?
         std::array<Vec2, 3> v;
@@ -325,7 +336,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
                 return out;
             }
             // A slip reversal: contact k slides on, opposite the friction it would have needed.
-            ws.hint[k] = -ws.f_held[k] / need;
+            ss.hint[k] = -ws.f_held[k] / need;
             refine_hints(1u << k);
             out.mode = Mode{};
             return out;
@@ -367,14 +378,14 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
     unsigned all = 0;
     for (int i = 0; i < nc; ++i) {
         const double fn = g.f[i].norm();
-        ws.hint[i] = fn > 0 ? Vec2(-g.f[i] / fn) : Vec2::Zero();
+        ss.hint[i] = fn > 0 ? Vec2(-g.f[i] / fn) : Vec2::Zero();
         all |= 1u << i;
     }
     if (!P.point) {
         // At a located stick exit (gauge 1) the twist that starts is opposite the one the rim's
         // friction opposes; the creep's Newton refines it from there (engine.hpp).
         const Vec3 d(g.direction[0], g.direction[1], P.rho() * g.direction[2]);
-        ws.creep_twist = d.norm() > 0 ? Vec3(-d.normalized()) : Vec3::Zero();
+        ss.creep_twist = d.norm() > 0 ? Vec3(-d.normalized()) : Vec3::Zero();
     }
     if (g.gamma > 1 + 1e-6) {
         if (P.point) refine_hints(all);
@@ -383,7 +394,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
             // are xi's -- found by relaxing xi along q''(xi) (the direction a part released at rest
             // takes, q' ~ t q''; the fixed-point iteration xi <- q''(xi) flips back and forth near the
             // stick boundary), from the twist the needed friction opposes, reversed.
-            Vec3 xi = ws.creep_twist.isZero() ? Vec3(Vec3::UnitX()) : ws.creep_twist;
+            Vec3 xi = ss.creep_twist.isZero() ? Vec3(Vec3::UnitX()) : ss.creep_twist;
             // (The relaxation step shrinks where the residual grows: near a contact whose slip
             // nearly vanishes -- a slide close to a pivot -- the flow is stiff.)
             auto misfit = [&](const Vec3& x, Vec3& Q) {
@@ -407,7 +418,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
                 }
             }
             set_twist_hints(P, q[2], xi, ws);
-            ws.creep_twist = xi;
+            ss.creep_twist = xi;
         }
     }
     out.mode = Mode{};

@@ -58,9 +58,9 @@ struct Mode {
 std::string mode_name(const Mode& m);
 
 // Mode-aware accelerations: fills ws.qdd and ws.n as accelerations() does, for any mode.
-//   Slide   accelerations(); a contact whose slip is below ws.hint_speed uses the unit direction
-//           ws.hint[i] (the break-away direction), since v/|v| is undefined at zero slip; a creeping
-//           contact (ws.creep, slip below ws.creep_speed) the direction along which it accelerates,
+//   Slide   accelerations(); a contact whose slip is below hint_speed uses the unit direction hint[i]
+//           (the break-away direction), since v/|v| is undefined at zero slip; a creeping contact
+//           (creep, slip below creep_speed) the direction along which it accelerates,
 //           solved here (Newton on its angle): the slip direction's relaxation, at a rate
 //           ~ |d a/d phi| / |v| that makes explicit steps collapse as a slip grows from zero after a
 //           break-away, is left out (its error is bounded by the engine, engine.hpp)
@@ -71,6 +71,8 @@ std::string mode_name(const Mode& m);
 //           reduced U-dynamics (35), whose configuration is frozen)
 //   Stuck   q'' = 0; the needed friction wrench (ws.F_needed, ws.tau_needed) and the normal forces
 //           (z force and x, y torques, with the friction total's moment about the raised s)
+// (hint_speed, hint, creep: the stick-slip state the engine and choose_mode set in the workspace,
+// numeric/src/workspace.hpp; an evaluation outside the engine has none.)
 void mode_accelerations(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate,
                         const Mode& mode, Workspace& ws);
 
@@ -78,7 +80,7 @@ void mode_accelerations(const Scene& scene, Dynamics level, const Vec3& q, const
 Vec2 contact_acceleration(const Part& part, Dynamics level, int i, const Vec3& q, const Vec3& qd, const Vec3& qdd);
 
 // The mode a state at zero slip of the contacts `zero` (a bit mask) enters, and the slip
-// directions of contacts that break away (written to ws.hint). `qd` is projected in place onto
+// directions of contacts that break away (written to the workspace's hints). `qd` is projected in place onto
 // zero slip of those contacts (all of them: qd = 0). Returns the new mode; `lost` is set (and
 // the mode meaningless) if a normal force is negative there.
 struct ModeChoice {
@@ -87,7 +89,7 @@ struct ModeChoice {
     int lost_contact = -1;
     double gamma = 0;            // the gauge (zero twist) or |f_k|/(mu_k N_k) (pivot test)
 };
-// Clears ws.creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
+// Clears the creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
 // the gauge is 1 to rounding.
 ModeChoice choose_mode(const Scene& scene, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& plate,
                        unsigned zero, Workspace& ws, bool hold = true);
