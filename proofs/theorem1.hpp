@@ -172,7 +172,7 @@ LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const D
 // The thin part of `scene` at configuration q0 and plate time t: its normal forces (38) and the
 // generated wrench kernel.
 WrenchMap thin_wrench_map(const Scene& scene, const Vec3& q0, double t, double* friction_scale = nullptr);
-// The generated thin_wrench kernel on given inputs (wrench_input, dynamics.hpp) as a WrenchMap.
+// The generated thin_wrench kernel on given inputs (wrench_input, friction.hpp) as a WrenchMap.
 WrenchMap wrench_map(gen::WrenchInput in);
 
 // --- Invertibility of A (Section III-E) -------------------------------------------------------

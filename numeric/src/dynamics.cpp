@@ -362,7 +362,8 @@ void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& 
     if (P.point) {
         // s'' = -(mu N u(v) + b_xy)/m with N = b_z independent of the twist.
         Jq.setZero();
-        Jq.topLeftCorner<2, 2>() = -P.friction().kinetic(0) * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
+        Jq.topLeftCorner<2, 2>() =
+            -P.friction().kinetic(0) * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
         return;
     }
     double A[36], D[36], V[18];

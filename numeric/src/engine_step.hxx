@@ -266,7 +266,7 @@ void Engine<Model>::reference_directions(const std::array<Vec2, 3>& slip) {
         const double s = slip[i].norm();
         const bool creeping = stick_slip().creep >> i & 1u;
         ref_[i] = s > stick_slip().hint_speed && !creeping ? Vec2(slip[i] / s) : stick_slip().hint[i];
-        // The friction direction a slip keeps near zero within the next step (dynamics.hpp).
+        // The friction direction a slip keeps near zero within the next step (StickSlipState, workspace.hpp).
         if (model_.mode.kind == ModeKind::Slide) {
             stick_slip().hint[i] = ref_[i];
             stick_slip().hint_from[i] = s;

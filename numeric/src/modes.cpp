@@ -242,6 +242,41 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
     }
 }
 
+// A rigid part that breaks away off the stick boundary (choose_mode): the twist that starts, the
+// direction xi (scaled) along which q'' points when the slips are xi's -- found by relaxing xi along
+// q''(xi) (the direction a part released at rest takes, q' ~ t q''; the fixed-point iteration
+// xi <- q''(xi) flips back and forth near the stick boundary), from the twist the needed friction
+// opposes, reversed (the creep twist choose_mode set). Leaves the hints and the creep twist at xi.
+void release_twist(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
+    const Part& P = sc.part;
+    detail::StickSlipState& ss = detail::stick_slip(ws);
+    Vec3 xi = ss.creep_twist.isZero() ? Vec3(Vec3::UnitX()) : ss.creep_twist;
+    // (The relaxation step shrinks where the residual grows: near a contact whose slip
+    // nearly vanishes -- a slide close to a pivot -- the flow is stiff.)
+    auto misfit = [&](const Vec3& x, Vec3& Q) {
+        set_twist_hints(P, q[2], x, ws);
+        mode_accelerations(sc, level, q, qd, ps, Mode{}, ws);
+        Q = scaled_qdd(P, ws);
+        const double lam = x.dot(Q);
+        return Q.norm() > 0 ? ((Q - lam * x).norm() + std::max(-lam, 0.0)) / Q.norm() : 0.0;
+    };
+    Vec3 Q;
+    double r = misfit(xi, Q), tau = 0.2;
+    for (int it = 0; it < 2000 && r > 1e-10 && tau > 1e-14; ++it) {
+        const Vec3 next = (xi + tau * Q.normalized()).normalized();
+        Vec3 Qn;
+        const double rn = misfit(next, Qn);
+        if (rn <= r) {
+            xi = next; Q = Qn; r = rn;
+            tau = std::min(0.5, 1.5 * tau);
+        } else {
+            tau *= 0.3;
+        }
+    }
+    set_twist_hints(P, q[2], xi, ws);
+    ss.creep_twist = xi;
+}
+
 }  // namespace
 
 void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
@@ -364,7 +399,8 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
             for (double sense : {1.0, -1.0}) {
                 const Mode pv{ModeKind::Pivot, kk, sense};
                 mode_accelerations(sc, level, q, qd, ps, pv, ws);
-                if (ws.n.minCoeff() >= 0 && ws.f_held[kk].norm() <= P.friction().static_(kk) * ws.n[kk] && sense * ws.qdd[2] > 0) {
+                const bool held = ws.f_held[kk].norm() <= P.friction().static_(kk) * ws.n[kk];
+                if (ws.n.minCoeff() >= 0 && held && sense * ws.qdd[2] > 0) {
                     out.mode = pv;
                     return out;
                 }
@@ -389,37 +425,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
     }
     if (g.gamma > 1 + 1e-6) {
         if (P.point) refine_hints(all);
-        else {
-            // The twist that starts: the direction xi (scaled) along which q'' points when the slips
-            // are xi's -- found by relaxing xi along q''(xi) (the direction a part released at rest
-            // takes, q' ~ t q''; the fixed-point iteration xi <- q''(xi) flips back and forth near the
-            // stick boundary), from the twist the needed friction opposes, reversed.
-            Vec3 xi = ss.creep_twist.isZero() ? Vec3(Vec3::UnitX()) : ss.creep_twist;
-            // (The relaxation step shrinks where the residual grows: near a contact whose slip
-            // nearly vanishes -- a slide close to a pivot -- the flow is stiff.)
-            auto misfit = [&](const Vec3& x, Vec3& Q) {
-                set_twist_hints(P, q[2], x, ws);
-                mode_accelerations(sc, level, q, qd, ps, Mode{}, ws);
-                Q = scaled_qdd(P, ws);
-                const double lam = x.dot(Q);
-                return Q.norm() > 0 ? ((Q - lam * x).norm() + std::max(-lam, 0.0)) / Q.norm() : 0.0;
-            };
-            Vec3 Q;
-            double r = misfit(xi, Q), tau = 0.2;
-            for (int it = 0; it < 2000 && r > 1e-10 && tau > 1e-14; ++it) {
-                const Vec3 next = (xi + tau * Q.normalized()).normalized();
-                Vec3 Qn;
-                const double rn = misfit(next, Qn);
-                if (rn <= r) {
-                    xi = next; Q = Qn; r = rn;
-                    tau = std::min(0.5, 1.5 * tau);
-                } else {
-                    tau *= 0.3;
-                }
-            }
-            set_twist_hints(P, q[2], xi, ws);
-            ss.creep_twist = xi;
-        }
+        else release_twist(sc, level, q, qd, ps, ws);
     }
     out.mode = Mode{};
     return out;
