@@ -11,6 +11,7 @@
 #include "plate/output.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
+#include "workspace.hpp"   // detail::kernels: the workspace's kernel inputs (numeric/src)
 
 #include <algorithm>
 #include <cmath>
@@ -72,9 +73,9 @@ template <class K>
 double kernel_ns(const Scene& sc, K kernel, double& checksum) {
     Workspace ws;
     const PlateState ps = plate_state(sc.plate, 0.013, Dynamics::ReducedU);
-    accelerations(sc, Dynamics::U, Vec3(0.01, 0.02, 0.3), Vec3(0.1, -0.05, 2), ps, ws);   // fills ws.in
+    accelerations(sc, Dynamics::U, Vec3(0.01, 0.02, 0.3), Vec3(0.1, -0.05, 2), ps, ws);   // fills the kernels' inputs
     accelerations(sc, Dynamics::ReducedU, Vec3(0.01, 0.02, 0.3), Vec3(0.1, -0.05, 2), ps, ws);   // the slots
-    gen::KernelInput in = ws.in;
+    gen::KernelInput in = detail::kernels(ws).in;
     const double a0 = std::atan2(in.u1y, in.u1x);
     double best = 1e300;
     for (int rep = 0; rep < 5; ++rep) {
@@ -85,7 +86,7 @@ double kernel_ns(const Scene& sc, K kernel, double& checksum) {
             const double a = a0 + 1e-7 * (i & 1023);
             in.u1x = 1 - 0.5 * (a - a0) * (a - a0);   // cos, sin of a small turn (to second order)
             in.u1y = a - a0;
-            kernel(in, ws.C.data(), nn, qdd);
+            kernel(in, detail::kernels(ws).C.data(), nn, qdd);
             checksum += qdd[0];
         }
         best = std::min(best, 1e9 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / n);

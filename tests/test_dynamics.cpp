@@ -9,6 +9,7 @@
 
 #include "models.hpp"   // Signal
 #include "so3.hpp"   // dexp_inv, exp_so3, hat
+#include "workspace.hpp"   // detail::StickSlipState
 
 #include <catch2/catch.hpp>
 
@@ -69,9 +70,11 @@ TEST_CASE("default model and workspace members are zero, not what the memory hel
         for (int i = 0; i < 3; ++i) {
             CHECK(ws.r[i] == Vec2::Zero());
             CHECK(ws.slip[i] == Vec2::Zero());
-            CHECK(ws.hint[i] == Vec2::Zero());
             CHECK(ws.f_held[i] == Vec2::Zero());
         }
+    });
+    on_poisoned_storage<detail::StickSlipState>([](const detail::StickSlipState& s) {
+        for (const Vec2& h : s.hint) CHECK(h == Vec2::Zero());
     });
     on_poisoned_storage<FrictionGauge>([](const FrictionGauge& g) {
         for (const Vec2& f : g.f) CHECK(f == Vec2::Zero());
@@ -211,8 +214,8 @@ TEST_CASE("thick part: the normal forces depend on the sliding direction (Append
             for (int i = 0; i < 3; ++i) {
                 const Vec3& c = P.c[i];
                 M(0, i) = c.y();
-                M(1, i) = -c.z() * P.mu[i] * ux - c.x();
-                M(2, i) = c.y() * P.mu[i] * ux;
+                M(1, i) = -c.z() * P.friction().kinetic(i) * ux - c.x();
+                M(2, i) = c.y() * P.friction().kinetic(i) * ux;
                 M(3, i) = 1;
             }
             M(0, 3) = -P.J(0, 2);
@@ -267,7 +270,7 @@ WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, con
                              const Vec3& qdd, const Vec3& n) {
     std::array<Vec2, 3> v, f;
     slip_velocities(sc.part, q, qd, v);
-    for (int i = 0; i < 3; ++i) f[i] = -sc.part.mu[i] * n[i] * v[i].normalized();
+    for (int i = 0; i < 3; ++i) f[i] = -sc.part.friction().kinetic(i) * n[i] * v[i].normalized();
     return world_residual(sc, q, qd, ps, qdd, n, f);
 }
 
@@ -332,7 +335,7 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
             std::array<Vec2, 3> v;
             slip_velocities(P, q, qd, v);
             for (int j = 0; j < 3; ++j)
-                if (j != k) CHECK((ws.f_held[j] + P.mu[j] * ws.n[j] * v[j].normalized()).norm() < 1e-12 * P.m * sc.g);
+                if (j != k) CHECK((ws.f_held[j] + P.friction().kinetic(j) * ws.n[j] * v[j].normalized()).norm() < 1e-12 * P.m * sc.g);
             const double hd = 1e-4;
             auto xk = [&](double t) {
                 const Vec2 s(q[0] + qd[0] * t + 0.5 * ws.qdd[0] * t * t, q[1] + qd[1] * t + 0.5 * ws.qdd[1] * t * t);
@@ -359,9 +362,9 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
         // capacity (mu dropped, or scaled) fails these where the residual above cannot see it.
         double h = 0;
         for (int i = 0; i < 3; ++i) {
-            CHECK(g.f[i].norm() <= g.gamma * P.mu[i] * ws.n[i] * (1 + 1e-9));
+            CHECK(g.f[i].norm() <= g.gamma * P.friction().static_(i) * ws.n[i] * (1 + 1e-9));
             const Vec2 ri = Eigen::Rotation2Dd(q[2]) * P.c[i].head<2>();
-            h += P.mu[i] * ws.n[i] * (g.direction.head<2>() + g.direction[2] * Vec2(-ri.y(), ri.x())).norm();
+            h += P.friction().static_(i) * ws.n[i] * (g.direction.head<2>() + g.direction[2] * Vec2(-ri.y(), ri.x())).norm();
         }
         const double dw = g.direction.head<2>().dot(ws.F_needed) + g.direction[2] * ws.tau_needed;
         CHECK(std::abs(dw / h / g.gamma - 1) < 1e-9);
@@ -458,7 +461,7 @@ double brute_gauge(const Part& P, double theta, const Vec3& n, const Vec2& F, do
         double h = 0;
         for (int i = 0; i < 3; ++i) {
             const Vec2 r = Eigen::Rotation2Dd(theta) * P.c[i].head<2>() / rg;
-            h += P.mu[i] * std::max(n[i], 0.0) * (d.head<2>() + d[2] * Vec2(-r.y(), r.x())).norm();
+            h += P.friction().static_(i) * std::max(n[i], 0.0) * (d.head<2>() + d[2] * Vec2(-r.y(), r.x())).norm();
         }
         return d.dot(w) / h;
     };
@@ -554,8 +557,8 @@ TEST_CASE("the friction gauge is the support function's optimum: brute force, an
                 const Vec2 r = arm(i);
                 F += g.f[i];
                 tau += r.x() * g.f[i].y() - r.y() * g.f[i].x();
-                CHECK(g.f[i].norm() <= g.gamma * P.mu[i] * ws.n[i] * (1 + 1e-9));
-                h += P.mu[i] * ws.n[i] * velocity(i).norm();
+                CHECK(g.f[i].norm() <= g.gamma * P.friction().static_(i) * ws.n[i] * (1 + 1e-9));
+                h += P.friction().static_(i) * ws.n[i] * velocity(i).norm();
             }
             // (In the scaled coordinates w = (F, tau / rho). Newton stops where the gradient in the plane
             // is below 1e-7 h |w|, which leaves the wrench within 1e-7 |w| (measured 8.7e-8); a stalled
@@ -576,7 +579,7 @@ TEST_CASE("the friction gauge is the support function's optimum: brute force, an
             // |v| + rho |omega|: exactly zero at a kink up to rounding, measured below 1e-15 of it.)
             int inside = -1, n_inside = 0;
             for (int i = 0; i < 3; ++i)
-                if (g.f[i].norm() < (1 - 1e-3) * g.gamma * P.mu[i] * ws.n[i]) {
+                if (g.f[i].norm() < (1 - 1e-3) * g.gamma * P.friction().static_(i) * ws.n[i]) {
                     inside = i;
                     ++n_inside;
                 }

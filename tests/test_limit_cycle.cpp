@@ -79,13 +79,13 @@ TEST_CASE("a circular drive just above mu g: the part slides at the rim from res
     // d|v|/dt = A w^2 cos(alpha) - mu g. While w |v| << A w^2 (here alpha < 2e-5) that is
     // |v(t)| = (A w^2 - mu g) t, to (w |v|)^2 t / (6 A w^2) ~ 1e-11 m/s, and v points against p''.
     // The engine's error near zero slip is bounded by its zero threshold, 3e2 rtol v_ref (7e-9 m/s
-    // here): allowed. Before the creep carried the slip's turn (Workspace::creep_rate) the slip
+    // here): allowed. Before the creep carried the slip's turn (StickSlipState::creep_rate) the slip
     // stayed at that threshold, 7.3e-9 m/s, where the exact reaches 2.9e-7 m/s, in 9.7e5 steps (the
     // creep's budget spent, stiff stretches between creeps); now 26 steps. At delta = 3e-8: 1.2e7 steps
     // and 20x low, now 26 steps and within 3e-11 m/s.
     // A rigid part with one friction coefficient on a translating plate is that point part (design.hpp,
     // transport): fig4's part, whose three contacts then creep as one twist (modes.cpp). Its twist's
-    // direction turns with the drive too (Workspace::creep_twist_rate): without that 9.2e5 steps and
+    // direction turns with the drive too (StickSlipState::creep_twist_rate): without that 9.2e5 steps and
     // 3.9e-8 m/s off at delta = 1e-6; with the turn as a difference vector instead of an angular
     // velocity (not turning within a step) 43 steps and 2.2e-7 m/s off; now 26 steps, 8.7e-10 m/s.
     const double T = 0.05, mu = 0.3, g = 9.81;

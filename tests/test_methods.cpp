@@ -122,7 +122,7 @@ TEST_CASE("event location: a part sliding on a still plate stops at v0 / (mu g) 
     for (const char* name : {"fig1_point", "fig5"}) {
         Scene sc = scene(name);
         for (auto& h : sc.plate.harmonics) h.amp = 0;
-        const double mu = sc.part.mu[0], g = sc.g, v0 = 0.05;
+        const double mu = sc.part.friction().kinetic(0), g = sc.g, v0 = 0.05;
         sc.part.mu = Vec3::Constant(mu);
         const double t_star = v0 / (mu * g);
         const Trajectory tr = simulate(sc, Dynamics::U, Vec3(0.01, 0.02, 0), Vec3(v0, 0, 0), 2 * t_star, t_star / 4);

@@ -79,7 +79,7 @@ TEST_CASE("peers: a plate translating harmonically in x drags the part as the 1-
     require_engines();
     Scene sc = scene("fig4");
     sc.plate.harmonics = {{Axis::x, 1, 20, 0}, {Axis::x, 2, 10, kPi / 2}};
-    const double w = 2 * kPi / sc.plate.T, f = sc.part.mu[0] * sc.g, t_end = 0.5;
+    const double w = 2 * kPi / sc.plate.T, f = sc.part.friction().kinetic(0) * sc.g, t_end = 0.5;
     auto vel = [&](double t) { return -20 / w * std::cos(w * t) - 10 / (2 * w) * std::cos(2 * w * t + kPi / 2); };
     auto acc = [&](double t) { return 20 * std::sin(w * t) + 10 * std::sin(2 * w * t + kPi / 2); };
     double u = 0, s = 0.04, t = 0;

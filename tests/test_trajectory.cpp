@@ -140,7 +140,7 @@ TEST_CASE("fig1 from rest: stuck at t = 0, breaks away at the root of the stick 
         Vec3 pdd, wd;
         pt.plate.acceleration(t, pdd, wd);
         const Vec3 a = pdd + wd.cross(s);
-        return pt.part.mu[0] * (a.z() + pt.g) - a.head<2>().norm();
+        return pt.part.friction().static_(0) * (a.z() + pt.g) - a.head<2>().norm();
     };
     REQUIRE(margin(0) > 0);
     double lo = 0, hi = 0;
@@ -197,7 +197,7 @@ TEST_CASE("fig1 from rest: stuck at t = 0, breaks away at the root of the stick 
         pt.plate.acceleration(t, pdd, wd);
         pt.plate.velocity(t, pd, w);
         const Vec3 r = R * s, F = pdd + wd.cross(r) + w.cross(w.cross(r)) + Vec3(0, 0, pt.g), n = R.col(2);
-        return pt.part.mu[0] * F.dot(n) - (F - F.dot(n) * n).norm();
+        return pt.part.friction().static_(0) * F.dot(n) - (F - F.dot(n) * n).norm();
     });
     CHECK(breakaway_time(pt, s, 0, Dynamics::Full) == Approx(tb_point_full).epsilon(1e-8));   // 7.2236e-4 s
     CHECK(tb_point_full > tb_point * 1.03);   // the tilt delays it by 3.75 %
@@ -258,7 +258,7 @@ TEST_CASE("friction never does positive work, in every mode (slide, pivot, stuck
             const double power = (P.m * ws.qdd.head<2>() + ws.b.head<2>()).dot(s.qd.head<2>()) +
                                  (P.point ? 0.0 : s.qd[2] * (P.J(2, 2) * ws.qdd[2] + ws.b[5]));
             worst = std::max(worst, power);
-            scale = std::max(scale, P.mu.maxCoeff() * P.m * sc.g * sc.v_ref());
+            scale = std::max(scale, P.friction().kinetic().maxCoeff() * P.m * sc.g * sc.v_ref());
         }
         INFO(c.scene << ": largest friction power " << worst << " W (scale mu m g v_ref = " << scale << " W); samples in slide "
                      << seen[0] << ", pivot " << seen[1] << ", stuck " << seen[2]);
@@ -303,7 +303,7 @@ TEST_CASE("a held contact's friction stays in its disk: no stick outlives its br
             } else if (s.mode.kind == ModeKind::Pivot) {
                 ++pivoting;
                 const int k = s.mode.k;
-                pivot = std::max(pivot, ws.f_held[k].norm() / (P.mu[k] * ws.n[k]));
+                pivot = std::max(pivot, ws.f_held[k].norm() / (P.friction().static_(k) * ws.n[k]));
             }
         }
         INFO(c.scene << ": samples stuck " << stuck << ", pivoting " << pivoting << "; largest gauge " << gamma

@@ -32,7 +32,7 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
         r.failure = "point parts are not modelled here (a ball would roll)";
         return r;
     }
-    if (P.mu.maxCoeff() != P.mu.minCoeff()) {
+    if (P.friction().kinetic().maxCoeff() != P.friction().kinetic().minCoeff()) {
         r.failure = "Bullet has one friction coefficient per body: contacts with different mu are not modelled";
         return r;
     }
@@ -68,7 +68,7 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     const Eigen::Quaterniond Vq(V);
     btCompoundShape part_shape;
     std::vector<std::unique_ptr<btSphereShape>> spheres;
-    const double mu = P.mu[0];
+    const double mu = P.friction().kinetic(0);
     for (int i = 0; i < 3; ++i) {
         spheres.push_back(std::make_unique<btSphereShape>(rad));
         const Vec3 at = V.transpose() * (P.c[i] + Vec3(0, 0, rad));

@@ -52,7 +52,7 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
       << " " << P.J(1, 1) << " " << P.J(2, 2) << " " << P.J(0, 1) << " " << P.J(0, 2) << " " << P.J(1, 2) << "\"/>";
     for (int i = 0; i < 3; ++i)
         x << "<geom type=\"sphere\" size=\"" << rad << "\" pos=\"" << P.c[i].x() << " " << P.c[i].y() << " "
-          << P.c[i].z() + rad << "\" friction=\"" << P.mu[i] << " 0 0\"/>";
+          << P.c[i].z() + rad << "\" friction=\"" << P.friction().kinetic(i) << " 0 0\"/>";
     x << "</body></worldbody></mujoco>";
     const std::string xml = x.str();
     auto vfs = std::make_unique<mjVFS>();

@@ -107,7 +107,7 @@ PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_
         w.spheres[i] = dCreateSphere(w.space, rad);
         dGeomSetBody(w.spheres[i], w.part);
         dGeomSetOffsetPosition(w.spheres[i], P.c[i].x(), P.c[i].y(), P.c[i].z() + rad);
-        w.mu[i] = P.mu[i];
+        w.mu[i] = P.friction().kinetic(i);
     }
     r.settings = std::string("dWorldStep (the Dantzig LCP, exact for the step, not the iterative QuickStep), dContactApprox1 "
                              "(friction bounded by mu N, not a force in newtons), ") +

@@ -10,6 +10,7 @@
 // to the plate at q0 and is read back in the plate frame as q = (s_x, s_y, theta).
 #pragma once
 
+#include "plate/friction.hpp"
 #include "plate/model.hpp"
 
 #include <Eigen/Geometry>

@@ -205,7 +205,7 @@ ModelEstimate estimate_model_errors(const Scene& sc, const Vec3& q0, double dura
             rotates = rotates || h.amp != 0;
         }
     }
-    const double mu = sc.part.point ? sc.part.mu[0] : sc.part.mu.mean();
+    const double mu = sc.part.point ? sc.part.friction().kinetic(0) : sc.part.friction().kinetic().mean();
     const double s = std::hypot(q0[0], q0[1]) + 0.05 * rho;
     e.eps_U = (sc.g * tilt + 2 * w1 * sc.v_ref() + w1 * w1 * s) / std::max(mu * sc.g, 1e-12);
     // From rest the two differ most in the transient (the tilted plate delays the break-away and

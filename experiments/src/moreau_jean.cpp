@@ -68,7 +68,7 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
     double theta = q0[2];
 
     Fc3d fc(nc, opt);
-    for (int i = 0; i < nc; ++i) fc.problem->mu[i] = P.mu[i];
+    for (int i = 0; i < nc; ++i) fc.problem->mu[i] = P.friction().kinetic(i);
     Eigen::VectorXd r = Eigen::VectorXd::Zero(n), u = Eigen::VectorXd::Zero(n);   // warm start: last step's
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, dof), Minv = Eigen::MatrixXd::Zero(dof, dof), W(n, n);
     Eigen::VectorXd Vf(dof), V(dof);

@@ -1,5 +1,6 @@
 #include "plate/study.hpp"
 
+#include "engine.hpp"
 #include "models.hpp"
 
 #include "plate/field.hpp"
@@ -415,7 +416,7 @@ Scene sticking_random_scene(std::uint64_t seed, Vec3& q0, double* ratio) {
     ro.thin = seed % 3 == 1;
     Scene sc = random_scene(seed, ro);
     Rng r(seed ^ 0x5715C0FFEEull);   // its own stream: the part and motion are random_scene's
-    const double mu = sc.part.point ? sc.part.mu[0] : sc.part.mu.maxCoeff();
+    const double mu = sc.part.friction().largest_kinetic();
     const double k = r.uniform(0.05, 1.2);
     const double heave = r.uniform(0.5, 2.5);
     double horizontal = 0;

@@ -1,5 +1,6 @@
 #include "plate/dynamics.hpp"
-#include "plate/modes.hpp"
+
+#include "workspace.hpp"
 
 #include <cmath>
 #include <limits>
@@ -9,53 +10,12 @@
 #include <stdexcept>
 
 namespace plate {
-namespace {
-
-
-// u = factor * v for the regularised friction laws (FrictionLaw).
-inline double regularised_factor(FrictionLaw law, double eps, double speed) {
-    if (law == FrictionLaw::Tanh) return speed > 1e-8 * eps ? std::tanh(speed / eps) / speed : 1.0 / eps;
-    if (law == FrictionLaw::Sqrt) return 1.0 / std::hypot(speed, eps);
-    return 1.0 / std::max(speed, eps);
-}
-
-// d u/d v (2x2) of the friction law at sliding velocity v.
-Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v) {
-    const double s = v.norm();
-    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-    if (law == FrictionLaw::Linear && s < eps) return I / eps;
-    if (law == FrictionLaw::Sqrt) {
-        const double r = std::hypot(s, eps);
-        return I / r - v * v.transpose() / (r * r * r);
-    }
-    if (law == FrictionLaw::Tanh) {
-        if (s < 1e-8 * eps) return I / eps;
-        const Vec2 e = v / s;
-        const double th = std::tanh(s / eps), sech2 = 1 - th * th;
-        return th / s * (I - e * e.transpose()) + sech2 / eps * e * e.transpose();
-    }
-    if (s == 0) return Eigen::Matrix2d::Zero();   // Coulomb at zero slip: undefined; no sliding term
-    const Vec2 e = v / s;
-    return (I - e * e.transpose()) / s;
-}
-
-}  // namespace
 
 const char* dynamics_name(Dynamics d) {
     switch (d) {
         case Dynamics::Full: return "full";
         case Dynamics::U: return "u";
         case Dynamics::ReducedU: return "reduced-u";
-    }
-    return "?";
-}
-
-const char* friction_law_name(FrictionLaw f) {
-    switch (f) {
-        case FrictionLaw::Coulomb: return "coulomb";
-        case FrictionLaw::Tanh: return "tanh";
-        case FrictionLaw::Linear: return "linear";
-        case FrictionLaw::Sqrt: return "sqrt";
     }
     return "?";
 }
@@ -123,50 +83,46 @@ Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const
     return b;
 }
 
-gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho) {
-    gen::WrenchInput in;
-    in.N1 = n[0]; in.N2 = n[1]; in.N3 = n[2];
-    in.r1x = r[0].x(); in.r1y = r[0].y();
-    in.r2x = r[1].x(); in.r2y = r[1].y();
-    in.r3x = r[2].x(); in.r3y = r[2].y();
-    in.mu1 = mu[0]; in.mu2 = mu[1]; in.mu3 = mu[2];
-    in.rho = rho;
-    return in;
-}
+Workspace::Workspace() = default;
+Workspace::Workspace(const Workspace& o) = default;
+Workspace& Workspace::operator=(const Workspace& o) = default;
+Workspace::~Workspace() = default;
 
 void Workspace::prepare(const Scene& sc) {
+    detail::KernelScratch& ks = detail::kernels(*this);
     const Part& P = sc.part;
-    prepared = &sc;
-    pivot_k = -1;   // (the part's parameters are in the pivot's matrix)
-    in = gen::KernelInput{};
-    in.m = P.m;
-    in.g = sc.g;
-    in.Jxx = P.J(0, 0);
-    in.Jxy = P.J(0, 1);
-    in.Jxz = P.J(0, 2);
-    in.Jyy = P.J(1, 1);
-    in.Jyz = P.J(1, 2);
-    in.Jzz = P.J(2, 2);
-    in.c1x = P.c[0].x(); in.c1y = P.c[0].y();
-    in.c2x = P.c[1].x(); in.c2y = P.c[1].y();
-    in.c3x = P.c[2].x(); in.c3y = P.c[2].y();
-    in.cz = P.point ? 0.0 : P.c[0].z();
-    in.sz = P.s_z();
-    in.mu1 = P.mu[0]; in.mu2 = P.mu[1]; in.mu3 = P.mu[2];
-    in.R11 = in.R22 = in.R33 = 1;
-    theta = std::numeric_limits<double>::quiet_NaN();
-    C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-    thin = P.thin();
-    if (thin) {
+    ks.prepared = &sc;
+    ks.pivot_k = -1;   // (the part's parameters are in the pivot's matrix)
+    ks.in = gen::KernelInput{};
+    ks.in.m = P.m;
+    ks.in.g = sc.g;
+    ks.in.Jxx = P.J(0, 0);
+    ks.in.Jxy = P.J(0, 1);
+    ks.in.Jxz = P.J(0, 2);
+    ks.in.Jyy = P.J(1, 1);
+    ks.in.Jyz = P.J(1, 2);
+    ks.in.Jzz = P.J(2, 2);
+    ks.in.c1x = P.c[0].x(); ks.in.c1y = P.c[0].y();
+    ks.in.c2x = P.c[1].x(); ks.in.c2y = P.c[1].y();
+    ks.in.c3x = P.c[2].x(); ks.in.c3y = P.c[2].y();
+    ks.in.cz = P.point ? 0.0 : P.c[0].z();
+    ks.in.sz = P.s_z();
+    const ContactFriction fr = P.friction();   // (the kernels' slides take the kinetic coefficients)
+    ks.in.mu1 = fr.kinetic(0); ks.in.mu2 = fr.kinetic(1); ks.in.mu3 = fr.kinetic(2);
+    ks.in.R11 = ks.in.R22 = ks.in.R33 = 1;
+    ks.theta = std::numeric_limits<double>::quiet_NaN();
+    ks.C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    ks.thin = P.thin();
+    if (ks.thin) {
         double M[9];
-        gen::thin_M38(in, M);
-        M38_inv = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).inverse();
-        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M38_inv_rowmajor.data()) = M38_inv;
+        gen::thin_M38(ks.in, M);
+        ks.M38_inv = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).inverse();
+        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(ks.M38_inv_rowmajor.data()) = ks.M38_inv;
     }
     // det of the reduced system ~ (contact spread)^2: below 1e-9 of that, fall back to LU.
     double size = 0;
     for (int i = 0; i < 3; ++i) size = std::max(size, P.c[i].head<2>().norm());
-    det_floor = 1e-9 * size * size;
+    ks.det_floor = 1e-9 * size * size;
 }
 
 namespace {
@@ -174,9 +130,10 @@ namespace {
 // Configuration inputs of the kernels: s, and cos/sin theta with R2 c_i (cached: constant in the
 // reduced U-dynamics).
 inline void set_configuration(const Part& P, const Vec3& q, Workspace& ws) {
-    gen::KernelInput& in = ws.in;
-    if (q[2] != ws.theta) {
-        ws.theta = q[2];
+    detail::KernelScratch& ks = detail::kernels(ws);
+    gen::KernelInput& in = ks.in;
+    if (q[2] != ks.theta) {
+        ks.theta = q[2];
         in.ct = std::cos(q[2]);
         in.st = std::sin(q[2]);
         for (int i = 0; i < 3; ++i)
@@ -190,6 +147,7 @@ inline void set_configuration(const Part& P, const Vec3& q, Workspace& ws) {
 // directions u_i = f_i v_i (zero at zero slip; the regularised laws scale instead). The contacts
 // are independent: computed side by side, so their square roots and divisions overlap.
 inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, double* uy) {
+    const detail::StickSlipState& ss = detail::stick_slip(ws);
     const double w = nc == 1 ? 0.0 : qd[2];
     double vx[3], vy[3], f[3];
     for (int i = 0; i < nc; ++i) {
@@ -219,13 +177,13 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
         ux[i] = vx[i] * f[i];
         uy[i] = vy[i] * f[i];
     }
-    if (ws.use_hints) {
-        const double hs2 = ws.hint_speed * ws.hint_speed;
+    if (ss.use_hints) {
+        const double hs2 = ss.hint_speed * ss.hint_speed;
         for (int i = 0; i < nc; ++i) {
             const double s2 = sp[i];
-            const double along = vx[i] * ws.hint[i].x() + vy[i] * ws.hint[i].y();
-            const bool past_zero = s2 < 0.01 * ws.hint_from[i] * ws.hint_from[i] && (along <= 0 || along * along <= 0.25 * s2);
-            if (s2 <= hs2 || past_zero || (ws.creep >> i & 1u)) { ux[i] = ws.hint[i].x(); uy[i] = ws.hint[i].y(); }
+            const double along = vx[i] * ss.hint[i].x() + vy[i] * ss.hint[i].y();
+            const bool past_zero = s2 < 0.01 * ss.hint_from[i] * ss.hint_from[i] && (along <= 0 || along * along <= 0.25 * s2);
+            if (s2 <= hs2 || past_zero || (ss.creep >> i & 1u)) { ux[i] = ss.hint[i].x(); uy[i] = ss.hint[i].y(); }
         }
     }
     for (int i = nc; i < 3; ++i) ws.slip[i].setZero();
@@ -239,15 +197,16 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
 // r_i = R2 c_i (v_i = s' + theta' e_z x r_i).
 bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws,
                              Mat3* Jq = nullptr) {
-    if (q[0] != ws.C_q[0] || q[1] != ws.C_q[1] || q[2] != ws.C_q[2]) {
+    detail::KernelScratch& ks = detail::kernels(ws);
+    if (q[0] != ks.C_q[0] || q[1] != ks.C_q[1] || q[2] != ks.C_q[2]) {
         set_configuration(P, q, ws);
-        ws.C_q = q;
-        if (P.point) gen::reduced_U_point_config(ws.in, ws.C.data());
-        else if (ws.thin) gen::reduced_U_thin_config(ws.in, ws.M38_inv_rowmajor.data(), ws.C.data());
-        else gen::reduced_U_thick_config(ws.in, ws.C.data());
+        ks.C_q = q;
+        if (P.point) gen::reduced_U_point_config(ks.in, ks.C.data());
+        else if (ks.thin) gen::reduced_U_thin_config(ks.in, ks.M38_inv_rowmajor.data(), ks.C.data());
+        else gen::reduced_U_thick_config(ks.in, ks.C.data());
     }
     // The staged kernels read only the slip directions and u(t): those fields are written here.
-    gen::KernelInput& k = ws.staged;
+    gen::KernelInput& k = ks.staged;
     k.pddx = ps.pdd.x(); k.pddy = ps.pdd.y(); k.pddz = ps.pdd.z();
     k.wdx = ps.wd.x(); k.wdy = ps.wd.y(); k.wdz = ps.wd.z();
     double ux[3], uy[3];
@@ -256,8 +215,8 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
         slip_directions(1, qd, ws, ux, uy);
         k.u1x = ux[0]; k.u1y = uy[0];
         double z[3];
-        if (Jq) gen::reduced_U_point_du(k, ws.C.data(), z, dq);
-        else gen::reduced_U_point(k, ws.C.data(), z);
+        if (Jq) gen::reduced_U_point_du(k, ks.C.data(), z, dq);
+        else gen::reduced_U_point(k, ks.C.data(), z);
         ws.qdd = Vec3(z[0], z[1], 0);
         ws.n = Vec3(z[2], 0, 0);
         if (Jq) {
@@ -272,14 +231,14 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
     k.u2x = ux[1]; k.u2y = uy[1];
     k.u3x = ux[2]; k.u3y = uy[2];
     bool regular = true;
-    if (ws.thin) {
-        if (Jq) gen::reduced_U_thin_du(k, ws.C.data(), ws.n.data(), ws.qdd.data(), dq);
-        else gen::reduced_U_thin(k, ws.C.data(), ws.n.data(), ws.qdd.data());
+    if (ks.thin) {
+        if (Jq) gen::reduced_U_thin_du(k, ks.C.data(), ws.n.data(), ws.qdd.data(), dq);
+        else gen::reduced_U_thin(k, ks.C.data(), ws.n.data(), ws.qdd.data());
     } else {
         double det;
-        if (Jq) gen::reduced_U_thick_du(k, ws.C.data(), ws.n.data(), ws.qdd.data(), &det, dq);
-        else gen::reduced_U_thick(k, ws.C.data(), ws.n.data(), ws.qdd.data(), &det);
-        regular = std::abs(det) > ws.det_floor;
+        if (Jq) gen::reduced_U_thick_du(k, ks.C.data(), ws.n.data(), ws.qdd.data(), &det, dq);
+        else gen::reduced_U_thick(k, ks.C.data(), ws.n.data(), ws.qdd.data(), &det);
+        regular = std::abs(det) > ks.det_floor;
     }
     if (Jq && regular) {
         const Eigen::Map<const Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> dqdd_du(dq);
@@ -311,7 +270,8 @@ namespace detail {
 // without their dispatch (7 % of fig6's field's instructions). False where that path declines (an
 // unprepared workspace, a near-singular thick part): the caller then takes mode_accelerations.
 bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
-    if (ws.prepared != &sc || !accelerations_reduced_U(sc.part, q, qd, ps, ws)) return false;
+    detail::KernelScratch& ks = detail::kernels(ws);
+    if (ks.prepared != &sc || !accelerations_reduced_U(sc.part, q, qd, ps, ws)) return false;
     ++ws.evals;
     return true;
 }
@@ -319,11 +279,12 @@ bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const Plate
 
 void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                    Workspace& ws) {
+    detail::KernelScratch& ks = detail::kernels(ws);
     const Part& P = sc.part;
     ++ws.evals;
-    if (ws.prepared != &sc) ws.prepare(sc);
+    if (ks.prepared != &sc) ws.prepare(sc);
     if (level == Dynamics::ReducedU && accelerations_reduced_U(P, q, qd, ps, ws)) return;
-    gen::KernelInput& in = ws.in;
+    gen::KernelInput& in = ks.in;
     set_configuration(P, q, ws);
     in.sxd = qd[0];
     in.syd = qd[1];
@@ -340,9 +301,9 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
     in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();
     double b[6];
-    if (ws.thin && level != Dynamics::Full) {   // the thin part's specialised kernel does it all
+    if (ks.thin && level != Dynamics::Full) {   // the thin part's specialised kernel does it all
         double n[3], qdd[3];
-        gen::thin_solve_U(in, ws.M38_inv_rowmajor.data(), b, n, qdd);
+        gen::thin_solve_U(in, ks.M38_inv_rowmajor.data(), b, n, qdd);
         ws.b = Eigen::Map<const Vec6>(b);
         ws.n = Vec3(n[0], n[1], n[2]);
         ws.qdd = Vec3(qdd[0], qdd[1], qdd[2]);
@@ -366,12 +327,12 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         return;
     }
     double n[3], qdd[3];
-    if (ws.thin) {
-        gen::thin_solve(in, b, ws.M38_inv_rowmajor.data(), n, qdd);   // (38)
+    if (ks.thin) {
+        gen::thin_solve(in, b, ks.M38_inv_rowmajor.data(), n, qdd);   // (38)
     } else {
         double det;
         gen::thick_solve(in, b, n, qdd, &det);
-        if (!(std::abs(det) > ws.det_floor)) {
+        if (!(std::abs(det) > ks.det_floor)) {
             // Near-collinear contacts: the cofactor solution loses accuracy; use a pivoted LU instead.
             double M[9], r[3];
             gen::thick_reduced(in, b, M, r);
@@ -387,27 +348,29 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
 
 void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                     Workspace& ws, Mat3& Jq) {
+    detail::KernelScratch& ks = detail::kernels(ws);
     if (level == Dynamics::Full) throw std::invalid_argument("twist_jacobian: U- and reduced U-dynamics only");
     if (level == Dynamics::ReducedU) {
         ++ws.evals;
-        if (ws.prepared != &sc) ws.prepare(sc);
+        if (ks.prepared != &sc) ws.prepare(sc);
         if (accelerations_reduced_U(sc.part, q, qd, ps, ws, &Jq)) return;
     }
     // At one instant the U- and reduced U-dynamics coincide; the U path leaves every input of the
-    // factor kernels (slip directions included) in ws.in.
+    // factor kernels (slip directions included) in the kernels' inputs.
     accelerations(sc, Dynamics::U, q, qd, ps, ws);
     const Part& P = sc.part;
     if (P.point) {
         // s'' = -(mu N u(v) + b_xy)/m with N = b_z independent of the twist.
         Jq.setZero();
-        Jq.topLeftCorner<2, 2>() = -P.mu[0] * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
+        Jq.topLeftCorner<2, 2>() =
+            -P.friction().kinetic(0) * ws.n[0] / P.m * direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
         return;
     }
     double A[36], D[36], V[18];
     const double n[3] = {ws.n[0], ws.n[1], ws.n[2]};
-    gen::thick_A(ws.in, A);
-    gen::dA_du(ws.in, n, D);
-    gen::dslip_dqd(ws.in, V);
+    gen::thick_A(ks.in, A);
+    gen::dA_du(ks.in, n, D);
+    gen::dslip_dqd(ks.in, V);
     Mat6 U = Mat6::Zero();
     for (int i = 0; i < 3; ++i) U.block<2, 2>(2 * i, 2 * i) = direction_derivative(ws.law, ws.law_eps, ws.slip[i]);
     const Eigen::Matrix<double, 6, 3> G = Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(D) * U *
@@ -419,6 +382,7 @@ void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& 
 
 void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                              Workspace& ws) {
+    detail::KernelScratch& ks = detail::kernels(ws);
     const Part& P = sc.part;
     ++ws.evals;
     slip_velocities(P, q, qd, ws.slip);
@@ -429,7 +393,7 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
         const double N = ws.b[2];
         const double v = ws.slip[0].norm();
         const Vec2 dir = v > 0 ? Vec2(ws.slip[0] / v) : Vec2::Zero();
-        const Vec2 sdd = (-P.mu[0] * N * dir - ws.b.head<2>()) / P.m;
+        const Vec2 sdd = (-P.friction().kinetic(0) * N * dir - ws.b.head<2>()) / P.m;
         ws.qdd = Vec3(sdd.x(), sdd.y(), 0);
         ws.n = Vec3(N, 0, 0);
         return;
@@ -442,52 +406,19 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
     A(0, 0) = -P.m;
     A(1, 1) = -P.m;
     A.block<3, 1>(3, 2) = -P.J.col(2);
+    const ContactFriction fr = P.friction();
     for (int i = 0; i < 3; ++i) {
         const double v = ws.slip[i].norm();
         const Vec2 u = v > 0 ? Vec2(ws.slip[i] / v) : Vec2::Zero();
-        const Vec3 d(-P.mu[i] * u.x(), -P.mu[i] * u.y(), 1.0);              // (17)
+        const Vec3 d(-fr.kinetic(i) * u.x(), -fr.kinetic(i) * u.y(), 1.0);              // (17)
         const Vec3 dS(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());  // R2^T d_i
         A.block<3, 1>(0, 3 + i) = d;
         A.block<3, 1>(3, 3 + i) = P.c[i].cross(dS);                          // h_i (23)
     }
-    ws.lu.compute(A);
-    ws.z = ws.lu.solve(ws.b);
-    ws.qdd = ws.z.head<3>();
-    ws.n = ws.z.tail<3>();
-}
-
-StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd,
-                     const PlateState& ps) {
-    const Part& P = sc.part;
-    Workspace ws;
-    StickTest r;
-    if (P.point) {   // s'' = 0: friction must supply f_xy, and N = f_z
-        mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
-        r.friction_needed = ws.F_needed.norm();
-        r.friction_available = P.mu[0] * ws.n[0];
-        r.sticks = ws.n[0] > 0 && r.friction_needed <= r.friction_available;
-        return r;
-    }
-    // The others turn about c_k with theta' (sense 0 at rest: no kinetic friction there).
-    const double sense = qd[2] > 0 ? 1.0 : qd[2] < 0 ? -1.0 : 0.0;
-    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Pivot, k, sense}, ws);
-    r.friction_needed = ws.f_held[k].norm();
-    r.friction_available = P.mu[k] * ws.n[k];
-    r.sticks = ws.n.minCoeff() >= 0 && r.friction_needed <= r.friction_available;
-    return r;
-}
-
-StickTest stick_test_all(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {
-    // The stuck mode's statics and the exact friction-disk gauge (modes.hpp).
-    Workspace ws;
-    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
-    const int nc = sc.part.contacts();
-    StickTest r;
-    r.friction_needed = ws.F_needed.norm();
-    for (int i = 0; i < nc; ++i) r.friction_available += sc.part.mu[i] * std::max(ws.n[i], 0.0);
-    r.sticks = ws.n.head(nc).minCoeff() >= 0 &&
-               friction_gauge(sc.part, q[2], ws.n, ws.F_needed, ws.tau_needed).gamma <= 1;
-    return r;
+    ks.lu.compute(A);
+    ks.z = ks.lu.solve(ws.b);
+    ws.qdd = ks.z.head<3>();
+    ws.n = ks.z.tail<3>();
 }
 
 }  // namespace plate

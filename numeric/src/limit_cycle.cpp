@@ -1,5 +1,6 @@
 #include "plate/limit_cycle.hpp"
 
+#include "engine.hpp"
 #include "models.hpp"
 
 #include <gsl/gsl_errno.h>
@@ -684,7 +685,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     // stalled at the loose map's noise).
     LimitCycleOptions shooting_opt = opt;
     opt.integration.large_slip_factor = 1;
-    if (sc.part.mu.head(sc.part.contacts()).maxCoeff() <= 0) {
+    if (sc.part.friction().largest_kinetic() <= 0) {
         // Without friction q'' = -(p'' + omega1' x s)_xy is periodic with zero mean: every initial
         // twist is periodic and none attracts the others, so the asymptotic twist is undefined.
         LimitCycleSummary out;

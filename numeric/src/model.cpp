@@ -1,5 +1,7 @@
 #include "plate/model.hpp"
 
+#include "plate/friction.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -75,7 +77,7 @@ double PlateMotion::angular_amplitude() const {
 }
 
 double Scene::v_ref() const {
-    const double mu = part.point ? part.mu[0] : part.mu.maxCoeff();
+    const double mu = part.friction().largest_kinetic();
     double a = std::max(mu * g, plate.horizontal_amplitude());
     if (a <= 0) a = g;
     return a / plate.omega();

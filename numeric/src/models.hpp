@@ -1,11 +1,17 @@
-// Internal: the three state layouts integrated by the engine.
+// Internal: the three state layouts integrated by the engine (engine.hpp drives any of them).
 //   ReducedU (35): y = [q'(3), Q(3)], Q = integral of q' (for the average (36)); q frozen.
 //   U (32):        y = [q(3), q'(3)]
 //   Full (31):     y = [q(3), q'(3), phi(3)], R1 = exp(phi^)
 #pragma once
 
-#include "engine.hpp"
+#include "plate/modes.hpp"
+#include "so3.hpp"
+#include "workspace.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 namespace plate::detail {
@@ -129,7 +135,7 @@ struct ReducedModel {
         const Vec3 qd(y[0], y[1], y[2]);
         u.acceleration(t, ps_last);   // (R1 and w1 stay identity and zero: unused at this level)
         t_last = t;
-        if (!(mode.kind == ModeKind::Slide && !ws.creep && reduced_U_slide(sc, q0, qd, ps_last, ws)))
+        if (!(mode.kind == ModeKind::Slide && !stick_slip(ws).creep && reduced_U_slide(sc, q0, qd, ps_last, ws)))
             mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
         for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
     }

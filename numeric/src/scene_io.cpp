@@ -1,5 +1,7 @@
 #include "plate/scene_io.hpp"
 
+#include "plate/friction.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -334,7 +336,7 @@ std::vector<std::string> scene_warnings(const Scene& s) {
     if (!p.point) {
         // Dynamic tipping: friction mu N at the contacts, a height h below the centre of mass, tips the
         // part about a support edge at distance d from the centre of mass's projection once mu h > d.
-        const double d = sup.edge, h = p.s_z(), mu = p.mu.maxCoeff();
+        const double d = sup.edge, h = p.s_z(), mu = p.friction().largest_kinetic();
         if (mu * h > d)
             w.push_back(src + ": part.contacts: sliding friction can tip the part: mu h = " + Reader::fmt(mu * h) +
                         " m exceeds the distance " + Reader::fmt(d) + " m from the centre of mass to the nearest support edge");

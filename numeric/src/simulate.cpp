@@ -1,5 +1,6 @@
 #include "plate/simulate.hpp"
 
+#include "engine.hpp"
 #include "models.hpp"
 
 #include <cmath>

@@ -20,7 +20,7 @@
 // answer, with no mode logic of ours. The scheme is first order; where a stick starts or ends inside
 // a step its error's size and sign jump from one h to the next (tests/test_siconos.cpp).
 // Three contacts give nine impulses against six velocities: a stuck part's friction distribution is
-// indeterminate (as in the engine's gauge, modes.hpp), its velocities are not.
+// indeterminate (as in the engine's gauge, friction.hpp), its velocities are not.
 #pragma once
 
 #include "plate/model.hpp"

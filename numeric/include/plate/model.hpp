@@ -28,6 +28,8 @@ std::array<V, N> zeros() {
     return a;
 }
 
+class ContactFriction;   // friction.hpp
+
 // sigma = (m, J, c1, c2, c3, mu_k1, mu_k2, mu_k3).
 // A point part has only m and mu (one contact at the centre of mass, no rotation).
 struct Part {
@@ -35,9 +37,11 @@ struct Part {
     double m = 0;                 // mass [kg]
     Mat3 J = Mat3::Zero();        // rotational inertia about s, in S [kg m^2]
     std::array<Vec3, 3> c = zeros<Vec3>();   // contacts c_i in S [m]; all share one z (flat plate)
-    Vec3 mu = Vec3::Zero();       // kinetic friction coefficients mu_ki
+    Vec3 mu = Vec3::Zero();       // friction coefficients mu_ki, as set (read them through friction())
 
     int contacts() const { return point ? 1 : 3; }
+    // The contacts' kinetic and static friction coefficients (friction.hpp, which defines it).
+    ContactFriction friction() const;
     // Height of the centre of mass above the plate: s_z = -c_iz (assumption 1).
     double s_z() const { return point ? 0.0 : -c[0].z(); }
     // Radius of gyration rho = sqrt(J_zz / m) (Appendix footnote); 1 m for a point part.

@@ -57,30 +57,10 @@ struct Mode {
 // "slide", "pivot1", "pivot2", "pivot3", "stuck" (1-based contacts, as in messages)
 std::string mode_name(const Mode& m);
 
-// The friction-disk gauge: the smallest gamma such that friction forces f_i with
-// |f_i| <= gamma mu_i N_i supply the wrench (F, tau) about s:
-//   sum_i f_i = F,  sum_i r_i x f_i = tau.
-// The part can be held (static friction) iff gamma <= 1. Exact (no direction sampling): by
-// duality gamma = max_d (d . w) / h(d) with h(d) = sum_i mu_i N_i |G_i^T d| the support function of
-// the friction set (G_i^T d = the velocity of contact i under the twist d, in the paper's scaled
-// coordinates: w = (F, tau/rho), d = (d_x, d_y, rho d_theta)); we minimise the convex h over the
-// plane d . w = 1 -- at a kink G_k^T d = 0 (a rotation about contact k, tested in closed form) or
-// by Newton's method where h is smooth; where Newton stalls next to a kink, a pattern search, and
-// where that stops short (its distribution misses the wrench), Newton on h smoothed by delta -> 0.
-// The optimal distribution is unique at a smooth boundary point: f_i = gamma mu_i N_i G_i^T d/|G_i^T d|.
-struct FrictionGauge {
-    double gamma = 0;               // 0 for w = 0; inf if no friction can supply w
-    std::array<Vec2, 3> f = zeros<Vec2>();        // the optimal friction distribution [N], P frame
-    int pivot = -1;                 // contact whose force lies inside its disk at the optimum, if any
-    Vec3 direction = Vec3::Zero();  // d: the twist (s_x', s_y', theta') the needed friction opposes
-    int iterations = 0;             // Newton iterations (0: closed form)
-};
-FrictionGauge friction_gauge(const Part& part, double theta, const Vec3& n, const Vec2& F, double tau);
-
 // Mode-aware accelerations: fills ws.qdd and ws.n as accelerations() does, for any mode.
-//   Slide   accelerations(); a contact whose slip is below ws.hint_speed uses the unit direction
-//           ws.hint[i] (the break-away direction), since v/|v| is undefined at zero slip; a creeping
-//           contact (ws.creep, slip below ws.creep_speed) the direction along which it accelerates,
+//   Slide   accelerations(); a contact whose slip is below hint_speed uses the unit direction hint[i]
+//           (the break-away direction), since v/|v| is undefined at zero slip; a creeping contact
+//           (creep, slip below creep_speed) the direction along which it accelerates,
 //           solved here (Newton on its angle): the slip direction's relaxation, at a rate
 //           ~ |d a/d phi| / |v| that makes explicit steps collapse as a slip grows from zero after a
 //           break-away, is left out (its error is bounded by the engine, engine.hpp)
@@ -91,6 +71,8 @@ FrictionGauge friction_gauge(const Part& part, double theta, const Vec3& n, cons
 //           reduced U-dynamics (35), whose configuration is frozen)
 //   Stuck   q'' = 0; the needed friction wrench (ws.F_needed, ws.tau_needed) and the normal forces
 //           (z force and x, y torques, with the friction total's moment about the raised s)
+// (hint_speed, hint, creep: the stick-slip state the engine and choose_mode set in the workspace,
+// numeric/src/workspace.hpp; an evaluation outside the engine has none.)
 void mode_accelerations(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate,
                         const Mode& mode, Workspace& ws);
 
@@ -98,7 +80,7 @@ void mode_accelerations(const Scene& scene, Dynamics level, const Vec3& q, const
 Vec2 contact_acceleration(const Part& part, Dynamics level, int i, const Vec3& q, const Vec3& qd, const Vec3& qdd);
 
 // The mode a state at zero slip of the contacts `zero` (a bit mask) enters, and the slip
-// directions of contacts that break away (written to ws.hint). `qd` is projected in place onto
+// directions of contacts that break away (written to the workspace's hints). `qd` is projected in place onto
 // zero slip of those contacts (all of them: qd = 0). Returns the new mode; `lost` is set (and
 // the mode meaningless) if a normal force is negative there.
 struct ModeChoice {
@@ -107,9 +89,29 @@ struct ModeChoice {
     int lost_contact = -1;
     double gamma = 0;            // the gauge (zero twist) or |f_k|/(mu_k N_k) (pivot test)
 };
-// Clears ws.creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
+// Clears the creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
 // the gauge is 1 to rounding.
 ModeChoice choose_mode(const Scene& scene, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& plate,
                        unsigned zero, Workspace& ws, bool hold = true);
+
+// Would contact k stay stuck if its sliding velocity were zero now? The pivot mode's dynamics
+// (Newton-Euler with contact k carrying an unknown tangential force F, the others sliding,
+// c_k not accelerating relative to the plate), then |F| <= mu_sk N_k (friction.hpp) with every N_i >= 0. A point
+// part: the stuck mode's statics.
+struct StickTest {
+    bool sticks = false;
+    double friction_needed = 0;   // |F| [N]
+    double friction_available = 0;  // mu_sk N_k [N] (stick_test_all: sum_i mu_si max(N_i, 0))
+};
+StickTest stick_test(const Scene& scene, Dynamics level, int k, const Vec3& q, const Vec3& qd,
+                     const PlateState& plate);
+
+// Would the whole part stay stuck to the plate (every contact at zero slip, q'' = 0)? The needed
+// frictional wrench (f_xy, tau_z) follows from b; the normal forces then follow exactly from the z
+// force and the x, y torques (the friction total is known, so its moment about the raised centre of
+// mass is too). The part sticks if the normal forces are >= 0 and the friction-disk gauge of that
+// wrench is <= 1 (friction_gauge: exact, by duality).
+StickTest stick_test_all(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
+                         const PlateState& plate);
 
 }  // namespace plate

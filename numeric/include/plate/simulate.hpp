@@ -91,7 +91,7 @@ struct Trajectory {
 };
 
 // A part at rest relative to the plate at q0 rides with it while friction can hold it (the gauge of
-// modes.hpp, from the needed wrench of `level`'s right-hand side; full dynamics: the plate tilted as
+// friction.hpp, from the needed wrench of `level`'s right-hand side; full dynamics: the plate tilted as
 // its zero-mean motion has it). Returns the first time >= t0 at which it breaks away, located as the
 // engine locates it, or NaN if it stays stuck for a whole period.
 double breakaway_time(const Scene& scene, const Vec3& q0, double t0, Dynamics level = Dynamics::U);
