@@ -79,6 +79,21 @@ DesignTarget parse_target(const std::vector<std::string>& target, const Scene& p
     }
 }
 
+// The library's judgement of the options (validate_design_options) as a UsageError naming the flag:
+// "hold: ..." -> "--hold: ...", local_evaluations -> --evaluations, max_harmonic -> --harmonics.
+void judge_options(const DesignOptions& o) {
+    try {
+        validate_design_options(o);
+    } catch (const std::invalid_argument& e) {
+        std::string m = e.what();
+        const std::pair<const char*, const char*> flags[] = {
+            {"local_evaluations:", "evaluations:"}, {"max_harmonic:", "harmonics:"}, {"max_coning:", "max-coning:"}};
+        for (const auto& [name, flag] : flags)
+            if (m.rfind(name, 0) == 0) m = flag + m.substr(std::string(name).size());
+        throw UsageError("--" + m);
+    }
+}
+
 // The search's and the verification's options from the command line, checked (UsageError).
 DesignOptions design_options(const DesignArgs& a) {
     DesignOptions o;
@@ -118,6 +133,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     if (!a.has("--out")) throw UsageError("missing --out SCENE.json");
     const DesignTarget t = parse_target(a.target, part);
     DesignOptions o = design_options(a);
+    judge_options(o);
     // Under mpirun the starts, the verification field's planes and the verification runs are shared
     // over the ranks; every rank follows the same path, rank 0 writes.
     if (cio.farm) o.tasks = sweep::farm_tasks(*cio.farm);

@@ -48,8 +48,7 @@ DesignSummary design_fixed_point(const Scene& part_scene, const DesignTarget& ta
 // friction coefficient on every contact a translating plate cannot turn the part, and the rotating
 // plate's search, design_rigid, is left.
 DesignSummary design_orientation(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
-    const auto mu = part_scene.part.mu.head(part_scene.part.contacts());
-    if (mu.maxCoeff() > mu.minCoeff() * (1 + 1e-9)) return design_orient(part_scene, target, opt, T);
+    if (friction_differs(part_scene.part)) return design_orient(part_scene, target, opt, T);
     return design_rigid(part_scene, target, opt, T);
 }
 

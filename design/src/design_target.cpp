@@ -127,7 +127,7 @@ void validate_design_options(const DesignOptions& o) {
             "period: expected 0 (the part scene's) or " + number_text(kPeriodRange[0]) + " to " + number_text(kPeriodRange[1]) +
                 " s");
     require(o.hold >= 0 && o.hold <= 3600, "hold: expected 0 to 3600 s (0: not checked)");
-    require(std::isfinite(o.max_coning), "max_coning: expected a number (negative: from the hold)");
+    require(!std::isnan(o.max_coning), "max_coning: expected a number (negative: from the hold; infinite: no limit)");
     require(o.starts >= 0, "starts: expected >= 0 (0: the target's default)");
     require(o.local_evaluations >= 1, "local_evaluations: expected >= 1");
     require(o.max_harmonic >= 0, "max_harmonic: expected >= 0 (0: the target's own)");
@@ -154,12 +154,9 @@ void validate_design_target(const DesignTarget& target, const Scene& part_scene,
             throw std::invalid_argument("transport with a turn: a plate that only translates cannot turn a part with one "
                                         "friction coefficient, and a turning plate's alpha x s makes the twist depend on "
                                         "position (a whirl), so no uniform twist with OMEGA != 0 is designed (DesignTarget)");
-        if (rigid) {
-            const auto mu = part_scene.part.mu.head(part_scene.part.contacts());
-            if (mu.maxCoeff() > mu.minCoeff() * (1 + 1e-9))
-                throw std::invalid_argument("transport of a part whose contacts' friction differs: a translating plate turns it "
-                                            "(the weathervane) and its velocity with it, so it has no uniform twist (try orient)");
-        }
+        if (rigid && friction_differs(part_scene.part))
+            throw std::invalid_argument("transport of a part whose contacts' friction differs: a translating plate turns it "
+                                        "(the weathervane) and its velocity with it, so it has no uniform twist (try orient)");
         return;
     }
     if (!(std::abs(target.at.x()) <= opt.region && std::abs(target.at.y()) <= opt.region))

@@ -456,6 +456,15 @@ struct SinkProblem : Problem<SinkProblem> {
 
 // --- the targets (one file each; design.cpp's dispatch picks one) ---------------------------------
 
+// Whether the part's contacts' kinetic friction differs (beyond 1e-9 relative): a translating plate
+// turns such a part like a weathervane, and cannot turn one whose contacts share one coefficient.
+inline bool friction_differs(const Part& part) {
+    const ContactFriction mu = part.friction();
+    double lo = mu.kinetic(0), hi = lo;
+    for (int i = 1; i < part.contacts(); ++i) lo = std::min(lo, mu.kinetic(i)), hi = std::max(hi, mu.kinetic(i));
+    return hi > lo * (1 + 1e-9);
+}
+
 // A registered kind of target by name (nullptr if none; design_target.cpp).
 const DesignTargetType* registered(const std::string& name);
 

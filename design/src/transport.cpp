@@ -48,7 +48,7 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
                             "part with that coefficient (no turn; the same velocity at every orientation); designed as that "
                             "point part, verified as the part itself");
         point.part.point = true;
-        point.part.mu.setConstant(part_scene.part.mu[0]);
+        point.part.mu.setConstant(part_scene.part.friction().kinetic(0));
     }
     const auto make = [&] { return TransportProblem(point, target.velocity, opt, T, &cycles); };
     // (stop within 0.01% of the target speed)

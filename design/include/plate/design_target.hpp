@@ -73,8 +73,9 @@ std::vector<double> design_target_values(const DesignTarget& t, bool point_part)
 
 // The options every front end may set, within the ranges every front end accepts (limits from 0 to
 // kMaxAmplitude, a period of 0 -- the part scene's -- or within kPeriodRange, hold 0 to 3600 s, starts
-// >= 0, evaluations and verify_starts >= 1, max_harmonic >= 0); throws std::invalid_argument naming the
-// option as Python names it ("limits: ...").
+// >= 0, evaluations and verify_starts >= 1, max_harmonic >= 0, max_coning a number); throws
+// std::invalid_argument naming the option as DesignOptions and Python name it ("limits: ..."; the
+// command line names its flag: "--limits: ...").
 void validate_design_options(const DesignOptions& opt);
 // The target for this part and these options (a period to design at, a transport's velocity, a target
 // inside the region, a line sink for point parts only, ...); throws std::invalid_argument with the
