@@ -1,8 +1,12 @@
+// The symbolic derivation, Section III: frames and rotations (1)-(9), the contacts' sliding
+// velocities, Newton's and Euler's laws (15), (21) with (27), (28), the linear system A z = b (31)
+// compared with (19), (30), and the U-dynamics (32)-(34); derive() runs these stages and those of
+// derivation_parts.cpp (stick-slip modes, the point/thick/thin parts, staging, Appendices A, B).
 #include "derivation.hpp"
 
 #include "codegen.hpp"
+#include "derivation_steps.hpp"
 
-#include <functional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -10,45 +14,9 @@
 namespace plate::symbolic {
 
 using namespace GiNaC;
+using namespace detail;
 
 namespace {
-
-std::string idx(const char* a, int i, const char* b = "") { return a + std::to_string(i + 1) + b; }
-
-matrix col(const ex& a, const ex& b, const ex& c) { return matrix{{a}, {b}, {c}}; }
-matrix hat(const matrix& v) { return matrix{{0, -v(2, 0), v(1, 0)}, {v(2, 0), 0, -v(0, 0)}, {-v(1, 0), v(0, 0), 0}}; }
-matrix cross(const matrix& a, const matrix& b) { return hat(a).mul(b); }
-matrix vee(const matrix& X) { return col(X(2, 1), X(0, 2), X(1, 0)); }
-
-matrix map(const matrix& M, const std::function<ex(const ex&)>& f) {
-    matrix out(M.rows(), M.cols());
-    for (unsigned i = 0; i < M.rows(); ++i)
-        for (unsigned j = 0; j < M.cols(); ++j) out(i, j) = f(M(i, j));
-    return out;
-}
-matrix expand_all(const matrix& M) { return map(M, [](const ex& e) { return e.expand(); }); }
-matrix sub(const matrix& a, const matrix& b) { return a.sub(b); }
-bool is_zero(const matrix& M) {
-    for (unsigned i = 0; i < M.rows(); ++i)
-        for (unsigned j = 0; j < M.cols(); ++j)
-            if (!M(i, j).expand().is_zero()) return false;
-    return true;
-}
-ex to_ex(const matrix& M) { return M; }
-
-// The total time derivative: d/dt e = sum over symbols s of (de/ds) s'.
-struct Jet {
-    std::vector<std::pair<realsymbol, ex>> rules;
-    ex D(const ex& e) const {
-        ex r = 0;
-        for (const auto& [s, ds] : rules) {
-            const ex de = e.diff(s);
-            if (!de.is_zero()) r += de * ds;
-        }
-        return r.expand();
-    }
-    matrix D(const matrix& M) const { return map(M, [this](const ex& e) { return D(e); }); }
-};
 
 std::vector<realsymbol> all_symbols(const Symbols& S) {
     std::vector<realsymbol> v = {S.m,  S.g,   S.Jxx, S.Jxy, S.Jxz, S.Jyy, S.Jyz, S.Jzz, S.cz,  S.thd, S.thdd,
@@ -58,32 +26,6 @@ std::vector<realsymbol> all_symbols(const Symbols& S) {
             v.push_back((*a)[i]);
     }
     return v;
-}
-
-// Eliminates s'' (rows 1, 2) and theta'' (row 6) from A z = b: returns M, r of the 3x3 system
-// M n = r (rows 3, 4, 5) and q'' in terms of n and b.
-struct Reduced {
-    matrix M, r, back;
-};
-Reduced reduce(const matrix& A, const std::array<realsymbol, 6>& b, const std::array<realsymbol, 3>& N) {
-    Reduced out{matrix(3, 3), matrix(3, 1), matrix(3, 1)};
-    const ex inv52 = 1 / A(5, 2);
-    const int rows[3] = {2, 3, 4};
-    for (int i = 0; i < 3; ++i) {
-        const int r = rows[i];
-        for (int k = 0; k < 3; ++k) out.M(i, k) = A(r, 3 + k) - A(r, 2) * inv52 * A(5, 3 + k);
-        out.r(i, 0) = b[r] - A(r, 2) * inv52 * b[5];
-    }
-    ex nx = b[0], ny = b[1], nt = b[5];
-    for (int k = 0; k < 3; ++k) {
-        nx -= A(0, 3 + k) * N[k];
-        ny -= A(1, 3 + k) * N[k];
-        nt -= A(5, 3 + k) * N[k];
-    }
-    out.back(0, 0) = nx / A(0, 0);
-    out.back(1, 0) = ny / A(1, 1);
-    out.back(2, 0) = nt * inv52;
-    return out;
 }
 
 }  // namespace
@@ -142,15 +84,13 @@ bool vanishes_on_rotations(const ex& e, const Symbols& S, int trials, unsigned s
     return true;
 }
 
-Derivation derive() {
-    Derivation d;
-    const Symbols& S = d.S;
-    for (int i = 0; i < 6; ++i) d.bsym[i] = realsymbol("b" + std::to_string(i));
-    auto find = [&](std::string eq, bool agrees, std::string printed, std::string derived, std::string reason) {
-        d.findings.push_back(Finding{std::move(eq), agrees, std::move(printed), std::move(derived), std::move(reason)});
-    };
+namespace {
 
-    // --- Frames (1)-(9) -------------------------------------------------------------------
+// --- Frames (1)-(9) -------------------------------------------------------------------
+// R1 from its entries, R2(theta) (2), the angular velocities, and the jet rule: p' = pd,
+// R1' = w1^ R1 (7), s' = sd, theta' = thd, ...; (8) is checked against the rule.
+Frames frames(Derivation& d) {
+    const Symbols& S = d.S;
     matrix R1(3, 3);
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) R1(i, j) = S.R[i][j];
@@ -175,26 +115,48 @@ Derivation derive() {
     J.rules.push_back({S.st, S.ct * S.thd});
     J.rules.push_back({S.thd, S.thdd});
     // s_z is constant (assumption 1): no rule.
-    find("(8)", is_zero(sub(J.D(R2), hat(w2).mul(R2))), "R2' = w2^ R2", "d/dt R2(theta) = w2^ R2, w2 = theta' e_z",
-         "derived by differentiating (2) in theta");
+    add_finding(d, "(8)", is_zero(sub(J.D(R2), hat(w2).mul(R2))), "R2' = w2^ R2", "d/dt R2(theta) = w2^ R2, w2 = theta' e_z",
+                "derived by differentiating (2) in theta");
+    return Frames{R1, R2, w1, wd1, w2, ez, J, {}, {}, {}, {}};   // s, s', W s'', the inertia J: set by later stages
+}
 
-    // --- Contacts and their sliding velocities (text after (14)) ---------------------------
+// --- Contacts and their sliding velocities (text after (14)) ---------------------------
+// The sliding velocity of each contact c_i, d/dt (s + R2 c_i) in P; sets s and s'.
+void contacts(Derivation& d, Frames& F) {
+    const Symbols& S = d.S;
+    const matrix& R2 = F.R2;
+    const matrix& w2 = F.w2;
+    const Jet& J = F.J;
     const matrix s = col(S.sx, S.sy, S.sz), sd = col(S.sxd, S.syd, 0);
     for (int i = 0; i < 3; ++i) {
         const matrix ci = col(S.cx[i], S.cy[i], S.cz);
         d.slip[i] = expand_all(J.D(s.add(R2.mul(ci))));     // velocity of c_i relative to the plate, in P
         const matrix printed = sd.add(hat(w2).mul(R2).mul(ci));
         if (i == 0)
-            find("text after (14)", is_zero(sub(d.slip[i], printed)), "P c_i' = s' + w2^ R2 c_i",
-                 "d/dt (s + R2 c_i) in the plate frame", "the sliding velocity of each contact");
+            add_finding(d, "text after (14)", is_zero(sub(d.slip[i], printed)), "P c_i' = s' + w2^ R2 c_i",
+                        "d/dt (s + R2 c_i) in the plate frame", "the sliding velocity of each contact");
     }
+    F.s = s;
+    F.sd = sd;
+}
 
-    // --- Newton (15) in W, premultiplied by R1^T (forces are in P' coordinates) -------------
+// --- Newton (15) in W, premultiplied by R1^T (forces are in P' coordinates) -------------
+// W s'' by differentiating W s = p + R1 s twice.
+void newton_acceleration(const Symbols& S, Frames& F) {
+    const Jet& J = F.J;
     const matrix pv = col(S.p[0], S.p[1], S.p[2]);
-    const matrix Ws = pv.add(R1.mul(s));
+    const matrix Ws = pv.add(F.R1.mul(F.s));
     const matrix Wsdd = J.D(J.D(Ws));
+    F.Wsdd = Wsdd;
+}
 
-    // --- Euler (21) in S' --------------------------------------------------------------------
+// --- Euler (21) in S' --------------------------------------------------------------------
+// The part's angular velocity (27) from R^T R', R = R1 R2, and its derivative (28), compared with
+// the printed forms; sets the inertia tensor J.
+void euler_angular_velocity(Derivation& d, Frames& F) {
+    const Symbols& S = d.S;
+    const matrix &R1 = F.R1, &R2 = F.R2, &w1 = F.w1, &wd1 = F.wd1, &w2 = F.w2;
+    const Jet& J = F.J;
     const matrix R = R1.mul(R2);
     const matrix X = R.transpose().mul(J.D(R));
     const matrix omega3_raw = vee(X.sub(X.transpose()).mul_scalar(numeric(1, 2)));
@@ -202,8 +164,8 @@ Derivation derive() {
     // R2^T w2 = w2 (w2 lies along the rotation axis of R2).
     d.omega3 = expand_all(R2.transpose().mul(R1.transpose()).mul(w1).add(w2));            // (27)
     const bool omega_ok = vanishes_on_rotations(to_ex(sub(omega3_raw, d.omega3)), S);
-    find("(27)", omega_ok && is_zero(sub(d.omega3, w2.add(R2.transpose().mul(R1.transpose()).mul(w1)))),
-         "w3 = w2 + R2^T R1^T w1", "vee(R^T R'), R = R1 R2, on SO(3)", "agrees (checked exactly on rational rotations)");
+    add_finding(d, "(27)", omega_ok && is_zero(sub(d.omega3, w2.add(R2.transpose().mul(R1.transpose()).mul(w1)))),
+                "w3 = w2 + R2^T R1^T w1", "vee(R^T R'), R = R1 R2, on SO(3)", "agrees (checked exactly on rational rotations)");
     d.omega3_dot = J.D(d.omega3);
     {
         const matrix w2dot = col(0, 0, S.thdd);
@@ -211,38 +173,57 @@ Derivation derive() {
         const matrix corrected = w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
         const bool printed_ok = vanishes_on_rotations(to_ex(sub(d.omega3_dot, printed)), S);
         const bool corrected_ok = is_zero(sub(d.omega3_dot, corrected));
-        find("(28)", printed_ok, "w3' = w2' - R2^T w2^ R1 w1 + R2^T R1^T w1'",
-             "w3' = w2' - R2^T w2^ R1^T w1 + R2^T R1^T w1'",
-             std::string("differentiating (27): d/dt(R1^T w1) = -R1^T w1^ w1 + R1^T w1' = R1^T w1', and ") +
-                 "d/dt R2^T = -R2^T w2^, so the middle term carries R1^T, as (30) uses it; the printed R1 " +
-                 "differs from R1^T unless the plate is level" + (corrected_ok ? "" : " [CORRECTED FORM FAILED]"));
+        add_finding(d, "(28)", printed_ok, "w3' = w2' - R2^T w2^ R1 w1 + R2^T R1^T w1'",
+                    "w3' = w2' - R2^T w2^ R1^T w1 + R2^T R1^T w1'",
+                    std::string("differentiating (27): d/dt(R1^T w1) = -R1^T w1^ w1 + R1^T w1' = R1^T w1', and ") +
+                        "d/dt R2^T = -R2^T w2^, so the middle term carries R1^T, as (30) uses it; the printed R1 " +
+                        "differs from R1^T unless the plate is level" + (corrected_ok ? "" : " [CORRECTED FORM FAILED]"));
     }
     const matrix Jm{{S.Jxx, S.Jxy, S.Jxz}, {S.Jxy, S.Jyy, S.Jyz}, {S.Jxz, S.Jyz, S.Jzz}};
+    F.Jm = Jm;
+}
 
-    // Newton's (15) and Euler's (21) laws for given friction forces f_i (P frame, z = 0); the
-    // contact force of contact i is N_i e_z + f_i (13). Returns [Newton; Euler] (6x1), zero on the
-    // motion. m W_s'' = R1 F - m g e_z (12)  =>  F - R1^T (m W_s'' + m g e_z) = 0, using R1^T R1 = I.
-    auto newton_euler = [&](const std::array<matrix, 3>& f) {
-        matrix Fsum = col(0, 0, 0), torque = col(0, 0, 0);
-        for (int i = 0; i < 3; ++i) {
-            const matrix Fi = ez.mul_scalar(S.N[i]).add(f[i]);
-            Fsum = Fsum.add(Fi);                                                             // (14)
-            torque = torque.add(cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(Fi)));   // (21) left side
-        }
-        const matrix EN = Fsum.sub(R1.transpose().mul(Wsdd.mul_scalar(S.m).add(ez.mul_scalar(S.m * S.g))));
-        const matrix EE = torque.sub(Jm.mul(d.omega3_dot).add(cross(d.omega3, Jm.mul(d.omega3))));
-        matrix E(6, 1);
-        for (int r = 0; r < 3; ++r) {
-            E(r, 0) = EN(r, 0).expand();
-            E(3 + r, 0) = EE(r, 0).expand();
-        }
-        return E;
-    };
-    std::array<matrix, 3> kinetic;   // (17): f_i = -mu_i N_i u_i, u_i the unit slip direction
+}  // namespace
+
+namespace detail {
+
+// Newton's (15) and Euler's (21) laws for given friction forces f_i (P frame, z = 0); the
+// contact force of contact i is N_i e_z + f_i (13). Returns [Newton; Euler] (6x1), zero on the
+// motion. m W_s'' = R1 F - m g e_z (12)  =>  F - R1^T (m W_s'' + m g e_z) = 0, using R1^T R1 = I.
+matrix newton_euler(const Derivation& d, const Frames& F, const std::array<matrix, 3>& f) {
+    const Symbols& S = d.S;
+    const matrix &R1 = F.R1, &R2 = F.R2, &ez = F.ez, &Wsdd = F.Wsdd, &Jm = F.Jm;
+    matrix Fsum = col(0, 0, 0), torque = col(0, 0, 0);
+    for (int i = 0; i < 3; ++i) {
+        const matrix Fi = ez.mul_scalar(S.N[i]).add(f[i]);
+        Fsum = Fsum.add(Fi);                                                             // (14)
+        torque = torque.add(cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(Fi)));   // (21) left side
+    }
+    const matrix EN = Fsum.sub(R1.transpose().mul(Wsdd.mul_scalar(S.m).add(ez.mul_scalar(S.m * S.g))));
+    const matrix EE = torque.sub(Jm.mul(d.omega3_dot).add(cross(d.omega3, Jm.mul(d.omega3))));
+    matrix E(6, 1);
+    for (int r = 0; r < 3; ++r) {
+        E(r, 0) = EN(r, 0).expand();
+        E(3 + r, 0) = EE(r, 0).expand();
+    }
+    return E;
+}
+
+}  // namespace detail
+
+namespace {
+
+// (17): f_i = -mu_i N_i u_i, u_i the unit slip direction.
+std::array<matrix, 3> kinetic_friction(const Symbols& S) {
+    std::array<matrix, 3> kinetic;
     for (int i = 0; i < 3; ++i) kinetic[i] = col(-S.mu[i] * S.N[i] * S.ux[i], -S.mu[i] * S.N[i] * S.uy[i], 0);
-    const matrix Eq = newton_euler(kinetic);
+    return kinetic;
+}
 
-    // --- A z = b (31) ------------------------------------------------------------------------
+// --- A z = b (31) ------------------------------------------------------------------------
+// A and b of the sliding dynamics from Newton-Euler Eq (linear in z = (s'', theta'', N)).
+void linear_system(Derivation& d, const matrix& Eq) {
+    const Symbols& S = d.S;
     const auto z = S.unknowns();
     d.A = matrix(6, 6);
     d.b_full = matrix(6, 1);
@@ -264,427 +245,115 @@ Derivation derive() {
                 throw std::logic_error("Newton's s'' coefficients are not -m I on SO(3)");
             d.A(r, k) = expect;
         }
-    {
-        // (31) as printed: [-M' D; -J' H], h_i = c_i^ R2^T d_i (23).
-        matrix Ap(6, 6);
-        Ap(0, 0) = -S.m;
-        Ap(1, 1) = -S.m;
-        for (int i = 0; i < 3; ++i) {
-            const matrix di = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0));
-            const matrix hi = cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(di));
-            for (int r = 0; r < 3; ++r) {
-                Ap(r, 3 + i) = di(r, 0);
-                Ap(3 + r, 3 + i) = hi(r, 0);
-                Ap(3 + r, 2) = -Jm(r, 2);
-            }
-        }
-        find("(31)", is_zero(sub(d.A, Ap)), "A = [-M' D; -J' H], M' = m(e_x e_x^T + e_y e_y^T), J' = J e_z e_z^T",
-             "coefficients of (s_x'', s_y'', theta'', N1, N2, N3) in Newton's and Euler's equations",
-             "agrees; uses (10): s_z'' = 0 and only theta'' about z");
-        // (19)
-        const matrix Rs = R1.mul(s);
-        const matrix f19 = R1.transpose()
-                               .mul(col(S.pdd[0], S.pdd[1], S.pdd[2])
-                                        .add(hat(w1).mul(hat(w1)).mul(Rs))
-                                        .add(hat(wd1).mul(Rs))
-                                        .add(hat(w1).mul(R1).mul(sd).mul_scalar(2))
-                                        .add(ez.mul_scalar(S.g)))
-                               .mul_scalar(S.m);
-        matrix bN(3, 1), bE(3, 1);
+}
+
+// A (31), f_dagger (19) and tau_dagger (30) compared with their printed forms.
+void compare_printed_dynamics(Derivation& d, const Frames& F) {
+    const Symbols& S = d.S;
+    const matrix &R1 = F.R1, &R2 = F.R2, &w1 = F.w1, &wd1 = F.wd1, &w2 = F.w2, &ez = F.ez, &s = F.s, &sd = F.sd,
+                 &Jm = F.Jm;
+    // (31) as printed: [-M' D; -J' H], h_i = c_i^ R2^T d_i (23).
+    matrix Ap(6, 6);
+    Ap(0, 0) = -S.m;
+    Ap(1, 1) = -S.m;
+    for (int i = 0; i < 3; ++i) {
+        const matrix di = ez.sub(col(S.mu[i] * S.ux[i], S.mu[i] * S.uy[i], 0));
+        const matrix hi = cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(di));
         for (int r = 0; r < 3; ++r) {
-            bN(r, 0) = d.b_full(r, 0);
-            bE(r, 0) = d.b_full(3 + r, 0);
-        }
-        find("(19)", is_zero(sub(bN, f19)), "f = m R1^T (p'' + w1^ w1^ R1 s + w1'^ R1 s + 2 w1^ R1 s' + g e_z)",
-             "twice d/dt of W s = p + R1 s with R1' = w1^ R1", "agrees");
-        // (30)
-        const matrix A2 = R2.transpose().mul(R1.transpose()).mul(w1);
-        const matrix t30 = Jm.mul(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1).mul_scalar(-1)
-                                      .add(R2.transpose().mul(R1.transpose()).mul(wd1)))
-                               .add(hat(w2).add(hat(A2)).mul(Jm).mul(w2.add(A2)));
-        find("(30)", is_zero(sub(bE, t30)), "tau = J(-R2^T w2^ R1^T w1 + R2^T R1^T w1') + (w2^ + (R2^T R1^T w1)^) J (w2 + R2^T R1^T w1)",
-             "J w3'|theta''=0 + w3^ J w3", "agrees (with R1^T in the first term, unlike (28))");
-    }
-
-    // --- Stick-slip modes (numeric/include/plate/modes.hpp) -------------------------------------
-    // Pivot k: contact k carries an unknown static friction f = (f_x, f_y) (P frame) instead of
-    // (17), and its slip stays zero, so its relative acceleration, the derivative of its sliding
-    // velocity, vanishes: two more rows. In the reduced U-dynamics (35) the configuration is
-    // frozen (R2 does not turn), so the same derivative is taken with theta' acting on nothing.
-    {
-        Jet frozen;
-        for (const auto& rule : J.rules)
-            if (!rule.first.is_equal(S.ct) && !rule.first.is_equal(S.st)) frozen.rules.push_back(rule);
-        const std::vector<realsymbol> zk = {S.sxdd, S.sydd, S.thdd, S.N[0], S.N[1], S.N[2], S.fx, S.fy};
-        exmap zero;
-        for (const auto& u : zk) zero[u] = 0;
-        for (int k = 0; k < 3; ++k) {
-            std::array<matrix, 3> f = kinetic;
-            f[k] = col(S.fx, S.fy, 0);
-            const matrix E = newton_euler(f);
-            const matrix c = J.D(d.slip[k]), cf = frozen.D(d.slip[k]);
-            if (!c(2, 0).is_zero()) throw std::logic_error("pivot constraint out of the plane");
-            matrix& A = d.pivot_A[k];
-            A = matrix(8, 8);
-            d.pivot_c[k] = matrix(2, 1);
-            for (int r = 0; r < 8; ++r) {
-                const ex e = r < 6 ? E(r, 0) : c(r - 6, 0);
-                ex lin = 0;
-                for (int j = 0; j < 8; ++j) {
-                    A(r, j) = e.diff(zk[j]).expand();
-                    lin += A(r, j) * zk[j];
-                }
-                const ex rest = (e - lin).expand();
-                if (!rest.subs(zero).is_equal(rest)) throw std::logic_error("pivot equations not linear in the unknowns");
-                // Friction does not enter b: the pivot's right side is the sliding one, (19)/(30).
-                if (r < 6 && !(rest + d.b_full(r, 0)).expand().is_zero())
-                    throw std::logic_error("pivot right-hand side differs from b");
-                // As for A: Newton's s'' coefficients are -m R1^T R1 = -m I on SO(3).
-                for (int j = 0; j < 2 && r < 3; ++j) {
-                    const ex expect = r == j ? ex(-S.m) : ex(0);
-                    if (!vanishes_on_rotations(A(r, j) - expect, S))
-                        throw std::logic_error("pivot: Newton's s'' coefficients are not -m I on SO(3)");
-                    A(r, j) = expect;
-                }
-                if (r >= 6) {
-                    d.pivot_c[k](r - 6, 0) = (-rest).expand();
-                    const ex ef = cf(r - 6, 0);
-                    for (int j = 0; j < 8; ++j)
-                        if (!(ef.diff(zk[j]) - A(r, j)).expand().is_zero())
-                            throw std::logic_error("frozen pivot constraint has other coefficients");
-                    if (!ef.subs(zero).expand().is_zero()) throw std::logic_error("frozen pivot constraint has a right side");
-                }
-            }
-        }
-        // The constraint is s'' + theta'' e_z x r_k - theta'^2 r_k = 0 (r_k = R2 c_k): check it.
-        {
-            const matrix rk = R2.mul(col(S.cx[0], S.cy[0], S.cz));
-            const matrix expect = col(S.sxdd - S.thdd * rk(1, 0) - S.thd * S.thd * rk(0, 0),
-                                      S.sydd + S.thdd * rk(0, 0) - S.thd * S.thd * rk(1, 0), 0);
-            find("pivot constraint", is_zero(sub(J.D(d.slip[0]), expect)), "(not in the paper)",
-                 "d/dt (s' + w2^ R2 c_k) = s'' + theta'' e_z x r_k - theta'^2 r_k = 0",
-                 "a contact held by static friction does not accelerate relative to the plate; the centripetal "
-                 "term theta'^2 r_k is absent in the reduced U-dynamics (35), whose configuration is frozen");
-        }
-
-        // Stuck: q'' = 0 and friction forces f_i = (f_ix, f_iy) of unknown distribution. The
-        // equations depend on the f_i only through the total F = sum f_i and the moment
-        // tau_z = sum r_i x f_i: every internal pair (equal and opposite forces along the line
-        // between two contacts) leaves them unchanged. So the normal forces and the needed friction
-        // wrench (F, tau_z) are determinate although the distribution is not.
-        std::array<realsymbol, 3> gx, gy;
-        std::array<matrix, 3> f;
-        for (int i = 0; i < 3; ++i) {
-            gx[i] = realsymbol(idx("f", i, "x"));
-            gy[i] = realsymbol(idx("f", i, "y"));
-            f[i] = col(gx[i], gy[i], 0);
-        }
-        exmap at_rest{{S.sxdd, 0}, {S.sydd, 0}, {S.thdd, 0}, {S.sxd, 0}, {S.syd, 0}, {S.thd, 0}};
-        const matrix E = newton_euler(f);
-        matrix lin(6, 1);   // the contact forces' part: E = lin - b at zero relative motion
-        for (int r = 0; r < 6; ++r) lin(r, 0) = (E(r, 0).subs(at_rest) + d.b_full(r, 0).subs(at_rest)).expand();
-        std::array<matrix, 3> r2;
-        for (int i = 0; i < 3; ++i) r2[i] = R2.mul(col(S.cx[i], S.cy[i], S.cz));
-        bool internal_ok = true;
-        for (int i = 0; i < 3; ++i) {
-            const int j = (i + 1) % 3;
-            exmap pair;
-            const ex ex_ = r2[j](0, 0) - r2[i](0, 0), ey = r2[j](1, 0) - r2[i](1, 0);
-            const realsymbol t("t");
-            pair[gx[i]] = gx[i] + t * ex_;
-            pair[gy[i]] = gy[i] + t * ey;
-            pair[gx[j]] = gx[j] - t * ex_;
-            pair[gy[j]] = gy[j] - t * ey;
-            for (int r = 0; r < 6; ++r) internal_ok = internal_ok && vanishes_on_rotations(lin(r, 0).subs(pair) - lin(r, 0), S);
-        }
-        if (!internal_ok) throw std::logic_error("the stuck equations depend on the friction distribution");
-        // f_1 = F - f_2 - f_3; then rows 1-5 hold F alone and row 6 is tau_z.
-        exmap total{{gx[0], S.Fx - gx[1] - gx[2]}, {gy[0], S.Fy - gy[1] - gy[2]}};
-        ex tau = 0;
-        for (int i = 0; i < 3; ++i) tau += r2[i](0, 0) * gy[i] - r2[i](1, 0) * gx[i];
-        lst eqs;
-        for (int r = 0; r < 6; ++r) {
-            ex e = lin(r, 0).subs(total).expand();
-            if (r == 5) {
-                const ex rest = (e - tau.subs(total)).expand();
-                if (!vanishes_on_rotations(rest.diff(gx[1]), S) || !vanishes_on_rotations(rest.diff(gy[1]), S) ||
-                    !vanishes_on_rotations(rest.diff(gx[2]), S) || !vanishes_on_rotations(rest.diff(gy[2]), S) ||
-                    !vanishes_on_rotations(rest.diff(S.Fx), S) || !vanishes_on_rotations(rest.diff(S.Fy), S))
-                    throw std::logic_error("the stuck yaw equation is not tau_z plus normal-force terms");
-                e = (rest.subs(exmap{{gx[1], 0}, {gy[1], 0}, {gx[2], 0}, {gy[2], 0}}) + S.tauz).expand();
-            }
-            for (int i = 1; i < 3; ++i)
-                if (!e.diff(gx[i]).is_zero() || !e.diff(gy[i]).is_zero())
-                    throw std::logic_error("the stuck equations depend on the friction distribution");
-            eqs.append(e == d.bsym[r]);
-        }
-        const ex sol = lsolve(eqs, lst{S.N[0], S.N[1], S.N[2], S.Fx, S.Fy, S.tauz});
-        // Written over the contacts' determinant (fixed here: normal() picks the sign of a
-        // denominator from GiNaC's run-dependent term order).
-        d.stuck_det = (S.cx[1] * S.cy[2] - S.cx[2] * S.cy[1] - S.cx[0] * S.cy[2] + S.cx[2] * S.cy[0] +
-                       S.cx[0] * S.cy[1] - S.cx[1] * S.cy[0]).expand();
-        d.stuck_solution = matrix(6, 1);
-        for (int r = 0; r < 6; ++r) {
-            const ex num = (sol.op(r).rhs() * d.stuck_det).normal().expand();
-            if (!is_a<add>(num) && !is_a<mul>(num) && !is_a<symbol>(num) && !is_a<numeric>(num))
-                throw std::logic_error("stuck solution: unexpected form");
-            if (!(num / d.stuck_det - sol.op(r).rhs()).normal().is_zero() || num.denom() != 1)
-                throw std::logic_error("stuck solution is not polynomial over the contacts' determinant");
-            d.stuck_solution(r, 0) = num;
-        }
-        find("stuck mode", internal_ok, "(not in the paper)",
-             "N (3), F = sum f_i, tau_z = sum r_i x f_i from Newton-Euler with q'' = 0",
-             "the friction distribution of a stuck part is indeterminate, but Newton-Euler depends on it only "
-             "through (F, tau_z): internal pairs of equal and opposite forces along the lines between contacts "
-             "change nothing (checked exactly). The part stays stuck while (F, tau_z) lies in the friction set, "
-             "whose support function is the dissipation power P of Appendix B");
-
-        // Break-away from stuck: the gauge max_d (d . w) / P(d) of the needed wrench w against the
-        // friction set, P(d) = sum_i mu_i N_i |G_i^T d| (the support function, Appendix B). Each term
-        // with its gradient and Hessian in d = (vx, vy, xith) drives the gauge's Newton iteration.
-        for (int i = 0; i < 3; ++i) {
-            const ex om = S.xith / S.rho;
-            const ex vix = S.vx - om * S.ry[i], viy = S.vy + om * S.rx[i];
-            d.support_speed[i] = sqrt(vix * vix + viy * viy);
-            d.support_term[i] = S.mu[i] * S.N[i] * d.support_speed[i];
+            Ap(r, 3 + i) = di(r, 0);
+            Ap(3 + r, 3 + i) = hi(r, 0);
+            Ap(3 + r, 2) = -Jm(r, 2);
         }
     }
-
-    // --- U-dynamics (32)-(34) -----------------------------------------------------------------
-    {
-        exmap level;   // R1 = I, omega1 = 0 (small amplitude, property 2)
-        for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) level[S.R[i][j]] = i == j ? 1 : 0;
-            level[S.w[i]] = 0;
-        }
-        const realsymbol lam("lam");
-        exmap scale{{S.thd, lam * S.thd}, {S.sxd, lam * S.sxd}, {S.syd, lam * S.syd}};
-        d.b_U = matrix(6, 1);
-        for (int r = 0; r < 6; ++r) {
-            // Property 4: drop products of velocities (Coriolis, centripetal and w2^ J w2).
-            const ex e = d.b_full(r, 0).subs(level).subs(scale).expand();
-            d.b_U(r, 0) = (e.coeff(lam, 0) + e.coeff(lam, 1).subs(lam == 1)).expand();
-        }
-        const matrix f33 = col(S.pdd[0], S.pdd[1], S.pdd[2]).add(cross(wd1, s)).add(ez.mul_scalar(S.g)).mul_scalar(S.m);
-        const matrix t34 = Jm.mul(R2.transpose()).mul(wd1);
-        matrix bN(3, 1), bE(3, 1);
-        for (int r = 0; r < 3; ++r) {
-            bN(r, 0) = d.b_U(r, 0);
-            bE(r, 0) = d.b_U(3 + r, 0);
-        }
-        find("(33)", is_zero(sub(bN, f33)), "f~ = m(p'' + w1'^ s0 + g e_z)",
-             "f_dagger with R1 = I, w1 = 0 (s0 is the current s)",
-             "agrees. Note: property 4 as worded (drop products of elements of x and u) would also drop "
-             "w1'^ s (u times x); (33) keeps it, and so does the derivation: what is dropped is R1 - I, "
-             "w1, and products of velocities");
-        find("(34)", is_zero(sub(bE, t34)), "tau~ = J R2^T w1'",
-             "tau_dagger with R1 = I, w1 = 0, no products of velocities",
-             "agrees; the part's own gyroscopic term w2^ J w2 = theta'^2 e_z^ J e_z is dropped too "
-             "(it vanishes when J_xz = J_yz = 0)");
+    add_finding(d, "(31)", is_zero(sub(d.A, Ap)), "A = [-M' D; -J' H], M' = m(e_x e_x^T + e_y e_y^T), J' = J e_z e_z^T",
+                "coefficients of (s_x'', s_y'', theta'', N1, N2, N3) in Newton's and Euler's equations",
+                "agrees; uses (10): s_z'' = 0 and only theta'' about z");
+    // (19)
+    const matrix Rs = R1.mul(s);
+    const matrix f19 = R1.transpose()
+                           .mul(col(S.pdd[0], S.pdd[1], S.pdd[2])
+                                    .add(hat(w1).mul(hat(w1)).mul(Rs))
+                                    .add(hat(wd1).mul(Rs))
+                                    .add(hat(w1).mul(R1).mul(sd).mul_scalar(2))
+                                    .add(ez.mul_scalar(S.g)))
+                           .mul_scalar(S.m);
+    matrix bN(3, 1), bE(3, 1);
+    for (int r = 0; r < 3; ++r) {
+        bN(r, 0) = d.b_full(r, 0);
+        bE(r, 0) = d.b_full(3 + r, 0);
     }
+    add_finding(d, "(19)", is_zero(sub(bN, f19)), "f = m R1^T (p'' + w1^ w1^ R1 s + w1'^ R1 s + 2 w1^ R1 s' + g e_z)",
+                "twice d/dt of W s = p + R1 s with R1' = w1^ R1", "agrees");
+    // (30)
+    const matrix A2 = R2.transpose().mul(R1.transpose()).mul(w1);
+    const matrix t30 = Jm.mul(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1).mul_scalar(-1)
+                                  .add(R2.transpose().mul(R1.transpose()).mul(wd1)))
+                           .add(hat(w2).add(hat(A2)).mul(Jm).mul(w2.add(A2)));
+    add_finding(d, "(30)", is_zero(sub(bE, t30)), "tau = J(-R2^T w2^ R1^T w1 + R2^T R1^T w1') + (w2^ + (R2^T R1^T w1)^) J (w2 + R2^T R1^T w1)",
+                "J w3'|theta''=0 + w3^ J w3", "agrees (with R1^T in the first term, unlike (28))");
+}
 
-    // --- Point part -----------------------------------------------------------------------------
-    {
-        const realsymbol &sxdd = S.sxdd, &sydd = S.sydd, &N = S.N[0];
-        const matrix F = ez.sub(col(S.mu[0] * S.ux[0], S.mu[0] * S.uy[0], 0)).mul_scalar(N);
-        const matrix E = F.sub(col(sxdd, sydd, 0).mul_scalar(S.m));   // = b (first three rows)
-        d.A_point = matrix(3, 3);
-        const ex zp[3] = {sxdd, sydd, N};
-        for (int r = 0; r < 3; ++r)
-            for (int k = 0; k < 3; ++k) d.A_point(r, k) = E(r, 0).diff(ex_to<symbol>(zp[k])).expand();
-        lst eqs, unk{sxdd, sydd, N};
-        for (int r = 0; r < 3; ++r) eqs.append(E(r, 0) == d.bsym[r]);
-        const ex sol = lsolve(eqs, unk);
-        d.point_solution = matrix(3, 1);
-        for (int k = 0; k < 3; ++k) d.point_solution(k, 0) = sol.op(k).rhs().expand();
+// --- U-dynamics (32)-(34) -----------------------------------------------------------------
+// b~ from b with the plate level (R1 = I, omega1 = 0) and no products of velocities, compared
+// with (33) and (34).
+void u_dynamics(Derivation& d, const Frames& F) {
+    const Symbols& S = d.S;
+    const matrix &R2 = F.R2, &wd1 = F.wd1, &ez = F.ez, &s = F.s, &Jm = F.Jm;
+    exmap level;   // R1 = I, omega1 = 0 (small amplitude, property 2)
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) level[S.R[i][j]] = i == j ? 1 : 0;
+        level[S.w[i]] = 0;
     }
-
-    // --- Thick part: reduce A z = b to 3x3 in n --------------------------------------------------
-    {
-        const matrix& A = d.A;
-        for (int r : {0, 1, 2, 3, 4, 5})
-            for (int k : {0, 1})
-                if (r != k && !A(r, k).is_zero()) throw std::logic_error("unexpected structure of A");
-        if (!A(0, 2).is_zero() || !A(1, 2).is_zero() || !A(2, 2).is_zero()) throw std::logic_error("theta'' in Newton");
-        // Row 6 (index 5) gives theta''; rows 1, 2 give s''; rows 3, 4, 5 then hold only n.
-        const Reduced red = reduce(A, d.bsym, S.N);
-        d.M_reduced = expand_all(red.M);
-        d.r_reduced = expand_all(red.r);
-        d.back_substitution = expand_all(red.back);
+    const realsymbol lam("lam");
+    exmap scale{{S.thd, lam * S.thd}, {S.sxd, lam * S.sxd}, {S.syd, lam * S.syd}};
+    d.b_U = matrix(6, 1);
+    for (int r = 0; r < 6; ++r) {
+        // Property 4: drop products of velocities (Coriolis, centripetal and w2^ J w2).
+        const ex e = d.b_full(r, 0).subs(level).subs(scale).expand();
+        d.b_U(r, 0) = (e.coeff(lam, 0) + e.coeff(lam, 1).subs(lam == 1)).expand();
     }
-
-    // --- Staged forms for code generation ----------------------------------------------------------
-    {
-        const matrix& A = d.A;
-        // The torque rows through the friction directions in the part frame, dS_i = R2^T d_i:
-        // h_i = c_i x dS_i (23) is then of degree 2 instead of a sum of degree-5 monomials.
-        std::array<matrix, 3> hS;
-        for (int i = 0; i < 3; ++i) {
-            const matrix dS = R2.transpose().mul(col(-S.mu[i] * S.ux[i], -S.mu[i] * S.uy[i], 1));
-            const realsymbol dx("dS" + std::to_string(i + 1) + "x"), dy("dS" + std::to_string(i + 1) + "y");
-            d.A_placeholders.push_back({dx, dS(0, 0).expand()});
-            d.A_placeholders.push_back({dy, dS(1, 0).expand()});
-            hS[i] = cross(col(S.cx[i], S.cy[i], S.cz), col(dx, dy, 1));
-            exmap back{{dx, dS(0, 0)}, {dy, dS(1, 0)}};
-            for (int r = 0; r < 3; ++r)
-                if (!(hS[i](r, 0).subs(back) - A(3 + r, 3 + i)).expand().is_zero())
-                    throw std::logic_error("h_i through dS_i differs from A");
-        }
-        matrix G(6, 6);
-        for (int r = 0; r < 6; ++r)
-            for (int k = 0; k < 6; ++k) {
-                const ex e = r >= 3 && k >= 3 ? hS[k - 3](r - 3, 0).expand() : A(r, k);
-                if (is_a<numeric>(e) || is_a<symbol>(e) || is_a<symbol>(-e)) {
-                    G(r, k) = e;
-                } else {
-                    const realsymbol a("a" + std::to_string(r) + std::to_string(k));
-                    d.A_placeholders.push_back({a, e});
-                    G(r, k) = a;
-                }
-            }
-        const Reduced staged = reduce(G, d.bsym, S.N);
-        d.M_staged = staged.M;
-        d.r_staged = staged.r;
-        d.back_staged = staged.back;
-        // The staged forms are the derived ones once the placeholders are filled in.
-        exmap fill;   // later placeholders may use earlier ones: fill in order
-        for (const auto& [a, e] : d.A_placeholders) fill[a] = e.subs(fill);
-        for (int i = 0; i < 3; ++i) {
-            for (int k = 0; k < 3; ++k)
-                if (!(d.M_staged(i, k).subs(fill) - d.M_reduced(i, k)).expand().is_zero())
-                    throw std::logic_error("staged reduction differs");
-            if (!(d.back_staged(i, 0).subs(fill) - d.back_substitution(i, 0)).expand().is_zero())
-                throw std::logic_error("staged back substitution differs");
-        }
-
-        // Full dynamics in plate-frame vectors.
-        const char* ax[] = {"x", "y", "z"};
-        matrix Om(3, 1), al(3, 1), ap(3, 1), ga(3, 1);
-        const matrix R1tw = R1.transpose().mul(w1), R1twd = R1.transpose().mul(wd1);
-        const matrix R1tp = R1.transpose().mul(col(S.pdd[0], S.pdd[1], S.pdd[2])), R1tez = R1.transpose().mul(ez);
-        for (int i = 0; i < 3; ++i) {
-            const realsymbol o(std::string("Om") + ax[i]), a(std::string("al") + ax[i]),
-                p(std::string("ap") + ax[i]), gm(std::string("ga") + ax[i]);
-            d.plate_frame_placeholders.push_back({o, R1tw(i, 0)});
-            d.plate_frame_placeholders.push_back({a, R1twd(i, 0)});
-            d.plate_frame_placeholders.push_back({p, R1tp(i, 0)});
-            d.plate_frame_placeholders.push_back({gm, R1tez(i, 0)});
-            Om(i, 0) = o;
-            al(i, 0) = a;
-            ap(i, 0) = p;
-            ga(i, 0) = gm;
-        }
-        // R1^T (w^ w^ R1 s) = Om^ Om^ s, R1^T (w'^ R1 s) = al^ s, R1^T (w^ R1 s') = Om^ s'.
-        const matrix f = ap.add(cross(Om, cross(Om, s))).add(cross(al, s)).add(cross(Om, sd).mul_scalar(2))
-                             .add(ga.mul_scalar(S.g)).mul_scalar(S.m);
-        const matrix R2t = R2.transpose();
-        const matrix w3 = w2.add(R2t.mul(Om));
-        const matrix tau = Jm.mul(R2t.mul(cross(w2, Om)).mul_scalar(-1).add(R2t.mul(al))).add(cross(w3, Jm.mul(w3)));
-        d.b_full_staged = matrix(6, 1);
-        exmap fillp;
-        for (const auto& [a, e] : d.plate_frame_placeholders) fillp[a] = e;
-        for (int r = 0; r < 3; ++r) {
-            d.b_full_staged(r, 0) = f(r, 0);
-            d.b_full_staged(3 + r, 0) = tau(r, 0);
-        }
-        for (int r = 0; r < 6; ++r)
-            if (!vanishes_on_rotations(d.b_full_staged(r, 0).subs(fillp) - d.b_full(r, 0), S))
-                throw std::logic_error("plate-frame form of b differs on SO(3), row " + std::to_string(r));
+    const matrix f33 = col(S.pdd[0], S.pdd[1], S.pdd[2]).add(cross(wd1, s)).add(ez.mul_scalar(S.g)).mul_scalar(S.m);
+    const matrix t34 = Jm.mul(R2.transpose()).mul(wd1);
+    matrix bN(3, 1), bE(3, 1);
+    for (int r = 0; r < 3; ++r) {
+        bN(r, 0) = d.b_U(r, 0);
+        bE(r, 0) = d.b_U(3 + r, 0);
     }
+    add_finding(d, "(33)", is_zero(sub(bN, f33)), "f~ = m(p'' + w1'^ s0 + g e_z)",
+                "f_dagger with R1 = I, w1 = 0 (s0 is the current s)",
+                "agrees. Note: property 4 as worded (drop products of elements of x and u) would also drop "
+                "w1'^ s (u times x); (33) keeps it, and so does the derivation: what is dropped is R1 - I, "
+                "w1, and products of velocities");
+    add_finding(d, "(34)", is_zero(sub(bE, t34)), "tau~ = J R2^T w1'",
+                "tau_dagger with R1 = I, w1 = 0, no products of velocities",
+                "agrees; the part's own gyroscopic term w2^ J w2 = theta'^2 e_z^ J e_z is dropped too "
+                "(it vanishes when J_xz = J_yz = 0)");
+}
 
-    // --- Thin part (Appendix A) --------------------------------------------------------------------
-    {
-        const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};
-        auto swapped = [](const matrix& A) {
-            matrix B = A;
-            for (int k = 0; k < 6; ++k) std::swap(B(2, k), B(5, k));   // rows 3 and 6
-            return B;
-        };
-        d.A_thin_swapped = swapped(map(d.A, [&](const ex& e) { return e.subs(thin).expand(); }));
-        d.A_thick_swapped = swapped(d.A);
-        d.M38 = matrix(3, 3);
-        d.r38_U = matrix(3, 1);
-        for (int i = 0; i < 3; ++i)
-            for (int k = 0; k < 3; ++k) d.M38(i, k) = d.A_thin_swapped(3 + i, 3 + k);
-        // The right-hand side follows the row swap: rows 4, 5 of b, then row 3.
-        const int rb[3] = {3, 4, 2};
-        for (int i = 0; i < 3; ++i) d.r38_U(i, 0) = d.b_U(rb[i], 0).subs(thin).expand();
-        bool lower_zero = true, upper_nonzero = false;
-        for (int r = 3; r < 6; ++r)
-            for (int k = 0; k < 3; ++k) lower_zero = lower_zero && d.A_thin_swapped(r, k).is_zero();
-        for (int r = 0; r < 3; ++r)
-            for (int k = 3; k < 6; ++k) upper_nonzero = upper_nonzero || !d.A_thin_swapped(r, k).is_zero();
-        find("Appendix A (block diagonal)", lower_zero && !upper_nonzero,
-             "swapping rows 3 and 6 makes A block diagonal",
-             "swapping rows 3 and 6 makes A block upper triangular: [[-m I, -, D_xy], [0, -J_zz, h_z], [0, 0, M38]]",
-             "the lower-left block vanishes, so n decouples (M38 n = r38), but the upper-right block "
-             "holds the friction terms d_i,xy and h_i,z, which are not zero; the claim that matters, "
-             "decoupled and velocity-free normal forces, holds");
-        const matrix Mp{{S.cy[0], S.cy[1], S.cy[2]}, {-S.cx[0], -S.cx[1], -S.cx[2]}, {1, 1, 1}};
-        const matrix Jt{{S.Jxx, S.Jxy, 0}, {S.Jxy, S.Jyy, 0}, {0, 0, S.Jzz}};
-        const matrix JRw = Jt.mul(R2.transpose()).mul(wd1);
-        const matrix s0 = col(S.sx, S.sy, 0);
-        const ex fz = col(S.pdd[0], S.pdd[1], S.pdd[2]).add(cross(wd1, s0)).add(ez.mul_scalar(S.g)).mul_scalar(S.m)(2, 0);
-        const matrix rp = col(JRw(0, 0), JRw(1, 0), fz);
-        const bool matrix_ok = is_zero(sub(d.M38, Mp)), rhs_ok = is_zero(sub(d.r38_U, rp));
-        // The printed right-hand side is not well formed (see the reason), so it cannot agree.
-        find("(38)", false,
-             "[c_y; -c_x; 1 1 1] n = [e_x^T J R R2^T w1'; e_y^T J R2^T w1'; e_z^T m(p'' + w1'^ s0 + g e_z^T)]",
-             "[c_y; -c_x; 1 1 1] n = [e_x^T J R2^T w1'; e_y^T J R2^T w1'; m e_z^T (p'' + w1'^ s0 + g e_z)]",
-             std::string(matrix_ok && rhs_ok ? "the derived system equals the corrected form" : "[DERIVED DIFFERS]") +
-                 ": the printed third row adds g e_z^T (a row) to column vectors, it is g e_z; the first "
-                 "row's 'J R R2^T' is J R2^T");
-        {
-            // (37) as printed: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1 1 1], [0 0 0 c_y], [0 0 0 -c_x],
-            // [0 0 -J_zz h_z]; h_i,z is not spelled out in the paper, so row 6 is compared up to it.
-            const matrix At = map(d.A, [&](const ex& e) { return e.subs(thin).expand(); });
-            matrix P37(6, 6);
-            P37(0, 0) = -S.m;
-            P37(1, 1) = -S.m;
-            P37(5, 2) = -S.Jzz;
-            for (int i = 0; i < 3; ++i) {
-                P37(0, 3 + i) = -S.mu[i] * S.ux[i];
-                P37(1, 3 + i) = -S.mu[i] * S.uy[i];
-                P37(2, 3 + i) = 1;
-                P37(3, 3 + i) = S.cy[i];
-                P37(4, 3 + i) = -S.cx[i];
-                P37(5, 3 + i) = At(5, 3 + i);
-            }
-            find("(37)", is_zero(sub(At, P37)), "thin-part A: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1], [0 0 0 c_y], [0 0 0 -c_x], [0 0 -J_zz h_z]",
-                 "A with c_z = 0, J_xz = J_yz = 0", "agrees: h_i = [c_i,y, -c_i,x, h_i,z]");
-        }
-    }
+}  // namespace
 
-    // --- Limit surface (Appendix B) ----------------------------------------------------------------
-    {
-        d.wrench = matrix(3, 1);
-        d.power = 0;
-        ex Fx = 0, Fy = 0, tau = 0;
-        for (int i = 0; i < 3; ++i) {
-            const ex om = S.xith / S.rho;                       // xi_theta = rho omega
-            const ex vix = S.vx - om * S.ry[i], viy = S.vy + om * S.rx[i];
-            const ex speed = sqrt(vix * vix + viy * viy);
-            const ex fx = -S.mu[i] * S.N[i] * vix / speed, fy = -S.mu[i] * S.N[i] * viy / speed;
-            Fx += fx;
-            Fy += fy;
-            tau += S.rx[i] * fy - S.ry[i] * fx;
-            d.power += S.mu[i] * S.N[i] * speed;
-        }
-        // Expanded: a canonical form whose structure does not depend on GiNaC's run-dependent
-        // term order (which decides, e.g., where a sign is pulled out of a sum).
-        d.wrench(0, 0) = Fx.expand();
-        d.wrench(1, 0) = Fy.expand();
-        d.wrench(2, 0) = (tau / S.rho).expand();                 // w_theta = tau / rho
-        const ex n0 = (d.wrench(0, 0) + d.power.diff(S.vx)).normal();
-        const ex n1 = (d.wrench(1, 0) + d.power.diff(S.vy)).normal();
-        const ex n2 = (d.wrench(2, 0) + d.power.diff(S.xith)).normal();
-        find("Appendix B (normality)", n0.is_zero() && n1.is_zero() && n2.is_zero(),
-             "the relative twist is normal to the limit surface at the frictional wrench",
-             "w = -grad_xi P(xi), P = sum mu_i N_i |v_i| (the dissipated power), in the footnote's scaled "
-             "coordinates",
-             "agrees: the wrench is minus the gradient of a convex function of the twist, so the twist is "
-             "normal to the level set (the limit surface) in wrench space");
-    }
+// The stages in the paper's order (and in the order in which they create symbols).
+Derivation derive() {
+    Derivation d;
+    for (int i = 0; i < 6; ++i) d.bsym[i] = realsymbol("b" + std::to_string(i));
+    Frames F = frames(d);                                  // (1)-(9)
+    contacts(d, F);                                        // text after (14)
+    newton_acceleration(d.S, F);                           // (15)
+    euler_angular_velocity(d, F);                          // (21), (27), (28)
+    const std::array<matrix, 3> kinetic = kinetic_friction(d.S);   // (17)
+    const matrix Eq = newton_euler(d, F, kinetic);
+    linear_system(d, Eq);                                  // (31)
+    compare_printed_dynamics(d, F);                        // (31), (19), (30)
+    pivot_modes(d, F, kinetic);                            // stick-slip modes
+    stuck_mode(d, F);
+    support_function(d);
+    u_dynamics(d, F);                                      // (32)-(34)
+    point_part(d, F);
+    thick_reduction(d);
+    staged_reduction(d, F);                                // for code generation
+    staged_plate_frame_b(d, F);
+    thin_part(d, F);                                       // Appendix A, (37), (38)
+    limit_surface(d);                                      // Appendix B
     return d;
 }
 
