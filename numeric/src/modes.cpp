@@ -32,7 +32,7 @@ gen::KernelInput mode_input(const Vec3& q, const Vec3& qd, const Workspace& ws) 
 }
 
 // Newton-Euler with contact k held (unknown f_k) and the others sliding along u_i: the derived
-// system pivotK_system (symbolic/derivation.cpp), unknowns [s_x'', s_y'', theta'', N1, N2, N3, f_kx, f_ky].
+// system pivotK_system (symbolic/derivation_parts.cpp, pivot_modes), unknowns [s_x'', s_y'', theta'', N1, N2, N3, f_kx, f_ky].
 void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd, const PlateState& ps,
                  const std::array<Vec2, 3>& u, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);

@@ -15,7 +15,7 @@
 // A point part has one contact: Slide or Stuck. The set is complete: every state has exactly
 // one Z, and a mode change is a change of Z (located as an event by the engine).
 //
-// DERIVED, NOT TYPED: symbolic/derivation.cpp derives each mode from the same Newton-Euler
+// DERIVED, NOT TYPED: symbolic/derivation_parts.cpp (pivot_modes, stuck_mode) derives each mode from the same Newton-Euler
 // equations as the sliding model -- the pivot's constraint by differentiating contact k's sliding
 // velocity (and checks that the frozen configuration of (35) drops theta'^2 r_k), the stuck
 // part's normal forces and needed wrench (and checks exactly that internal force pairs change
