@@ -44,7 +44,7 @@ inline std::string esc(const std::string& s) {
 
 
 // gnuplot SCRIPT run in folder `dir`, stderr to `log`, without a shell (a folder's name is data, not
-// a command: an apostrophe in --out once ran what followed it).
+// a command: through a shell, a quote in --out would run what follows it).
 inline bool run_gnuplot(const fs::path& dir, const std::string& script, const fs::path& log) {
     const pid_t pid = ::fork();
     if (pid < 0) return false;

@@ -6,13 +6,11 @@
 # under valgrind. Any sanitizer or valgrind report fails the run (halt_on_error; UBSan made fatal).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# Clang (Debian's clang 14 with its sanitizer runtime, scripts/install-deps.sh): its ASan/UBSan build
-# took 470 s of this machine's 2 cores where g++ 12's took 908 s (CI, 2026-11-28: half of CI's
-# time), and its UBSan checks more: float-cast-overflow is in clang's -fsanitize=undefined, not in
-# g++'s (it found a cast of 1.7e308 to long long in the fuzz mutator). Its -O1 code runs the cases
-# about 1.5x slower than g++'s (Fig. 6's field test 26 s against 17 s), so the stage as a whole went
-# from 1 178 s to 795 s (build 550 s, the runs below 245 s); at -O2 the build took 650 s and the runs
-# 180 s (831 s), so -O1 stays, the level the sanitizers are meant for. -g1: line tables for the reports.
+# Clang (Debian's clang 14 with its sanitizer runtime, scripts/install-deps.sh), not g++: its ASan/UBSan
+# build takes about half as long, which outweighs its slower -O1 code, and its UBSan checks more
+# (float-cast-overflow is in clang's -fsanitize=undefined, not in g++'s). -O1, the level the sanitizers
+# are meant for: at -O2 the longer build costs more than the faster runs save. -g1: line tables for the
+# reports. (docs/decisions.md, The sanitizer stage: clang at -O1, runs side by side)
 cmake -S . -B build-asan -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
       -DPLATE_SANITIZE=ON >/dev/null
 # (A sanitizer build compiles only the test files whose cases run here: tests/CMakeLists.txt.)
@@ -33,9 +31,9 @@ sed '/^[[:space:]]*$/d' "$work/listing" > "$work/cases"
 ncases=$(wc -l < "$work/cases")
 [ "$ncases" -ge 60 ] || { echo "sanitizers: only $ncases cases listed for $tags" >&2; exit 1; }
 # Each of the four runs below takes one core most of its time and they are independent, so they run
-# side by side on the machine's cores (in sequence they took 270 s, one core idle; CI 2026-11-28):
-# the cases in two halves (every other case in the listing, which interleaves the slow and the
-# fast files), the fuzz replay, valgrind.
+# side by side on the machine's cores (in sequence one core would idle): the cases in two halves
+# (every other case in the listing, which interleaves the slow and the fast files), the fuzz replay,
+# valgrind.
 # (Catch2 2 reads each line of -f as one name, but splits it at commas and takes [ ] * ~ \ as test-spec
 # syntax: those are escaped.)
 sed 's/[],[*~\\]/\\&/g' "$work/cases" |
@@ -47,9 +45,8 @@ run() {   # NAME COMMAND...: output to $work/NAME.log, exit code to $work/NAME.r
 # The fuzz target's replay: the committed corpus and 3 000 new seeded mutants (tests/fuzz/), seed 2:
 # others than the release test's 10^4 (seed 1), so that the two runs together cover more inputs.
 fuzz() { (cd build-asan && tests/plate_fuzz_replay ../tests/fuzz/corpus --mutants 3000 --seed 2); }
-# Uninitialised reads, which ASan does not see (a point part's contacts were once garbage and its
-# motion depended on the environment's size): the release program under valgrind on each kind of
-# part and command. Any report fails the run.
+# Uninitialised reads, which ASan does not see (a motion that depends on the environment): the
+# release program under valgrind on each kind of part and command. Any report fails the run.
 memcheck() {
   local args
   for args in "twist scenes/fig4.json --at 0.03 -0.02 1.0" "twist scenes/fig1_point.json --at 0.01 0.02" \

@@ -267,8 +267,9 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
 namespace detail {
 // The engine's most frequent evaluation (models.hpp): a slide without creep in the reduced
 // U-dynamics, straight to the staged kernels -- what mode_accelerations and accelerations do for it,
-// without their dispatch (7 % of fig6's field's instructions). False where that path declines (an
-// unprepared workspace, a near-singular thick part): the caller then takes mode_accelerations.
+// without their dispatch. False where that path declines (an unprepared workspace, a near-singular
+// thick part): the caller then takes mode_accelerations. (docs/decisions.md, Per-evaluation cuts in
+// the right-hand side)
 bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
     if (ks.prepared != &sc || !accelerations_reduced_U(sc.part, q, qd, ps, ws)) return false;

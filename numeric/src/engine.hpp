@@ -207,10 +207,10 @@ private:
 
     // --- large slips (try_step) ---
     // A step whose slips all exceed this (relative to v_ref) may take IntegrationOptions::large_slip_factor
-    // rtol: three times the creep speed (fig6's field, factor 10: 1e-2 and 3e-2 save alike, 1e-1 a third less).
+    // rtol: three times the creep speed.
     static constexpr double kLargeSlip = 3e-2;
-    // ... but no looser than 1e-6 (and never tighter than rtol): fig4's cycle at (0.02, -0.01, 0.5),
-    // shot at rtol 1e-6 from 0.05 v_ref off, 8.9 cycle tolerances off without the cap, 0.27 with it.
+    // ... but no looser than 1e-6 (and never tighter than rtol): looser, a shot cycle lands several
+    // cycle tolerances off. (docs/decisions.md, Where every slip is large, the shooting steps coarser)
     static constexpr double kLargeSlipRtolCap = 1e-6;
 
     // --- lingering slips (accept_step) ---
@@ -228,17 +228,15 @@ private:
     double creep_h_ = std::numeric_limits<double>::infinity();
     static constexpr double kCreepFirst = 1e-4;   // the first step of a creep, relative to T
     // creep_inconsistent judges a creeping slip's direction only above this many hint_speeds: below, a
-    // slip is within a few times the integration's noise and so is its direction (heave_yaw at
-    // (0, 0.02, 0), rtol 1e-9: a rim-sliding slip at ~1.5 hint speeds stopped its creep after every
-    // step, 2.2e7 right-hand sides for the cycle; now 2.5e5; 10 let a creep run on where it no longer
-    // held, 1.2e-6 v_ref off the regularised reference).
+    // slip is within a few times the integration's noise and so is its direction: judged there, a
+    // rim-sliding slip would stop its creep after every step; judged only far above, a creep would run
+    // on where it no longer holds. (docs/decisions.md, A creep's direction judged only above four hint
+    // speeds)
     static constexpr double kCreepJudged = 4;
     static constexpr int kRecreep = 16;   // steps below zero_abs_ before a spent creep restarts
-    // ... doubling after each restart up to this many. A sustained slide at the rim (a circular drive
-    // at mu g (1 + 3e-8): the slip under 1e-9 m/s for periods, the creep's budget spent every third
-    // of a period) took 1.2e7 steps for 0.1 s with a cap of 2^20 -- stiff stretches of up to 2^20
-    // steps between creeps -- and 2 061 with 64 (its slip 2e-10 m/s apart, ~rtol v_ref); measured before
-    // the creeps carried the slip's turn (creep_rate: 26 steps since, point and rigid parts).
+    // ... doubling after each restart up to this many: a sustained slide at the rim spends a creep's
+    // budget again and again, and a larger cap would leave stiff stretches of that many steps between
+    // its creeps. (docs/decisions.md, A spent creep restarts, doubling up to 64 steps)
     static constexpr int kRecreepMax = 64;
     std::array<int, 3> recreep_need_{kRecreep, kRecreep, kRecreep};
     std::array<int, 3> slow_{};

@@ -47,19 +47,19 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
             const double sn = slip[i].norm();
             // A contact whose creep was spent but whose slip stays below zero_abs_ (it grows or
             // shrinks so slowly that it neither lingers nor crosses zero: a slide at the rim of
-            // the disk) creeps again after recreep_need_ such steps, twice as many each time:
-            // heave_yaw (z 2, rz 60) at (0, 0.02, 0) had a contact slide at ~2e-9 m/s for 15 ms
-            // in steps of 3e-9 s, 3.2e6 right-hand sides a period.
+            // the disk) creeps again after recreep_need_ such steps, twice as many each time
+            // (without, such a slide crawls on at the noise floor in tiny steps).
             // A slip that more than doubles while it is counted is growing away from zero (it
             // leaves the band by itself); where its restart would make every contact of a rigid
             // part creep -- a creep of the whole twist (modes.cpp), whose direction is
             // ill-conditioned next to a pivot -- the count starts again. After a stuck part's
             // break-away next to a pivot (one contact at its disk's rim, the two others growing
             // from zero) such restarts reversed the slips at once (the creep stopped as
-            // inconsistent, about ten rejected tries each time): sticking_random_scene(3121)
-            // spent the 2e7 budget at the default rtol 1e-8 and 2512 at 1e-9; now 1.8e4 and 1.3e4
-            // right-hand sides. (Not counting any growing slip's steps also fixed 2512 at 5e-9
-            // and 1e-10, but cost up to 25x on other seeds at rtol 1e-6: docs/speed.md.)
+            // inconsistent, about ten rejected tries each time), and the run could spend its work
+            // budget. Only the whole twist's restart waits: at a loose tolerance the zero band is
+            // wide, and a single contact's restarted creep is what carries a growing slip through
+            // it cheaply. (docs/decisions.md, A spent creep restarts, doubling up to 64 steps; A
+            // growing slip does not restart a creep of the whole twist)
             if (sn > 0 && sn < zero_abs_) {
                 if (slow_[i] == 0) slow_from_[i] = sn;
                 ++slow_[i];
@@ -92,12 +92,8 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
         // (the turn less the last rate's), times the slip.
         const double turn = creep_dir_[i].isZero() ? 0.0 : std::atan2(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x(), creep_dir_[i].dot(u));
         const double sn = slip[i].norm(), inc = std::abs(turn - ss.creep_rate[i] * h) * sn;
-        // Rigid parts too: fig6's field 1.86e6 -> 1.69e6 right-hand sides, heave_yaw's 1.90e6 ->
-        // 1.56e6 (with the twist creep's turn, modes.cpp). (heave_yaw's cycle at (0, 0.02, 0) then
-        // shows no reversal 1e-6 T after contact 3's pivot breaks away at rtol 1e-9, where rtol
-        // 1e-8 and 1e-10 show one: that contact slides on at the noise floor, 2e-10 and 2e-11 m/s,
-        // and whether it touches zero is noise; the mode-sequence test ties reversals to
-        // break-aways instead of matching each.)
+        // Rigid parts carry the turn too (with the twist creep's turn, modes.cpp; docs/decisions.md,
+        // Creeps carry the slip's turn).
         ss.creep_rate[i] = creep_dir_[i].isZero() || !(h > 0) ? 0.0 : turn / h;
         creep_err_[i] += inc;
         creep_dir_[i] = u;

@@ -58,10 +58,9 @@ double Engine<Model>::locate(int i, double t1, double tb, double gb, const State
 
 // The hold guards at the step's stages (its right-hand sides, evaluated anyway): a normal force or
 // a pivot's static-friction margin that goes negative between two positive ends of a step shows
-// at a stage, the candidate right end of the root's bracket (an outside review found a pivot's
-// break-away missed that way: seed 132 of the random stick-slip scenes at rtol 1e-5, the margin
-// 7.7e-4 -> -3.6e-3 -> 1.9e-3 within one step of 0.075 T, the cycle then held 0.82 of the period
-// instead of 0.72).
+// at a stage, the candidate right end of the root's bracket: the guards' signs at the step's ends
+// alone would miss such a dip, and with it a break-away. (docs/decisions.md, Guards read at the
+// step's stages; a pivot's turn searched for its minimum)
 template <class Model>
 void Engine<Model>::note_stage(double t, const State& y) {
     const Workspace& ws = model_.ws;
@@ -110,12 +109,12 @@ double Engine<Model>::guard_at(int i, double t, double t1, State& ym) {
 
 // A pivot's turn (theta' times its sense, guard 4) that dips through zero and back within one
 // step: the part comes to rest for a moment and turns on the same way, and both ends of the step
-// are positive, so their signs miss it (a thin part of the random stick-slip scenes, seed 562:
-// a 3 ms stuck phase missed by a step of 0.011 T, its cycle 1.9e-5 v_ref off the regularised
-// limit). theta'' at the step's ends (its derivatives, already evaluated) says whether the turn
-// has a minimum inside -- decelerating at the start, accelerating at the end; then that minimum
-// of the dense output is found by golden section (the guard is a state component: no
-// right-hand sides), and where it is crossed it becomes the root's bracket (tb, gb, yb).
+// are positive, so their signs miss it (and with it a short stuck phase). theta'' at the step's
+// ends (its derivatives, already evaluated) says whether the turn has a minimum inside --
+// decelerating at the start, accelerating at the end; then that minimum of the dense output is
+// found by golden section (the guard is a state component: no right-hand sides), and where it is
+// crossed it becomes the root's bracket (tb, gb, yb). (docs/decisions.md, Guards read at the
+// step's stages; a pivot's turn searched for its minimum)
 template <class Model>
 bool Engine<Model>::turn_dip(double t1, double g1, double& tb, double& gb, State& yb) {
     if (model_.mode.kind != ModeKind::Pivot || frozen_ || !(g0_[4] > 0 && g1 > 0)) return false;

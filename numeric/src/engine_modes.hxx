@@ -154,9 +154,9 @@ bool Engine<Model>::switch_mode(unsigned zero, bool hold) {
     const bool ok = enter(c.mode, y, qd);
     // A slip that reached zero and slides on (static friction cannot hold it) is not tested for
     // zero again until it has left the zero band (|v| > zero_abs_): at the noise floor right
-    // after a reversal its guard crosses zero over and over (heave_yaw at (0, 0.02, 0), rtol 1e-9:
-    // 1 500 reversals of two contacts within 1e-5 T). A slip that stays in the band lingers and
-    // is offered to static friction by try_hold, with its backoff.
+    // after a reversal its guard crosses zero over and over, each crossing a new reversal. A slip
+    // that stays in the band lingers and is offered to static friction by try_hold, with its
+    // backoff. (docs/decisions.md, Reversals: no re-test inside the zero band)
     if (reversal) fresh_ |= zero;
     return ok;
 }

@@ -22,17 +22,16 @@ Engine<Model>::Engine(Model& model, const Scene& scene, const IntegrationOptions
     stick_slip().use_hints = true;
     // Both grow with rtol only up to rtol 1e-5's values, so that hint_speed < zero_abs_ < the
     // creep speed (1e-2 v_ref) at any tolerance: uncapped, at rtol 1e-2 every slip below 3 v_ref
-    // counted as zero and fig4's never-sticking part stuck 797 times in 20 s (3 rad off).
+    // would count as zero and a part that never sticks would stick (docs/decisions.md, Slip
+    // thresholds: the hint speed, the linger test and their cap).
     stick_slip().hint_speed = std::clamp(10 * opt_.rtol, 1e-12, 1e-4) * v_ref_;
     zero_abs_ = zero_band(opt_.rtol) * v_ref_;
     // A contact that breaks away creeps (StickSlipState::creep: its friction along the consistent
     // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
     // the error that leaves stays below creep_budget_ (creep_step), 100 rtol v_ref: about the
     // integration's own error over the stretch the creep replaces (the local error's allowance,
-    // ~rtol v_ref a step, over the ~100 stiff steps a decade of slip takes without it). fig6's field
-    // against 10 rtol v_ref: 7 % fewer right-hand sides, the same largest error against the rtol-1e-11
-    // field (2.4e-7 v_ref sliding, 6.5e-7 sticking), the sticking median 4.1e-8 -> 5.1e-8;
-    // heave_yaw's 15 % fewer, its largest 3.4e-7 -> 2.6e-7.
+    // ~rtol v_ref a step, over the ~100 stiff steps a decade of slip takes without it).
+    // (docs/decisions.md, Creep: the consistent direction for a slip growing from zero)
     stick_slip().creep_speed = 1e-2 * v_ref_;
     creep_budget_ = 100 * opt_.rtol * v_ref_;
 }
@@ -163,8 +162,8 @@ bool Engine<Model>::accept_step(double t1, const Guards& g1, const Vec3& n1, con
     // A slip that lingers just above zero (near a grazing stick, where the deceleration
     // vanishes with the slip, it need not cross zero) makes v/|v| stiff and the steps tiny:
     // after kLinger steps below zero_abs_ it is taken as zero (the error is below zero_abs_,
-    // i.e. 3e2 rtol v_ref; measured on fig6's sticking cycles, about a fifth of it: 1e3 rtol
-    // v_ref left 4 of 78 at 1.4-2.1e-6 v_ref from the regularised limit at rtol 1e-8).
+    // i.e. 3e2 rtol v_ref, and in practice about a fifth of it; docs/decisions.md, Slip
+    // thresholds: the hint speed, the linger test and their cap).
     unsigned linger = 0;
     if (model_.mode.kind == ModeKind::Slide)
         for (int i = 0; i < nc; ++i) {
@@ -223,10 +222,8 @@ bool Engine<Model>::try_step(double& t1, double& dt) {
 // stages far past zero take the reversed friction, the error estimate jumps by 10^3-10^5 and the
 // step is rejected, and so on down to the zero, where a step accepted at an error near 1 straddles
 // the reversed friction (dynamics.cpp keeps the start's direction only for stage slips below a
-// tenth of the start's). fig1_point's cycle at (0, -0.05), one period from the cycle's start at rtol
-// 1e-8 against 1e-11: 3e-7 to 5e-7 v_ref off depending on the first step, 2e-9 with the cap; its
-// field 277 520 -> 64 469 right-hand sides, the largest error 1.07e-6 -> 8.4e-9 v_ref (docs/speed.md).
-// Ending 5 % past the predicted zero keeps the stages past it inside that tenth.
+// tenth of the start's). Ending 5 % past the predicted zero keeps the stages past it inside that
+// tenth. (docs/decisions.md, Steps end just past a slip's predicted zero (`zero_cap`))
 template <class Model>
 double Engine<Model>::zero_cap() {
     const int nc = scene_.part.contacts();

@@ -334,27 +334,25 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     double h;
     const double last_gy = newton(p, y, d, h, g);
     // Newton's quadratic model fails next to a kink of h (a contact's term |G_i^T d| near zero, its
-    // Hessian unbounded): drawn there, the line search stalled with the gradient far from zero and
-    // the gauge came out low (fig6 at (0.0167, 0, 2.693), t = 0.01759: 0.967 where the minimum gives
-    // 0.992 -- the part was held 0.13 ms too long, its cycle's twist 1.8e-4 v_ref off the regularised
-    // reference). Then the kinks and a pattern search in the plane decide (16 directions; h is convex,
-    // but next to a kink its descent cone can be narrower than their spacing: repaired below).
+    // Hessian unbounded): drawn there, the line search stalls with the gradient far from zero and the
+    // gauge comes out low, holding the part too long. Then the kinks and a pattern search in the plane
+    // decide (16 directions; h is convex, but next to a kink its descent cone can be narrower than
+    // their spacing: repaired below).
     const bool stalled = last_gy > 1e-7 * h * p.wn;
     if (stalled) pattern_search(p, y, d, h);
     // At the optimum the distribution f_i = gamma cap_i v_i / |v_i| (v_i = G_i^T d) supplies w exactly.
     // Where the pattern search's does not (by more than 1e-6 of |w|; its own stopping leaves less away
-    // from kinks, and next to one the repair below only refines a correct optimum), it stopped at a kink that is not the optimum (its descent cone
-    // narrower than the 16 directions: random scene 15 of the held-modes test, the wrench 0.22 N off
-    // and the gauge 4.7997 for 4.8008), or at the optimum on a kink whose test failed by rounding (the
-    // kink's force, inside its disk, is then missing). Then h is smoothed, h_delta(d) = sum cap_i
-    // sqrt(|v_i|^2 + delta^2) (convex and smooth for delta > 0, within 3 cap delta of h), and minimised
-    // by Newton while delta falls from 1e-2 to 1e-12 of |d0| = 1/|w|, each stage from the last. Its
-    // stationary point gives f_i = cap_i v_i / (s_i h~), s_i = sqrt(|v_i|^2 + delta^2), h~ = sum cap_i
-    // |v_i|^2 / s_i, whose wrench is w (grad h_delta = h~ w there), a contact at the kink included: its
-    // force is then inside its disk, and it is the pivot (choose_mode breaks away about it). The repair
-    // is kept only where it is at least as low as the search's h (it always was where measured). (Where
-    // measured -- fig6's, heave_yaw's, fig1's and foot's fields, the [stick] and [dynamics] tests -- the
-    // repair ran over a hundred times and never ended at a kink: its pivot is a guard, not a path seen.)
+    // from kinks, and next to one the repair below only refines a correct optimum), it stopped at a
+    // kink that is not the optimum (its descent cone narrower than the 16 directions), or at the
+    // optimum on a kink whose test failed by rounding (the kink's force, inside its disk, is then
+    // missing). Then h is smoothed, h_delta(d) = sum cap_i sqrt(|v_i|^2 + delta^2) (convex and smooth
+    // for delta > 0, within 3 cap delta of h), and minimised by Newton while delta falls from 1e-2 to
+    // 1e-12 of |d0| = 1/|w|, each stage from the last. Its stationary point gives f_i = cap_i v_i /
+    // (s_i h~), s_i = sqrt(|v_i|^2 + delta^2), h~ = sum cap_i |v_i|^2 / s_i, whose wrench is w
+    // (grad h_delta = h~ w there), a contact at the kink included: its force is then inside its disk,
+    // and it is the pivot (choose_mode breaks away about it). The repair is kept only where it is at
+    // least as low as the search's h. (docs/decisions.md, The friction gauge: exact, with a smoothed
+    // Newton where the search stops on a kink)
     if (stalled && misses_wrench(p, d, h) && smoothed_repair(p, y, h, g)) return g;
     p.finish(g, d, h);
     for (int i = 0; i < 3; ++i) {

@@ -23,15 +23,16 @@ bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const Plate
 // u(t) (eq. 11) and the plate's velocity regrouped by harmonic number: a sin(n w t + phi) =
 // sin(n w t) a cos(phi) + cos(n w t) a sin(phi), so u(t) = sum_n sin(n w t) A_n + cos(n w t) B_n
 // with one sine and cosine per distinct n where PlateMotion::acceleration calls sin once per harmonic
-// (fig6: two harmonics of n = 1; libm's sin took 13 % of its field's time). The velocity's
-// -a/k cos(k t + phi) = -(cos(k t) A_n - sin(k t) B_n)/k with k = n w.
+// (harmonics often share n). The velocity's -a/k cos(k t + phi) = -(cos(k t) A_n - sin(k t) B_n)/k
+// with k = n w.
 // The sine and cosine of phi = n w t: phi = j pi/8 + x with j the nearest multiple (Cody-Waite, pi/8
 // split so that j times its head, 31 significant bits, is exact for |j| < 2^20) and |x| <= pi/16, then
 // sin(j pi/8 + x) from a table of sixteen and Taylor polynomials in x (the first terms left out,
 // x^13/13! and x^12/12!, below 1.1e-19 and 6.9e-18 = 0.03 ulp of 1 there) -- the
 // same argument fl(n w t) libm's sincos takes, to a few ulp, and deterministic in t (a cache of the
-// last call would make u(t) depend on the order of calls, and a field on its threads). libm's sincos
-// took 17 % of fig6's field (perf); tests/test_dynamics.cpp compares it with PlateMotion.
+// last call would make u(t) depend on the order of calls, and a field on its threads), and cheaper
+// than libm's sincos; tests/test_dynamics.cpp compares it with PlateMotion. (docs/decisions.md,
+// u(t) regrouped by harmonic number; u(t)'s sine and cosine from a table)
 class Signal {
 public:
     explicit Signal(const PlateMotion& p) : w_(p.omega()) {
@@ -56,8 +57,8 @@ public:
     }
     // u(t) into ps.pdd, ps.wd, and with `velocity` the plate's angular velocity into ps.w1; the rest of
     // ps untouched. The reduced U- and U-dynamics call it on a PlateState of their own, which saves
-    // building one per evaluation (state() doing so took 11 % of fig6's field's instructions, most of
-    // them in the struct's construction and copies).
+    // building and copying one per evaluation (docs/decisions.md, Per-evaluation cuts in the
+    // right-hand side).
     void acceleration(double t, PlateState& ps, bool velocity = false) const {
         double u[6] = {0, 0, 0, 0, 0, 0}, w[3] = {0, 0, 0};
         for (const Term& term : terms_) {

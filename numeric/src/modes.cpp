@@ -47,8 +47,9 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
     using System = void (*)(const gen::KernelInput&, double*, double*);
     static constexpr System system[3] = {gen::pivot1_system, gen::pivot2_system, gen::pivot3_system};
     // The matrix depends on theta, k and u only (the generated code reads no twist there): factorised
-    // once per pivot of the reduced U-dynamics (fig6's field: the 8 x 8 factorisation was 6 % of its
-    // instructions). c (theta'^2 r_k) only where kappa is not 0.
+    // once per pivot of the reduced U-dynamics, and reused while they stay equal, which gives the same
+    // factors bit for bit. c (theta'^2 r_k) only where kappa is not 0. (docs/decisions.md,
+    // Per-evaluation cuts in the right-hand side)
     const bool same = ks.pivot_k == k && ks.pivot_ct == in.ct && ks.pivot_st == in.st && ks.pivot_u == u;
     if (!same || kappa(level) != 0) system[k](in, M.data(), c);
     if (!same) {
@@ -150,9 +151,8 @@ void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, c
         accelerations(sc, level, q, qd, ps, ws);
         const Vec3 Q = scaled_qdd(P, ws);
         // zero iff q'' less |q'| times the measured turn of the direction is parallel to x (as a point
-        // part's contact, u x a = |v| rate: with no turn a slide at the rim of the disk is held at the
-        // zero threshold -- fig4's part under a circular drive at mu g (1 + 1e-6), 9.2e5 steps and 5.5x
-        // the threshold off)
+        // part's contact, u x a = |v| rate: with no turn a slide at the rim of the disk, under a
+        // turning drive, is held at the zero threshold; docs/decisions.md, Creeps carry the slip's turn)
         const Vec3 D = Q - qs.norm() * ss.creep_twist_rate.cross(x);
         const Vec3 r = D - x.dot(D) * x;
         return Eigen::Vector2d(r.dot(e1), r.dot(e2));
@@ -199,7 +199,7 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
     if (m == 0) return;
     // (a_j x u_j + |v_j| rate_j: the slip turns with its direction at the rate the engine measured,
     // d(v/|v|)/dt = (u x a) / |v|; with rate 0 the slip could not turn with a turning drive, and a
-    // slide at the rim of the disk stayed at the zero threshold, 20x below the exact speed.)
+    // slide at the rim of the disk would stay at the zero threshold, far below the exact speed.)
     // (r_i from the workspace's cache when it holds this theta: no cosine and sine per contact and
     // evaluation)
     const bool cached = !P.point && q[2] == ks.theta;

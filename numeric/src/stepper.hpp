@@ -14,12 +14,12 @@ template <class State>
 class Dopri5Controller {
 public:
     // One step of size dt from (t, y, f = y'(t)) into (y1, f1 = y'(t + dt)); sys(y, dy, t) is the
-    // right-hand side. The error norm is max_i |err_i| / (rtol (1 + max(|y_i|, |y1_i|))). odeint's
-    // default checker divides by rtol (1 + |y_i| + dt |y'_i|) instead: a tolerance that grows with
-    // the step, so the error no longer scales as dt^5 and its controller overshoots (29% of fig4's
-    // field steps rejected). The step size follows the PI controller of Hairer & Wanner's DOPRI5
-    // (Solving ODEs I, II.4; beta = 0.04, safety 0.9, factors in [0.2, 10]). On success t1 += dt and
-    // dt becomes the next step; on failure dt becomes the step to retry with.
+    // right-hand side. The error norm is max_i |err_i| / (rtol (1 + max(|y_i|, |y1_i|))), not odeint's
+    // default rtol (1 + |y_i| + dt |y'_i|): a tolerance that grows with the step would stop the error
+    // scaling as dt^5, and the controller would overshoot. The step size follows the PI controller of
+    // Hairer & Wanner's DOPRI5 (Solving ODEs I, II.4; beta = 0.04, safety 0.9, factors in [0.2, 10]).
+    // On success t1 += dt and dt becomes the next step; on failure dt becomes the step to retry with.
+    // (docs/decisions.md, Our own Dormand-Prince 5(4) stepper, with a step-independent error norm)
     template <class Sys>
     bool try_step(Sys&& sys, const State& y, const State& f, double& t1, State& y1, State& f1, double& dt, double rtol) {
         stepper_.do_step(sys, y, f, t1, y1, f1, dt, err_);

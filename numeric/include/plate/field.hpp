@@ -103,18 +103,17 @@ struct FixedLine {
 
 struct FixedPointOptions {
     // The cycles evaluated while refining. Newton needs a field whose noise is well below ftol: the
-    // twist of a cycle carries the integrator's error, measured at ~60 rtol v_ref (fig1 near its
-    // stable line: 6e-7 v_ref at rtol 1e-8, which made the line search fail at random), so the
-    // refinement runs at rtol <= 1e-3 ftol and cycle tol <= 1e-2 ftol whatever this asks for (at
-    // 3e-3 ftol, noise ~0.2 ftol, fig1's line still broke).
+    // twist of a cycle carries the integrator's error, tens of rtol v_ref, which makes the line search
+    // fail at random, so the refinement runs at rtol <= 1e-3 ftol and cycle tol <= 1e-2 ftol whatever
+    // this asks for. (docs/decisions.md, Fixed-point refinement at a tighter tolerance than the field)
     LimitCycleOptions cycle;
     double ftol = 1e-6;      // |xi_a| accepted as zero, relative to v_ref
     int max_newton = 25;
     double null_ratio = 0.02;  // singular value ratio that makes a line candidate
     // Bounded work: no further cell is searched once the refinement's cycles have spent this many
     // right-hand-side evaluations (0: no bound; deterministic, unlike a time limit); the cells left
-    // are counted and the summary says so. ~1e4 per sliding cycle at the refinement's tolerance,
-    // ~2e5 per sticking one (heave_yaw); fig1's four lines take 3e6, fig3_random's search 1.5e6.
+    // are counted and the summary says so. (The scale: docs/decisions.md, Fixed-point refinement at a
+    // tighter tolerance than the field.)
     long max_rhs_evaluations = 20'000'000;
 };
 
