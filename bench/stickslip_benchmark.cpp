@@ -34,11 +34,8 @@ double distance(const Scene& sc, const Vec3& a, const Vec3& b) {
     return (a - b).cwiseQuotient(Vec3(v, v, v / sc.part.rho())).cwiseAbs().maxCoeff();
 }
 
-}  // namespace
-
-int main() {
-    std::printf("machine: %s\n", machine_description().c_str());
-
+// (1) fields on 1 and all threads, and the goal for fig6's.
+void fields_timing() {
     // Each field seven times (this machine's speed drifts by up to 30 % over seconds): the best and the
     // median wall time; the field itself is the same every time (and on any threads).
     std::printf("\n(1) fields, 7x7x7 (point parts 7x7), default options (rtol 1e-8, cycle tol 1e-7), seven runs each\n");
@@ -73,6 +70,10 @@ int main() {
     std::printf("  the goal, fig6's field in at most 0.1 s on this machine: %s at the best of seven runs (%.3f s), %s at "
                 "the median (%.3f s)\n", fig6_best <= 0.1 ? "met" : "not met", fig6_best, fig6_median <= 0.1 ? "met" : "not met",
                 fig6_median);
+}
+
+// (1b), (1c) where fig6's field goes: sticking against sliding configurations.
+void fig6_costs() {
     std::printf("\n(1b) where fig6's field goes (one thread): right-hand sides and periods, sticking against sliding\n"
                 "     configurations (README, Limit-cycle solvers)\n");
     {
@@ -131,7 +132,10 @@ int main() {
                         steps ? 100.0 * small / steps : 0.0, pct(0.5), pct(0.1), pct(0.9));
         }
     }
+}
 
+// (2) the engine against the regularised-friction method at equal accuracy.
+void against_regularised() {
     std::printf("\n(2) fig6's sticking configurations, every 5th in grid order: error against the regularised\n"
                 "    reference (eps -> 0), relative to v_ref, and time per configuration\n");
     const Scene sc = scene("fig6");
@@ -211,5 +215,15 @@ int main() {
                     chosen_eps, chosen_time / t_engine, err_engine.back());
     else
         std::printf("  no eps tried reaches 1e-6 v_ref on the whole sample\n");
+}
+
+}  // namespace
+
+int main() {
+    std::printf("machine: %s\n", machine_description().c_str());
+
+    fields_timing();
+    fig6_costs();
+    against_regularised();
     return 0;
 }

@@ -298,6 +298,26 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
               "eps near a stick, whatever the integrator; and fixed steps must resolve its time scale eps/(mu g).)</p>\n";
 }
 
+// The cycle solvers' chart: maximum error against time for each configuration NAMES (their data files
+// cycle_SLUG.dat and cycle_SLUG_tol1.dat) and the RK4 baseline (cycle_rk4.dat).
+void plot_cycle_solvers(Ctx& c, const std::vector<std::string>& names) {
+    std::ostringstream gp;
+    gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the field'\n"
+          "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first " << kTarget << " to graph 1, first "
+       << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
+    int i = 0;
+    for (const std::string& name : names) {
+        gp << (i ? ", " : "") << "'data/cycle_" << slug(name) << ".dat' u 1:3 w lp lt " << i + 1 << " pt " << i + 1
+           << " title '" << name << "', 'data/cycle_" << slug(name) << "_tol1.dat' u 1:3 w p lt " << i + 1 << " pt " << i + 1
+           << " notitle";
+        ++i;
+    }
+    gp << ", 'data/cycle_rk4.dat' u 1:3 w lp pt 7 lc rgb 'black' title 'RK4 period by period'\n";
+    c.plot("cycle_solvers", gp.str(), "fig4 field (343 configurations): maximum twist error against wall time for each "
+                                      "limit-cycle solver (engine rtol swept; lines: cycle tolerance 10 rtol, points of the "
+                                      "same colour: cycle tolerance = rtol) and the RK4 baseline.");
+}
+
 // Limit-cycle solvers on fig4's 343-configuration field, and the ratio against period-by-period RK4.
 void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     FieldOptions ro;
@@ -401,22 +421,9 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     }
     c.html << "</table>\n";
     progress_line("bench: RK4 baseline done\n");
-    std::ostringstream gp;
-    gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the field'\n"
-          "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first " << kTarget << " to graph 1, first "
-       << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
-    int i = 0;
-    for (const auto& cfg : cfgs) {
-        const std::string name = cfg.name();
-        gp << (i ? ", " : "") << "'data/cycle_" << slug(name) << ".dat' u 1:3 w lp lt " << i + 1 << " pt " << i + 1
-           << " title '" << name << "', 'data/cycle_" << slug(name) << "_tol1.dat' u 1:3 w p lt " << i + 1 << " pt " << i + 1
-           << " notitle";
-        ++i;
-    }
-    gp << ", 'data/cycle_rk4.dat' u 1:3 w lp pt 7 lc rgb 'black' title 'RK4 period by period'\n";
-    c.plot("cycle_solvers", gp.str(), "fig4 field (343 configurations): maximum twist error against wall time for each "
-                                      "limit-cycle solver (engine rtol swept; lines: cycle tolerance 10 rtol, points of the "
-                                      "same colour: cycle tolerance = rtol) and the RK4 baseline.");
+    std::vector<std::string> names;
+    for (const auto& cfg : cfgs) names.push_back(cfg.name());
+    plot_cycle_solvers(c, names);
     // The ratio, head to head: this machine's speed drifts by up to 30% over seconds (a shared host),
     // so the best field and the RK4 baseline are timed alternately, F R F R ... F, and each round's
     // ratio divides R by the mean of the fields on either side of it. Reported: the median of five.

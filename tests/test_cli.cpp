@@ -498,7 +498,7 @@ TEST_CASE("plate design: a verified sink is a scene whose own field has its one 
     CHECK(bad.err.find("--target") != std::string::npos);
 
     // Coning allowed with the hold on: the fastest sink walks off its target, and the hold says so
-    // (400 s: over 5 mm for any coning above 7.3e-4 rad/s; test_design.cpp, "without the hold").
+    // (400 s: over 5 mm for any coning above 7.3e-4 rad/s; tests/design/test_design_sink.cpp, "without the hold").
     const Run coned = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
                           "--max-coning 1e9 --hold 400 --out " + (d / "coned.json").string());
     CHECK(coned.code == 4);

@@ -33,6 +33,60 @@ RandomState random_state(Rng& r, bool tilt) {
     return s;
 }
 
+// A random kernel input IN (a part, its contacts, a state, a plate motion) and SUB, the same values for
+// the derivation's symbols S.
+void random_input(Rng& r, const symbolic::Symbols& S, gen::KernelInput& in, GiNaC::exmap& sub) {
+    using namespace GiNaC;
+    auto set = [&](double& field, const realsymbol& s, double v) {
+        field = v;
+        sub[s] = v;
+    };
+    set(in.m, S.m, r.uniform(0.01, 0.1));
+    set(in.g, S.g, 9.81);
+    set(in.Jxx, S.Jxx, r.uniform(1e-5, 5e-5));
+    set(in.Jxy, S.Jxy, r.uniform(-1e-6, 1e-6));
+    set(in.Jxz, S.Jxz, r.uniform(-1e-6, 1e-6));
+    set(in.Jyy, S.Jyy, r.uniform(1e-5, 5e-5));
+    set(in.Jyz, S.Jyz, r.uniform(-1e-6, 1e-6));
+    set(in.Jzz, S.Jzz, r.uniform(2e-5, 6e-5));
+    double* cx[3] = {&in.c1x, &in.c2x, &in.c3x};
+    double* cy[3] = {&in.c1y, &in.c2y, &in.c3y};
+    double* mu[3] = {&in.mu1, &in.mu2, &in.mu3};
+    double* ux[3] = {&in.u1x, &in.u2x, &in.u3x};
+    double* uy[3] = {&in.u1y, &in.u2y, &in.u3y};
+    for (int i = 0; i < 3; ++i) {
+        const double a = 2 * kPi * i / 3 + r.uniform(-0.3, 0.3), rad = r.uniform(0.01, 0.05);
+        set(*cx[i], S.cx[i], rad * std::cos(a));
+        set(*cy[i], S.cy[i], rad * std::sin(a));
+        set(*mu[i], S.mu[i], r.uniform(0.1, 0.4));
+        const double b = r.uniform(-kPi, kPi);
+        set(*ux[i], S.ux[i], std::cos(b));
+        set(*uy[i], S.uy[i], std::sin(b));
+    }
+    set(in.cz, S.cz, -r.uniform(0.001, 0.01));
+    set(in.sz, S.sz, -in.cz);
+    const double th = r.uniform(-kPi, kPi);
+    set(in.ct, S.ct, std::cos(th));
+    set(in.st, S.st, std::sin(th));
+    set(in.thd, S.thd, r.uniform(-20, 20));
+    set(in.sx, S.sx, r.uniform(-0.03, 0.03));
+    set(in.sy, S.sy, r.uniform(-0.03, 0.03));
+    set(in.sxd, S.sxd, r.uniform(-0.3, 0.3));
+    set(in.syd, S.syd, r.uniform(-0.3, 0.3));
+    double* pdd[3] = {&in.pddx, &in.pddy, &in.pddz};
+    double* w[3] = {&in.wx, &in.wy, &in.wz};
+    double* wd[3] = {&in.wdx, &in.wdy, &in.wdz};
+    for (int i = 0; i < 3; ++i) {
+        set(*pdd[i], S.pdd[i], r.uniform(-20, 20));
+        set(*w[i], S.w[i], r.uniform(-3, 3));
+        set(*wd[i], S.wd[i], r.uniform(-100, 100));
+    }
+    const Mat3 R1 = detail::exp_so3(Vec3{r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)});
+    double* Rf[9] = {&in.R11, &in.R12, &in.R13, &in.R21, &in.R22, &in.R23, &in.R31, &in.R32, &in.R33};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) set(*Rf[3 * i + j], S.R[i][j], R1(i, j));
+}
+
 }  // namespace
 
 TEST_CASE("generated kernels equal the reference implementation on 10^4 random states", "[kernels]") {
@@ -87,54 +141,7 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
     for (int trial = 0; trial < 30; ++trial) {
         gen::KernelInput in;
         exmap sub;
-        auto set = [&](double& field, const realsymbol& s, double v) {
-            field = v;
-            sub[s] = v;
-        };
-        set(in.m, S.m, r.uniform(0.01, 0.1));
-        set(in.g, S.g, 9.81);
-        set(in.Jxx, S.Jxx, r.uniform(1e-5, 5e-5));
-        set(in.Jxy, S.Jxy, r.uniform(-1e-6, 1e-6));
-        set(in.Jxz, S.Jxz, r.uniform(-1e-6, 1e-6));
-        set(in.Jyy, S.Jyy, r.uniform(1e-5, 5e-5));
-        set(in.Jyz, S.Jyz, r.uniform(-1e-6, 1e-6));
-        set(in.Jzz, S.Jzz, r.uniform(2e-5, 6e-5));
-        double* cx[3] = {&in.c1x, &in.c2x, &in.c3x};
-        double* cy[3] = {&in.c1y, &in.c2y, &in.c3y};
-        double* mu[3] = {&in.mu1, &in.mu2, &in.mu3};
-        double* ux[3] = {&in.u1x, &in.u2x, &in.u3x};
-        double* uy[3] = {&in.u1y, &in.u2y, &in.u3y};
-        for (int i = 0; i < 3; ++i) {
-            const double a = 2 * kPi * i / 3 + r.uniform(-0.3, 0.3), rad = r.uniform(0.01, 0.05);
-            set(*cx[i], S.cx[i], rad * std::cos(a));
-            set(*cy[i], S.cy[i], rad * std::sin(a));
-            set(*mu[i], S.mu[i], r.uniform(0.1, 0.4));
-            const double b = r.uniform(-kPi, kPi);
-            set(*ux[i], S.ux[i], std::cos(b));
-            set(*uy[i], S.uy[i], std::sin(b));
-        }
-        set(in.cz, S.cz, -r.uniform(0.001, 0.01));
-        set(in.sz, S.sz, -in.cz);
-        const double th = r.uniform(-kPi, kPi);
-        set(in.ct, S.ct, std::cos(th));
-        set(in.st, S.st, std::sin(th));
-        set(in.thd, S.thd, r.uniform(-20, 20));
-        set(in.sx, S.sx, r.uniform(-0.03, 0.03));
-        set(in.sy, S.sy, r.uniform(-0.03, 0.03));
-        set(in.sxd, S.sxd, r.uniform(-0.3, 0.3));
-        set(in.syd, S.syd, r.uniform(-0.3, 0.3));
-        double* pdd[3] = {&in.pddx, &in.pddy, &in.pddz};
-        double* w[3] = {&in.wx, &in.wy, &in.wz};
-        double* wd[3] = {&in.wdx, &in.wdy, &in.wdz};
-        for (int i = 0; i < 3; ++i) {
-            set(*pdd[i], S.pdd[i], r.uniform(-20, 20));
-            set(*w[i], S.w[i], r.uniform(-3, 3));
-            set(*wd[i], S.wd[i], r.uniform(-100, 100));
-        }
-        const Mat3 R1 = detail::exp_so3(Vec3{r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-1, 1)});
-        double* Rf[9] = {&in.R11, &in.R12, &in.R13, &in.R21, &in.R22, &in.R23, &in.R31, &in.R32, &in.R33};
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) set(*Rf[3 * i + j], S.R[i][j], R1(i, j));
+        random_input(r, S, in, sub);
 
         auto value = [&](const ex& e) { return ex_to<numeric>(e.subs(sub).evalf()).to_double(); };
         auto close = [](double a, double b, double scale) { return std::abs(a - b) <= 1e-12 * (std::abs(b) + scale); };

@@ -1,0 +1,79 @@
+// What the design tests share (tests/design/test_design_*.cpp): scenes by name, tight cycle options,
+// short searches, the targets used more than once, and the field's twist and Jacobian at tight tolerances.
+#pragma once
+
+#include "plate/design.hpp"
+#include "plate/scene_io.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+namespace design_tests {
+using namespace plate;
+
+inline Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+
+inline LimitCycleOptions tight() {
+    LimitCycleOptions o;
+    o.tol = 1e-10;
+    o.integration.rtol = 1e-11;
+    return o;
+}
+
+// A short search: `starts` seeded starts of `evaluations` each, verified by `runs` full-dynamics runs.
+inline DesignOptions searched(int starts, int evaluations, int runs, int threads = 0) {
+    DesignOptions o;
+    o.starts = starts;
+    o.local_evaluations = evaluations;
+    o.verify_starts = runs;
+    o.threads = threads;
+    return o;
+}
+
+// The README's rigid fixed point: fig4's part at (0.02, -0.01), THETA 0.5.
+inline DesignTarget fig4_fixed_point() {
+    DesignTarget t;
+    t.kind = DesignTargetKind::FixedPoint;
+    t.at = Vec2(0.02, -0.01);
+    t.theta = 0.5;
+    return t;
+}
+
+inline DesignTarget transport(const Vec2& velocity) {
+    DesignTarget t;
+    t.kind = DesignTargetKind::Transport;
+    t.velocity = velocity;
+    return t;
+}
+
+// A transport design at `velocity` under 15 m/s^2, which must verify.
+inline DesignSummary verified_transport(const Scene& part, const Vec2& velocity, DesignOptions o) {
+    o.lin_limit = 15;
+    const DesignSummary s = design(part, transport(velocity), o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    return s;
+}
+
+inline Vec3 xi(const Scene& sc, const Vec3& q) {
+    const LimitCycleSummary lc = limit_cycle(sc, q, tight());
+    REQUIRE(lc.converged);
+    return lc.twist;
+}
+
+// A point part's field Jacobian at s by central differences of 1 mm at tight tolerances (the field
+// is smooth there: truncation ~ (1 mm)^2 |d^3 v| ~ 1e-3 of the entries, noise 1e-8 v_ref / 1 mm).
+inline Eigen::Matrix2d jacobian(const Scene& sc, const Vec2& s) {
+    Eigen::Matrix2d J;
+    const double h = 1e-3;
+    for (int d = 0; d < 2; ++d) {
+        Vec3 e = Vec3::Zero();
+        e[d] = h;
+        const Vec3 q(s.x(), s.y(), 0);
+        J.col(d) = (xi(sc, q + e) - xi(sc, q - e)).head<2>() / (2 * h);
+    }
+    return J;
+}
+
+}  // namespace design_tests

@@ -1,0 +1,50 @@
+// Line sinks (design/src/line_sink.cpp): every start ends on the line asked and stays there.
+#include "design_test_helpers.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace plate;
+using namespace design_tests;
+
+TEST_CASE("line sink: every start ends on the line asked and stays where it arrives", "[design][line]") {
+    const Scene part = scene("fig1_point");
+    DesignTarget t;
+    t.kind = DesignTargetKind::LineSink;
+    t.at = Vec2(0.01, -0.02);
+    t.theta = 0.6;
+    DesignOptions o = searched(2, 60, 6, 2);
+    o.lin_limit = 15;
+    o.ang_limit = 100;
+    const DesignSummary s = design(part, t, o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    CHECK(s.rate > 0.2);
+    for (const Harmonic& h : s.scene.plate.harmonics)
+        CHECK(std::abs(h.amp) <= (static_cast<int>(h.axis) < 3 ? o.lin_limit : o.ang_limit) * (1 + 1e-9));
+    // Independently, at tight tolerances: on the line the velocity vanishes (anywhere along it, not only
+    // at the point given); off it, it points back across it, and along it there is none.
+    const Vec2 dir(std::cos(t.theta), std::sin(t.theta)), nrm(-dir.y(), dir.x());
+    const double v = s.scene.v_ref();
+    for (double a : {-0.03, 0.0, 0.025}) {
+        INFO("along " << a);
+        const Vec2 on = t.at + a * dir;
+        CHECK(xi(s.scene, Vec3(on.x(), on.y(), 0)).head<2>().norm() < 1e-8 * v);
+        for (double d : {-0.02, 0.01}) {
+            const Vec2 off = on + d * nrm;
+            const Vec2 w = xi(s.scene, Vec3(off.x(), off.y(), 0)).head<2>();
+            CHECK(w.dot(nrm) * d < 0);
+            CHECK(std::abs(w.dot(dir)) < 1e-8 * v);
+        }
+    }
+    // Full dynamics from two corners: on the line (within 5 mm) after 8 / rate.
+    for (const Vec2& c : {Vec2(-0.045, 0.045), Vec2(0.045, -0.045)}) {
+        const double secs = 8 / s.rate;
+        const Trajectory tr = simulate(s.scene, Dynamics::Full, Vec3(c.x(), c.y(), 0), Vec3::Zero(), secs, secs);
+        REQUIRE(tr.stop.reason == StopReason::None);
+        CHECK(std::abs((tr.samples.back().q.head<2>() - t.at).dot(nrm)) < 0.005);
+    }
+    // A rigid part is not served.
+    CHECK_THROWS_WITH(design(scene("fig4"), t, o), Catch::Contains("point parts only"));
+}
