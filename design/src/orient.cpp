@@ -9,7 +9,7 @@ namespace plate::design_detail {
 // part not turning), friction's torque about the centre of mass is -(sum_i mu_i N_i r_i) x u, and the
 // normal forces balance friction's moment about the horizontal axes, which makes sum_i N_i r_i
 // parallel to u: with one friction coefficient the torque vanishes, and such a plate never turns the
-// part (tests/test_design.cpp). With unequal ones it is a weathervane: the torque vanishes where
+// part (tests/design/test_design_orient.cpp). With unequal ones it is a weathervane: the torque vanishes where
 // sum_i (mu_i - mu) N_i r_i lies along u; on a plate shaken along one line with a heave in phase
 // (the transport driven by the normal force: the part slips backwards while pressed hardest, and
 // friction pushes it on) the part turns until its high-friction contact leads -- one stable

@@ -3,7 +3,7 @@
 // before it is reported (the field's fixed points on a grid, and full-dynamics runs from seeded
 // random starts), and a design that fails verification says so.
 //
-// EXACT SYMMETRIES the search uses (checked in tests/test_design.cpp against fields computed both ways):
+// EXACT SYMMETRIES the search uses (checked in tests/design/test_design_symmetry.cpp against fields computed both ways):
 //   rotate_motion(u, a)   the plate motion turned by a about z (x/y and rx/ry harmonics rotate, z and
 //                         rz stay): the field turns with it, xi'(R s, theta + a) = (R v, omega)
 //                         (friction disks are isotropic);
@@ -45,7 +45,7 @@ PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& a
 // different n average out): 0.0025 rad/s for fig4. The asymptotic field (first-order averaging) does
 // not see it; the full dynamics does: fig4's part, at the field's stable fixed point (0, 0, 0),
 // turns steadily in the plate frame at psi', sign included. Rigid-part designs are constrained to
-// |psi'| <= 1e-4 rad/s. (Checked in tests/test_design.cpp against the full dynamics of fig4 and of its
+// |psi'| <= 1e-4 rad/s. (Checked in tests/design/test_design_symmetry.cpp against the full dynamics of fig4 and of its
 // mirror image, within 1 %; the plate's own world-frame turn is not tested separately.)
 // The whole field turns with it about the plate's centre, so a sink placed at D off the centre walks
 // |D| |psi'| per second: a point-part sink is held to |psi'| <= sink_coning_limit (below), and every

@@ -30,7 +30,7 @@ struct DesignTarget {
     // construction and the search only sets its value. A rigid part with one friction coefficient on
     // such a plate is that point part exactly: every contact slides with the centre of mass (nothing
     // turns it: the torque -(sum_i N_i r_i) x mu u vanishes, sum_i N_i r_i being along u), and friction's
-    // resultant is -mu N u as for the point (tests/test_design.cpp checks fig4's and fig1's parts at
+    // resultant is -mu N u as for the point (tests/design/test_design_transport.cpp checks fig4's part at
     // every orientation). So it is designed as that point part and
     // verified as itself (the 7^3 field's twists, theta' included, and full-dynamics runs). `omega`
     // (transport with a turn) is refused: a translating plate cannot turn such a part, and a turning
