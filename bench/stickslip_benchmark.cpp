@@ -75,7 +75,7 @@ void fields_timing() {
 // (1b), (1c) where fig6's field goes: sticking against sliding configurations.
 void fig6_costs() {
     std::printf("\n(1b) where fig6's field goes (one thread): right-hand sides and periods, sticking against sliding\n"
-                "     configurations (README, Limit-cycle solvers)\n");
+                "     configurations (docs/decisions.md, Where fig6's field's work goes)\n");
     {
         FieldOptions opt;
         opt.threads = 1;

@@ -1,7 +1,7 @@
 # Costs of the longest Catch2 cases (seconds on this machine, ctest -j2), read by ctest after
 # catch_discover_tests' list (tests/CMakeLists.txt says why). ctest ignores a name it does not know
-# (tried: no message, no failure), so a case renamed here only loses its place at the front of a
-# fresh checkout's run; the order, not a result, depends on this list.
+# (no message, no failure), so a case renamed here only loses its place at the front of a fresh
+# checkout's run; the order, not a result, depends on this list.
 set_tests_properties(
   "plate report writes index.html whose every figure exists"
   PROPERTIES COST 60)

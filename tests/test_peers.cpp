@@ -46,7 +46,7 @@ TEST_CASE("peers: on a plate at rest every engine keeps the part at rest", "[pee
 // A plate rocking about x and y with period 1 s (angular amplitude 6 rad/s^2: tilt up to 0.152 rad, below
 // the friction angle atan 0.3 = 0.29 rad; the accelerations of plate points near the centre are
 // ~0.1 m/s^2): static friction holds the part, q stays q0. An engine given the plate's angular velocity
-// in the wrong frame moves it by millimetres (measured 6 mm and 0.28 rad by an outside audit).
+// in the wrong frame moves it by millimetres (about 6 mm and 0.28 rad).
 TEST_CASE("peers: on a slowly rocking plate every engine keeps the part stuck", "[peers]") {
     require_engines();
     Scene sc = scene("fig4");

@@ -537,19 +537,19 @@ TEST_CASE("stick-slip on scenes nobody tuned: 36 seeded random sticking scenes a
 
 TEST_CASE("slips at the rim of the disk and grazing contacts: random scenes that broke a faster step control or spent the budget",
           "[stick][random]") {
-    // An outside audit of a predictive step control with a lower hold threshold (docs/speed.md,
-    // *Measured and reverted*) found, among 3 000 sticking_random_scene seeds: seed 2512 (a thin part
+    // Among 3 000 sticking_random_scene seeds (docs/decisions.md, "Predictive step control with a lower
+    // hold threshold: landed, then reverted"): seed 2512 (a thin part
     // with a contact sliding at its disk's rim, its slip chattering between 3e-8 and 1.5e-6 v_ref at
     // rtol 1e-8) spent the whole 2e7 budget without a cycle at the default options; seed 495 (its cycle
     // grazes, smallest normal force about 1e-3 m g) was reported losing contact in the transient from
     // rest at rtol 1e-9 and 1e-10. The engine as it stands finds both cycles, and the tight cycle (rtol
     // 1e-11) is the reference for their twists: within the zero band plus both cycle tolerances.
-    // Seed 2512 at rtol 1e-9 and seed 3121 at the default rtol 1e-8 (a later audit): after the stuck
+    // Seed 2512 at rtol 1e-9 and seed 3121 at the default rtol 1e-8: after the stuck
     // part breaks away next to a pivot one contact slides at its disk's rim while the two others grow
     // from zero, and their repeated creeps, each completing a creep of the whole twist (which reversed
     // the slips at once), spent the whole 2e7 budget until a growing slip no longer restarts such a
-    // creep (engine.hpp, creep_step); without that rule this case fails on both. (2512 still spends
-    // it at rtol 5e-9, 5e-10, 2e-10 and 1e-10: README, Reliability.)
+    // creep (engine_creep.hxx, creep_step); without that rule this case fails on both. (2512 still spends
+    // it at rtol 5e-9, 5e-10, 2e-10 and 1e-10: docs/guide.md, Reliability.)
     LimitCycleOptions tight;
     tight.integration.rtol = 1e-11;
     tight.tol = 1e-10;
@@ -634,7 +634,7 @@ TEST_CASE("full dynamics through stick-slip on random scenes: the regularised tr
     // study.hpp: the engine at rtol 1e-10; GSL's bsimp with f = -mu N v / sqrt(|v|^2 + eps^2) at
     // eps = 1e-4, 1e-5, 1e-6 v_ref, tol 1e-10), the configuration's difference at 0.5 s (relative to
     // rho, rho, 1 rad). Where the engine is the eps -> 0 limit the difference shrinks like eps^p, p
-    // about 0.8 near sticking (README): at least 10^0.5 per decade here. A model error in the engine
+    // about 0.8 near sticking (docs/stick-slip.md): at least 10^0.5 per decade here. A model error in the engine
     // (mu 1 % off) makes it level off at that error instead.
     int held = 0;
     for (std::uint64_t seed : {22, 92, 102, 138, 148}) {

@@ -140,9 +140,8 @@ class StickSlip1D:
         return integral / T, stuck
 
 
-# (amplitude of the first harmonic, friction, second harmonic): mu = 0.29 under 1.5 (0.3 g) is the
-# scene that once ran away (relative speed growing by mu g T per period) when the process's
-# environment left garbage in a point part's unused contacts.
+# (amplitude of the first harmonic, friction, second harmonic): mu = 0.29 under 1.5 (0.3 g) runs away
+# (relative speed growing by mu g T per period) if a point part's unused contacts hold garbage.
 @pytest.mark.parametrize("A1, mu, A2", [(1.5 * 0.3 * G, 0.3, 0.0), (1.5 * 0.3 * G, 0.3, 2.0), (1.5 * 0.3 * G, 0.29, 2.0)])
 def test_a_point_part_shaken_above_mu_g_follows_the_piecewise_closed_form_stick_slip_cycle(A1, mu, A2):
     T = 0.05

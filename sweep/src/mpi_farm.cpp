@@ -12,8 +12,8 @@
 //
 // The main threads poll (MPI_Iprobe, then a 1 ms sleep when idle) rather than block in MPI_Recv:
 // Open MPI's blocking receive spins, which would take a core from the threads computing beside it.
-// Measured on fig4_amp_phase (400 cases, 2 ranks x 1 thread on 2 cores): polling every 0.2 ms with
-// one task in flight cost 10% more compute time per case than threads; every 2 ms, 12% idle time.
+// Two tasks in flight per thread and a 1 ms poll: shorter polls cost compute, longer ones idle time
+// (docs/decisions.md, "Self-scheduling with two tasks in flight per thread, polled at 1 ms").
 #include "plate/farm.hpp"
 
 #include <mpi.h>

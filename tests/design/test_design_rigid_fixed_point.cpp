@@ -14,7 +14,7 @@ using namespace design_tests;
 TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair, verified and reported as not unique",
           "[design][rigid]") {
     // fig4's part at (0.02, -0.01, 0.5): no motion found gives it one orientation together with the
-    // position's pull (README), so after the unique search fails the design falls back on the sink's odd
+    // position's pull (docs/inverse-design.md), so after the unique search fails the design falls back on the sink's odd
     // harmonics with THETA a stable zero of theta'. Turning such a motion by pi is shifting it by half a
     // period, so the twin (s, theta) -> (-s, theta + pi) about the design's centre is a stable fixed
     // point too, with the same eigenvalues; the runs end at one or the other, and the report says so.
@@ -104,7 +104,7 @@ TEST_CASE("a rigid fixed point out of reach as a unique one: the half-turn pair,
 
 TEST_CASE("the half-turn pair broken by rz about its centre: fig4's fixed point unique, every run at the target",
           "[design][rigid]") {
-    // docs/inverse-design.md (2026-11-28): at the pair's fixed point theta' has no first harmonic; rz at
+    // docs/inverse-design.md: at the pair's fixed point theta' has no first harmonic; rz at
     // n = 2 about the design's centre brings its two minima near a saddle-node and rz at n = 1 lifts one
     // of them, so the part turns into one orientation from everywhere (through a slow passage where the
     // twin was). The field's fixed points lie on the curve s*(theta) where the position's twist

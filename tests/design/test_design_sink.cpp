@@ -29,8 +29,8 @@ TEST_CASE("a point-part sink: designed within the limits, unique, verified in fu
     CHECK(s.fixed_point_eigenvalues[1].real() < 0);
     CHECK(s.worst_end_distance <= 0.005);
     CHECK(s.runs.size() == 20u);
-    // Judged where they end (only transport's runs are judged over a window; a window sneaking in
-    // here once sampled the runs every few ms and took the report's design section from 11 s to hours).
+    // Judged where they end (only transport's runs are judged over a window; a window here would sample
+    // the runs every few ms and make the report's design section take hours).
     for (const DesignStartRun& r : s.runs) CHECK(r.from == 0);
     // The limits hold in the scene as written (one harmonic per axis and n), and no flight.
     for (const Harmonic& h : s.scene.plate.harmonics)

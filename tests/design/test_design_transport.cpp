@@ -47,8 +47,8 @@ TEST_CASE("transport: a translating plate carries a point part at the target vel
         CHECK(std::abs(std::remainder(r.seconds - r.from, s.scene.plate.T)) < 1e-9);
         CHECK(r.end_distance <= 0.02 * t.velocity.norm() * (r.seconds - r.from));
     }
-    // Faster, where the start-up's lag alone (9.6 mm at 0.08 m/s, an outside audit measured) exceeded
-    // the 5 mm a check from the start allowed, and the field is as close as ever: verified.
+    // Faster, where the start-up's lag alone (about 9.6 mm at 0.08 m/s) exceeds the 5 mm a check from the
+    // start would allow, and the field is as close as ever: verified.
     DesignTarget quick = t;
     quick.velocity = Vec2(0.08, 0);
     DesignOptions oq = o;

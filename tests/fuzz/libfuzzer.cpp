@@ -1,4 +1,4 @@
-// libFuzzer entry (clang: cmake -DPLATE_FUZZ=ON with CXX=clang++, see README "Reliability"):
+// libFuzzer entry (clang: cmake -DPLATE_FUZZ=ON with CXX=clang++, see docs/guide.md, "Reliability"):
 // coverage-guided exploration of the same target the replay runs (fuzz_one.hpp). Inputs it finds
 // that reach new behaviour go into tests/fuzz/corpus/, which ctest replays.
 #include "fuzz_one.hpp"
