@@ -92,169 +92,228 @@ void record_modes(LimitCycleSummary& out, const E& e, const Mode& start_mode, do
     for (ModeEvent& ev : out.mode_events) ev.t -= t_start;
 }
 
-LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
-    detail::ReducedModel model(sc, q0);
-    detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
-    const double T = sc.plate.T;
-    const detail::Scales sc_(sc);
-    const Vec3 scale(sc_.v, sc_.v, sc_.w);
+// The twist's scales (v_ref, v_ref, v_ref / rho).
+Vec3 twist_scale(const Scene& sc) {
+    const detail::Scales s(sc);
+    return Vec3(s.v, s.v, s.w);
+}
 
+// One limit_cycle by periods (plain, or Anderson's extrapolation) from one start: the engine, the
+// iteration's history and what its stages share -- a period's integration, the acceptance, Anderson's
+// stall and the next period's start.
+struct PeriodIteration {
+    using State = detail::ReducedModel::State;
+    const Scene& sc;
+    const Vec3& q0;
+    const LimitCycleOptions& opt;
+    detail::ReducedModel model;
+    detail::Engine<detail::ReducedModel> e;
+    const double T;
+    const Vec3 scale;
     LimitCycleSummary out;
-    const Vec3 qd_init = sc.part.point ? Vec3(qd0[0], qd0[1], 0) : qd0;
-    detail::ReducedModel::State y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0};
-    Vec3 prev = qd_init;
+    State y;
+    Vec3 prev;
     double r_prev = std::numeric_limits<double>::quiet_NaN();
-    // From rest the part rides with the plate while friction holds it (the engine's stuck mode).
-    const double t0 = 0.0;
-    if (e.start(t0, y)) {
-        if (opt.record) out.path.push_back(Sample{t0, q0, model.qd(e.y()), e.n(), e.mode()});
-        auto record = [&](double t, const auto& z, const Vec3& n) {
-            if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n, e.mode()});
-        };
-        // Periods are the windows [kT, (k+1)T]: after a breakaway at t0 > 0, first reach the
-        // next period boundary, so that every cycle state (and warm start) has phase 0.
-        const double t_first = t0 > 0 ? T * std::ceil(t0 / T * (1 + 1e-12)) : 0.0;
-        bool ok = t0 > 0 ? e.advance(t_first, record) : true;
-        if (ok) prev = model.qd(e.y());
-        const bool anderson = opt.solver == CycleSolver::Anderson;
-        std::deque<Vec3> X, Fx;
-        double lambda = 0, r_prev_plain = std::numeric_limits<double>::infinity();
-        Vec3 start = prev;
-        bool extrapolated = false;   // did the period just integrated start from an extrapolation?
-        // Anderson stalls where the period map's noise (event times located to rtol, slip reversals)
-        // is as large as the residual it extrapolates from: fig6 at (-0.05, 0.0167, 4.49) with tol
-        // 1e-5 and rtol 1e-6 hovered at 2e-5 for 400 periods, where plain periods converge in 13.
-        // When the best residual has not halved for this many periods, give up: plain periods decide.
-        constexpr int kAndersonStall = 25;
-        double best_r = std::numeric_limits<double>::infinity();
-        int best_k = 0;
-        // After a period in which the part stuck as a whole the next starts on a fresh engine, as the
-        // shooting's does (its first step small again, its mode chosen afresh):
-        // that period forgets its start, so its end is the cycle's start to the integration's error --
-        // but carried over, the step in progress made that error depend on the history: heave_yaw (z 2
-        // m/s^2, rz 60 rad/s^2) at (0, 0.02, 0), stuck twice a period, returned within 4e-7-1.6e-6
-        // v_ref of each start for 10 periods and Anderson's r / (1 - lambda) accepted it when one return
-        // fell below tol by chance (12 periods, 3.2e5 right-hand sides); from fresh starts it returns
-        // within 3e-8 v_ref and is accepted after two. (Within a period the step still carries across
-        // the stick, from before it to after the break-away, so fresh periods can return up to the
-        // zero band apart: see the acceptance below. A fresh step at each break-away from a stick made
-        // them agree to 1e-16, but sent random scene 2512 at rtol 1e-9 into its rim-creep crawl: not kept.)
-        bool fresh = false;
-        double r_floor = std::numeric_limits<double>::infinity();   // the last such return
-        for (int k = 1; ok && k <= opt.max_periods; ++k) {
-            const bool began_fresh = fresh;
-            if (fresh) {
-                auto z = e.y();
-                z[3] = z[4] = z[5] = 0;
-                ok = e.start(e.t(), z);
-                if (!ok) break;
-            } else {
-                e.modify([](auto& z) { z[3] = z[4] = z[5] = 0; });
-            }
-            e.reset_log();
-            const Mode start_mode = e.mode();
-            double min_n = e.n().head(sc.part.contacts()).minCoeff();
-            ok = e.advance(t_first + k * T, [&](double t, const auto& z, const Vec3& n) {
-                min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
-                record(t, z, n);
-            });
-            out.periods = k;
-            out.min_normal_force = min_n;
-            if (!ok) break;
-            if (e.stats.rhs_evals > opt.max_rhs_evaluations) {
-                e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
-                break;
-            }
-            y = e.y();
-            const Vec3 qd = model.qd(y);
-            out.twist = Vec3(y[3], y[4], y[5]) / T;   // (36)
-            record_modes(out, e, start_mode, t_first + (k - 1) * T, T);
-            out.qd_start = prev;
-            const double r = ((qd - prev).array() / scale.array()).abs().maxCoeff();
-            out.residual = r;
-            // Stuck as a whole during this period: it forgets its start. (Not a period that starts
-            // stuck without sticking again, as from rest: taking that one too put random scene 132's
-            // loose cycle, rtol 1e-5, a period later and 11 rtol v_ref off its tight cycle for 8.)
-            const bool reset = stuck_during(e.events);
-            if (k >= 2 && r_prev > 0) {
-                // With Anderson the ratio r/r_prev measures the acceleration, not the map: keep the
-                // map's contraction from the first plain periods for the error estimate.
-                // The twist is the average over the period from the start x_k, which lies within
-                // r/(1 - lambda) of the cycle; plain periods report their end, within r c/(1 - c).
-                if (!extrapolated) lambda = std::min(r / r_prev, 0.99);
-                out.contraction = anderson ? lambda : std::min(r / r_prev, 0.99);
-                out.error_estimate = anderson ? r / (1 - lambda) : r * out.contraction / (1 - out.contraction);
-                // After a full stick the map is constant: this period's start is the cycle's when it
-                // sticks as a whole too, and its return r is then the integration's error in the start,
-                // not a contraction's step, which no number of periods makes smaller (c = r / r_prev
-                // would compare it with the transient: r^2 / r_prev, 7e-15 for a 3e-8 return). The
-                // start is within r of the cycle; the cycle is accepted where r is within the engine's
-                // own accuracy (the zero band plus tol, the bound it claims for sticking cycles:
-                // README). A lower return met by chance later is not a better cycle:
-                // sticking_random_scene 256 alternated between two ends 6e-7 v_ref apart forever, and
-                // heave_yaw with z 2, rz 60 at (0, 0.02, 0) returned 4e-7-1.6e-6 apart for 10 periods.
-                // That is taken as the floor once a second such return is no smaller than half the
-                // first (one that still halves is a transient, and the first return alone cannot
-                // tell). Where this period does not stick as a whole the usual rule decides, with the
-                // estimate at least r.
-                if (began_fresh) {
-                    out.error_estimate = std::max(out.error_estimate, r);
-                    if (reset && at_stuck_floor(r, r_floor, opt)) {
-                        out.converged = true;
-                        break;
-                    }
-                }
-                if (out.error_estimate <= opt.tol) {
-                    out.converged = true;
-                    break;
-                }
-            } else if (r == 0) {
+    double t_first = 0;
+    const bool anderson;
+    std::deque<Vec3> X, Fx;
+    double lambda = 0, r_prev_plain = std::numeric_limits<double>::infinity();
+    Vec3 start;
+    bool extrapolated = false;   // did the period just integrated start from an extrapolation?
+    // Anderson stalls where the period map's noise (event times located to rtol, slip reversals)
+    // is as large as the residual it extrapolates from: fig6 at (-0.05, 0.0167, 4.49) with tol
+    // 1e-5 and rtol 1e-6 hovered at 2e-5 for 400 periods, where plain periods converge in 13.
+    // When the best residual has not halved for this many periods, give up: plain periods decide.
+    static constexpr int kAndersonStall = 25;
+    double best_r = std::numeric_limits<double>::infinity();
+    int best_k = 0;
+    // After a period in which the part stuck as a whole the next starts on a fresh engine, as the
+    // shooting's does (its first step small again, its mode chosen afresh):
+    // that period forgets its start, so its end is the cycle's start to the integration's error --
+    // but carried over, the step in progress made that error depend on the history: heave_yaw (z 2
+    // m/s^2, rz 60 rad/s^2) at (0, 0.02, 0), stuck twice a period, returned within 4e-7-1.6e-6
+    // v_ref of each start for 10 periods and Anderson's r / (1 - lambda) accepted it when one return
+    // fell below tol by chance (12 periods, 3.2e5 right-hand sides); from fresh starts it returns
+    // within 3e-8 v_ref and is accepted after two. (Within a period the step still carries across
+    // the stick, from before it to after the break-away, so fresh periods can return up to the
+    // zero band apart: see the acceptance below. A fresh step at each break-away from a stick made
+    // them agree to 1e-16, but sent random scene 2512 at rtol 1e-9 into its rim-creep crawl: not kept.)
+    bool fresh = false;
+    double r_floor = std::numeric_limits<double>::infinity();   // the last such return
+
+    PeriodIteration(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd_init)
+        : sc(sc), q0(q0), opt(opt), model(sc, q0), e(model, sc, opt.integration), T(sc.plate.T),
+          scale(twist_scale(sc)),
+          y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0}, prev(qd_init), anderson(opt.solver == CycleSolver::Anderson) {}
+
+    void record(double t, const State& z, const Vec3& n) {
+        if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n, e.mode()});
+    }
+    void run(double t0);
+    bool integrate(int k, bool began_fresh, Mode& start_mode);
+    bool accepted(int k, double r, bool began_fresh, bool reset);
+    bool stalled(int k, double r);
+    void next_start(int k, double r, const Vec3& qd, bool began_fresh, bool reset);
+    void finish();
+};
+
+// The periods from the engine's start at t0 until the cycle is accepted or a cap or stop ends them.
+void PeriodIteration::run(double t0) {
+    if (opt.record) out.path.push_back(Sample{t0, q0, model.qd(e.y()), e.n(), e.mode()});
+    // Periods are the windows [kT, (k+1)T]: after a breakaway at t0 > 0, first reach the
+    // next period boundary, so that every cycle state (and warm start) has phase 0.
+    t_first = t0 > 0 ? T * std::ceil(t0 / T * (1 + 1e-12)) : 0.0;
+    bool ok = t0 > 0 ? e.advance(t_first, [&](double t, const State& z, const Vec3& n) { record(t, z, n); }) : true;
+    if (ok) prev = model.qd(e.y());
+    start = prev;
+    for (int k = 1; ok && k <= opt.max_periods; ++k) {
+        const bool began_fresh = fresh;
+        Mode start_mode;
+        if (!integrate(k, began_fresh, start_mode)) break;
+        y = e.y();
+        const Vec3 qd = model.qd(y);
+        out.twist = Vec3(y[3], y[4], y[5]) / T;   // (36)
+        record_modes(out, e, start_mode, t_first + (k - 1) * T, T);
+        out.qd_start = prev;
+        const double r = ((qd - prev).array() / scale.array()).abs().maxCoeff();
+        out.residual = r;
+        // Stuck as a whole during this period: it forgets its start. (Not a period that starts
+        // stuck without sticking again, as from rest: taking that one too put random scene 132's
+        // loose cycle, rtol 1e-5, a period later and 11 rtol v_ref off its tight cycle for 8.)
+        const bool reset = stuck_during(e.events);
+        if (accepted(k, r, began_fresh, reset)) break;
+        if (stalled(k, r)) break;
+        next_start(k, r, qd, began_fresh, reset);
+    }
+}
+
+// Period k on the engine (fresh after a full stick); false if it stopped or spent the budget.
+bool PeriodIteration::integrate(int k, bool began_fresh, Mode& start_mode) {
+    if (began_fresh) {
+        auto z = e.y();
+        z[3] = z[4] = z[5] = 0;
+        if (!e.start(e.t(), z)) return false;
+    } else {
+        e.modify([](auto& z) { z[3] = z[4] = z[5] = 0; });
+    }
+    e.reset_log();
+    start_mode = e.mode();
+    double min_n = e.n().head(sc.part.contacts()).minCoeff();
+    const bool ok = e.advance(t_first + k * T, [&](double t, const auto& z, const Vec3& n) {
+        min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
+        record(t, z, n);
+    });
+    out.periods = k;
+    out.min_normal_force = min_n;
+    if (!ok) return false;
+    if (e.stats.rhs_evals > opt.max_rhs_evaluations) {
+        e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
+        return false;
+    }
+    return true;
+}
+
+// Is the cycle converged after period k, whose return is r?
+bool PeriodIteration::accepted(int k, double r, bool began_fresh, bool reset) {
+    if (k >= 2 && r_prev > 0) {
+        // With Anderson the ratio r/r_prev measures the acceleration, not the map: keep the
+        // map's contraction from the first plain periods for the error estimate.
+        // The twist is the average over the period from the start x_k, which lies within
+        // r/(1 - lambda) of the cycle; plain periods report their end, within r c/(1 - c).
+        if (!extrapolated) lambda = std::min(r / r_prev, 0.99);
+        out.contraction = anderson ? lambda : std::min(r / r_prev, 0.99);
+        out.error_estimate = anderson ? r / (1 - lambda) : r * out.contraction / (1 - out.contraction);
+        // After a full stick the map is constant: this period's start is the cycle's when it
+        // sticks as a whole too, and its return r is then the integration's error in the start,
+        // not a contraction's step, which no number of periods makes smaller (c = r / r_prev
+        // would compare it with the transient: r^2 / r_prev, 7e-15 for a 3e-8 return). The
+        // start is within r of the cycle; the cycle is accepted where r is within the engine's
+        // own accuracy (the zero band plus tol, the bound it claims for sticking cycles:
+        // README). A lower return met by chance later is not a better cycle:
+        // sticking_random_scene 256 alternated between two ends 6e-7 v_ref apart forever, and
+        // heave_yaw with z 2, rz 60 at (0, 0.02, 0) returned 4e-7-1.6e-6 apart for 10 periods.
+        // That is taken as the floor once a second such return is no smaller than half the
+        // first (one that still halves is a transient, and the first return alone cannot
+        // tell). Where this period does not stick as a whole the usual rule decides, with the
+        // estimate at least r.
+        if (began_fresh) {
+            out.error_estimate = std::max(out.error_estimate, r);
+            if (reset && at_stuck_floor(r, r_floor, opt)) {
                 out.converged = true;
-                break;
+                return true;
             }
-            if (anderson) {
-                if (r < 0.5 * best_r) {
-                    best_r = r;
-                    best_k = k;
-                } else if (k - best_k >= kAndersonStall) {
-                    break;
-                }
-            }
-            r_prev = r;
-            prev = qd;
-            extrapolated = false;
-            r_floor = began_fresh && reset ? r : std::numeric_limits<double>::infinity();
-            fresh = reset;
-            if (anderson && reset) {
-                // The part was stuck during the period: that resets its state, so the map is all but
-                // constant and the plain period is the best next start; extrapolating across the
-                // map's pieces threw the start off (157 periods instead of 4 on a heave + yaw scene).
-                X.clear();
-                Fx.clear();
-            } else if (anderson) {
-                // Plain periods until the map's own contraction is measured, then extrapolate.
-                X.push_back(start.cwiseQuotient(scale));
-                Fx.push_back(qd.cwiseQuotient(scale));
-                if (static_cast<int>(X.size()) > opt.anderson_memory + 1) { X.pop_front(); Fx.pop_front(); }
-                // Extrapolate only where the iteration contracts; forget the transient before.
-                if (r >= r_prev_plain) { X.erase(X.begin(), X.end() - 1); Fx.erase(Fx.begin(), Fx.end() - 1); }
-                r_prev_plain = r;
-                if (k >= 2 && X.size() >= 2) {
-                    const Vec3 next = anderson_next(X, Fx).cwiseProduct(scale);
-                    extrapolated = next != prev;
-                    e.modify([&](auto& z) { z[0] = next[0]; z[1] = next[1]; z[2] = sc.part.point ? 0.0 : next[2]; });
-                    prev = model.qd(e.y());
-                }
-            }
-            start = prev;
+        }
+        if (out.error_estimate <= opt.tol) {
+            out.converged = true;
+            return true;
+        }
+    } else if (r == 0) {
+        out.converged = true;
+        return true;
+    }
+    return false;
+}
+
+// Has Anderson's best residual not halved for kAndersonStall periods?
+bool PeriodIteration::stalled(int k, double r) {
+    if (anderson) {
+        if (r < 0.5 * best_r) {
+            best_r = r;
+            best_k = k;
+        } else if (k - best_k >= kAndersonStall) {
+            return true;
         }
     }
+    return false;
+}
+
+// The next period's start: period k's end qd, or Anderson's extrapolation from the history.
+void PeriodIteration::next_start(int k, double r, const Vec3& qd, bool began_fresh, bool reset) {
+    r_prev = r;
+    prev = qd;
+    extrapolated = false;
+    r_floor = began_fresh && reset ? r : std::numeric_limits<double>::infinity();
+    fresh = reset;
+    if (anderson && reset) {
+        // The part was stuck during the period: that resets its state, so the map is all but
+        // constant and the plain period is the best next start; extrapolating across the
+        // map's pieces threw the start off (157 periods instead of 4 on a heave + yaw scene).
+        X.clear();
+        Fx.clear();
+    } else if (anderson) {
+        // Plain periods until the map's own contraction is measured, then extrapolate.
+        X.push_back(start.cwiseQuotient(scale));
+        Fx.push_back(qd.cwiseQuotient(scale));
+        if (static_cast<int>(X.size()) > opt.anderson_memory + 1) { X.pop_front(); Fx.pop_front(); }
+        // Extrapolate only where the iteration contracts; forget the transient before.
+        if (r >= r_prev_plain) { X.erase(X.begin(), X.end() - 1); Fx.erase(Fx.begin(), Fx.end() - 1); }
+        r_prev_plain = r;
+        if (k >= 2 && X.size() >= 2) {
+            const Vec3 next = anderson_next(X, Fx).cwiseProduct(scale);
+            extrapolated = next != prev;
+            e.modify([&](auto& z) { z[0] = next[0]; z[1] = next[1]; z[2] = sc.part.point ? 0.0 : next[2]; });
+            prev = model.qd(e.y());
+        }
+    }
+    start = prev;
+}
+
+void PeriodIteration::finish() {
     out.stop = e.stop;
     out.stats = e.stats;
     out.step_hint = e.next_step() / T;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
-    return out;
+}
+
+LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+    const Vec3 qd_init = sc.part.point ? Vec3(qd0[0], qd0[1], 0) : qd0;
+    PeriodIteration it(sc, q0, opt, qd_init);
+    // From rest the part rides with the plate while friction holds it (the engine's stuck mode).
+    const double t0 = 0.0;
+    if (it.e.start(t0, it.y)) it.run(t0);
+    it.finish();
+    return it.out;
 }
 
 
@@ -434,17 +493,23 @@ constexpr double kDifferenceMonodromyNear = 3e-2;   // |P(x) - x| / scale below 
 constexpr int kPlainPeriodsMax = 20;                 // plain periods toward a switching cycle, then Anderson
 constexpr double kPaError = 0.02;                    // relative error allowed for Pa (and M) in the estimates
 
-LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
-    detail::ReducedModel model(sc, q0);
-    detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
+// One shooting_cycle: the engine, the iterate x and its monodromy, and what the stages of a period
+// share -- its integration with the variational equations, the full stick's acceptance, the
+// monodromy by differences and the Newton (or chord) step with its acceptance.
+struct Shooting {
+    using State = detail::ReducedModel::State;
+    const Scene& sc;
+    const Vec3& q0;
+    const LimitCycleOptions& opt;
+    detail::ReducedModel model;
+    detail::Engine<detail::ReducedModel> e;
     Workspace jws;   // the Jacobian's own workspace: the engine's holds its last evaluation
-    const double T = sc.plate.T;
-    const detail::Scales sc_(sc);
-    const Vec3 S(sc_.v, sc_.v, sc_.w);
-    const int nc = sc.part.contacts();
-    const bool point = sc.part.point;
+    const double T;
+    const Vec3 S;
+    const int nc;
+    const bool point;
     LimitCycleSummary out;
-    Vec3 x = point ? Vec3(qd0[0], qd0[1], 0) : qd0;
+    Vec3 x;
     bool refresh = true;
     bool reset_prev = false;   // the last period stuck fully (its end is the cycle's start)
     double res_floor = std::numeric_limits<double>::infinity();   // its return, if it began fresh too
@@ -452,218 +517,238 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     int fd_periods = 0;
     int plain_periods = 0;
     Mat3 M = Mat3::Zero(), Pa = Mat3::Zero();
-    bool loose = opt.integration.large_slip_factor != 1;
+    bool loose;
     bool on_curve = false;   // x is the previous period's end (on the period map's image)
     Vec3 line = Vec3::Zero();   // with a rank-one M: its range, along which the iterates stay
     double d_prev = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < opt.max_periods; ++k) {
-        const detail::ReducedModel::State y{x[0], x[1], x[2], 0, 0, 0};
-        IntegrationOptions io = opt.integration;
-        if (!loose || (k == 0 && opt.first_period_tight)) io.large_slip_factor = 1;
-        const bool io_tight = io.large_slip_factor == 1;
-        e.set_large_slip_factor(io.large_slip_factor);
-        bool ok = true;
-        // After a full stick the next period starts on a fresh engine (its first step small again):
-        // one carried over from a far start can step over a brief pivot (an outside audit found a
-        // cycle 4.7e-6 v_ref off that way), and that period is the one accepted below.
-        if (k == 0 || reset_prev) ok = e.start(k * T, y);
-        else e.modify([&](auto& z) { z = y; });
-        // The variational equations Phi' = J(t) Phi, Psi' = Phi (J = d q''/d q', generated) on the
-        // engine's accepted steps by the trapezoidal rule, J at each step's end: second order,
-        // within 1% of central differences of the period map on fig4, fig5 and fig3 (tests), one
-        // Jacobian per step: a chord needs no more, and the error estimate allows for it.
-        Mat3 Phi = Mat3::Identity(), Psi = Mat3::Zero(), J;
-        double t_prev = e.t();
-        e.reset_log();
-        const Mode start_mode = e.mode();
-        // The variational equations below are those of sliding; a period that starts held or
-        // changes mode takes the difference monodromy instead (above).
-        const bool variational = refresh && start_mode.kind == ModeKind::Slide;
-        if (variational) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
-        double min_n = e.n().head(nc).minCoeff();
-        ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
-            min_n = std::min(min_n, n.head(nc).minCoeff());
-            if (!variational) return;
-            const double h = t - t_prev;
-            Mat3 J1;
-            twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), model.plate_at(t), jws, J1);
-            const Mat3 Phi1 = (Mat3::Identity() - 0.5 * h * J1).inverse() * ((Mat3::Identity() + 0.5 * h * J) * Phi);
-            Psi += 0.5 * h * (Phi + Phi1);
-            Phi = Phi1;
-            J = J1;
-            t_prev = t;
-        });
-        out.periods = k + 1 + fd_periods;
-        if (!ok) break;
-        if (e.stats.rhs_evals + fd_stats.rhs_evals + jws.evals > opt.max_rhs_evaluations) {
-            e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
-            break;
-        }
-        const auto z = e.y();
-        const Vec3 r_now = (model.qd(z) - x).cwiseQuotient(S);   // the residual P(x) - x, scaled
-        record_modes(out, e, start_mode, k * T, T);
-        const bool switched = start_mode.kind != ModeKind::Slide || !e.events.empty();
-        // A period that changed mode is accepted only if it ran tight, and so are the ones after it.
-        const bool accept = !(switched && !io_tight);
-        if (switched) loose = false;
-        // A period in which the part was stuck as a whole forgets its start: P is constant near x,
-        // so M = 0 exactly and P(x) is the cycle's start (to the integration's noise). The period
-        // after it, from P(x), is then the cycle: when it sticks fully too, it is converged.
-        const bool full_stick = start_mode.kind == ModeKind::Stuck || stuck_during(e.events);
-        if (full_stick) {
-            const double res = r_now.cwiseAbs().maxCoeff();
-            if (k >= 1 && reset_prev && accept &&
-                (res <= opt.tol || at_stuck_floor(res, res_floor, opt))) {
-                // This period ran on a fresh engine from the previous one's end, and returns to its
-                // start within tol, or within tol plus the zero band where the return has stopped
-                // halving (the integration's error, which more periods do not shrink: one_start
-                // above): the cycle.
-                out.twist = Vec3(z[3], z[4], z[5]) / T;
-                out.qd_start = x;
-                out.residual = res;
-                out.error_estimate = res;
-                out.min_normal_force = min_n;
-                out.has_monodromy = true;            // dP/dx = 0: every Floquet multiplier is 0
-                out.monodromy.setZero();
-                out.converged = true;
-                break;
-            }
-            res_floor = reset_prev && accept ? res : std::numeric_limits<double>::infinity();
-            reset_prev = true;
-            on_curve = true;
-            x = model.qd(z);
-            d_prev = std::numeric_limits<double>::infinity();
-            refresh = true;
-            continue;
-        }
-        reset_prev = false;
-        // A difference monodromy pays only near enough to the cycle, where Newton then ends in a
-        // step or two; further off (a poor warm start in a field) plain periods approach it first
-        // (Anderson from the warm start itself once took 56 periods for one of them). The right-hand
-        // sides of fig6's 78 sticking cycles in its 7^3 field, by threshold: 3e-4 1.56e6, 1e-3 1.41e6,
-        // 3e-2 1.18e6, 1e-1 1.15e6, differences at every start 1.40e6 (the whole field 2.05e6 at
-        // 3e-2, 2.29e6 at 1e-3).
-        if (refresh && switched && r_now.cwiseAbs().maxCoeff() > kDifferenceMonodromyNear) {
-            if (++plain_periods > kPlainPeriodsMax) break;   // slow or alternating: Anderson's
-            x = model.qd(z);
-            on_curve = true;
-            d_prev = std::numeric_limits<double>::infinity();
-            continue;
-        }
-        if (refresh) line.setZero();
-        const double h = 1e-4;   // the differences' step, relative to the scales
-        if (refresh && switched && on_curve && !point && r_now.norm() > 0 &&
-            (start_mode.kind == ModeKind::Pivot ||
-             std::any_of(e.events.begin(), e.events.end(), [](const ModeEvent& m) { return m.to.kind == ModeKind::Pivot; }))) {
-            // The rank-one monodromy (above): one difference along the residual.
-            const Vec3 u = r_now.normalized();
-            const PeriodResult pu = one_period(sc, q0, x + h * u.cwiseProduct(S), io, fd_stats);
-            ++fd_periods;
-            ++out.periods;
-            if (!pu.ok) break;
-            const Vec3 dP = (pu.end - model.qd(z)).cwiseQuotient(S) / h;
-            const double lambda = dP.dot(u);
-            if ((dP - lambda * u).norm() <= 0.05 * dP.norm()) {
-                M = lambda * u * u.transpose();
-                Pa = (pu.average - Vec3(z[3], z[4], z[5]) / T).cwiseQuotient(S) / h * u.transpose();
-                line = u;
-            }
-        }
-        if (refresh && switched && line.isZero()) {
-            // Forward differences of the period map (and of its average) in the scaled twist.
-            const Vec3 end = model.qd(z), avg = Vec3(z[3], z[4], z[5]) / T;
-            bool fd_ok = true;
-            on_curve = false;   // the Newton step below leaves the image curve
-            M.setZero();
-            Pa.setZero();
-            for (int j = 0; j < (point ? 2 : 3) && fd_ok; ++j) {
-                Vec3 xj = x;
-                xj[j] += h * S[j];
-                const PeriodResult pj = one_period(sc, q0, xj, io, fd_stats);
-                fd_ok = pj.ok;
-                M.col(j) = (pj.end - end).cwiseQuotient(S) / h;
-                Pa.col(j) = (pj.average - avg).cwiseQuotient(S) / h;
-            }
-            fd_periods += point ? 2 : 3;
-            out.periods += point ? 2 : 3;
-            if (!fd_ok) break;
-        } else if (refresh && line.isZero()) {
-            on_curve = false;
-            M = S.asDiagonal().inverse() * Phi * S.asDiagonal();
-            Pa = S.asDiagonal().inverse() * Psi * S.asDiagonal() / T;
-        }
-        const bool was_fresh = refresh;
-        refresh = false;
-        const Vec3& r = r_now;
-        Mat3 A = Mat3::Identity() - M;
-        if (point) {   // no rotation: the third component is not an unknown
-            A.row(2).setZero();
-            A.col(2).setZero();
-            A(2, 2) = 1;
-        }
-        const Vec3 delta = A.partialPivLu().solve(r);
-        const double dn = delta.cwiseAbs().maxCoeff();
-        // A step beyond a quarter of the slip-speed scale means a Floquet multiplier near 1 (or a
-        // start far from the cycle): Newton is no better than its linearisation there. Where the map
-        // contracts strongly (every multiplier below 1/2) the step is still better than a plain period
-        // (fig6's field: neighbours' warm starts 0.3-0.9 of the scale off, which sent 1 in 3 of its
-        // configurations back to Anderson from the start): take it and linearise afresh at its end.
-        // Otherwise give up.
-        if (!(dn <= 0.25)) {
-            if (!std::isfinite(dn) || !was_fresh || M.eigenvalues().cwiseAbs().maxCoeff() >= 0.5) break;
-            x += delta.cwiseProduct(S);
-            refresh = true;
-            d_prev = std::numeric_limits<double>::infinity();   // no contraction measured across it
-            continue;
-        }
-        out.twist = Vec3(z[3], z[4], z[5]) / T + (Pa * delta).cwiseProduct(S);
-        out.qd_start = x + delta.cwiseProduct(S);   // the Newton estimate of the cycle's start
-        out.residual = r.cwiseAbs().maxCoeff();
-        out.min_normal_force = min_n;
-        out.has_monodromy = true;
-        out.monodromy = M;
-        // With a monodromy fresh at this start, dn is the linear estimate of the start's distance
-        // from the cycle; the twist's error is at most |d xi_a/dx| times it (before the correction
-        // Pa delta, which leaves only its second-order remainder), doubled for a difference
-        // monodromy's or a nonlinearity's error. Near the cycle this ends a warm start after one
-        // period (the period map's noise, ~rtol v_ref per switch, left the contraction
-        // theta below unmeasurable there).
-        // (And the start itself within tol of the cycle, for the warm starts it gives: dn to first
-        // order, which the monodromy's error, ~2% as below, leaves.)
-        // With a rank-one M the residual's part off its line, r_perp, is taken as it stands (M has no
-        // component there, which is exact for the step: the true M's range is the line) but Pa u leaves
-        // out the twist's sensitivity across the line (|Pa| <= 1.72 |Pa u|, with |Pa| <= 0.7, on fig6):
-        // nothing is accepted before r_perp is below a tenth of tol. It falls quadratically (the map
-        // puts every start on its image curve; r_perp is that curve's bend over the last step).
-        const bool on_line = line.isZero() || (r - line * line.dot(r)).norm() <= 0.1 * opt.tol;
-        if (accept && was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol && kPaError * dn <= opt.tol) {
-            out.error_estimate = 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn;
-            out.converged = true;
-            break;
-        }
-        if (k >= 1 && std::isfinite(d_prev)) {   // (not after a full stick: no previous step)
-            const double theta = d_prev > 0 ? dn / d_prev : 0.0;
-            out.contraction = theta;
-            // The next step contracts by about theta again on a chord, by less under Newton; but a
-            // chord step after a fresh monodromy at the previous start contracts by up to 2 theta
-            // (the monodromy it uses is then one step stale). The twist's error is the start's
-            // times |d xi_a/dx| (max-row-sum norm).
-            if (2 * theta < 1) {
-                // Plus the correction Pa delta's own error: the variational Pa is about 1% off
-                // (trapezoidal rule on the engine's steps), which an outside audit found left a
-                // chord-accepted twist 1e-6 v_ref off with an estimate of 7e-8.
-                const double dist = 2 * theta / (1 - 2 * theta) * dn;
-                out.error_estimate = Pa.cwiseAbs().rowwise().sum().maxCoeff() * (dist + kPaError * dn);
-                if (accept && on_line && out.error_estimate <= opt.tol) { out.converged = true; break; }
-            }
-            if (theta > 0.5) {
-                if (was_fresh) break;   // even a fresh monodromy does not contract: give up
-                refresh = true;         // a stale chord: refresh M at this start
-            }
-        }
-        x += delta.cwiseProduct(S);
-        d_prev = dn;
+    // The period just integrated (integrate): its integration options (the difference periods run
+    // with them too), whether it ran tight, its mode at the start, its least normal force and the
+    // variational monodromy Phi and its integral Psi.
+    IntegrationOptions io;
+    bool io_tight = true;
+    Mode start_mode;
+    double min_n = 0;
+    Mat3 Phi, Psi;
+
+    Shooting(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0)
+        : sc(sc), q0(q0), opt(opt), model(sc, q0), e(model, sc, opt.integration), T(sc.plate.T),
+          S(twist_scale(sc)), nc(sc.part.contacts()), point(sc.part.point),
+          x(point ? Vec3(qd0[0], qd0[1], 0) : qd0), loose(opt.integration.large_slip_factor != 1) {}
+
+    bool integrate(int k);
+    bool after_full_stick(int k, const State& z, const Vec3& r_now, bool accept);
+    bool update_monodromy(const State& z, const Vec3& r_now, bool switched);
+    bool newton_step(int k, const State& z, const Vec3& r_now, bool accept);
+    void finish();
+};
+
+// Period k from x (on a fresh engine at the first and after a full stick); false if it stopped or
+// spent the budget.
+bool Shooting::integrate(int k) {
+    const State y{x[0], x[1], x[2], 0, 0, 0};
+    io = opt.integration;
+    if (!loose || (k == 0 && opt.first_period_tight)) io.large_slip_factor = 1;
+    io_tight = io.large_slip_factor == 1;
+    e.set_large_slip_factor(io.large_slip_factor);
+    bool ok = true;
+    // After a full stick the next period starts on a fresh engine (its first step small again):
+    // one carried over from a far start can step over a brief pivot (an outside audit found a
+    // cycle 4.7e-6 v_ref off that way), and that period is the one accepted below.
+    if (k == 0 || reset_prev) ok = e.start(k * T, y);
+    else e.modify([&](auto& z) { z = y; });
+    // The variational equations Phi' = J(t) Phi, Psi' = Phi (J = d q''/d q', generated) on the
+    // engine's accepted steps by the trapezoidal rule, J at each step's end: second order,
+    // within 1% of central differences of the period map on fig4, fig5 and fig3 (tests), one
+    // Jacobian per step: a chord needs no more, and the error estimate allows for it.
+    Phi = Mat3::Identity();
+    Psi = Mat3::Zero();
+    Mat3 J;
+    double t_prev = e.t();
+    e.reset_log();
+    start_mode = e.mode();
+    // The variational equations below are those of sliding; a period that starts held or
+    // changes mode takes the difference monodromy instead (above).
+    const bool variational = refresh && start_mode.kind == ModeKind::Slide;
+    if (variational) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
+    min_n = e.n().head(nc).minCoeff();
+    ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
+        min_n = std::min(min_n, n.head(nc).minCoeff());
+        if (!variational) return;
+        const double h = t - t_prev;
+        Mat3 J1;
+        twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), model.plate_at(t), jws, J1);
+        const Mat3 Phi1 = (Mat3::Identity() - 0.5 * h * J1).inverse() * ((Mat3::Identity() + 0.5 * h * J) * Phi);
+        Psi += 0.5 * h * (Phi + Phi1);
+        Phi = Phi1;
+        J = J1;
+        t_prev = t;
+    });
+    out.periods = k + 1 + fd_periods;
+    if (!ok) return false;
+    if (e.stats.rhs_evals + fd_stats.rhs_evals + jws.evals > opt.max_rhs_evaluations) {
+        e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
+        return false;
     }
+    return true;
+}
+
+// A period in which the part was stuck as a whole forgets its start: P is constant near x,
+// so M = 0 exactly and P(x) is the cycle's start (to the integration's noise). The period
+// after it, from P(x), is then the cycle: when it sticks fully too, it is converged (true).
+bool Shooting::after_full_stick(int k, const State& z, const Vec3& r_now, bool accept) {
+    const double res = r_now.cwiseAbs().maxCoeff();
+    if (k >= 1 && reset_prev && accept &&
+        (res <= opt.tol || at_stuck_floor(res, res_floor, opt))) {
+        // This period ran on a fresh engine from the previous one's end, and returns to its
+        // start within tol, or within tol plus the zero band where the return has stopped
+        // halving (the integration's error, which more periods do not shrink: one_start
+        // above): the cycle.
+        out.twist = Vec3(z[3], z[4], z[5]) / T;
+        out.qd_start = x;
+        out.residual = res;
+        out.error_estimate = res;
+        out.min_normal_force = min_n;
+        out.has_monodromy = true;            // dP/dx = 0: every Floquet multiplier is 0
+        out.monodromy.setZero();
+        out.converged = true;
+        return true;
+    }
+    res_floor = reset_prev && accept ? res : std::numeric_limits<double>::infinity();
+    reset_prev = true;
+    on_curve = true;
+    x = model.qd(z);
+    d_prev = std::numeric_limits<double>::infinity();
+    refresh = true;
+    return false;
+}
+
+// M and Pa at x where they are refreshed: one difference along the residual (a rank-one M), three
+// differences (a period that changed mode) or the variational Phi and Psi; false if a difference
+// period stopped.
+bool Shooting::update_monodromy(const State& z, const Vec3& r_now, bool switched) {
+    if (refresh) line.setZero();
+    const double h = 1e-4;   // the differences' step, relative to the scales
+    if (refresh && switched && on_curve && !point && r_now.norm() > 0 &&
+        (start_mode.kind == ModeKind::Pivot ||
+         std::any_of(e.events.begin(), e.events.end(), [](const ModeEvent& m) { return m.to.kind == ModeKind::Pivot; }))) {
+        // The rank-one monodromy (above): one difference along the residual.
+        const Vec3 u = r_now.normalized();
+        const PeriodResult pu = one_period(sc, q0, x + h * u.cwiseProduct(S), io, fd_stats);
+        ++fd_periods;
+        ++out.periods;
+        if (!pu.ok) return false;
+        const Vec3 dP = (pu.end - model.qd(z)).cwiseQuotient(S) / h;
+        const double lambda = dP.dot(u);
+        if ((dP - lambda * u).norm() <= 0.05 * dP.norm()) {
+            M = lambda * u * u.transpose();
+            Pa = (pu.average - Vec3(z[3], z[4], z[5]) / T).cwiseQuotient(S) / h * u.transpose();
+            line = u;
+        }
+    }
+    if (refresh && switched && line.isZero()) {
+        // Forward differences of the period map (and of its average) in the scaled twist.
+        const Vec3 end = model.qd(z), avg = Vec3(z[3], z[4], z[5]) / T;
+        bool fd_ok = true;
+        on_curve = false;   // the Newton step below leaves the image curve
+        M.setZero();
+        Pa.setZero();
+        for (int j = 0; j < (point ? 2 : 3) && fd_ok; ++j) {
+            Vec3 xj = x;
+            xj[j] += h * S[j];
+            const PeriodResult pj = one_period(sc, q0, xj, io, fd_stats);
+            fd_ok = pj.ok;
+            M.col(j) = (pj.end - end).cwiseQuotient(S) / h;
+            Pa.col(j) = (pj.average - avg).cwiseQuotient(S) / h;
+        }
+        fd_periods += point ? 2 : 3;
+        out.periods += point ? 2 : 3;
+        if (!fd_ok) return false;
+    } else if (refresh && line.isZero()) {
+        on_curve = false;
+        M = S.asDiagonal().inverse() * Phi * S.asDiagonal();
+        Pa = S.asDiagonal().inverse() * Psi * S.asDiagonal() / T;
+    }
+    return true;
+}
+
+// The Newton (or chord) step from x with M, and its acceptance; false when the iteration ends
+// (converged, or giving up to Anderson).
+bool Shooting::newton_step(int k, const State& z, const Vec3& r_now, bool accept) {
+    const bool was_fresh = refresh;
+    refresh = false;
+    const Vec3& r = r_now;
+    Mat3 A = Mat3::Identity() - M;
+    if (point) {   // no rotation: the third component is not an unknown
+        A.row(2).setZero();
+        A.col(2).setZero();
+        A(2, 2) = 1;
+    }
+    const Vec3 delta = A.partialPivLu().solve(r);
+    const double dn = delta.cwiseAbs().maxCoeff();
+    // A step beyond a quarter of the slip-speed scale means a Floquet multiplier near 1 (or a
+    // start far from the cycle): Newton is no better than its linearisation there. Where the map
+    // contracts strongly (every multiplier below 1/2) the step is still better than a plain period
+    // (fig6's field: neighbours' warm starts 0.3-0.9 of the scale off, which sent 1 in 3 of its
+    // configurations back to Anderson from the start): take it and linearise afresh at its end.
+    // Otherwise give up.
+    if (!(dn <= 0.25)) {
+        if (!std::isfinite(dn) || !was_fresh || M.eigenvalues().cwiseAbs().maxCoeff() >= 0.5) return false;
+        x += delta.cwiseProduct(S);
+        refresh = true;
+        d_prev = std::numeric_limits<double>::infinity();   // no contraction measured across it
+        return true;
+    }
+    out.twist = Vec3(z[3], z[4], z[5]) / T + (Pa * delta).cwiseProduct(S);
+    out.qd_start = x + delta.cwiseProduct(S);   // the Newton estimate of the cycle's start
+    out.residual = r.cwiseAbs().maxCoeff();
+    out.min_normal_force = min_n;
+    out.has_monodromy = true;
+    out.monodromy = M;
+    // With a monodromy fresh at this start, dn is the linear estimate of the start's distance
+    // from the cycle; the twist's error is at most |d xi_a/dx| times it (before the correction
+    // Pa delta, which leaves only its second-order remainder), doubled for a difference
+    // monodromy's or a nonlinearity's error. Near the cycle this ends a warm start after one
+    // period (the period map's noise, ~rtol v_ref per switch, left the contraction
+    // theta below unmeasurable there).
+    // (And the start itself within tol of the cycle, for the warm starts it gives: dn to first
+    // order, which the monodromy's error, ~2% as below, leaves.)
+    // With a rank-one M the residual's part off its line, r_perp, is taken as it stands (M has no
+    // component there, which is exact for the step: the true M's range is the line) but Pa u leaves
+    // out the twist's sensitivity across the line (|Pa| <= 1.72 |Pa u|, with |Pa| <= 0.7, on fig6):
+    // nothing is accepted before r_perp is below a tenth of tol. It falls quadratically (the map
+    // puts every start on its image curve; r_perp is that curve's bend over the last step).
+    const bool on_line = line.isZero() || (r - line * line.dot(r)).norm() <= 0.1 * opt.tol;
+    if (accept && was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol && kPaError * dn <= opt.tol) {
+        out.error_estimate = 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn;
+        out.converged = true;
+        return false;
+    }
+    if (k >= 1 && std::isfinite(d_prev)) {   // (not after a full stick: no previous step)
+        const double theta = d_prev > 0 ? dn / d_prev : 0.0;
+        out.contraction = theta;
+        // The next step contracts by about theta again on a chord, by less under Newton; but a
+        // chord step after a fresh monodromy at the previous start contracts by up to 2 theta
+        // (the monodromy it uses is then one step stale). The twist's error is the start's
+        // times |d xi_a/dx| (max-row-sum norm).
+        if (2 * theta < 1) {
+            // Plus the correction Pa delta's own error: the variational Pa is about 1% off
+            // (trapezoidal rule on the engine's steps), which an outside audit found left a
+            // chord-accepted twist 1e-6 v_ref off with an estimate of 7e-8.
+            const double dist = 2 * theta / (1 - 2 * theta) * dn;
+            out.error_estimate = Pa.cwiseAbs().rowwise().sum().maxCoeff() * (dist + kPaError * dn);
+            if (accept && on_line && out.error_estimate <= opt.tol) { out.converged = true; return false; }
+        }
+        if (theta > 0.5) {
+            if (was_fresh) return false;   // even a fresh monodromy does not contract: give up
+            refresh = true;                // a stale chord: refresh M at this start
+        }
+    }
+    x += delta.cwiseProduct(S);
+    d_prev = dn;
+    return true;
+}
+
+void Shooting::finish() {
     out.stop = e.stop;
     out.stats = e.stats;
     out.stats += fd_stats;   // the difference monodromies' periods
@@ -671,7 +756,43 @@ LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCyc
     out.step_hint = e.next_step() / T;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
-    return out;
+}
+
+LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+    Shooting s(sc, q0, opt, qd0);
+    for (int k = 0; k < opt.max_periods; ++k) {
+        if (!s.integrate(k)) break;
+        const auto z = s.e.y();
+        const Vec3 r_now = (s.model.qd(z) - s.x).cwiseQuotient(s.S);   // the residual P(x) - x, scaled
+        record_modes(s.out, s.e, s.start_mode, k * s.T, s.T);
+        const bool switched = s.start_mode.kind != ModeKind::Slide || !s.e.events.empty();
+        // A period that changed mode is accepted only if it ran tight, and so are the ones after it.
+        const bool accept = !(switched && !s.io_tight);
+        if (switched) s.loose = false;
+        const bool full_stick = s.start_mode.kind == ModeKind::Stuck || stuck_during(s.e.events);
+        if (full_stick) {
+            if (s.after_full_stick(k, z, r_now, accept)) break;
+            continue;
+        }
+        s.reset_prev = false;
+        // A difference monodromy pays only near enough to the cycle, where Newton then ends in a
+        // step or two; further off (a poor warm start in a field) plain periods approach it first
+        // (Anderson from the warm start itself once took 56 periods for one of them). The right-hand
+        // sides of fig6's 78 sticking cycles in its 7^3 field, by threshold: 3e-4 1.56e6, 1e-3 1.41e6,
+        // 3e-2 1.18e6, 1e-1 1.15e6, differences at every start 1.40e6 (the whole field 2.05e6 at
+        // 3e-2, 2.29e6 at 1e-3).
+        if (s.refresh && switched && r_now.cwiseAbs().maxCoeff() > kDifferenceMonodromyNear) {
+            if (++s.plain_periods > kPlainPeriodsMax) break;   // slow or alternating: Anderson's
+            s.x = s.model.qd(z);
+            s.on_curve = true;
+            s.d_prev = std::numeric_limits<double>::infinity();
+            continue;
+        }
+        if (!s.update_monodromy(z, r_now, switched)) break;
+        if (!s.newton_step(k, z, r_now, accept)) break;
+    }
+    s.finish();
+    return s.out;
 }
 
 }  // namespace
