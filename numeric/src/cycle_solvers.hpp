@@ -3,6 +3,8 @@
 // which limit_cycle() calls (limit_cycle.cpp: plain periods, Anderson, Newton).
 #pragma once
 
+#include "engine.hpp"
+#include "models.hpp"
 #include "plate/limit_cycle.hpp"
 
 #include <vector>
@@ -39,6 +41,21 @@ struct PeriodResult {
     StopEvent stop;
 };
 PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const IntegrationOptions& io, Stats& total);
+
+// A solver's run at q0 (PeriodIteration, Shooting): the scene, the options and the engine over the
+// reduced model it integrates the periods on.
+struct CycleRun {
+    using State = ReducedModel::State;
+    const Scene& sc;
+    const Vec3& q0;
+    const LimitCycleOptions& opt;
+    ReducedModel model;
+    Engine<ReducedModel> e;
+    const double T;
+
+    CycleRun(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt)
+        : sc(sc), q0(q0), opt(opt), model(sc, q0), e(model, sc, opt.integration), T(sc.plate.T) {}
+};
 
 // Newton shooting from the warm start qd0 (shooting_cycle.cpp).
 LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0);

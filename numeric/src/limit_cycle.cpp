@@ -120,14 +120,7 @@ Vec3 anderson_next(const std::deque<Vec3>& X, const std::deque<Vec3>& F) {
 // One limit_cycle by periods (plain, or Anderson's extrapolation) from one start: the engine, the
 // iteration's history and what its stages share -- a period's integration, the acceptance, Anderson's
 // stall and the next period's start.
-struct PeriodIteration {
-    using State = detail::ReducedModel::State;
-    const Scene& sc;
-    const Vec3& q0;
-    const LimitCycleOptions& opt;
-    detail::ReducedModel model;
-    detail::Engine<detail::ReducedModel> e;
-    const double T;
+struct PeriodIteration : detail::CycleRun {
     const Vec3 scale;
     LimitCycleSummary out;
     State y;
@@ -161,8 +154,7 @@ struct PeriodIteration {
     double r_floor = std::numeric_limits<double>::infinity();   // the last such return
 
     PeriodIteration(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd_init)
-        : sc(sc), q0(q0), opt(opt), model(sc, q0), e(model, sc, opt.integration), T(sc.plate.T),
-          scale(twist_scale(sc)),
+        : CycleRun(sc, q0, opt), scale(twist_scale(sc)),
           y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0}, prev(qd_init), anderson(opt.solver == CycleSolver::Anderson) {}
 
     void record(double t, const State& z, const Vec3& n) {

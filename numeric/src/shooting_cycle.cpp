@@ -59,15 +59,8 @@ constexpr double kPaError = 0.02;                    // relative error allowed f
 // One shooting_cycle: the engine, the iterate x and its monodromy, and what the stages of a period
 // share -- its integration with the variational equations, the full stick's acceptance, the
 // monodromy by differences and the Newton (or chord) step with its acceptance.
-struct Shooting {
-    using State = detail::ReducedModel::State;
-    const Scene& sc;
-    const Vec3& q0;
-    const LimitCycleOptions& opt;
-    detail::ReducedModel model;
-    detail::Engine<detail::ReducedModel> e;
+struct Shooting : detail::CycleRun {
     Workspace jws;   // the Jacobian's own workspace: the engine's holds its last evaluation
-    const double T;
     const Vec3 S;
     const int nc;
     const bool point;
@@ -94,8 +87,7 @@ struct Shooting {
     Mat3 Phi, Psi;
 
     Shooting(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0)
-        : sc(sc), q0(q0), opt(opt), model(sc, q0), e(model, sc, opt.integration), T(sc.plate.T),
-          S(twist_scale(sc)), nc(sc.part.contacts()), point(sc.part.point),
+        : CycleRun(sc, q0, opt), S(twist_scale(sc)), nc(sc.part.contacts()), point(sc.part.point),
           x(point ? Vec3(qd0[0], qd0[1], 0) : qd0), loose(opt.integration.large_slip_factor != 1) {}
 
     bool integrate(int k);
