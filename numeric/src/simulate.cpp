@@ -146,7 +146,7 @@ struct Averaging {
     const double T;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     Trajectory tr;
-    FullState y;
+    FullState y{};
     std::vector<Knot> knots;
     long N = 0;     // whole periods in the duration
     long n = 0;     // periods done
