@@ -113,171 +113,214 @@ static bool stuck_all_period(const FieldPoint& p, int dim) {
     return true;
 }
 
-FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPointOptions& opt) {
-    FixedPoints out;
-    const GridSpec& g = field.grid;
-    const int dim = sc.part.point ? 2 : 3;
-    LimitCycleOptions cycle = opt.cycle;   // field noise well below ftol (FixedPointOptions)
-    cycle.integration.rtol = std::min(cycle.integration.rtol, 1e-3 * opt.ftol);
-    cycle.tol = std::min(cycle.tol, 1e-2 * opt.ftol);
-    ScaledField f{sc, cycle, dim, sc.part.rho()};
-    const double ftol = opt.ftol * sc.v_ref();
-    double cell = std::min(g.dx() > 0 ? g.dx() : 1.0, g.dy() > 0 ? g.dy() : 1.0);
-    if (dim == 3) cell = std::min(cell, f.rho * g.dth());
-    const double h = 5e-3 * cell;
+namespace {
 
-    auto inside = [&](const VecX& z) {
+// One find_fixed_points: the scaled field, the zeros found so far and the search's scales, with its
+// stages -- a cell's corners (is it a candidate?), Newton from its centre, and the zero's
+// classification as a point or a line followed both ways.
+struct FixedPointSearch {
+    const Field& field;
+    const FixedPointOptions& opt;
+    const GridSpec& g;
+    const int dim;
+    LimitCycleOptions cycle;
+    ScaledField f;
+    double ftol;
+    double cell;
+    double h;
+    FixedPoints out;
+
+    FixedPointSearch(const Scene& sc, const Field& field, const FixedPointOptions& opt)
+        : field(field), opt(opt), g(field.grid), dim(sc.part.point ? 2 : 3), cycle(opt.cycle),
+          f{sc, cycle, dim, sc.part.rho()} {
+        // field noise well below ftol (FixedPointOptions)
+        cycle.integration.rtol = std::min(cycle.integration.rtol, 1e-3 * opt.ftol);
+        cycle.tol = std::min(cycle.tol, 1e-2 * opt.ftol);
+        ftol = opt.ftol * sc.v_ref();
+        cell = std::min(g.dx() > 0 ? g.dx() : 1.0, g.dy() > 0 ? g.dy() : 1.0);
+        if (dim == 3) cell = std::min(cell, f.rho * g.dth());
+        h = 5e-3 * cell;
+    }
+
+    bool inside(const VecX& z) const {
         const double mx = 0.25 * g.dx(), my = 0.25 * g.dy();
         return z[0] >= g.x0 - mx && z[0] <= g.x1 + mx && z[1] >= g.y0 - my && z[1] <= g.y1 + my;
-    };
+    }
     // Scaled distance with theta periodic.
-    auto dist = [&](const VecX& a, const VecX& b) {
+    double dist(const VecX& a, const VecX& b) const {
         VecX d = a - b;
         if (dim == 3) d[2] = f.rho * wrap_angle((a[2] - b[2]) / f.rho);
         return d.norm();
-    };
-    auto known = [&](const VecX& z, double radius) {
-        for (const auto& p : out.points)
-            if (dist(z, f.z_of(p.q)) < radius) return true;
-        for (const auto& l : out.lines)
-            for (const auto& q : l.points)
-                if (dist(z, f.z_of(q)) < radius) return true;
-        return false;
-    };
+    }
+    bool known(const VecX& z, double radius) const;
+    bool in_cell(const Vec3& qc) const;
+    bool candidate(int i, int j, int k);
+    void search_cell(int i, int j, int k);
+    bool follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3,
+                     const VecX& v, const Vec3& q);
+};
 
-    // Is a known zero within the cell centred at qc, widened by half a cell each way?
-    auto in_cell = [&](const Vec3& qc) {
-        auto near = [&](const Vec3& q) {
-            return std::abs(q[0] - qc[0]) <= g.dx() && std::abs(q[1] - qc[1]) <= g.dy() &&
-                   (dim == 2 || std::abs(wrap_angle(q[2] - qc[2])) <= g.dth());
-        };
-        for (const auto& p : out.points)
-            if (near(p.q)) return true;
-        for (const auto& l : out.lines)
-            for (const auto& q : l.points)
-                if (near(q)) return true;
-        return false;
-    };
+bool FixedPointSearch::known(const VecX& z, double radius) const {
+    for (const auto& p : out.points)
+        if (dist(z, f.z_of(p.q)) < radius) return true;
+    for (const auto& l : out.lines)
+        for (const auto& q : l.points)
+            if (dist(z, f.z_of(q)) < radius) return true;
+    return false;
+}
 
+// Is a known zero within the cell centred at qc, widened by half a cell each way?
+bool FixedPointSearch::in_cell(const Vec3& qc) const {
+    auto near = [&](const Vec3& q) {
+        return std::abs(q[0] - qc[0]) <= g.dx() && std::abs(q[1] - qc[1]) <= g.dy() &&
+               (dim == 2 || std::abs(wrap_angle(q[2] - qc[2])) <= g.dth());
+    };
+    for (const auto& p : out.points)
+        if (near(p.q)) return true;
+    for (const auto& l : out.lines)
+        for (const auto& q : l.points)
+            if (near(q)) return true;
+    return false;
+}
+
+// Does the cell at (i, j, k) hold a zero, by its corners' twists (counted in out: every cell, the
+// undefined, the stuck and the candidates)?
+bool FixedPointSearch::candidate(int i, int j, int k) {
+    // Corners of the cell; theta wraps.
+    Eigen::Vector3d lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+    bool ok = true;
+    for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
+        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
+        const FieldPoint& p = field.points[g.index(ii, jj, kk)];
+        if (!p.converged) { ok = false; break; }
+        const Vec3 v(p.twist[0], p.twist[1], f.rho * p.twist[2]);
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+    }
+    ++out.cells;
+    if (!ok) {
+        ++out.undefined_cells;
+        return false;
+    }
+    bool stuck = false;
+    for (int c = 0; c < (dim == 3 ? 8 : 4) && !stuck; ++c) {
+        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
+        stuck = stuck_all_period(field.points[g.index(ii, jj, kk)], dim);
+    }
+    if (stuck) {
+        ++out.stuck_cells;
+        return false;
+    }
+    bool cand = true;
+    for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
+    if (!cand) return false;
+    ++out.candidates;
+    return true;
+}
+
+// Newton from a candidate cell's centre; a new zero is classified and kept as a point or a line.
+void FixedPointSearch::search_cell(int i, int j, int k) {
+    Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
+    VecX z = f.z_of(qc);
+    if (in_cell(qc)) return;   // a zero already found lies in (or next to) this cell
+    f.warm.setZero();
+    try {
+        if (!newton(f, z, ftol, opt.max_newton, cell, h, kCut)) return;
+    } catch (const FieldUndefined&) {
+        return;
+    }
+    if (!inside(z) || known(z, 0.5 * cell)) return;
+    if (f.F(z).isZero(0)) return;   // landed where the part is stuck all period (a region)
+
+    // Classify.
+    MatX Jm;
+    try { Jm = f.J(z, h); } catch (const FieldUndefined&) { return; }
+    Eigen::EigenSolver<MatX> es(Jm);
+    const Eigen::VectorXcd ev = es.eigenvalues();
+    Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
+    ev3.head(dim) = ev;
+    Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullV);
+    const VecX s = svd.singularValues();
+    const Vec3 q = f.q_of(z);
+
+    bool is_line = false;
+    if (s[dim - 1] < opt.null_ratio * s[0]) is_line = follow_line(z, Jm, ev, ev3, svd.matrixV().col(dim - 1), q);
+    if (!is_line) {
+        FixedPoint fp;
+        fp.q = q;
+        fp.q[2] = dim == 3 ? wrap_angle(q[2]) : 0;
+        fp.eigenvalues = ev3;
+        fp.stability = classify(ev, -1);
+        fp.residual = f.F(z).norm();
+        out.points.push_back(fp);
+    }
+}
+
+// Follows the null direction v of the zero z (at q; Jm its Jacobian, ev its eigenvalues) both ways;
+// kept as a line if it goes on for at least two points.
+bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev,
+                                   const Eigen::Vector3cd& ev3, const VecX& v, const Vec3& q) {
+    FixedLine line;
+    std::vector<Vec3> fwd, bwd;
+    for (int sgn : {1, -1}) {
+        VecX zc = z, dir = sgn * v;
+        double travelled = 0;
+        for (int step = 0; step < 400; ++step) {
+            VecX zn = zc + 0.5 * cell * dir;
+            try {
+                if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir, &Jm)) break;
+            } catch (const FieldUndefined&) {
+                break;
+            }
+            if (!inside(zn)) break;
+            travelled += dist(zn, zc);
+            dir = (zn - zc).normalized();
+            zc = zn;
+            (sgn > 0 ? fwd : bwd).push_back(f.q_of(zc));
+            if (dim == 3 && travelled > 2 * kPi * f.rho + (g.x1 - g.x0) + (g.y1 - g.y0)) break;
+        }
+    }
+    if (fwd.size() + bwd.size() < 2) return false;
+    for (auto it = bwd.rbegin(); it != bwd.rend(); ++it) line.points.push_back(*it);
+    line.points.push_back(q);
+    for (const auto& p : fwd) line.points.push_back(p);
+    for (auto& p : line.points) p[2] = wrap_angle(p[2]);
+    line.direction = f.q_of(v);
+    if (dim == 3) line.direction[2] = v[2] / f.rho;
+    line.eigenvalues = ev3;
+    int skip = 0;
+    ev.cwiseAbs().minCoeff(&skip);
+    line.stability = classify(ev, skip);
+    for (std::size_t m = 1; m < line.points.size(); ++m)
+        line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
+    out.lines.push_back(line);
+    return true;
+}
+
+}  // namespace
+
+FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPointOptions& opt) {
+    FixedPointSearch run(sc, field, opt);
+    const GridSpec& g = run.g;
+    const int dim = run.dim;
     const int nk = dim == 3 ? g.nth : 1;
-    f.budget = opt.max_rhs_evaluations;
+    run.f.budget = opt.max_rhs_evaluations;
     try {
         for (int i = 0; i + 1 < g.nx; ++i)
             for (int j = 0; j + 1 < g.ny; ++j)
                 for (int k = 0; k < nk; ++k) {
                     if (dim == 3 && g.nth < 2) break;
-                    // Corners of the cell; theta wraps.
-                    Eigen::Vector3d lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-                    bool ok = true;
-                    for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
-                        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
-                        const FieldPoint& p = field.points[g.index(ii, jj, kk)];
-                        if (!p.converged) { ok = false; break; }
-                        const Vec3 v(p.twist[0], p.twist[1], f.rho * p.twist[2]);
-                        lo = lo.cwiseMin(v);
-                        hi = hi.cwiseMax(v);
-                    }
-                    ++out.cells;
-                    if (!ok) {
-                        ++out.undefined_cells;
-                        continue;
-                    }
-                    bool stuck = false;
-                    for (int c = 0; c < (dim == 3 ? 8 : 4) && !stuck; ++c) {
-                        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
-                        stuck = stuck_all_period(field.points[g.index(ii, jj, kk)], dim);
-                    }
-                    if (stuck) {
-                        ++out.stuck_cells;
-                        continue;
-                    }
-                    bool cand = true;
-                    for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
-                    if (!cand) continue;
-                    ++out.candidates;
-                    Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
-                    VecX z = f.z_of(qc);
-                    if (in_cell(qc)) continue;   // a zero already found lies in (or next to) this cell
-                    f.warm.setZero();
-                    try {
-                        if (!newton(f, z, ftol, opt.max_newton, cell, h, kCut)) continue;
-                    } catch (const FieldUndefined&) {
-                        continue;
-                    }
-                    if (!inside(z) || known(z, 0.5 * cell)) continue;
-                    if (f.F(z).isZero(0)) continue;   // landed where the part is stuck all period (a region)
-
-                    // Classify.
-                    MatX Jm;
-                    try { Jm = f.J(z, h); } catch (const FieldUndefined&) { continue; }
-                    Eigen::EigenSolver<MatX> es(Jm);
-                    const Eigen::VectorXcd ev = es.eigenvalues();
-                    Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
-                    ev3.head(dim) = ev;
-                    Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullV);
-                    const VecX s = svd.singularValues();
-                    const Vec3 q = f.q_of(z);
-
-                    bool is_line = false;
-                    if (s[dim - 1] < opt.null_ratio * s[0]) {
-                        // Follow the null direction both ways.
-                        FixedLine line;
-                        VecX v = svd.matrixV().col(dim - 1);
-                        std::vector<Vec3> fwd, bwd;
-                        for (int sgn : {1, -1}) {
-                            VecX zc = z, dir = sgn * v;
-                            double travelled = 0;
-                            for (int step = 0; step < 400; ++step) {
-                                VecX zn = zc + 0.5 * cell * dir;
-                                try {
-                                    if (!newton(f, zn, ftol, 8, 0.5 * cell, h, opt.null_ratio, &dir, &Jm)) break;
-                                } catch (const FieldUndefined&) {
-                                    break;
-                                }
-                                if (!inside(zn)) break;
-                                travelled += dist(zn, zc);
-                                dir = (zn - zc).normalized();
-                                zc = zn;
-                                (sgn > 0 ? fwd : bwd).push_back(f.q_of(zc));
-                                if (dim == 3 && travelled > 2 * kPi * f.rho + (g.x1 - g.x0) + (g.y1 - g.y0)) break;
-                            }
-                        }
-                        if (fwd.size() + bwd.size() >= 2) {
-                            is_line = true;
-                            for (auto it = bwd.rbegin(); it != bwd.rend(); ++it) line.points.push_back(*it);
-                            line.points.push_back(q);
-                            for (const auto& p : fwd) line.points.push_back(p);
-                            for (auto& p : line.points) p[2] = wrap_angle(p[2]);
-                            line.direction = f.q_of(v);
-                            if (dim == 3) line.direction[2] = v[2] / f.rho;
-                            line.eigenvalues = ev3;
-                            int skip = 0;
-                            ev.cwiseAbs().minCoeff(&skip);
-                            line.stability = classify(ev, skip);
-                            for (std::size_t m = 1; m < line.points.size(); ++m)
-                                line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
-                            out.lines.push_back(line);
-                        }
-                    }
-                    if (!is_line) {
-                        FixedPoint fp;
-                        fp.q = q;
-                        fp.q[2] = dim == 3 ? wrap_angle(q[2]) : 0;
-                        fp.eigenvalues = ev3;
-                        fp.stability = classify(ev, -1);
-                        fp.residual = f.F(z).norm();
-                        out.points.push_back(fp);
-                    }
+                    if (run.candidate(i, j, k)) run.search_cell(i, j, k);
                 }
     } catch (const BudgetSpent&) {
         // The budget is spent: the cell in progress and every later one are counted as not searched.
         const int total = (g.nx - 1) * (g.ny - 1) * (dim == 3 && g.nth >= 2 ? nk : dim == 3 ? 0 : 1);
-        out.unsearched_cells = total - out.cells + 1;
-        out.cells = total;
+        run.out.unsearched_cells = total - run.out.cells + 1;
+        run.out.cells = total;
     }
-    out.evaluations = f.evals;
-    out.rhs_evaluations = f.rhs_evals;
-    return out;
+    run.out.evaluations = run.f.evals;
+    run.out.rhs_evaluations = run.f.rhs_evals;
+    return run.out;
 }
 
 std::string fixed_points_sentence(const FixedPoints& fp) {

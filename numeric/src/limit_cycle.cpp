@@ -1,5 +1,6 @@
 #include "plate/limit_cycle.hpp"
 
+#include "cycle_solvers.hpp"
 #include "engine.hpp"
 #include "models.hpp"
 
@@ -45,20 +46,54 @@ CycleSolver parse_cycle_solver(const std::string& name) {
                                 "' (expected period-by-period, anderson, newton or shooting)");
 }
 
-namespace {
+// What the limit-cycle solvers share (described in cycle_solvers.hpp).
+namespace detail {
 
-// Did the part stick as a whole during the period (a mode change into Stuck)? It then forgets the
-// period's start.
 bool stuck_during(const std::vector<ModeEvent>& events) {
     return std::any_of(events.begin(), events.end(), [](const ModeEvent& m) { return m.to.kind == ModeKind::Stuck; });
 }
 
-// After two periods in a row that stuck as a whole, the second on a fresh engine: is its return r at
-// the integration's floor -- within tol plus the zero band, and no smaller than half the previous such
-// return r_floor (one that still halves is a transient)? More periods do not shrink it (one_start).
 bool at_stuck_floor(double r, double r_floor, const LimitCycleOptions& opt) {
     return r <= opt.tol + detail::zero_band(opt.integration.rtol) && r >= 0.5 * r_floor;
 }
+
+Vec3 twist_scale(const Scene& sc) {
+    const detail::Scales s(sc);
+    return Vec3(s.v, s.v, s.w);
+}
+
+PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const IntegrationOptions& io, Stats& total) {
+    detail::ReducedModel model(sc, q0);
+    detail::Engine<detail::ReducedModel> e(model, sc, io);
+    PeriodResult r;
+    const Vec3 qd = sc.part.point ? Vec3(x[0], x[1], 0) : x;
+    double min_n = std::numeric_limits<double>::infinity();
+    r.ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) &&
+           e.advance(sc.plate.T, [&](double, const auto&, const Vec3& n) {
+               min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
+           });
+    r.stop = e.stop;
+    total += e.stats;
+    if (r.ok) {
+        const auto y = e.y();
+        r.end = model.qd(y);
+        r.average = Vec3(y[3], y[4], y[5]) / sc.plate.T;
+        r.min_n = min_n;
+    }
+    return r;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::at_stuck_floor;
+using detail::one_period;
+using detail::PeriodResult;
+using detail::record_modes;
+using detail::shooting_cycle;
+using detail::stuck_during;
+using detail::twist_scale;
 
 // Anderson extrapolation (type II) from the history of starts x_j and images f_j = P(x_j), in
 // scaled coordinates: minimise |g_k - dG gamma| over the differences of residuals g = f - x,
@@ -82,209 +117,216 @@ Vec3 anderson_next(const std::deque<Vec3>& X, const std::deque<Vec3>& F) {
     return x;
 }
 
-// The stick bookkeeping of the period that just ended: per-contact stick fractions, the mode at
-// its start and its mode changes (times from the period's start).
-template <class E>
-void record_modes(LimitCycleSummary& out, const E& e, const Mode& start_mode, double t_start, double T) {
-    for (int i = 0; i < 3; ++i) out.stick_fraction[i] = e.held_time[i] / T;
-    out.start_mode = start_mode;
-    out.mode_events = e.events;
-    for (ModeEvent& ev : out.mode_events) ev.t -= t_start;
+// One limit_cycle by periods (plain, or Anderson's extrapolation) from one start: the engine, the
+// iteration's history and what its stages share -- a period's integration, the acceptance, Anderson's
+// stall and the next period's start.
+struct PeriodIteration : detail::CycleRun {
+    const Vec3 scale;
+    LimitCycleSummary out;
+    State y;
+    Vec3 prev;
+    double r_prev = std::numeric_limits<double>::quiet_NaN();
+    double t_first = 0;
+    const bool anderson;
+    std::deque<Vec3> X, Fx;
+    double lambda = 0, r_prev_plain = std::numeric_limits<double>::infinity();
+    Vec3 start;
+    bool extrapolated = false;   // did the period just integrated start from an extrapolation?
+    // Anderson stalls where the period map's noise (event times located to rtol, slip reversals)
+    // is as large as the residual it extrapolates from: fig6 at (-0.05, 0.0167, 4.49) with tol
+    // 1e-5 and rtol 1e-6 hovered at 2e-5 for 400 periods, where plain periods converge in 13.
+    // When the best residual has not halved for this many periods, give up: plain periods decide.
+    static constexpr int kAndersonStall = 25;
+    double best_r = std::numeric_limits<double>::infinity();
+    int best_k = 0;
+    // After a period in which the part stuck as a whole the next starts on a fresh engine, as the
+    // shooting's does (its first step small again, its mode chosen afresh):
+    // that period forgets its start, so its end is the cycle's start to the integration's error --
+    // but carried over, the step in progress made that error depend on the history: heave_yaw (z 2
+    // m/s^2, rz 60 rad/s^2) at (0, 0.02, 0), stuck twice a period, returned within 4e-7-1.6e-6
+    // v_ref of each start for 10 periods and Anderson's r / (1 - lambda) accepted it when one return
+    // fell below tol by chance (12 periods, 3.2e5 right-hand sides); from fresh starts it returns
+    // within 3e-8 v_ref and is accepted after two. (Within a period the step still carries across
+    // the stick, from before it to after the break-away, so fresh periods can return up to the
+    // zero band apart: see the acceptance below. A fresh step at each break-away from a stick made
+    // them agree to 1e-16, but sent random scene 2512 at rtol 1e-9 into its rim-creep crawl: not kept.)
+    bool fresh = false;
+    double r_floor = std::numeric_limits<double>::infinity();   // the last such return
+
+    PeriodIteration(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd_init)
+        : CycleRun(sc, q0, opt), scale(twist_scale(sc)),
+          y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0}, prev(qd_init), anderson(opt.solver == CycleSolver::Anderson) {}
+
+    void record(double t, const State& z, const Vec3& n) {
+        if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n, e.mode()});
+    }
+    void run(double t0);
+    bool integrate(int k, bool began_fresh, Mode& start_mode);
+    bool accepted(int k, double r, bool began_fresh, bool reset);
+    bool stalled(int k, double r);
+    void next_start(int k, double r, const Vec3& qd, bool began_fresh, bool reset);
+    void finish();
+};
+
+// The periods from the engine's start at t0 until the cycle is accepted or a cap or stop ends them.
+void PeriodIteration::run(double t0) {
+    if (opt.record) out.path.push_back(Sample{t0, q0, model.qd(e.y()), e.n(), e.mode()});
+    // Periods are the windows [kT, (k+1)T]: after a breakaway at t0 > 0, first reach the
+    // next period boundary, so that every cycle state (and warm start) has phase 0.
+    t_first = t0 > 0 ? T * std::ceil(t0 / T * (1 + 1e-12)) : 0.0;
+    bool ok = t0 > 0 ? e.advance(t_first, [&](double t, const State& z, const Vec3& n) { record(t, z, n); }) : true;
+    if (ok) prev = model.qd(e.y());
+    start = prev;
+    for (int k = 1; ok && k <= opt.max_periods; ++k) {
+        const bool began_fresh = fresh;
+        Mode start_mode;
+        if (!integrate(k, began_fresh, start_mode)) break;
+        y = e.y();
+        const Vec3 qd = model.qd(y);
+        out.twist = Vec3(y[3], y[4], y[5]) / T;   // (36)
+        record_modes(out, e, start_mode, t_first + (k - 1) * T, T);
+        out.qd_start = prev;
+        const double r = ((qd - prev).array() / scale.array()).abs().maxCoeff();
+        out.residual = r;
+        // Stuck as a whole during this period: it forgets its start. (Not a period that starts
+        // stuck without sticking again, as from rest: taking that one too put random scene 132's
+        // loose cycle, rtol 1e-5, a period later and 11 rtol v_ref off its tight cycle for 8.)
+        const bool reset = stuck_during(e.events);
+        if (accepted(k, r, began_fresh, reset)) break;
+        if (stalled(k, r)) break;
+        next_start(k, r, qd, began_fresh, reset);
+    }
 }
 
-LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
-    detail::ReducedModel model(sc, q0);
-    detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
-    const double T = sc.plate.T;
-    const detail::Scales sc_(sc);
-    const Vec3 scale(sc_.v, sc_.v, sc_.w);
+// Period k on the engine (fresh after a full stick); false if it stopped or spent the budget.
+bool PeriodIteration::integrate(int k, bool began_fresh, Mode& start_mode) {
+    if (began_fresh) {
+        auto z = e.y();
+        z[3] = z[4] = z[5] = 0;
+        if (!e.start(e.t(), z)) return false;
+    } else {
+        e.modify([](auto& z) { z[3] = z[4] = z[5] = 0; });
+    }
+    e.reset_log();
+    start_mode = e.mode();
+    double min_n = e.n().head(sc.part.contacts()).minCoeff();
+    const bool ok = e.advance(t_first + k * T, [&](double t, const auto& z, const Vec3& n) {
+        min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
+        record(t, z, n);
+    });
+    out.periods = k;
+    out.min_normal_force = min_n;
+    if (!ok) return false;
+    if (e.stats.rhs_evals > opt.max_rhs_evaluations) {
+        e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
+        return false;
+    }
+    return true;
+}
 
-    LimitCycleSummary out;
-    const Vec3 qd_init = sc.part.point ? Vec3(qd0[0], qd0[1], 0) : qd0;
-    detail::ReducedModel::State y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0};
-    Vec3 prev = qd_init;
-    double r_prev = std::numeric_limits<double>::quiet_NaN();
-    // From rest the part rides with the plate while friction holds it (the engine's stuck mode).
-    const double t0 = 0.0;
-    if (e.start(t0, y)) {
-        if (opt.record) out.path.push_back(Sample{t0, q0, model.qd(e.y()), e.n(), e.mode()});
-        auto record = [&](double t, const auto& z, const Vec3& n) {
-            if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n, e.mode()});
-        };
-        // Periods are the windows [kT, (k+1)T]: after a breakaway at t0 > 0, first reach the
-        // next period boundary, so that every cycle state (and warm start) has phase 0.
-        const double t_first = t0 > 0 ? T * std::ceil(t0 / T * (1 + 1e-12)) : 0.0;
-        bool ok = t0 > 0 ? e.advance(t_first, record) : true;
-        if (ok) prev = model.qd(e.y());
-        const bool anderson = opt.solver == CycleSolver::Anderson;
-        std::deque<Vec3> X, Fx;
-        double lambda = 0, r_prev_plain = std::numeric_limits<double>::infinity();
-        Vec3 start = prev;
-        bool extrapolated = false;   // did the period just integrated start from an extrapolation?
-        // Anderson stalls where the period map's noise (event times located to rtol, slip reversals)
-        // is as large as the residual it extrapolates from: fig6 at (-0.05, 0.0167, 4.49) with tol
-        // 1e-5 and rtol 1e-6 hovered at 2e-5 for 400 periods, where plain periods converge in 13.
-        // When the best residual has not halved for this many periods, give up: plain periods decide.
-        constexpr int kAndersonStall = 25;
-        double best_r = std::numeric_limits<double>::infinity();
-        int best_k = 0;
-        // After a period in which the part stuck as a whole the next starts on a fresh engine, as the
-        // shooting's does (its first step small again, its mode chosen afresh):
-        // that period forgets its start, so its end is the cycle's start to the integration's error --
-        // but carried over, the step in progress made that error depend on the history: heave_yaw (z 2
-        // m/s^2, rz 60 rad/s^2) at (0, 0.02, 0), stuck twice a period, returned within 4e-7-1.6e-6
-        // v_ref of each start for 10 periods and Anderson's r / (1 - lambda) accepted it when one return
-        // fell below tol by chance (12 periods, 3.2e5 right-hand sides); from fresh starts it returns
-        // within 3e-8 v_ref and is accepted after two. (Within a period the step still carries across
-        // the stick, from before it to after the break-away, so fresh periods can return up to the
-        // zero band apart: see the acceptance below. A fresh step at each break-away from a stick made
-        // them agree to 1e-16, but sent random scene 2512 at rtol 1e-9 into its rim-creep crawl: not kept.)
-        bool fresh = false;
-        double r_floor = std::numeric_limits<double>::infinity();   // the last such return
-        for (int k = 1; ok && k <= opt.max_periods; ++k) {
-            const bool began_fresh = fresh;
-            if (fresh) {
-                auto z = e.y();
-                z[3] = z[4] = z[5] = 0;
-                ok = e.start(e.t(), z);
-                if (!ok) break;
-            } else {
-                e.modify([](auto& z) { z[3] = z[4] = z[5] = 0; });
-            }
-            e.reset_log();
-            const Mode start_mode = e.mode();
-            double min_n = e.n().head(sc.part.contacts()).minCoeff();
-            ok = e.advance(t_first + k * T, [&](double t, const auto& z, const Vec3& n) {
-                min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
-                record(t, z, n);
-            });
-            out.periods = k;
-            out.min_normal_force = min_n;
-            if (!ok) break;
-            if (e.stats.rhs_evals > opt.max_rhs_evaluations) {
-                e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
-                break;
-            }
-            y = e.y();
-            const Vec3 qd = model.qd(y);
-            out.twist = Vec3(y[3], y[4], y[5]) / T;   // (36)
-            record_modes(out, e, start_mode, t_first + (k - 1) * T, T);
-            out.qd_start = prev;
-            const double r = ((qd - prev).array() / scale.array()).abs().maxCoeff();
-            out.residual = r;
-            // Stuck as a whole during this period: it forgets its start. (Not a period that starts
-            // stuck without sticking again, as from rest: taking that one too put random scene 132's
-            // loose cycle, rtol 1e-5, a period later and 11 rtol v_ref off its tight cycle for 8.)
-            const bool reset = stuck_during(e.events);
-            if (k >= 2 && r_prev > 0) {
-                // With Anderson the ratio r/r_prev measures the acceleration, not the map: keep the
-                // map's contraction from the first plain periods for the error estimate.
-                // The twist is the average over the period from the start x_k, which lies within
-                // r/(1 - lambda) of the cycle; plain periods report their end, within r c/(1 - c).
-                if (!extrapolated) lambda = std::min(r / r_prev, 0.99);
-                out.contraction = anderson ? lambda : std::min(r / r_prev, 0.99);
-                out.error_estimate = anderson ? r / (1 - lambda) : r * out.contraction / (1 - out.contraction);
-                // After a full stick the map is constant: this period's start is the cycle's when it
-                // sticks as a whole too, and its return r is then the integration's error in the start,
-                // not a contraction's step, which no number of periods makes smaller (c = r / r_prev
-                // would compare it with the transient: r^2 / r_prev, 7e-15 for a 3e-8 return). The
-                // start is within r of the cycle; the cycle is accepted where r is within the engine's
-                // own accuracy (the zero band plus tol, the bound it claims for sticking cycles:
-                // README). A lower return met by chance later is not a better cycle:
-                // sticking_random_scene 256 alternated between two ends 6e-7 v_ref apart forever, and
-                // heave_yaw with z 2, rz 60 at (0, 0.02, 0) returned 4e-7-1.6e-6 apart for 10 periods.
-                // That is taken as the floor once a second such return is no smaller than half the
-                // first (one that still halves is a transient, and the first return alone cannot
-                // tell). Where this period does not stick as a whole the usual rule decides, with the
-                // estimate at least r.
-                if (began_fresh) {
-                    out.error_estimate = std::max(out.error_estimate, r);
-                    if (reset && at_stuck_floor(r, r_floor, opt)) {
-                        out.converged = true;
-                        break;
-                    }
-                }
-                if (out.error_estimate <= opt.tol) {
-                    out.converged = true;
-                    break;
-                }
-            } else if (r == 0) {
+// Is the cycle converged after period k, whose return is r?
+bool PeriodIteration::accepted(int k, double r, bool began_fresh, bool reset) {
+    if (k >= 2 && r_prev > 0) {
+        // With Anderson the ratio r/r_prev measures the acceleration, not the map: keep the
+        // map's contraction from the first plain periods for the error estimate.
+        // The twist is the average over the period from the start x_k, which lies within
+        // r/(1 - lambda) of the cycle; plain periods report their end, within r c/(1 - c).
+        if (!extrapolated) lambda = std::min(r / r_prev, 0.99);
+        out.contraction = anderson ? lambda : std::min(r / r_prev, 0.99);
+        out.error_estimate = anderson ? r / (1 - lambda) : r * out.contraction / (1 - out.contraction);
+        // After a full stick the map is constant: this period's start is the cycle's when it
+        // sticks as a whole too, and its return r is then the integration's error in the start,
+        // not a contraction's step, which no number of periods makes smaller (c = r / r_prev
+        // would compare it with the transient: r^2 / r_prev, 7e-15 for a 3e-8 return). The
+        // start is within r of the cycle; the cycle is accepted where r is within the engine's
+        // own accuracy (the zero band plus tol, the bound it claims for sticking cycles:
+        // README). A lower return met by chance later is not a better cycle:
+        // sticking_random_scene 256 alternated between two ends 6e-7 v_ref apart forever, and
+        // heave_yaw with z 2, rz 60 at (0, 0.02, 0) returned 4e-7-1.6e-6 apart for 10 periods.
+        // That is taken as the floor once a second such return is no smaller than half the
+        // first (one that still halves is a transient, and the first return alone cannot
+        // tell). Where this period does not stick as a whole the usual rule decides, with the
+        // estimate at least r.
+        if (began_fresh) {
+            out.error_estimate = std::max(out.error_estimate, r);
+            if (reset && at_stuck_floor(r, r_floor, opt)) {
                 out.converged = true;
-                break;
+                return true;
             }
-            if (anderson) {
-                if (r < 0.5 * best_r) {
-                    best_r = r;
-                    best_k = k;
-                } else if (k - best_k >= kAndersonStall) {
-                    break;
-                }
-            }
-            r_prev = r;
-            prev = qd;
-            extrapolated = false;
-            r_floor = began_fresh && reset ? r : std::numeric_limits<double>::infinity();
-            fresh = reset;
-            if (anderson && reset) {
-                // The part was stuck during the period: that resets its state, so the map is all but
-                // constant and the plain period is the best next start; extrapolating across the
-                // map's pieces threw the start off (157 periods instead of 4 on a heave + yaw scene).
-                X.clear();
-                Fx.clear();
-            } else if (anderson) {
-                // Plain periods until the map's own contraction is measured, then extrapolate.
-                X.push_back(start.cwiseQuotient(scale));
-                Fx.push_back(qd.cwiseQuotient(scale));
-                if (static_cast<int>(X.size()) > opt.anderson_memory + 1) { X.pop_front(); Fx.pop_front(); }
-                // Extrapolate only where the iteration contracts; forget the transient before.
-                if (r >= r_prev_plain) { X.erase(X.begin(), X.end() - 1); Fx.erase(Fx.begin(), Fx.end() - 1); }
-                r_prev_plain = r;
-                if (k >= 2 && X.size() >= 2) {
-                    const Vec3 next = anderson_next(X, Fx).cwiseProduct(scale);
-                    extrapolated = next != prev;
-                    e.modify([&](auto& z) { z[0] = next[0]; z[1] = next[1]; z[2] = sc.part.point ? 0.0 : next[2]; });
-                    prev = model.qd(e.y());
-                }
-            }
-            start = prev;
+        }
+        if (out.error_estimate <= opt.tol) {
+            out.converged = true;
+            return true;
+        }
+    } else if (r == 0) {
+        out.converged = true;
+        return true;
+    }
+    return false;
+}
+
+// Has Anderson's best residual not halved for kAndersonStall periods?
+bool PeriodIteration::stalled(int k, double r) {
+    if (anderson) {
+        if (r < 0.5 * best_r) {
+            best_r = r;
+            best_k = k;
+        } else if (k - best_k >= kAndersonStall) {
+            return true;
         }
     }
+    return false;
+}
+
+// The next period's start: period k's end qd, or Anderson's extrapolation from the history.
+void PeriodIteration::next_start(int k, double r, const Vec3& qd, bool began_fresh, bool reset) {
+    r_prev = r;
+    prev = qd;
+    extrapolated = false;
+    r_floor = began_fresh && reset ? r : std::numeric_limits<double>::infinity();
+    fresh = reset;
+    if (anderson && reset) {
+        // The part was stuck during the period: that resets its state, so the map is all but
+        // constant and the plain period is the best next start; extrapolating across the
+        // map's pieces threw the start off (157 periods instead of 4 on a heave + yaw scene).
+        X.clear();
+        Fx.clear();
+    } else if (anderson) {
+        // Plain periods until the map's own contraction is measured, then extrapolate.
+        X.push_back(start.cwiseQuotient(scale));
+        Fx.push_back(qd.cwiseQuotient(scale));
+        if (static_cast<int>(X.size()) > opt.anderson_memory + 1) { X.pop_front(); Fx.pop_front(); }
+        // Extrapolate only where the iteration contracts; forget the transient before.
+        if (r >= r_prev_plain) { X.erase(X.begin(), X.end() - 1); Fx.erase(Fx.begin(), Fx.end() - 1); }
+        r_prev_plain = r;
+        if (k >= 2 && X.size() >= 2) {
+            const Vec3 next = anderson_next(X, Fx).cwiseProduct(scale);
+            extrapolated = next != prev;
+            e.modify([&](auto& z) { z[0] = next[0]; z[1] = next[1]; z[2] = sc.part.point ? 0.0 : next[2]; });
+            prev = model.qd(e.y());
+        }
+    }
+    start = prev;
+}
+
+void PeriodIteration::finish() {
     out.stop = e.stop;
     out.stats = e.stats;
     out.step_hint = e.next_step() / T;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
-    return out;
 }
 
-
-// One period of (35) from twist x at t = 0: the twist at T and the period average (36).
-struct PeriodResult {
-    bool ok = false;
-    Vec3 end = Vec3::Zero(), average = Vec3::Zero();
-    double min_n = 0;
-    StopEvent stop;
-};
-PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const IntegrationOptions& io, Stats& total) {
-    detail::ReducedModel model(sc, q0);
-    detail::Engine<detail::ReducedModel> e(model, sc, io);
-    PeriodResult r;
-    const Vec3 qd = sc.part.point ? Vec3(x[0], x[1], 0) : x;
-    double min_n = std::numeric_limits<double>::infinity();
-    r.ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) &&
-           e.advance(sc.plate.T, [&](double, const auto&, const Vec3& n) {
-               min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
-           });
-    r.stop = e.stop;
-    total += e.stats;
-    if (r.ok) {
-        const auto y = e.y();
-        r.end = model.qd(y);
-        r.average = Vec3(y[3], y[4], y[5]) / sc.plate.T;
-        r.min_n = min_n;
-    }
-    return r;
+LimitCycleSummary one_start(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
+    const Vec3 qd_init = sc.part.point ? Vec3(qd0[0], qd0[1], 0) : qd0;
+    PeriodIteration it(sc, q0, opt, qd_init);
+    // From rest the part rides with the plate while friction holds it (the engine's stuck mode).
+    const double t0 = 0.0;
+    if (it.e.start(t0, it.y)) it.run(t0);
+    it.finish();
+    return it.out;
 }
+
 
 // Newton shooting on G(x) = (P(x) - x)/scale = 0 with GSL's gnewton (a Newton step with a
 // backtracking guard) and a finite-difference monodromy.
@@ -391,286 +433,6 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
     }
     out.stats = d.stats;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, 0};
-    return out;
-}
-
-// Newton shooting on G(x) = P(x) - x in the scaled twist: x+ = x + (I - M)^-1 (P(x) - x), with the
-// monodromy M = dP/dx from the variational equations along the first period, then chord steps with
-// that M (plain periods); a step that contracts by less than half refreshes M at its start. The
-// periods run on one engine, so the step size carries over from period to period.
-//
-// Stopping: the twist is the average over the period from x_k plus (d xi_a/dx) delta_k, i.e. the
-// average at x_{k+1} to first order, so its error is |d xi_a/dx| times the distance of x_{k+1} from
-// the cycle. With theta = |delta_k| / |delta_{k-1}| the observed contraction, that distance is
-// taken as 2 theta/(1 - 2 theta) |delta_k| (see the loop for the 2). Measured on fig4, where a line's
-// first point starts 0.025 v_ref from its cycle: theta alone under-estimated the error 5x there.
-// A step sequence that does not contract gives up (the caller falls back to Anderson).
-//
-// Across a change of contact mode (a period that starts held, or in which a contact sticks, pivots
-// or breaks away) the sliding variational equations do not hold: the monodromy then takes a
-// saltation at every switch (a projection onto the held contact's constraint where a slip reaches
-// zero, a jump from the shifted break-away time where one starts), and a full stick makes it zero.
-// Instead of those matrices we take their product, the derivative of the period map itself, by
-// forward differences of P (one_period from x + h e_j, h = 1e-4 of the scales): the map is
-// continuous and piecewise smooth, so the chord is as good as the exact monodromy for Newton, and
-// its error (h |P''| + rtol/h ~ 1e-4) only slows the contraction, which the stopping rule measures.
-// It costs one period per unknown; Anderson's fallback cost 9 periods per sticking cycle from a
-// neighbour's warm start on fig6 (its contraction estimate drowns in noise near the cycle).
-// A pivot cuts that to one period: while contact k is held the twist has one free component, so
-// P(x) = g(phi(x)) through a scalar and M = a b^T has rank one (fig6's 62 difference monodromies in
-// its field: second singular value below 1e-5 of the first in 55, at most 0.9 %). Its range a is the
-// image curve's direction; from x on that curve (x the previous period's end) x* is on it too, so
-// the residual r = P(x) - x lies along a, and r is an eigenvector: M r = lambda r, lambda = b^T a.
-// One difference along u = r/|r| gives lambda and Pa u, all Newton needs: delta = r / (1 - lambda),
-// and the twist's correction Pa delta = (Pa u) |delta|. It is taken when the difference confirms it
-// (M u along u within 5 %; the three differences otherwise) and kept for the chord steps after it
-// (a pivot-free period or a stalled contraction refreshes as before); the error estimate then uses
-// Pa u, the sensitivity along the line on which the iterates stay (fig6's full differences: |Pa| at
-// most 1.72 |Pa u|), and nothing is accepted while the residual leaves the line by more than tol / 10
-// (see the loop). Measured on fig6's 7^3 field: right-hand sides 2.05e6 -> 1.84e6, periods 1 492 ->
-// 1 410, 0.177 -> 0.157 s on two threads; its largest errors against the rtol-1e-11 reference
-// unchanged (1.66e-7 v_ref sliding, 6.63e-7 sticking; median of the sticking ones 4.2e-8 -> 3.5e-8).
-constexpr double kDifferenceMonodromyNear = 3e-2;   // |P(x) - x| / scale below which (see the loop)
-constexpr int kPlainPeriodsMax = 20;                 // plain periods toward a switching cycle, then Anderson
-constexpr double kPaError = 0.02;                    // relative error allowed for Pa (and M) in the estimates
-
-LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
-    detail::ReducedModel model(sc, q0);
-    detail::Engine<detail::ReducedModel> e(model, sc, opt.integration);
-    Workspace jws;   // the Jacobian's own workspace: the engine's holds its last evaluation
-    const double T = sc.plate.T;
-    const detail::Scales sc_(sc);
-    const Vec3 S(sc_.v, sc_.v, sc_.w);
-    const int nc = sc.part.contacts();
-    const bool point = sc.part.point;
-    LimitCycleSummary out;
-    Vec3 x = point ? Vec3(qd0[0], qd0[1], 0) : qd0;
-    bool refresh = true;
-    bool reset_prev = false;   // the last period stuck fully (its end is the cycle's start)
-    double res_floor = std::numeric_limits<double>::infinity();   // its return, if it began fresh too
-    Stats fd_stats;   // the difference monodromies' periods
-    int fd_periods = 0;
-    int plain_periods = 0;
-    Mat3 M = Mat3::Zero(), Pa = Mat3::Zero();
-    bool loose = opt.integration.large_slip_factor != 1;
-    bool on_curve = false;   // x is the previous period's end (on the period map's image)
-    Vec3 line = Vec3::Zero();   // with a rank-one M: its range, along which the iterates stay
-    double d_prev = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < opt.max_periods; ++k) {
-        const detail::ReducedModel::State y{x[0], x[1], x[2], 0, 0, 0};
-        IntegrationOptions io = opt.integration;
-        if (!loose || (k == 0 && opt.first_period_tight)) io.large_slip_factor = 1;
-        const bool io_tight = io.large_slip_factor == 1;
-        e.set_large_slip_factor(io.large_slip_factor);
-        bool ok = true;
-        // After a full stick the next period starts on a fresh engine (its first step small again):
-        // one carried over from a far start can step over a brief pivot (an outside audit found a
-        // cycle 4.7e-6 v_ref off that way), and that period is the one accepted below.
-        if (k == 0 || reset_prev) ok = e.start(k * T, y);
-        else e.modify([&](auto& z) { z = y; });
-        // The variational equations Phi' = J(t) Phi, Psi' = Phi (J = d q''/d q', generated) on the
-        // engine's accepted steps by the trapezoidal rule, J at each step's end: second order,
-        // within 1% of central differences of the period map on fig4, fig5 and fig3 (tests), one
-        // Jacobian per step: a chord needs no more, and the error estimate allows for it.
-        Mat3 Phi = Mat3::Identity(), Psi = Mat3::Zero(), J;
-        double t_prev = e.t();
-        e.reset_log();
-        const Mode start_mode = e.mode();
-        // The variational equations below are those of sliding; a period that starts held or
-        // changes mode takes the difference monodromy instead (above).
-        const bool variational = refresh && start_mode.kind == ModeKind::Slide;
-        if (variational) twist_jacobian(sc, Dynamics::ReducedU, q0, x, model.plate_at(t_prev), jws, J);
-        double min_n = e.n().head(nc).minCoeff();
-        ok = ok && e.advance((k + 1) * T, [&](double t, const auto& z, const Vec3& n) {
-            min_n = std::min(min_n, n.head(nc).minCoeff());
-            if (!variational) return;
-            const double h = t - t_prev;
-            Mat3 J1;
-            twist_jacobian(sc, Dynamics::ReducedU, q0, model.qd(z), model.plate_at(t), jws, J1);
-            const Mat3 Phi1 = (Mat3::Identity() - 0.5 * h * J1).inverse() * ((Mat3::Identity() + 0.5 * h * J) * Phi);
-            Psi += 0.5 * h * (Phi + Phi1);
-            Phi = Phi1;
-            J = J1;
-            t_prev = t;
-        });
-        out.periods = k + 1 + fd_periods;
-        if (!ok) break;
-        if (e.stats.rhs_evals + fd_stats.rhs_evals + jws.evals > opt.max_rhs_evaluations) {
-            e.stop = StopEvent{StopReason::StepLimit, -1, e.t()};
-            break;
-        }
-        const auto z = e.y();
-        const Vec3 r_now = (model.qd(z) - x).cwiseQuotient(S);   // the residual P(x) - x, scaled
-        record_modes(out, e, start_mode, k * T, T);
-        const bool switched = start_mode.kind != ModeKind::Slide || !e.events.empty();
-        // A period that changed mode is accepted only if it ran tight, and so are the ones after it.
-        const bool accept = !(switched && !io_tight);
-        if (switched) loose = false;
-        // A period in which the part was stuck as a whole forgets its start: P is constant near x,
-        // so M = 0 exactly and P(x) is the cycle's start (to the integration's noise). The period
-        // after it, from P(x), is then the cycle: when it sticks fully too, it is converged.
-        const bool full_stick = start_mode.kind == ModeKind::Stuck || stuck_during(e.events);
-        if (full_stick) {
-            const double res = r_now.cwiseAbs().maxCoeff();
-            if (k >= 1 && reset_prev && accept &&
-                (res <= opt.tol || at_stuck_floor(res, res_floor, opt))) {
-                // This period ran on a fresh engine from the previous one's end, and returns to its
-                // start within tol, or within tol plus the zero band where the return has stopped
-                // halving (the integration's error, which more periods do not shrink: one_start
-                // above): the cycle.
-                out.twist = Vec3(z[3], z[4], z[5]) / T;
-                out.qd_start = x;
-                out.residual = res;
-                out.error_estimate = res;
-                out.min_normal_force = min_n;
-                out.has_monodromy = true;            // dP/dx = 0: every Floquet multiplier is 0
-                out.monodromy.setZero();
-                out.converged = true;
-                break;
-            }
-            res_floor = reset_prev && accept ? res : std::numeric_limits<double>::infinity();
-            reset_prev = true;
-            on_curve = true;
-            x = model.qd(z);
-            d_prev = std::numeric_limits<double>::infinity();
-            refresh = true;
-            continue;
-        }
-        reset_prev = false;
-        // A difference monodromy pays only near enough to the cycle, where Newton then ends in a
-        // step or two; further off (a poor warm start in a field) plain periods approach it first
-        // (Anderson from the warm start itself once took 56 periods for one of them). The right-hand
-        // sides of fig6's 78 sticking cycles in its 7^3 field, by threshold: 3e-4 1.56e6, 1e-3 1.41e6,
-        // 3e-2 1.18e6, 1e-1 1.15e6, differences at every start 1.40e6 (the whole field 2.05e6 at
-        // 3e-2, 2.29e6 at 1e-3).
-        if (refresh && switched && r_now.cwiseAbs().maxCoeff() > kDifferenceMonodromyNear) {
-            if (++plain_periods > kPlainPeriodsMax) break;   // slow or alternating: Anderson's
-            x = model.qd(z);
-            on_curve = true;
-            d_prev = std::numeric_limits<double>::infinity();
-            continue;
-        }
-        if (refresh) line.setZero();
-        const double h = 1e-4;   // the differences' step, relative to the scales
-        if (refresh && switched && on_curve && !point && r_now.norm() > 0 &&
-            (start_mode.kind == ModeKind::Pivot ||
-             std::any_of(e.events.begin(), e.events.end(), [](const ModeEvent& m) { return m.to.kind == ModeKind::Pivot; }))) {
-            // The rank-one monodromy (above): one difference along the residual.
-            const Vec3 u = r_now.normalized();
-            const PeriodResult pu = one_period(sc, q0, x + h * u.cwiseProduct(S), io, fd_stats);
-            ++fd_periods;
-            ++out.periods;
-            if (!pu.ok) break;
-            const Vec3 dP = (pu.end - model.qd(z)).cwiseQuotient(S) / h;
-            const double lambda = dP.dot(u);
-            if ((dP - lambda * u).norm() <= 0.05 * dP.norm()) {
-                M = lambda * u * u.transpose();
-                Pa = (pu.average - Vec3(z[3], z[4], z[5]) / T).cwiseQuotient(S) / h * u.transpose();
-                line = u;
-            }
-        }
-        if (refresh && switched && line.isZero()) {
-            // Forward differences of the period map (and of its average) in the scaled twist.
-            const Vec3 end = model.qd(z), avg = Vec3(z[3], z[4], z[5]) / T;
-            bool fd_ok = true;
-            on_curve = false;   // the Newton step below leaves the image curve
-            M.setZero();
-            Pa.setZero();
-            for (int j = 0; j < (point ? 2 : 3) && fd_ok; ++j) {
-                Vec3 xj = x;
-                xj[j] += h * S[j];
-                const PeriodResult pj = one_period(sc, q0, xj, io, fd_stats);
-                fd_ok = pj.ok;
-                M.col(j) = (pj.end - end).cwiseQuotient(S) / h;
-                Pa.col(j) = (pj.average - avg).cwiseQuotient(S) / h;
-            }
-            fd_periods += point ? 2 : 3;
-            out.periods += point ? 2 : 3;
-            if (!fd_ok) break;
-        } else if (refresh && line.isZero()) {
-            on_curve = false;
-            M = S.asDiagonal().inverse() * Phi * S.asDiagonal();
-            Pa = S.asDiagonal().inverse() * Psi * S.asDiagonal() / T;
-        }
-        const bool was_fresh = refresh;
-        refresh = false;
-        const Vec3& r = r_now;
-        Mat3 A = Mat3::Identity() - M;
-        if (point) {   // no rotation: the third component is not an unknown
-            A.row(2).setZero();
-            A.col(2).setZero();
-            A(2, 2) = 1;
-        }
-        const Vec3 delta = A.partialPivLu().solve(r);
-        const double dn = delta.cwiseAbs().maxCoeff();
-        // A step beyond a quarter of the slip-speed scale means a Floquet multiplier near 1 (or a
-        // start far from the cycle): Newton is no better than its linearisation there. Where the map
-        // contracts strongly (every multiplier below 1/2) the step is still better than a plain period
-        // (fig6's field: neighbours' warm starts 0.3-0.9 of the scale off, which sent 1 in 3 of its
-        // configurations back to Anderson from the start): take it and linearise afresh at its end.
-        // Otherwise give up.
-        if (!(dn <= 0.25)) {
-            if (!std::isfinite(dn) || !was_fresh || M.eigenvalues().cwiseAbs().maxCoeff() >= 0.5) break;
-            x += delta.cwiseProduct(S);
-            refresh = true;
-            d_prev = std::numeric_limits<double>::infinity();   // no contraction measured across it
-            continue;
-        }
-        out.twist = Vec3(z[3], z[4], z[5]) / T + (Pa * delta).cwiseProduct(S);
-        out.qd_start = x + delta.cwiseProduct(S);   // the Newton estimate of the cycle's start
-        out.residual = r.cwiseAbs().maxCoeff();
-        out.min_normal_force = min_n;
-        out.has_monodromy = true;
-        out.monodromy = M;
-        // With a monodromy fresh at this start, dn is the linear estimate of the start's distance
-        // from the cycle; the twist's error is at most |d xi_a/dx| times it (before the correction
-        // Pa delta, which leaves only its second-order remainder), doubled for a difference
-        // monodromy's or a nonlinearity's error. Near the cycle this ends a warm start after one
-        // period (the period map's noise, ~rtol v_ref per switch, left the contraction
-        // theta below unmeasurable there).
-        // (And the start itself within tol of the cycle, for the warm starts it gives: dn to first
-        // order, which the monodromy's error, ~2% as below, leaves.)
-        // With a rank-one M the residual's part off its line, r_perp, is taken as it stands (M has no
-        // component there, which is exact for the step: the true M's range is the line) but Pa u leaves
-        // out the twist's sensitivity across the line (|Pa| <= 1.72 |Pa u|, with |Pa| <= 0.7, on fig6):
-        // nothing is accepted before r_perp is below a tenth of tol. It falls quadratically (the map
-        // puts every start on its image curve; r_perp is that curve's bend over the last step).
-        const bool on_line = line.isZero() || (r - line * line.dot(r)).norm() <= 0.1 * opt.tol;
-        if (accept && was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol && kPaError * dn <= opt.tol) {
-            out.error_estimate = 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn;
-            out.converged = true;
-            break;
-        }
-        if (k >= 1 && std::isfinite(d_prev)) {   // (not after a full stick: no previous step)
-            const double theta = d_prev > 0 ? dn / d_prev : 0.0;
-            out.contraction = theta;
-            // The next step contracts by about theta again on a chord, by less under Newton; but a
-            // chord step after a fresh monodromy at the previous start contracts by up to 2 theta
-            // (the monodromy it uses is then one step stale). The twist's error is the start's
-            // times |d xi_a/dx| (max-row-sum norm).
-            if (2 * theta < 1) {
-                // Plus the correction Pa delta's own error: the variational Pa is about 1% off
-                // (trapezoidal rule on the engine's steps), which an outside audit found left a
-                // chord-accepted twist 1e-6 v_ref off with an estimate of 7e-8.
-                const double dist = 2 * theta / (1 - 2 * theta) * dn;
-                out.error_estimate = Pa.cwiseAbs().rowwise().sum().maxCoeff() * (dist + kPaError * dn);
-                if (accept && on_line && out.error_estimate <= opt.tol) { out.converged = true; break; }
-            }
-            if (theta > 0.5) {
-                if (was_fresh) break;   // even a fresh monodromy does not contract: give up
-                refresh = true;         // a stale chord: refresh M at this start
-            }
-        }
-        x += delta.cwiseProduct(S);
-        d_prev = dn;
-    }
-    out.stop = e.stop;
-    out.stats = e.stats;
-    out.stats += fd_stats;   // the difference monodromies' periods
-    out.stats.rhs_evals += jws.evals;   // the Jacobians' evaluations
-    out.step_hint = e.next_step() / T;
-    if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
-    if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
     return out;
 }
 

@@ -126,93 +126,110 @@ Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3&
     return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, duration, sample_dt, opt);
 }
 
-Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
-                             const IntegrationOptions& opt, const AveragingOptions& avg) {
-    if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate_averaged: duration and sample_dt must be > 0");
-    if (avg.max_macro_periods < 1 || !(avg.macro_tol > 0) || avg.relax_periods < 0 || avg.start_periods < 0)
-        throw std::invalid_argument("simulate_averaged: macro_tol > 0, max_macro_periods >= 1, relax_periods and start_periods >= 0");
-    using State = detail::FullModel::State;
-    const double T = sc.plate.T;
-    constexpr int kSlow[6] = {0, 1, 2, 6, 7, 8};   // q and phi; the twist (3..5) is fast
-    Trajectory tr;
+namespace {
+
+using FullState = detail::FullModel::State;
+constexpr int kSlow[6] = {0, 1, 2, 6, 7, 8};   // q and phi; the twist (3..5) is fast
+
+// Macro points (t, q, dq/dt) for the samples.
+struct Knot {
+    double t;
+    Vec3 q, v;
+};
+
+// One simulate_averaged: the trajectory it fills, the state and the macro points its stages share --
+// the start (direct periods), the macro steps (bursts of full dynamics), the samples and the rest.
+struct Averaging {
+    const Scene& sc;
+    const IntegrationOptions& opt;
+    const AveragingOptions& avg;
+    const double T;
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    // Runs the full dynamics from (t0, y) to t1; false (tr.stop set) if it stopped.
-    auto run_to = [&](double t0, State& y, double t1) {
-        detail::FullModel m(sc);
-        detail::Engine<detail::FullModel> e(m, sc, opt);
-        const bool ok = e.start(t0, y) && e.advance(t1, [](double, const auto&, const Vec3&) {});
-        tr.stats += e.stats;
-        tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
-        if (!ok) tr.stop = e.stop;
-        y = e.y();
-        return ok;
-    };
-    // A stage's slope of (q, phi) at y (time t = a whole number of periods), along `back` (the last
-    // slope); y's twist becomes the burst's end twist.
-    auto slope = [&](double t, State& y, const State& back, State& k) {
-        State b = y;
-        const double lead = (avg.relax_periods + 0.5) * T;
-        for (int i : kSlow) b[i] -= lead * back[i];
-        const double t0 = t - lead + 0.5 * T;   // (a whole number of periods before t)
-        if (!run_to(t0, b, t0 + avg.relax_periods * T)) return false;
-        const State a = b;
-        if (!run_to(t0 + avg.relax_periods * T, b, t0 + (avg.relax_periods + 1) * T)) return false;
-        for (int i = 0; i < 9; ++i) k[i] = (b[i] - a[i]) / T;
-        for (int i : {3, 4, 5}) y[i] = b[i];
-        return true;
-    };
-    Vec3 p, phi;
-    sc.plate.displacement(0.0, p, phi);
-    State y = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]};
-    tr.stats.min_normal_force = std::numeric_limits<double>::infinity();
-    // Macro points (t, q, dq/dt) for the samples.
-    struct Knot {
-        double t;
-        Vec3 q, v;
-    };
+    Trajectory tr;
+    FullState y{};
     std::vector<Knot> knots;
-    const long N = static_cast<long>(std::floor(duration / T + 1e-9));
-    const double rho = sc.part.rho();
-    long n = 0;
-    State k1{}, k2{}, last{};
+    long N = 0;     // whole periods in the duration
+    long n = 0;     // periods done
+    double t = 0;   // their end, n T (after the start)
+    FullState last{};   // the last slope of (q, phi)
     bool ok = true;
-    {   // The start, directly, period by period: at least start_periods, and on until the twist at the
-        // periods' starts changes by at most macro_tol (of v_ref, v_ref, v_ref / rho) over a period --
-        // the fast variable settled, which the bursts' relax periods assume (fig4 from rest at (0.04,
-        // -0.04, 1): averaging from the fifth period put the run 2.4e-2 rho off at 0.8 s, whatever the
-        // macro tolerance). Its samples are the dynamics' own; its last period's change is the first
-        // slope's guess (the burst's lead).
-        detail::FullModel m(sc);
-        detail::Engine<detail::FullModel> e(m, sc, opt);
-        ok = e.start(0, y);
-        if (ok) tr.samples.push_back(Sample{0, m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
-        const detail::Scales scale(sc);
-        const Vec3 S(scale.v, scale.v, scale.w);
-        State begin = y;   // the state at the current period's start
-        long s = 1;
-        while (ok && avg.start_periods > 0 && n < N) {
-            const double tn = (n + 1) * T;
-            for (; ok && s * sample_dt < tn - 1e-12 * T; ++s)
-                if ((ok = e.advance(s * sample_dt, [](double, const auto&, const Vec3&) {})))
-                    tr.samples.push_back(Sample{e.t(), m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
-            if (!ok || !(ok = e.advance(tn, [](double, const auto&, const Vec3&) {}))) break;
-            ++n;
-            const State yn = e.y();
-            double change = 0;
-            for (int i = 0; i < 3; ++i) change = std::max(change, std::abs(yn[3 + i] - begin[3 + i]) / S[i]);
-            for (int i = 0; i < 9; ++i) last[i] = (yn[i] - begin[i]) / T;
-            begin = yn;
-            if (n >= avg.start_periods && change <= avg.macro_tol) break;
-        }
-        tr.stats += e.stats;
-        tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
-        if (!ok) tr.stop = e.stop;
-        y = e.y();
+
+    Averaging(const Scene& sc, const IntegrationOptions& opt, const AveragingOptions& avg)
+        : sc(sc), opt(opt), avg(avg), T(sc.plate.T) {}
+    bool run_to(double t0, FullState& y, double t1);
+    bool slope(double t, FullState& y, const FullState& back, FullState& k);
+    void run_start(double sample_dt);
+    void run_macro_steps();
+    void finish(double duration, double sample_dt);
+};
+
+// Runs the full dynamics from (t0, y) to t1; false (tr.stop set) if it stopped.
+bool Averaging::run_to(double t0, FullState& y, double t1) {
+    detail::FullModel m(sc);
+    detail::Engine<detail::FullModel> e(m, sc, opt);
+    const bool ok = e.start(t0, y) && e.advance(t1, [](double, const auto&, const Vec3&) {});
+    tr.stats += e.stats;
+    tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
+    if (!ok) tr.stop = e.stop;
+    y = e.y();
+    return ok;
+}
+
+// A stage's slope of (q, phi) at y (time t = a whole number of periods), along `back` (the last
+// slope); y's twist becomes the burst's end twist.
+bool Averaging::slope(double t, FullState& y, const FullState& back, FullState& k) {
+    FullState b = y;
+    const double lead = (avg.relax_periods + 0.5) * T;
+    for (int i : kSlow) b[i] -= lead * back[i];
+    const double t0 = t - lead + 0.5 * T;   // (a whole number of periods before t)
+    if (!run_to(t0, b, t0 + avg.relax_periods * T)) return false;
+    const FullState a = b;
+    if (!run_to(t0 + avg.relax_periods * T, b, t0 + (avg.relax_periods + 1) * T)) return false;
+    for (int i = 0; i < 9; ++i) k[i] = (b[i] - a[i]) / T;
+    for (int i : {3, 4, 5}) y[i] = b[i];
+    return true;
+}
+
+// The start, directly, period by period: at least start_periods, and on until the twist at the
+// periods' starts changes by at most macro_tol (of v_ref, v_ref, v_ref / rho) over a period --
+// the fast variable settled, which the bursts' relax periods assume (fig4 from rest at (0.04,
+// -0.04, 1): averaging from the fifth period put the run 2.4e-2 rho off at 0.8 s, whatever the
+// macro tolerance). Its samples are the dynamics' own; its last period's change is the first
+// slope's guess (the burst's lead).
+void Averaging::run_start(double sample_dt) {
+    detail::FullModel m(sc);
+    detail::Engine<detail::FullModel> e(m, sc, opt);
+    ok = e.start(0, y);
+    if (ok) tr.samples.push_back(Sample{0, m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
+    const detail::Scales scale(sc);
+    const Vec3 S(scale.v, scale.v, scale.w);
+    FullState begin = y;   // the state at the current period's start
+    long s = 1;
+    while (ok && avg.start_periods > 0 && n < N) {
+        const double tn = (n + 1) * T;
+        for (; ok && s * sample_dt < tn - 1e-12 * T; ++s)
+            if ((ok = e.advance(s * sample_dt, [](double, const auto&, const Vec3&) {})))
+                tr.samples.push_back(Sample{e.t(), m.q(e.y()), m.qd(e.y()), e.n(), e.mode()});
+        if (!ok || !(ok = e.advance(tn, [](double, const auto&, const Vec3&) {}))) break;
+        ++n;
+        const FullState yn = e.y();
+        double change = 0;
+        for (int i = 0; i < 3; ++i) change = std::max(change, std::abs(yn[3 + i] - begin[3 + i]) / S[i]);
+        for (int i = 0; i < 9; ++i) last[i] = (yn[i] - begin[i]) / T;
+        begin = yn;
+        if (n >= avg.start_periods && change <= avg.macro_tol) break;
     }
-    double t = n * T;
-    knots.push_back({t, Vec3(y[0], y[1], y[2]), Vec3::Constant(nan)});
-    // Macro steps of K periods, K chosen from Heun's local error estimate, H/2 |k2 - k1| in (rho, rho,
-    // 1 rad) against macro_tol (the usual controller, exponent 1/2; a rejected step keeps k1).
+    tr.stats += e.stats;
+    tr.stats.min_normal_force = std::min(tr.stats.min_normal_force, e.stats.min_normal_force);
+    if (!ok) tr.stop = e.stop;
+    y = e.y();
+}
+
+// Macro steps of K periods, K chosen from Heun's local error estimate, H/2 |k2 - k1| in (rho, rho,
+// 1 rad) against macro_tol (the usual controller, exponent 1/2; a rejected step keeps k1).
+void Averaging::run_macro_steps() {
+    const double rho = sc.part.rho();
+    FullState k1{}, k2{};
     long K = std::min<long>(avg.start_periods > 0 ? avg.start_periods : 1, avg.max_macro_periods);
     bool have_k1 = false;
     while (ok && n < N) {
@@ -223,7 +240,7 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
         // except a predictor's at K > 1 (its point is Heun's guess): a rejected step.
         if (!have_k1 && !slope(t, y, last, k1)) break;
         have_k1 = true;
-        State ye = y;
+        FullState ye = y;
         for (int i : kSlow) ye[i] += H * k1[i];
         const bool k2_ok = slope(t + H, ye, k1, k2);
         if (!k2_ok && K == 1) break;
@@ -248,7 +265,10 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
         knots.push_back({t, Vec3(y[0], y[1], y[2]), Vec3(k2[0], k2[1], k2[2])});
         K = std::max<long>(1, std::lround(K * std::clamp(grow, 0.3, 2.0)));
     }
-    if (ok) tr.stop = StopEvent{};   // (a burst's stop: the direct run below finds the real one)
+}
+
+// The samples of the macro phase, then the rest of the run directly.
+void Averaging::finish(double duration, double sample_dt) {
     // Samples of the macro phase: cubic Hermite between knots with both slopes known, else linear.
     const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
     long s = static_cast<long>(tr.samples.size());
@@ -285,7 +305,28 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
     }
     if (ok && !tr.samples.empty() && !tr.samples.back().qd.allFinite() && tr.samples.back().t == t)
         tr.samples.back().qd = Vec3(y[3], y[4], y[5]);
-    return tr;
+}
+
+}  // namespace
+
+Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
+                             const IntegrationOptions& opt, const AveragingOptions& avg) {
+    if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate_averaged: duration and sample_dt must be > 0");
+    if (avg.max_macro_periods < 1 || !(avg.macro_tol > 0) || avg.relax_periods < 0 || avg.start_periods < 0)
+        throw std::invalid_argument("simulate_averaged: macro_tol > 0, max_macro_periods >= 1, relax_periods and start_periods >= 0");
+    Averaging run(sc, opt, avg);
+    Vec3 p, phi;
+    sc.plate.displacement(0.0, p, phi);
+    run.y = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]};
+    run.tr.stats.min_normal_force = std::numeric_limits<double>::infinity();
+    run.N = static_cast<long>(std::floor(duration / run.T + 1e-9));
+    run.run_start(sample_dt);
+    run.t = run.n * run.T;
+    run.knots.push_back({run.t, Vec3(run.y[0], run.y[1], run.y[2]), Vec3::Constant(run.nan)});
+    run.run_macro_steps();
+    if (run.ok) run.tr.stop = StopEvent{};   // (a burst's stop: the direct run below finds the real one)
+    run.finish(duration, sample_dt);
+    return run.tr;
 }
 
 }  // namespace plate

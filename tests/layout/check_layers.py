@@ -45,7 +45,8 @@ NUMERIC_LEVELS = [
     ("engine", ["src/engine.hpp", "src/engine.cpp", "src/engine_step.hxx", "src/engine_events.hxx",
                 "src/engine_modes.hxx", "src/engine_creep.hxx",
                 "include/plate/simulate.hpp"]),   # the options, stops and samples the engine fills
-    ("simulate/limit_cycle", ["src/simulate.cpp", "include/plate/limit_cycle.hpp", "src/limit_cycle.cpp"]),
+    ("simulate/limit_cycle", ["src/simulate.cpp", "include/plate/limit_cycle.hpp", "src/limit_cycle.cpp",
+                              "src/cycle_solvers.hpp", "src/shooting_cycle.cpp"]),
     ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp",
                             "include/plate/output.hpp", "src/output.cpp"]),
 ]
