@@ -47,7 +47,7 @@ constexpr AddCommand kCommands[] = {
     add_sweep,          // plate sweep
 };
 
-}  // namespace
+}   // namespace
 
 int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
     Io cio{out, err, nullptr};
@@ -55,9 +55,7 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
     app.get_formatter()->label("Usage", "usage");   // (as before: the help says "usage: plate ...")
     app.get_formatter()->label("SUBCOMMAND", "COMMAND");
     app.footer(kFooter);
-    app.set_version_flag("--version", [] {
-        return "plate " PLATE_VERSION " (scenes and report inputs: " + data_root() + ")";
-    });
+    app.set_version_flag("--version", [] { return "plate " PLATE_VERSION " (scenes and report inputs: " + data_root() + ")"; });
     app.require_subcommand(1);
     app.allow_extras();   // (and so every command) what is left over is judged by Options::reject
     std::vector<Command> commands;
@@ -130,4 +128,4 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
     }
 }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

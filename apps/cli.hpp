@@ -10,4 +10,4 @@ namespace plate::cli {
 
 int run(int argc, char** argv, std::ostream& out, std::ostream& err);
 
-}  // namespace plate::cli
+}   // namespace plate::cli

@@ -32,8 +32,8 @@ long parse_whole(const std::string& k, const std::string& s, long lo, long hi) {
     char* end = nullptr;
     const long x = std::strtol(s.c_str(), &end, 10);
     if (s.empty() || *end != '\0' || x < lo || x > hi)
-        throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " +
-                         std::to_string(hi) + ", got '" + s + "'");
+        throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) +
+                         ", got '" + s + "'");
     return x;
 }
 
@@ -85,8 +85,8 @@ void Options::number(const std::string& name, double& x, const std::string& help
         [name, &x](const std::string& s) { x = parse_num(name, s); });
 }
 
-void Options::numbers(const std::string& name, std::vector<double>& v, std::size_t lo, std::size_t hi,
-                      const std::string& names, const std::string& help) {
+void Options::numbers(const std::string& name, std::vector<double>& v, std::size_t lo, std::size_t hi, const std::string& names,
+                      const std::string& help) {
     const std::string count = std::to_string(lo) + (lo < hi ? " or " + std::to_string(hi) : "");
     add(name, static_cast<int>(hi), names, help, [name, &v, lo, hi, count](const std::vector<std::string>& s) {
         if (s.size() < lo || s.size() > hi) throw UsageError(name + ": expected " + count + " numbers");
@@ -98,8 +98,7 @@ void Options::numbers(const std::string& name, std::vector<double>& v, std::size
 void Options::words(const std::string& name, std::vector<std::string>& v, std::size_t n, const std::string& names,
                     const std::string& help) {
     add(name, static_cast<int>(n), names, help, [name, &v, n](const std::vector<std::string>& s) {
-        if (s.size() != n)
-            throw UsageError("option " + name + " expects " + std::to_string(n) + " value(s)");
+        if (s.size() != n) throw UsageError("option " + name + " expects " + std::to_string(n) + " value(s)");
         v = s;
     });
 }
@@ -108,8 +107,7 @@ void Options::words(const std::string& name, std::vector<std::string>& v, std::s
                     const std::string& names, const std::string& help) {
     add(name, static_cast<int>(hi), names, help, [name, &v, lo, hi](const std::vector<std::string>& s) {
         if (s.size() < lo || s.size() > hi)
-            throw UsageError("option " + name + " expects " + std::to_string(lo) + " to " + std::to_string(hi) +
-                             " values");
+            throw UsageError("option " + name + " expects " + std::to_string(lo) + " to " + std::to_string(hi) + " values");
         v = s;
     });
 }
@@ -119,7 +117,13 @@ void Options::text(const std::string& name, std::string& s, const std::string& v
 }
 
 void Options::flag(const std::string& name, bool& b, const std::string& help) {
-    cmd_->add_flag_function(name, [this, name, &b](std::int64_t) { once(name); b = true; }, help)
+    cmd_->add_flag_function(
+            name,
+            [this, name, &b](std::int64_t) {
+                once(name);
+                b = true;
+            },
+            help)
         ->disable_flag_override()
         ->trigger_on_parse();
 }
@@ -129,28 +133,34 @@ namespace {
 // Declares option `name` of `cmd`, taking 1 to max_values values of type T (std::string or a vector
 // of them), each occurrence passed through `once` to `store` as it is parsed.
 template <class T>
-void add_option(CLI::App* cmd, const std::string& name, int max_values, const std::string& names,
-                const std::string& help, std::function<void(const std::string&)> once,
-                std::function<void(const T&)> store) {
-    cmd->add_option_function<T>(name, [name, once, store](const T& v) { once(name); store(v); }, help)
+void add_option(CLI::App* cmd, const std::string& name, int max_values, const std::string& names, const std::string& help,
+                std::function<void(const std::string&)> once, std::function<void(const T&)> store) {
+    cmd->add_option_function<T>(
+           name,
+           [name, once, store](const T& v) {
+               once(name);
+               store(v);
+           },
+           help)
         ->expected(1, max_values)
-        ->allow_extra_args(false)                   // (a vector's default: eat every value that follows)
+        ->allow_extra_args(false)   // (a vector's default: eat every value that follows)
         ->option_text(names)
         ->type_name(names.substr(0, names.find(' ')))   // "--at: 1 required SX missing"
         ->trigger_on_parse();
 }
 
-}  // namespace
+}   // namespace
 
 void Options::add(const std::string& name, const std::string& names, const std::string& help,
                   std::function<void(const std::string&)> store) {
-    add_option<std::string>(cmd_, name, 1, names, help, [this](const std::string& n) { once(n); }, std::move(store));
+    add_option<std::string>(
+        cmd_, name, 1, names, help, [this](const std::string& n) { once(n); }, std::move(store));
 }
 
 void Options::add(const std::string& name, int max_values, const std::string& names, const std::string& help,
                   std::function<void(const std::vector<std::string>&)> store) {
-    add_option<std::vector<std::string>>(cmd_, name, max_values, names, help,
-                                         [this](const std::string& n) { once(n); }, std::move(store));
+    add_option<std::vector<std::string>>(
+        cmd_, name, max_values, names, help, [this](const std::string& n) { once(n); }, std::move(store));
 }
 
 void Options::once(const std::string& name) {
@@ -204,8 +214,7 @@ void add_cycle_options(Options& p, CycleArgs& c) {
     p.number("--tol", c.o.tol, "accepted distance to the cycle, relative to the slip-speed scale");
     p.number("--rtol", c.o.integration.rtol, "integrator tolerance, in (0, 1e-2)");
     p.whole("--max-periods", c.o.max_periods, 2, 100000, "periods before the cycle counts as not converged");
-    p.whole("--max-rhs", c.o.max_rhs_evaluations, 1000, 1'000'000'000'000L,
-            "work budget of one cycle, right-hand sides");
+    p.whole("--max-rhs", c.o.max_rhs_evaluations, 1000, 1'000'000'000'000L, "work budget of one cycle, right-hand sides");
     p.text("--cycle-solver", c.solver, "NAME", "period-by-period, anderson, newton or shooting (default shooting)");
 }
 
@@ -286,8 +295,9 @@ void require_within_budget(const Field& f, long budget) {
 sweep::Farm* launched_farm(Io& cio, int threads) {
     if (!sweep::mpi_launched()) return nullptr;
     if (!sweep::mpi_built())
-        throw UsageError("started by an MPI launcher with several ranks, but this plate was built without MPI: "
-                         "every process would do the whole job (rebuild with libopenmpi-dev, or run it alone)");
+        throw UsageError(
+            "started by an MPI launcher with several ranks, but this plate was built without MPI: "
+            "every process would do the whole job (rebuild with libopenmpi-dev, or run it alone)");
     cio.farm = sweep::mpi_farm(threads);
     return cio.farm.get();
 }
@@ -306,4 +316,4 @@ Field bounded_field(const Scene& sc, const GridSpec& g, const LimitCycleOptions&
     return f;
 }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

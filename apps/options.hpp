@@ -99,14 +99,14 @@ public:
             [name, &x, lo, hi](const std::string& s) { x = static_cast<Int>(parse_whole(name, s, lo, hi)); });
     }
     // lo to hi numbers (`names` in the help); how many a part takes is checked where that is known (config_arg).
-    void numbers(const std::string& name, std::vector<double>& v, std::size_t lo, std::size_t hi,
-                 const std::string& names, const std::string& help);
+    void numbers(const std::string& name, std::vector<double>& v, std::size_t lo, std::size_t hi, const std::string& names,
+                 const std::string& help);
     // Exactly n words.
     void words(const std::string& name, std::vector<std::string>& v, std::size_t n, const std::string& names,
                const std::string& help);
     // From lo to hi words.
-    void words(const std::string& name, std::vector<std::string>& v, std::size_t lo, std::size_t hi,
-               const std::string& names, const std::string& help);
+    void words(const std::string& name, std::vector<std::string>& v, std::size_t lo, std::size_t hi, const std::string& names,
+               const std::string& help);
     // One word of any text (`value` in the help: FILE, DIR, NAME, json|csv ...).
     void text(const std::string& name, std::string& s, const std::string& value, const std::string& help);
     // A flag: b becomes true when given.
@@ -197,7 +197,6 @@ sweep::Farm* launched_farm(Io& cio, int threads);
 // The field of `field` and `fixed-points`: its work estimated up front against `max_work`, progress
 // on a terminal, and refused if the budget was spent anyway. Under mpirun (cio.farm) its planes are
 // shared over the ranks and every rank returns the whole field, the same as one process computes.
-Field bounded_field(const Scene& sc, const GridSpec& g, const LimitCycleOptions& cycle, int threads, long max_work,
-                    Io& cio);
+Field bounded_field(const Scene& sc, const GridSpec& g, const LimitCycleOptions& cycle, int threads, long max_work, Io& cio);
 
-}  // namespace plate::cli
+}   // namespace plate::cli

@@ -17,8 +17,8 @@ int main() {
     const Scene part = load_scene(PLATE_SOURCE_DIR "/scenes/fig1_point.json");
     std::printf("machine: %s\n", machine_description().c_str());
     std::printf("point-part sink at (0.02, -0.01), limits 15 / 100; 4 starts x 400 evaluations, 2 threads\n");
-    std::printf("%-6s %-22s %10s %12s %12s %10s %9s\n", "seed", "local search", "rate[1/s]", "evaluations", "cycles",
-                "wall[s]", "verified");
+    std::printf("%-6s %-22s %10s %12s %12s %10s %9s\n", "seed", "local search", "rate[1/s]", "evaluations", "cycles", "wall[s]",
+                "verified");
     double ev[2] = {0, 0}, rate[2] = {0, 0};
     for (std::uint64_t seed : {1, 2, 3}) {
         for (int m = 0; m < 2; ++m) {

@@ -21,8 +21,8 @@ int main(int argc, char** argv) {
     const std::string path = argc > 1 ? argv[1] : PLATE_SOURCE_DIR "/scenes/fig4.json";
     const Scene sc = load_scene(path);
     std::printf("machine: %s\n", machine_description().c_str());
-    std::printf("scene: %s, v_ref = %.4g m/s (errors below are relative to v_ref, angular rates times rho)\n",
-                sc.name.c_str(), sc.v_ref());
+    std::printf("scene: %s, v_ref = %.4g m/s (errors below are relative to v_ref, angular rates times rho)\n", sc.name.c_str(),
+                sc.v_ref());
 
     // One right-hand side: the generic 6x6 solve of (32).
     {
@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
             accelerations(sc, Dynamics::ReducedU, Vec3(0.01, 0.02, 0.3), qd, ps, ws);
         }
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::printf("rhs (generic Eigen 6x6 LU): %.1f ns per evaluation (%d evaluations, checksum %.3g)\n",
-                    1e9 * s / n, n, ws.qdd.sum());
+        std::printf("rhs (generic Eigen 6x6 LU): %.1f ns per evaluation (%d evaluations, checksum %.3g)\n", 1e9 * s / n, n,
+                    ws.qdd.sum());
     }
 
     FieldOptions ref_opt;
@@ -55,12 +55,12 @@ int main(int argc, char** argv) {
             periods += p.periods;
             converged += p.converged;
         }
-        std::printf("field %dx%dx%d, %d thread(s): %.3f s wall, %ld rhs evaluations, %.1f ns per evaluation "
-                    "(wall x threads / evaluations), %.1f periods per configuration, %d/%zu converged, "
-                    "max error %.2g\n",
-                    f.grid.nx, f.grid.ny, f.grid.nth, f.threads, f.seconds, f.rhs_evals,
-                    1e9 * f.seconds * f.threads / f.rhs_evals, periods / f.points.size(), converged,
-                    f.points.size(), field_max_error(sc, f, ref));
+        std::printf(
+            "field %dx%dx%d, %d thread(s): %.3f s wall, %ld rhs evaluations, %.1f ns per evaluation "
+            "(wall x threads / evaluations), %.1f periods per configuration, %d/%zu converged, "
+            "max error %.2g\n",
+            f.grid.nx, f.grid.ny, f.grid.nth, f.threads, f.seconds, f.rhs_evals, 1e9 * f.seconds * f.threads / f.rhs_evals,
+            periods / f.points.size(), converged, f.points.size(), field_max_error(sc, f, ref));
     }
     std::printf("reference field (rtol 1e-12, tol 1e-11): %.3f s, %ld rhs evaluations\n", ref.seconds, ref.rhs_evals);
     return 0;

@@ -73,7 +73,7 @@ template <class K>
 double kernel_ns(const Scene& sc, K kernel, double& checksum) {
     Workspace ws;
     const PlateState ps = plate_state(sc.plate, 0.013, Dynamics::ReducedU);
-    accelerations(sc, Dynamics::U, Vec3(0.01, 0.02, 0.3), Vec3(0.1, -0.05, 2), ps, ws);   // fills the kernels' inputs
+    accelerations(sc, Dynamics::U, Vec3(0.01, 0.02, 0.3), Vec3(0.1, -0.05, 2), ps, ws);          // fills the kernels' inputs
     accelerations(sc, Dynamics::ReducedU, Vec3(0.01, 0.02, 0.3), Vec3(0.1, -0.05, 2), ps, ws);   // the slots
     gen::KernelInput in = detail::kernels(ws).in;
     const double a0 = std::atan2(in.u1y, in.u1x);
@@ -94,7 +94,7 @@ double kernel_ns(const Scene& sc, K kernel, double& checksum) {
     return best;
 }
 
-}  // namespace
+}   // namespace
 
 int main() {
     std::printf("machine: %s (timed on one core)\n", machine_description().c_str());
@@ -119,13 +119,14 @@ int main() {
                 ref_thick / gen_thick, k_thick);
     std::printf("%-36s %8.1f ns %8.1f ns %7.2fx %9.1f ns\n", "thin part ((38) inverse)", gen_thin, ref_thin, ref_thin / gen_thin,
                 k_thin);
-    std::printf("%-36s %8.1f ns %8.1f ns %7.2fx %9.1f ns\n", "point part (explicit)", gen_point, ref_point,
-                ref_point / gen_point, k_point);
+    std::printf("%-36s %8.1f ns %8.1f ns %7.2fx %9.1f ns\n", "point part (explicit)", gen_point, ref_point, ref_point / gen_point,
+                k_point);
     std::printf("%-36s %8.1f ns %8.1f ns %7.2fx\n", "thick part, full dynamics (31)", gen_full, ref_full, ref_full / gen_full);
-    std::printf("targets: thick right-hand side < 60 ns: %s, >= 3x the generic solve: %s; thin kernel < 20 ns: %s "
-                "(thin right-hand side %s)\n",
-                gen_thick < 60 ? "met" : "MISSED", ref_thick / gen_thick >= 3 ? "met" : "MISSED", k_thin < 20 ? "met" : "MISSED",
-                gen_thin < 20 ? "also < 20 ns" : ">= 20 ns: it adds the slip normalisation, three square roots and divisions");
+    std::printf(
+        "targets: thick right-hand side < 60 ns: %s, >= 3x the generic solve: %s; thin kernel < 20 ns: %s "
+        "(thin right-hand side %s)\n",
+        gen_thick < 60 ? "met" : "MISSED", ref_thick / gen_thick >= 3 ? "met" : "MISSED", k_thin < 20 ? "met" : "MISSED",
+        gen_thin < 20 ? "also < 20 ns" : ">= 20 ns: it adds the slip normalisation, three square roots and divisions");
     std::printf("(checksum %.6g)\n", cs);
     return 0;
 }

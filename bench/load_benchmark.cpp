@@ -27,7 +27,7 @@ double since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace
+}   // namespace
 
 int main() {
     std::printf("machine: %s\n", machine_description().c_str());
@@ -64,9 +64,12 @@ int main() {
         for (const auto& p : f.points) defined += p.converged;
         std::printf("  run %d: %.2f s wall on %d threads, %d/%zu defined, VmRSS %ld kB, VmHWM %ld kB\n", run, f.seconds,
                     f.threads, defined, f.points.size(), status_kb("VmRSS:"), status_kb("VmHWM:"));
-        if (run == 0) { t_first = f.seconds; hwm_after_first = status_kb("VmHWM:"); }
-        else std::printf("  second / first: %.3f; VmHWM growth in the second run: %ld kB\n", f.seconds / t_first,
-                         status_kb("VmHWM:") - hwm_after_first);
+        if (run == 0) {
+            t_first = f.seconds;
+            hwm_after_first = status_kb("VmHWM:");
+        } else
+            std::printf("  second / first: %.3f; VmHWM growth in the second run: %ld kB\n", f.seconds / t_first,
+                        status_kb("VmHWM:") - hwm_after_first);
     }
     return 0;
 }

@@ -20,7 +20,7 @@ double seconds(const std::chrono::steady_clock::time_point& t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace
+}   // namespace
 
 int main() {
     std::printf("machine: %s\n\n", machine_description().c_str());
@@ -49,8 +49,10 @@ int main() {
             Dynamics d;
             predicted = a_priori_pick(sc, est, tol, p, d);
             const Scene s = simplified(sc, p);
-            if (d == Dynamics::ReducedU) field_curve(s, q0, D, D);
-            else simulate(s, d, q0, Vec3::Zero(), D, D);
+            if (d == Dynamics::ReducedU)
+                field_curve(s, q0, D, D);
+            else
+                simulate(s, d, q0, Vec3::Zero(), D, D);
             t_auto.push_back(seconds(t0));
             Rung r;
             r.part = p;

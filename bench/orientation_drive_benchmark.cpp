@@ -42,9 +42,7 @@ const Axis kAxes[6] = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
 
 // Parameter 4 a + 2 (n - 1) + {0, 1}: the cosine and sine coefficients of axis a's harmonic n (the
 // rigid design's layout).
-PlateMotion motion(const std::vector<double>& p, double T) {
-    return motion_from(p, {kAxes, kAxes + 6}, {1, 2}, T);
-}
+PlateMotion motion(const std::vector<double>& p, double T) { return motion_from(p, {kAxes, kAxes + 6}, {1, 2}, T); }
 
 // The measure: B_1 / (|M| + B_2 + ... + B_6 + 1e-3 rad/s) (the floor keeps a motion that turns
 // nothing from scoring).
@@ -60,9 +58,7 @@ struct Search {
     std::string lines;
 };
 
-double score(const Search& s, const OrientationHarmonics& h) {
-    return !h.defined ? -1.0 : s.first_alone ? h.first() : ratio(h);
-}
+double score(const Search& s, const OrientationHarmonics& h) { return !h.defined ? -1.0 : s.first_alone ? h.first() : ratio(h); }
 
 double objective(const std::vector<double>& p, std::vector<double>&, void* data) {
     Search& s = *static_cast<Search*>(data);
@@ -156,16 +152,17 @@ OrientationHarmonics search(Search& s, int starts, int evaluations, std::uint64_
     return best;
 }
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     const int starts = argc > 1 ? std::atoi(argv[1]) : 4;
     const int evaluations = argc > 2 ? std::atoi(argv[2]) : 400;
     std::printf("machine: %s\n", machine_description().c_str());
-    std::printf("theta' on 12 orientations at the centre; COBYLA over x..rz, n = 1, 2 (24 coefficients), %d starts x %d "
-                "evaluations per part and objective, seed 1; limits 20 m/s^2, 150 rad/s^2 (plate design keeps 3 %% of "
-                "them in hand), flight 0.2 g, |coning| <= 1e-4 rad/s\n",
-                starts, evaluations);
+    std::printf(
+        "theta' on 12 orientations at the centre; COBYLA over x..rz, n = 1, 2 (24 coefficients), %d starts x %d "
+        "evaluations per part and objective, seed 1; limits 20 m/s^2, 150 rad/s^2 (plate design keeps 3 %% of "
+        "them in hand), flight 0.2 g, |coning| <= 1e-4 rad/s\n",
+        starts, evaluations);
     const char* names[2] = {"fig4", "foot"};
     Search runs[2][2];   // [part][objective: ratio, B1 alone]
     OrientationHarmonics best[2][2];
@@ -181,17 +178,19 @@ int main(int argc, char** argv) {
     for (int m = 0; m < 2; ++m) best[0][m] = search(runs[0][m], starts, evaluations, 1);
     other.join();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("%-6s %-9s %5s %9s %9s %9s %9s %9s %8s %5s %6s %7s %9s\n", "part", "objective", "start", "M", "B1", "B2",
-                "B3", "B4", "ratio", "one", "use", "margin", "coning");
+    std::printf("%-6s %-9s %5s %9s %9s %9s %9s %9s %8s %5s %6s %7s %9s\n", "part", "objective", "start", "M", "B1", "B2", "B3",
+                "B4", "ratio", "one", "use", "margin", "coning");
     for (int i = 0; i < 2; ++i)
         for (int m = 0; m < 2; ++m) std::printf("%s", runs[i][m].lines.c_str());
-    std::printf("[rad/s; ratio = B1 / (|M| + B2 + ... + B6 + 1e-3); one: B1^2 > rest^2 + (sum_k>=2 k B_k)^2, exactly one "
-                "stable orientation (OrientationHarmonics::one_stable); use: the largest harmonic over its limit]\n");
+    std::printf(
+        "[rad/s; ratio = B1 / (|M| + B2 + ... + B6 + 1e-3); one: B1^2 > rest^2 + (sum_k>=2 k B_k)^2, exactly one "
+        "stable orientation (OrientationHarmonics::one_stable); use: the largest harmonic over its limit]\n");
     for (int i = 0; i < 2; ++i)
-        std::printf("best %-6s ratio %.2f (B1 %.5f rad/s against |M| + B2 + ... + B6 = %.5f); largest B1 %.5f rad/s "
-                    "(against %.5f); %ld evaluations\n",
-                    names[i], ratio(best[i][0]), best[i][0].first(), best[i][0].rest(), best[i][1].first(),
-                    best[i][1].rest(), runs[i][0].evaluations + runs[i][1].evaluations);
+        std::printf(
+            "best %-6s ratio %.2f (B1 %.5f rad/s against |M| + B2 + ... + B6 = %.5f); largest B1 %.5f rad/s "
+            "(against %.5f); %ld evaluations\n",
+            names[i], ratio(best[i][0]), best[i][0].first(), best[i][0].rest(), best[i][1].first(), best[i][1].rest(),
+            runs[i][0].evaluations + runs[i][1].evaluations);
     std::printf("foot / fig4: best ratio %.0fx, largest B1 %.0fx; wall %.1f s on 2 threads (one part each)\n",
                 ratio(best[1][0]) / ratio(best[0][0]), best[1][1].first() / best[0][1].first(), wall);
     return 0;

@@ -61,21 +61,24 @@ void fields_timing() {
                 converged += p.converged;
                 sticking += *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) > 0;
             }
-            std::printf("  %-16s %d thread(s): %.3f s wall (median %.3f), %.3g right-hand sides, %d/%zu defined, %d stick "
-                        "during their cycle\n", name, f.threads, wall.front(), wall[3], static_cast<double>(f.rhs_evals), converged,
-                        f.points.size(), sticking);
+            std::printf(
+                "  %-16s %d thread(s): %.3f s wall (median %.3f), %.3g right-hand sides, %d/%zu defined, %d stick "
+                "during their cycle\n",
+                name, f.threads, wall.front(), wall[3], static_cast<double>(f.rhs_evals), converged, f.points.size(), sticking);
         }
     }
 
-    std::printf("  the goal, fig6's field in at most 0.1 s on this machine: %s at the best of seven runs (%.3f s), %s at "
-                "the median (%.3f s)\n", fig6_best <= 0.1 ? "met" : "not met", fig6_best, fig6_median <= 0.1 ? "met" : "not met",
-                fig6_median);
+    std::printf(
+        "  the goal, fig6's field in at most 0.1 s on this machine: %s at the best of seven runs (%.3f s), %s at "
+        "the median (%.3f s)\n",
+        fig6_best <= 0.1 ? "met" : "not met", fig6_best, fig6_median <= 0.1 ? "met" : "not met", fig6_median);
 }
 
 // (1b), (1c) where fig6's field goes: sticking against sliding configurations.
 void fig6_costs() {
-    std::printf("\n(1b) where fig6's field goes (one thread): right-hand sides and periods, sticking against sliding\n"
-                "     configurations (docs/decisions.md, Where fig6's field's work goes)\n");
+    std::printf(
+        "\n(1b) where fig6's field goes (one thread): right-hand sides and periods, sticking against sliding\n"
+        "     configurations (docs/decisions.md, Where fig6's field's work goes)\n");
     {
         FieldOptions opt;
         opt.threads = 1;
@@ -89,16 +92,19 @@ void fig6_costs() {
             ++n[k];
         }
         for (int k : {1, 0})
-            std::printf("  %-8s %3d configurations: %4.1f %% of the right-hand sides, %.1f periods each, %.0f right-hand sides "
-                        "a period\n", k ? "sticking" : "sliding", n[k], 100.0 * rhs[k] / f.rhs_evals,
-                        n[k] ? double(periods[k]) / n[k] : 0.0, periods[k] ? double(rhs[k]) / periods[k] : 0.0);
+            std::printf(
+                "  %-8s %3d configurations: %4.1f %% of the right-hand sides, %.1f periods each, %.0f right-hand sides "
+                "a period\n",
+                k ? "sticking" : "sliding", n[k], 100.0 * rhs[k] / f.rhs_evals, n[k] ? double(periods[k]) / n[k] : 0.0,
+                periods[k] ? double(rhs[k]) / periods[k] : 0.0);
 
         // (1c) Why a sticking period costs more: of the accepted steps of each cycle's last period
         // (recorded), the slides whose smallest slip at the step's start is between 5e-5 and 1e-2
         // v_ref, and there the step relative to T |v| / v_ref. Where a slip is small the friction
         // direction relaxes at a rate ~ |a| / |v|, which bounds an explicit step: it grows with the slip.
-        std::printf("\n(1c) fig6's cycles, last period's accepted steps (every mode), and among them the slides whose\n"
-                    "     smallest slip s at the step's start is small\n");
+        std::printf(
+            "\n(1c) fig6's cycles, last period's accepted steps (every mode), and among them the slides whose\n"
+            "     smallest slip s at the step's start is small\n");
         const Scene sc = scene("fig6");
         const double T = sc.plate.T, v = sc.v_ref();
         for (int k : {1, 0}) {
@@ -127,17 +133,19 @@ void fig6_costs() {
             }
             std::sort(ratio.begin(), ratio.end());
             const auto pct = [&](double f) { return ratio.empty() ? 0.0 : ratio[std::size_t(f * (ratio.size() - 1))]; };
-            std::printf("  %-8s %5ld steps, %4.1f %% with 5e-5 <= s / v_ref <= 1e-2; there step / (T s / v_ref): "
-                        "median %.2f (10-90 %%: %.2f-%.2f)\n", k ? "sticking" : "sliding", steps,
-                        steps ? 100.0 * small / steps : 0.0, pct(0.5), pct(0.1), pct(0.9));
+            std::printf(
+                "  %-8s %5ld steps, %4.1f %% with 5e-5 <= s / v_ref <= 1e-2; there step / (T s / v_ref): "
+                "median %.2f (10-90 %%: %.2f-%.2f)\n",
+                k ? "sticking" : "sliding", steps, steps ? 100.0 * small / steps : 0.0, pct(0.5), pct(0.1), pct(0.9));
         }
     }
 }
 
 // (2) the engine against the regularised-friction method at equal accuracy.
 void against_regularised() {
-    std::printf("\n(2) fig6's sticking configurations, every 5th in grid order: error against the regularised\n"
-                "    reference (eps -> 0), relative to v_ref, and time per configuration\n");
+    std::printf(
+        "\n(2) fig6's sticking configurations, every 5th in grid order: error against the regularised\n"
+        "    reference (eps -> 0), relative to v_ref, and time per configuration\n");
     const Scene sc = scene("fig6");
     const GridSpec grid;
     std::vector<Vec3> sample;
@@ -147,8 +155,7 @@ void against_regularised() {
         const Vec3 q = grid.at(i, j, k);
         const LimitCycleSummary lc = limit_cycle(sc, q);
         if (!lc.converged) continue;
-        if (*std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end()) > 0 && seen++ % 5 == 0)
-            sample.push_back(q);
+        if (*std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end()) > 0 && seen++ % 5 == 0) sample.push_back(q);
     }
     std::vector<Vec3> ref(sample.size());
     double t_ref = 0;
@@ -170,13 +177,15 @@ void against_regularised() {
         if (err_engine.back() >= err_engine[at]) at = n;
     }
     const double t_engine = since(t0);
-    std::printf("  engine (events, rtol 1e-8):   %8.2f ms per configuration (slowest %.1f ms), largest error %.1e at "
-                "(%.4f, %.4f, %.3f)\n", 1e3 * t_engine / sample.size(), *std::max_element(ms.begin(), ms.end()),
-                err_engine[at], sample[at][0], sample[at][1], sample[at][2]);
+    std::printf(
+        "  engine (events, rtol 1e-8):   %8.2f ms per configuration (slowest %.1f ms), largest error %.1e at "
+        "(%.4f, %.4f, %.3f)\n",
+        1e3 * t_engine / sample.size(), *std::max_element(ms.begin(), ms.end()), err_engine[at], sample[at][0], sample[at][1],
+        sample[at][2]);
     std::sort(err_engine.begin(), err_engine.end());
     std::sort(ms.begin(), ms.end());
-    std::printf("                                 median %.2f ms; error median %.1e, second largest %.1e\n",
-                ms[ms.size() / 2], err_engine[err_engine.size() / 2], err_engine[err_engine.size() - 2]);
+    std::printf("                                 median %.2f ms; error median %.1e, second largest %.1e\n", ms[ms.size() / 2],
+                err_engine[err_engine.size() / 2], err_engine[err_engine.size() - 2]);
 
     double chosen_time = 0, chosen_eps = 0;
     for (double eps : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7}) {
@@ -195,13 +204,18 @@ void against_regularised() {
             ok = ok && r.ok;
             if (!r.ok) continue;
             errs.push_back(distance(sc, Vec3(r.value[0], r.value[1], r.value[2]), ref[n]));
-            if (errs.back() > worst) { worst = errs.back(); at = n; }
+            if (errs.back() > worst) {
+                worst = errs.back();
+                at = n;
+            }
         }
         std::sort(errs.begin(), errs.end());
         std::sort(rms.begin(), rms.end());
-        std::printf("  regularised eps %.0e v_ref:   %8.2f ms per configuration (median %.2f), error median %.1e, largest %.1e at "
-                    "(%.4f, %.4f, %.3f)%s\n", eps, 1e3 * t / sample.size(), rms[rms.size() / 2], errs.empty() ? 0.0 : errs[errs.size() / 2],
-                    worst, sample[at][0], sample[at][1], sample[at][2], ok ? "" : " (some runs failed)");
+        std::printf(
+            "  regularised eps %.0e v_ref:   %8.2f ms per configuration (median %.2f), error median %.1e, largest %.1e at "
+            "(%.4f, %.4f, %.3f)%s\n",
+            eps, 1e3 * t / sample.size(), rms[rms.size() / 2], errs.empty() ? 0.0 : errs[errs.size() / 2], worst, sample[at][0],
+            sample[at][1], sample[at][2], ok ? "" : " (some runs failed)");
         std::printf("                                 %.0fx the engine's time in all, %.0fx at the median\n", t / t_engine,
                     rms[rms.size() / 2] / ms[ms.size() / 2]);
         if (ok && worst <= 1e-6 && chosen_eps == 0) {
@@ -210,14 +224,15 @@ void against_regularised() {
         }
     }
     if (chosen_eps > 0)
-        std::printf("  at 1e-6 v_ref: the regularised method needs eps = %.0e v_ref and is %.1fx slower than the "
-                    "engine (largest engine error %.1e)\n",
-                    chosen_eps, chosen_time / t_engine, err_engine.back());
+        std::printf(
+            "  at 1e-6 v_ref: the regularised method needs eps = %.0e v_ref and is %.1fx slower than the "
+            "engine (largest engine error %.1e)\n",
+            chosen_eps, chosen_time / t_engine, err_engine.back());
     else
         std::printf("  no eps tried reaches 1e-6 v_ref on the whole sample\n");
 }
 
-}  // namespace
+}   // namespace
 
 int main() {
     std::printf("machine: %s\n", machine_description().c_str());

@@ -22,14 +22,13 @@ namespace {
 namespace odeint = boost::numeric::odeint;
 using Pair = std::array<double, 6>;
 
-}  // namespace
+}   // namespace
 
-ContractionCase contraction_case(const Scene& sc, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b, int periods,
-                                 double rtol) {
+ContractionCase contraction_case(const Scene& sc, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b, int periods, double rtol) {
     ContractionCase out;
     const double v = sc.v_ref(), rho = sc.part.rho(), T = sc.plate.T;
-    const Vec3 scale(v, v, v / rho);     // state scaling: errors relative to the slip-speed scale
-    const Vec3 S(1, 1, rho);             // the Appendix's scaled twist: (v_x, v_y, rho omega)
+    const Vec3 scale(v, v, v / rho);   // state scaling: errors relative to the slip-speed scale
+    const Vec3 S(1, 1, rho);           // the Appendix's scaled twist: (v_x, v_y, rho omega)
     Workspace wa, wb;
     auto sys = [&](const Pair& y, Pair& dy, double t) {
         const PlateState ps = plate_state(sc.plate, t, Dynamics::ReducedU);
@@ -51,8 +50,8 @@ ContractionCase contraction_case(const Scene& sc, const Vec3& q0, const Vec3& xi
         return 0.5 * s;
     };
     auto ctrl = odeint::make_controlled<odeint::runge_kutta_dopri5<Pair>>(rtol, rtol);
-    Pair y{xi_a[0] / scale[0], xi_a[1] / scale[1], xi_a[2] / scale[2], xi_b[0] / scale[0], xi_b[1] / scale[1],
-           xi_b[2] / scale[2]};
+    Pair y{xi_a[0] / scale[0], xi_a[1] / scale[1], xi_a[2] / scale[2],
+           xi_b[0] / scale[0], xi_b[1] / scale[1], xi_b[2] / scale[2]};
     Pair dydt, y1, dydt1;
     double t = 0, dt = 1e-4 * T;
     sys(y, dydt, t);
@@ -227,11 +226,11 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
         std::ostringstream o;
         o.precision(3);
         if (!(es <= kTieTolerance))
-            o << "statics: the normal forces differ from an independent solve of the part's statics by " << es
-              << " m g (seed " << seed << ", sample " << k << ")";
+            o << "statics: the normal forces differ from an independent solve of the part's statics by " << es << " m g (seed "
+              << seed << ", sample " << k << ")";
         else if (!(ew <= kTieTolerance))
-            o << "wrench: m q'' + b~ differs from the limit-surface wrench (39) of the relative twist by " << ew
-              << " m g (seed " << seed << ", sample " << k << ")";
+            o << "wrench: m q'' + b~ differs from the limit-surface wrench (39) of the relative twist by " << ew << " m g (seed "
+              << seed << ", sample " << k << ")";
         t.failure = o.str();
     }
     return t;
@@ -467,4 +466,4 @@ std::vector<CollinearScene> collinear_scenes(const std::vector<double>& ratios) 
     return out;
 }
 
-}  // namespace plate::proofs
+}   // namespace plate::proofs

@@ -56,53 +56,53 @@ DynamicsTie check_dynamics_tie(const Scene& scene, const Vec3& q0, int samples, 
 struct ContractionOptions {
     int cases = 100;
     std::uint64_t seed = 1;
-    bool thin = true;          // thin parts (Theorem 1) or thick ones (beyond it)
-    int periods = 400;         // at most; each case stops when V has fallen by 1e12 (converged)
+    bool thin = true;    // thin parts (Theorem 1) or thick ones (beyond it)
+    int periods = 400;   // at most; each case stops when V has fallen by 1e12 (converged)
     double rtol = 1e-10;
-    int starts = 4;            // Observation 1: further initial twists whose cycles must coincide
-    int threads = 0;           // 0: all cores
+    int starts = 4;    // Observation 1: further initial twists whose cycles must coincide
+    int threads = 0;   // 0: all cores
     // Plate motions and parts come from random_scene; override for deliberately broken cases.
     std::function<void(Scene&)> modify;
     // The dynamics the tie checks (above) hold against the paper; empty: production_dynamics().
     DynamicsUnderTest dynamics;
-    int tie_samples = 10;      // per case
+    int tie_samples = 10;                                // per case
     std::function<void(int done, int total)> progress;   // called from workers, serialised
 };
 
 struct ContractionCase {
     std::uint64_t seed = 0;
-    bool valid = false;             // stayed in the model (contact, sliding)
+    bool valid = false;   // stayed in the model (contact, sliding)
     std::string why_invalid;
     double V0 = 0, V_end = 0;
-    double worst_increase = 0;      // largest rise of V / its error bound (<= 1 passes)
-    double rate = 0;                // |xi_rel| contraction per period (geometric mean)
-    double spectral_radius = 0;     // of the period map's Jacobian at the cycle (Floquet multipliers)
+    double worst_increase = 0;                  // largest rise of V / its error bound (<= 1 passes)
+    double rate = 0;                            // |xi_rel| contraction per period (geometric mean)
+    double spectral_radius = 0;                 // of the period map's Jacobian at the cycle (Floquet multipliers)
     bool monotone = false, converged = false;   // V never rose beyond error; V fell by 1e12
-    bool unique = false;            // all `starts` initial twists reached the same cycle
-    double cycle_spread = 0;        // largest distance between their cycle starts / v_ref
-    int starts_left_model = 0;      // further starts whose transient stuck or lost contact (replaced)
-    std::vector<double> V_periods;  // V at each period boundary
-    DynamicsTie tie;                // thin parts: the dynamics tied to statics and the limit surface
+    bool unique = false;                        // all `starts` initial twists reached the same cycle
+    double cycle_spread = 0;                    // largest distance between their cycle starts / v_ref
+    int starts_left_model = 0;                  // further starts whose transient stuck or lost contact (replaced)
+    std::vector<double> V_periods;              // V at each period boundary
+    DynamicsTie tie;                            // thin parts: the dynamics tied to statics and the limit surface
 };
 
 struct ContractionSummary {
     int cases = 0, valid = 0, monotone = 0, converged = 0, floquet_below_one = 0, unique = 0;
     double seconds = 0;
-    double worst_increase = 0;      // over all valid cases
+    double worst_increase = 0;   // over all valid cases
     std::uint64_t worst_seed = 0;
     double median_rate = 0, max_rate = 0, max_spectral_radius = 0;
     std::vector<ContractionCase> details;
     std::vector<std::uint64_t> counterexamples;   // valid cases failing any of the checks
-    DynamicsTie tie;                // over all cases (thin parts only; none for thick ones)
-    bool tie_required = true;       // thin parts: the tie must have been checked and passed
+    DynamicsTie tie;                              // over all cases (thin parts only; none for thick ones)
+    bool tie_required = true;                     // thin parts: the tie must have been checked and passed
     bool passed() const {
         return valid > 0 && monotone == valid && converged == valid && floquet_below_one == valid && unique == valid &&
                (!tie_required || tie.passed());
     }
 };
 
-ContractionCase contraction_case(const Scene& scene, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b,
-                                 int periods, double rtol);
+ContractionCase contraction_case(const Scene& scene, const Vec3& q0, const Vec3& xi_a, const Vec3& xi_b, int periods,
+                                 double rtol);
 ContractionSummary check_contraction(const ContractionOptions& opt);
 // check_contraction in pieces, for cases computed elsewhere (MPI ranks: plate proofs): case k of the
 // campaign (seed opt.seed + k; opt.threads and opt.progress unused), and the summary of cases 0..n-1
@@ -133,8 +133,8 @@ using WrenchMap = std::function<Vec3(const Vec3& xi)>;   // scaled twist -> (F_x
 // -xi_i . w_j <= h_s(-xi_i) / cos(pi / angles) for all pairs.
 struct FrictionSet {
     std::array<Vec2, 3> r = zeros<Vec2>();   // contacts from the centre of mass, plate frame [m]
-    Vec3 cap = Vec3::Zero();   // mu_i N_i [N]
-    double rho = 1;            // radius of gyration [m]
+    Vec3 cap = Vec3::Zero();                 // mu_i N_i [N]
+    double rho = 1;                          // radius of gyration [m]
     double support_sampled(const Vec3& d, int angles) const;
 };
 // The thin part of `scene` at q0 and plate time t (U-dynamics, normal forces by statics).
@@ -143,28 +143,28 @@ FrictionSet thin_friction_set(const Scene& scene, const Vec3& q0, double t);
 struct LimitSurfaceResult {
     int directions = 0;
     long pairs = 0;
-    double max_work_violation = 0;     // max (xi_i.w_i - xi_i.w_j) / (sum mu N), <= 1e-12 passes
-    double monotonicity_violation = 0; // max (xi_i - xi_j).(w_i - w_j) / (sum mu N)
-    double min_separation = 0;         // min |w_i - w_j| / (sum mu N) over well-separated pairs
-    double min_strict_margin = 0;      // min (xi_i.w_j - xi_i.w_i) / (sum mu N) over them: > 0, no flat faces
+    double max_work_violation = 0;       // max (xi_i.w_i - xi_i.w_j) / (sum mu N), <= 1e-12 passes
+    double monotonicity_violation = 0;   // max (xi_i - xi_j).(w_i - w_j) / (sum mu N)
+    double min_separation = 0;           // min |w_i - w_j| / (sum mu N) over well-separated pairs
+    double min_strict_margin = 0;        // min (xi_i.w_j - xi_i.w_i) / (sum mu N) over them: > 0, no flat faces
     // Against the independent friction set (when given): both <= 1e-12 pass.
     bool set_checked = false;
-    double support_violation = 0;      // max (h_s(-xi) - (-xi . w(xi))) / (sum mu N): not the support point
-    double outside_violation = 0;      // max (-xi_i . w_j - h_s(-xi_i)/cos(pi/K)) / (sum mu N): outside the set
+    double support_violation = 0;   // max (h_s(-xi) - (-xi . w(xi))) / (sum mu N): not the support point
+    double outside_violation = 0;   // max (-xi_i . w_j - h_s(-xi_i)/cos(pi/K)) / (sum mu N): outside the set
     bool convex_and_normal() const { return max_work_violation <= 1e-12 && monotonicity_violation <= 1e-12; }
     bool strictly_convex() const { return min_strict_margin > 0 && min_separation > 0; }
     bool on_friction_set() const { return set_checked && support_violation <= 1e-12 && outside_violation <= 1e-12; }
 };
 
-LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int directions = 600,
-                                       double separation = 0.2, const FrictionSet* set = nullptr);
+LimitSurfaceResult check_limit_surface(const WrenchMap& w, double scale, int directions = 600, double separation = 0.2,
+                                       const FrictionSet* set = nullptr);
 // Limit surfaces of `parts` random thin parts (seeded), each at a random configuration and plate
 // time, 300 directions each.
 struct LimitSurfaceCampaign {
     int parts = 0, convex = 0, strict = 0, on_set = 0;
     double worst_max_work = 0, worst_monotonicity = 0, min_separation = 0, min_strict_margin = 0;
     double worst_support = 0, worst_outside = 0;   // against the independent friction set
-    DynamicsTie tie;                // each part's dynamics tied to its surface (10 states each)
+    DynamicsTie tie;                               // each part's dynamics tied to its surface (10 states each)
     bool passed() const { return parts > 0 && convex == parts && strict == parts && on_set == parts && tie.passed(); }
 };
 LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const DynamicsUnderTest& dynamics = {});
@@ -191,4 +191,4 @@ struct CollinearScene {
 };
 std::vector<CollinearScene> collinear_scenes(const std::vector<double>& ratios);
 
-}  // namespace plate::proofs
+}   // namespace plate::proofs

@@ -49,48 +49,58 @@ void write_report(const ReportOptions& opt) {
     const fs::path kdir = "/usr/share/javascript/katex";
     if (fs::exists(kdir / "katex.min.js")) {
         fs::copy(kdir, c.dir / "katex", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
-        katex = "<link rel=\"stylesheet\" href=\"katex/katex.min.css\"><script src=\"katex/katex.min.js\"></script>"
-                "<script src=\"katex/contrib/auto-render.js\"></script><script>document.addEventListener('DOMContentLoaded',"
-                "function(){renderMathInElement(document.body,{delimiters:[{left:'$$',right:'$$',display:true}],throwOnError:false});});</script>\n";
+        katex =
+            "<link rel=\"stylesheet\" href=\"katex/katex.min.css\"><script src=\"katex/katex.min.js\"></script>"
+            "<script src=\"katex/contrib/auto-render.js\"></script><script>document.addEventListener('DOMContentLoaded',"
+            "function(){renderMathInElement(document.body,{delimiters:[{left:'$$',right:'$$',display:true}],throwOnError:false});"
+            "});</script>\n";
     }
     std::ostringstream html;
-    html << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: verification report</title>\n" << kErrorTrap << kStyle << katex
+    html << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: verification report</title>\n"
+         << kErrorTrap << kStyle << katex
          << "</head><body>\n<h1>Sliding manipulation on a 6-DoF plate: verification report</h1>\n";
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
-         << "; machine: " << esc(machine_description()) << "; total "
-         << fmt(total, 4) << " s." << (left_out.empty() ? "" : " Sections left out of this run (--sections): " + esc(left_out) + ".")
+         << "; machine: " << esc(machine_description()) << "; total " << fmt(total, 4) << " s."
+         << (left_out.empty() ? "" : " Sections left out of this run (--sections): " + esc(left_out) + ".")
          << "</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
     html << "</table>\n" << c.html.str();
     // The speed-accuracy study (plate bench) keeps its section between the markers.
     html << kSpeedBegin;
     const fs::path speed = c.dir / "data" / "speed_section.html";
-    if (fs::exists(speed)) html << std::ifstream(speed).rdbuf();
-    else html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
-              << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
+    if (fs::exists(speed))
+        html << std::ifstream(speed).rdbuf();
+    else
+        html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
+             << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
     html << kSpeedEnd << "\n";
     // The peer engines' study (bench/peers/study.py) keeps its section between these.
     html << kPeersBegin;
     const fs::path peers = c.dir / "data" / "peers_section.html";
-    if (fs::exists(peers)) html << std::ifstream(peers).rdbuf();
-    else html << "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet: <code>bench/peers/study.py --out " << esc(opt.out)
-              << "</code> writes this section (the same questions to the engines found at build time and to plate, "
-                 "error against CPU time).</p>\n";
+    if (fs::exists(peers))
+        html << std::ifstream(peers).rdbuf();
+    else
+        html << "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet: <code>bench/peers/study.py --out "
+             << esc(opt.out)
+             << "</code> writes this section (the same questions to the engines found at build time and to plate, "
+                "error against CPU time).</p>\n";
     html << kPeersEnd << "\n";
     // The campaigns' scaling study (bench/scaling.py) keeps its section between these.
     html << kCampaignsBegin;
     const fs::path campaigns = c.dir / "data" / "campaigns_section.html";
-    if (fs::exists(campaigns)) html << std::ifstream(campaigns).rdbuf();
-    else html << "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " << esc(opt.out)
-              << "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
-                 "load balance, the cost of a 1 000-core campaign).</p>\n";
+    if (fs::exists(campaigns))
+        html << std::ifstream(campaigns).rdbuf();
+    else
+        html << "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " << esc(opt.out)
+             << "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
+                "load balance, the cost of a 1 000-core campaign).</p>\n";
     html << kCampaignsEnd << "\n" << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
 }
 
 const std::vector<std::string>& report_section_names() {
     static const std::vector<std::string> names = {"derivation", "kernels", "proofs", "fig3",
-                                                   "fields", "design", "orient", "fixed-point"};
+                                                   "fields",     "design",  "orient", "fixed-point"};
     return names;
 }
 
@@ -133,8 +143,8 @@ std::string scene_heading(const std::string& title, const std::string& scene_nam
 std::string observation1_sentence(int valid, int converged, int unique, int attracting) {
     if (valid <= 0) return "No thick case stayed in the model, so this campaign says nothing on Observation 1.";
     if (converged == valid && unique == valid && attracting == valid)
-        return "In this campaign every cycle found was unique and attracting (Observation 1), in all " +
-               std::to_string(valid) + " cases.";
+        return "In this campaign every cycle found was unique and attracting (Observation 1), in all " + std::to_string(valid) +
+               " cases.";
     std::string s = "Observation 1 does not hold in this campaign for every case: of " + std::to_string(valid) + " cases, ";
     std::string parts;
     auto add = [&](int bad, const char* what) {
@@ -148,4 +158,4 @@ std::string observation1_sentence(int valid, int converged, int unique, int attr
     return s + parts + ".";
 }
 
-}  // namespace plate::report
+}   // namespace plate::report

@@ -10,10 +10,10 @@
 namespace plate::report {
 
 struct ReportOptions {
-    std::string out;                 // folder (created)
-    std::string source_dir;          // project root: scenes/ and reports/generated/
+    std::string out;          // folder (created)
+    std::string source_dir;   // project root: scenes/ and reports/generated/
     std::uint64_t seed = 1;
-    bool quick = false;              // small campaigns and grids (tests); the main job runs the full one
+    bool quick = false;   // small campaigns and grids (tests); the main job runs the full one
     int threads = 0;
     // The sections to compute (names from report_section_names()); empty: all of them. The page names
     // the ones left out.
@@ -55,4 +55,4 @@ struct SpeedOptions {
 };
 void write_speed_study(const SpeedOptions& opt);
 
-}  // namespace plate::report
+}   // namespace plate::report

@@ -32,12 +32,18 @@ inline std::string fmt(double x, int p = 4) {
 inline std::string esc(const std::string& s) {
     std::string o;
     for (char c : s) {
-        if (c == '<') o += "&lt;";
-        else if (c == '>') o += "&gt;";
-        else if (c == '&') o += "&amp;";
-        else if (c == '"') o += "&quot;";
-        else if (c == '\'') o += "&#39;";
-        else o += c;
+        if (c == '<')
+            o += "&lt;";
+        else if (c == '>')
+            o += "&gt;";
+        else if (c == '&')
+            o += "&amp;";
+        else if (c == '"')
+            o += "&quot;";
+        else if (c == '\'')
+            o += "&#39;";
+        else
+            o += c;
     }
     return o;
 }
@@ -85,7 +91,8 @@ struct Ctx {
               const std::string& size = "640,480") {
         const fs::path gp = dir / "data" / (name + ".gp");
         std::ofstream(gp) << "set terminal svg size " << size << " fixed background rgb 'white' font 'sans,11'\n"
-                          << "set output '" << name << ".svg'\n" << script;
+                          << "set output '" << name << ".svg'\n"
+                          << script;
         if (!run_gnuplot(dir, "data/" + name + ".gp", dir / "data" / (name + ".log")) || !fs::exists(dir / (name + ".svg")))
             throw std::runtime_error("gnuplot failed on " + gp.string() + " (see data/" + name + ".log)");
         html << "<figure><img src=\"" << name << ".svg\" alt=\"" << esc(caption) << "\"><figcaption>" << caption
@@ -136,9 +143,11 @@ inline const char* kPageCheck =
     "<div id=\"zoom\"><img alt=\"enlarged figure\"></div>\n<script>(function(){var z=document.getElementById('zoom');"
     "document.addEventListener('click',function(e){var t=e.target;if(t.closest&&t.closest('figure')&&t.tagName==='IMG'){"
     "z.firstChild.src=t.src;z.style.display='block';}else if(t===z||t.parentNode===z){z.style.display='none';}});})();\n"
-    "window.addEventListener('load',function(){setTimeout(function(){var b=document.body;var imgs=[].slice.call(document.querySelectorAll('figure img'));"
+    "window.addEventListener('load',function(){setTimeout(function(){var b=document.body;var "
+    "imgs=[].slice.call(document.querySelectorAll('figure img'));"
     "var bad=imgs.filter(function(i){return !(i.complete&&i.naturalWidth>0);});"
-    "b.setAttribute('data-images',bad.length?'missing:'+bad.map(function(i){return i.getAttribute('src');}).join(','):'ok:'+imgs.length);"
+    "b.setAttribute('data-images',bad.length?'missing:'+bad.map(function(i){return "
+    "i.getAttribute('src');}).join(','):'ok:'+imgs.length);"
     "var w=imgs.map(function(i){return i.getBoundingClientRect().width;});"
     "b.setAttribute('data-figure-width',w.length?Math.round(Math.min.apply(null,w)):0);"
     "var k=document.querySelectorAll('.katex').length,ke=document.querySelectorAll('.katex-error').length;"
@@ -146,4 +155,4 @@ inline const char* kPageCheck =
     "b.setAttribute('data-math',ke?'errors:'+ke:left?(window.katex?'untypeset $$ left':'KaTeX not loaded'):'ok:'+k);"
     "b.setAttribute('data-errors',window.__errors.length?window.__errors.join(' | '):'none');},1000);});</script>\n";
 
-}  // namespace plate::report::html
+}   // namespace plate::report::html

@@ -22,4 +22,4 @@ void section_design(html::Ctx& c, const std::filesystem::path& src, const Report
 void section_orient(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_fixed_point(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 
-}  // namespace plate::report
+}   // namespace plate::report

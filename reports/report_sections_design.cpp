@@ -22,8 +22,8 @@ using namespace html;
 // evaluations and cycles.
 std::string design_cells(const std::string& target, const DesignSummary& d) {
     return "<tr><td>" + target + "</td><td>" + verdict(d.verified) + (d.verified ? "" : " " + esc(d.failure)) + "</td><td>" +
-           (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) + "</td><td>" + std::to_string(d.evaluations) +
-           "</td><td>" + std::to_string(d.cycles) + "</td>";
+           (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) + "</td><td>" + std::to_string(d.evaluations) + "</td><td>" +
+           std::to_string(d.cycles) + "</td>";
 }
 
 // The cell of the part released at the target: how far it is after the hold, marked beyond `allowed`,
@@ -46,15 +46,16 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         o.local_evaluations = 120;
         o.verify_starts = 6;
     }
-    c.html << "<h2>Inverse design</h2>\n<p>Plate motions designed by <code>design()</code> (NLopt COBYLA from "
-           << o.starts << " seeded feasible starts, " << o.local_evaluations << " evaluations each) so that "
-           << esc(part.name) << "'s point part has its unique stable fixed point at the target, within amplitude limits of "
-           << fmt(o.lin_limit, 3) << " m/s² and " << fmt(o.ang_limit, 3) << " rad/s² per harmonic and keeping g + a<sub>z</sub> ≥ "
+    c.html << "<h2>Inverse design</h2>\n<p>Plate motions designed by <code>design()</code> (NLopt COBYLA from " << o.starts
+           << " seeded feasible starts, " << o.local_evaluations << " evaluations each) so that " << esc(part.name)
+           << "'s point part has its unique stable fixed point at the target, within amplitude limits of " << fmt(o.lin_limit, 3)
+           << " m/s² and " << fmt(o.ang_limit, 3) << " rad/s² per harmonic and keeping g + a<sub>z</sub> ≥ "
            << fmt(o.flight_margin, 3) << " g over the plate; each verified on a " << o.verify_grid << "×" << o.verify_grid
            << " grid (one stable fixed point within " << fmt(1e3 * o.fixed_point_tolerance, 3) << " mm) and by "
            << o.verify_starts << " full-dynamics runs from seeded random starts (ending within "
            << fmt(1e3 * o.verify_distance, 3) << " mm), and by a part released at rest at the target still within that "
-           << "distance after " << fmt(o.hold, 3) << " s of full dynamics (the last column). Odd harmonics (n = 1, 3) on x, "
+           << "distance after " << fmt(o.hold, 3)
+           << " s of full dynamics (the last column). Odd harmonics (n = 1, 3) on x, "
               "y, rx, ry make the field odd about the design's centre (a fixed point by construction); adding −α×D to the "
               "linear acceleration moves it onto the target exactly. Tilting in circles cones: the plate turns about z "
               "at a second-order rate the asymptotic field does not see, and the whole field, the sink with it, turns "
@@ -74,8 +75,8 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         t.at = at;
         const DesignSummary d = design(part, t, o);
         c.html << design_cells("sink (" + fmt(at.x(), 3) + ", " + fmt(at.y(), 3) + ")", d) << "<td>"
-               << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td><td>"
-               << fmt(d.coning, 3) << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop);
+               << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td><td>" << fmt(d.coning, 3)
+               << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop);
         if (k++ == 0) {   // the figures are the first target's
             first = d;
             first_at = at;
@@ -102,15 +103,18 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const Trajectory hold = simulate(d.scene, Dynamics::Full, Vec3(t.at.x(), t.at.y(), 0), Vec3::Zero(), o.hold, o.hold);
         const double walked = hold.samples.empty() ? std::numeric_limits<double>::quiet_NaN()
                                                    : std::abs((hold.samples.back().q.head<2>() - t.at).dot(nrm));
-        c.html << design_cells("line sink through (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ") along " +
-                                   fmt(t.theta, 3) + " rad", d)
-               << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << " (from the line)</td><td>" << fmt(d.seconds, 3)
-               << "</td><td>" << fmt(coning_rate(d.scene.plate), 3) << "</td>"
+        c.html << design_cells(
+                      "line sink through (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ") along " + fmt(t.theta, 3) + " rad",
+                      d)
+               << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << " (from the line)</td><td>" << fmt(d.seconds, 3) << "</td><td>"
+               << fmt(coning_rate(d.scene.plate), 3) << "</td>"
                << held_cell(walked, o.verify_distance, " (from the line)",
                             hold.stop.reason != StopReason::None ? hold.stop.describe() : "");
     }
     c.html << "</table>\n<p>For the sinks the last column is the verification's hold; the line sink's (y and rx "
-              "only: no coning) is measured here, released on the line for " << fmt(o.hold, 3) << " s. A distance "
+              "only: no coning) is measured here, released on the line for "
+           << fmt(o.hold, 3)
+           << " s. A distance "
               "beyond the verification's is marked.</p>\n";
     {
         const DesignSummary& d = first;
@@ -134,31 +138,42 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         {
             auto o3 = c.data(n + "_field.dat");
             const double scale = 0.004 / std::max(1e-12, [&] {
-                double m = 0;
-                for (const auto& p : f.points) m = std::max(m, p.twist.head<2>().norm());
-                return m;
-            }());
+                                     double m = 0;
+                                     for (const auto& p : f.points) m = std::max(m, p.twist.head<2>().norm());
+                                     return m;
+                                 }());
             for (const auto& p : f.points)
                 o3 << p.q[0] << ' ' << p.q[1] << ' ' << scale * p.twist[0] << ' ' << scale * p.twist[1] << '\n';
             auto o4 = c.data(n + "_runs.dat");
             for (const DesignStartRun& r : d.runs) {
-                const Trajectory tr = simulate(d.scene, Dynamics::Full, Vec3(r.x, r.y, 0), Vec3::Zero(), r.seconds, r.seconds / 200);
+                const Trajectory tr =
+                    simulate(d.scene, Dynamics::Full, Vec3(r.x, r.y, 0), Vec3::Zero(), r.seconds, r.seconds / 200);
                 for (const Sample& smp : tr.samples) o4 << smp.q[0] << ' ' << smp.q[1] << '\n';
                 o4 << "\n\n";
             }
             c.data(n + "_target.dat") << at.x() << ' ' << at.y() << '\n';
         }
-        c.plot(n + "_signal", "set xlabel 't [s]'\nset ylabel 'm/s²'\nset y2label 'rad/s²'\nset ytics nomirror\nset y2tics\n"
-               "set key outside right\nplot for [i=2:4] 'data/" + n + "_signal.dat' u 1:i w l lw 2 t word('x y z', i-1), "
-               "for [i=5:7] 'data/" + n + "_signal.dat' u 1:i axes x1y2 w l dt 2 lw 2 t word('rx ry rz', i-4)\n",
-               "The designed signal over one period: the plate's linear (solid) and angular (dashed) acceleration.",
-               "800,420");
-        c.plot(n + "_field", "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nset key outside right\n"
-               "plot 'data/" + n + "_field.dat' u 1:2:3:4 w vec head size 0.002,20 lc rgb '#777777' t 'field', "
-               "'data/" + n + "_runs.dat' u 1:2 w l lc rgb '#3050c0' t 'full dynamics, random starts', "
-               "'data/" + n + "_target.dat' u 1:2 w p pt 7 ps 2 lc rgb '#c02020' t 'target'\n",
+        c.plot(n + "_signal",
+               "set xlabel 't [s]'\nset ylabel 'm/s²'\nset y2label 'rad/s²'\nset ytics nomirror\nset y2tics\n"
+               "set key outside right\nplot for [i=2:4] 'data/" +
+                   n +
+                   "_signal.dat' u 1:i w l lw 2 t word('x y z', i-1), "
+                   "for [i=5:7] 'data/" +
+                   n + "_signal.dat' u 1:i axes x1y2 w l dt 2 lw 2 t word('rx ry rz', i-4)\n",
+               "The designed signal over one period: the plate's linear (solid) and angular (dashed) acceleration.", "800,420");
+        c.plot(n + "_field",
+               "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nset key outside right\n"
+               "plot 'data/" +
+                   n +
+                   "_field.dat' u 1:2:3:4 w vec head size 0.002,20 lc rgb '#777777' t 'field', "
+                   "'data/" +
+                   n +
+                   "_runs.dat' u 1:2 w l lc rgb '#3050c0' t 'full dynamics, random starts', "
+                   "'data/" +
+                   n + "_target.dat' u 1:2 w p pt 7 ps 2 lc rgb '#c02020' t 'target'\n",
                "The designed velocity field (arrows, scaled) and the full-dynamics runs of the verification converging "
-               "on the target.", "800,640");
+               "on the target.",
+               "800,640");
     }
 }
 
@@ -193,14 +208,13 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
               "(full dynamics = U-dynamics: no tilt, no coning); with one friction coefficient on every contact it "
               "cannot turn the part at all (friction's torque −(Σ μ<sub>i</sub>N<sub>i</sub>r<sub>i</sub>)×u "
               "vanishes when the normal forces balance friction's moment), with unequal ones it is a weathervane. "
-              "Designed on a ring of 12 orientations (" << d.starts << " starts, " << o.local_evaluations
-           << " evaluations each), turned onto θ, verified on a ring of " << d.ring_theta.size()
-           << " orientations and by " << d.runs.size() << " full-dynamics runs from random starts.</p>\n"
+              "Designed on a ring of 12 orientations ("
+           << d.starts << " starts, " << o.local_evaluations << " evaluations each), turned onto θ, verified on a ring of "
+           << d.ring_theta.size() << " orientations and by " << d.runs.size() << " full-dynamics runs from random starts.</p>\n"
            << "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
               "<th>cycles</th><th>worst end angle [rad]</th><th>travel at θ [m/s]</th><th>seconds</th></tr>\n"
-           << design_cells("orient " + fmt(t.theta, 3), d) << "<td>"
-           << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3) << "</td><td>" << fmt(d.transport_mean.norm(), 3)
-           << "</td><td>" << fmt(d.seconds, 3) << "</td></tr>\n</table>\n";
+           << design_cells("orient " + fmt(t.theta, 3), d) << "<td>" << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3)
+           << "</td><td>" << fmt(d.transport_mean.norm(), 3) << "</td><td>" << fmt(d.seconds, 3) << "</td></tr>\n</table>\n";
     if (d.ring_theta.empty()) return;
     {
         auto r = c.data("design_orient_ring.dat");
@@ -213,7 +227,8 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         for (const DesignStartRun& s : d.runs) {
             IntegrationOptions io;
             io.rtol = 1e-7;   // (the verification's)
-            const Trajectory tr = simulate(d.scene, Dynamics::Full, Vec3(s.x, s.y, s.theta), Vec3::Zero(), s.seconds, s.seconds / 200, io);
+            const Trajectory tr =
+                simulate(d.scene, Dynamics::Full, Vec3(s.x, s.y, s.theta), Vec3::Zero(), s.seconds, s.seconds / 200, io);
             double prev = 0, unwrapped = 0;
             for (std::size_t k = 0; k < tr.samples.size(); ++k) {
                 const double th = tr.samples[k].q[2];
@@ -228,18 +243,24 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     int stable_zeros = 0;
     for (std::size_t k = 0; k < d.ring_twist.size(); ++k)
         stable_zeros += d.ring_twist[k][2] > 0 && d.ring_twist[(k + 1) % d.ring_twist.size()][2] <= 0;
-    c.plot("design_orient_ring", "set xlabel 'θ [rad]'\nset ylabel 'θ′ [rad/s]'\nset xrange [0:2*pi]\nset key outside right\n"
-           "plot 'data/design_orient_ring.dat' u 1:2 w lp pt 7 ps 0.5 lw 2 t 'designed: θ′ at the centre', 0 w l lc rgb '#999999' notitle, "
+    c.plot("design_orient_ring",
+           "set xlabel 'θ [rad]'\nset ylabel 'θ′ [rad/s]'\nset xrange [0:2*pi]\nset key outside right\n"
+           "plot 'data/design_orient_ring.dat' u 1:2 w lp pt 7 ps 0.5 lw 2 t 'designed: θ′ at the centre', 0 w l lc rgb "
+           "'#999999' notitle, "
            "'data/design_orient_target.dat' u 1:2 w p pt 7 ps 2 lc rgb '#c02020' t 'target θ'\n",
            "The designed plate motion's turning rate over a full turn of the part, at the centre (the same at every "
-           "position of the 7³ grid, to " + fmt(d.transport_spread, 2) + " of v_ref): " + std::to_string(stable_zeros) +
-           " stable zero(s) (θ′ falling through zero), the one found at θ = " + fmt(d.fixed_point[2], 4) + " rad.", "800,420");
+           "position of the 7³ grid, to " +
+               fmt(d.transport_spread, 2) + " of v_ref): " + std::to_string(stable_zeros) +
+               " stable zero(s) (θ′ falling through zero), the one found at θ = " + fmt(d.fixed_point[2], 4) + " rad.",
+           "800,420");
     int reached = 0;
     for (const DesignStartRun& s : d.runs) reached += s.stop.empty() && s.end_distance <= o.verify_distance;
-    c.plot("design_orient_runs", "set xlabel 't [s]'\nset ylabel 'θ − target [rad]'\nset yrange [-pi:pi]\nset key off\n"
+    c.plot("design_orient_runs",
+           "set xlabel 't [s]'\nset ylabel 'θ − target [rad]'\nset yrange [-pi:pi]\nset key off\n"
            "plot 'data/design_orient_runs.dat' u 1:2 w l lw 1.5\n",
            "The verification's full-dynamics runs from random starts (rtol 1e-7): " + std::to_string(reached) + " of " +
-           std::to_string(d.runs.size()) + " end within 0.05 rad of the target.", "800,420");
+               std::to_string(d.runs.size()) + " end within 0.05 rad of the target.",
+           "800,420");
 }
 
 // A rigid part's fixed point (design.cpp): fig4's part at (0.02, -0.01, 0.5). The design starts from a
@@ -254,9 +275,9 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
     t.at = Vec2(0.02, -0.01);
     t.theta = 0.5;
     const DesignSummary d = design(part, t, o);
-    c.html << "<h3>Fixing a rigid part: position and orientation</h3>\n<p>" << esc(part.name)
-           << "'s part, target (x, y, θ) = (" << fmt(t.at.x(), 3) << ", " << fmt(t.at.y(), 3) << ", " << fmt(t.theta, 3)
-           << "), default limits, " << d.starts << " starts in all, " << o.local_evaluations
+    c.html << "<h3>Fixing a rigid part: position and orientation</h3>\n<p>" << esc(part.name) << "'s part, target (x, y, θ) = ("
+           << fmt(t.at.x(), 3) << ", " << fmt(t.at.y(), 3) << ", " << fmt(t.theta, 3) << "), default limits, " << d.starts
+           << " starts in all, " << o.local_evaluations
            << " evaluations each. What the design reports about how it got there:</p>\n<ul>\n";
     for (const std::string& n : d.notes) c.html << "<li>" << esc(n) << "</li>\n";
     c.html << "</ul>\n<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
@@ -265,10 +286,10 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
            << design_cells("fixed point (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ", " + fmt(t.theta, 3) + ")", d)
            << "<td>" << fmt(d.basin_share, 3) << "</td><td>";
     for (const DesignSummary::Competitor& k : d.competitors)
-        c.html << "(" << fmt(k.point.q[0], 4) << ", " << fmt(k.point.q[1], 4) << ", " << fmt(k.point.q[2], 4) << "): "
-               << fmt(k.basin_share, 3) << "<br>";
-    c.html << "</td><td>" << fmt(d.seconds, 3) << "</td>"
-           << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop) << "</table>\n";
+        c.html << "(" << fmt(k.point.q[0], 4) << ", " << fmt(k.point.q[1], 4) << ", " << fmt(k.point.q[2], 4)
+               << "): " << fmt(k.basin_share, 3) << "<br>";
+    c.html << "</td><td>" << fmt(d.seconds, 3) << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop)
+           << "</table>\n";
     if (d.runs.empty()) return;
     {
         auto runs = c.data("design_fixed_point_runs.dat");
@@ -312,9 +333,9 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
            "set ytics nomirror\nset y2tics\nset yrange [-pi/2:3*pi/2]\nset key outside right\n"
            "plot 'data/design_fixed_point_runs.dat' u 1:3 w l lw 1.5 lc rgb '#3050c0' t 'θ − target', "
            "'' u 1:2 axes x1y2 w l lw 1 lc rgb '#c08020' t 'distance'\n",
-           "The verification's full-dynamics runs from random (x, y, θ) (rtol 1e-7; angles shown from −π/2 to 3π/2): " +
-               where + (d.verified ? "." : "; the design failed verification: " + d.failure + "."),
+           "The verification's full-dynamics runs from random (x, y, θ) (rtol 1e-7; angles shown from −π/2 to 3π/2): " + where +
+               (d.verified ? "." : "; the design failed verification: " + d.failure + "."),
            "800,420");
 }
 
-}  // namespace plate::report
+}   // namespace plate::report

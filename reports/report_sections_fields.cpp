@@ -24,12 +24,13 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
     const Scene sc = load_scene((src / "scenes/fig6.json").string());
     const double v = sc.v_ref();
     const Vec3 S(v, v, v / sc.part.rho());
-    c.html << "<h3>Stick-slip against the regularised-friction limit</h3>\n<p>The engine holds a contact (or the "
-              "part) as long as <i>some</i> static friction inside the disks can (rigid Coulomb friction: the distribution "
-              "is indeterminate). The reference replaces Coulomb's law by f = −μN v/√(|v|²+ε²) (no stick, no events; GSL "
-              "bsimp), ε = 10<sup>-5</sup>…10<sup>-8</sup> v<sub>ref</sub>, extrapolated to ε = 0 with the observed order. "
-              "Differences relative to v<sub>ref</sub>:</p>\n<table><tr><th>configuration (fig6)</th><th>cycle</th>"
-              "<th>engine</th><th>regularised limit</th><th>observed order</th><th>difference</th><th>reference's error</th></tr>\n";
+    c.html
+        << "<h3>Stick-slip against the regularised-friction limit</h3>\n<p>The engine holds a contact (or the "
+           "part) as long as <i>some</i> static friction inside the disks can (rigid Coulomb friction: the distribution "
+           "is indeterminate). The reference replaces Coulomb's law by f = −μN v/√(|v|²+ε²) (no stick, no events; GSL "
+           "bsimp), ε = 10<sup>-5</sup>…10<sup>-8</sup> v<sub>ref</sub>, extrapolated to ε = 0 with the observed order. "
+           "Differences relative to v<sub>ref</sub>:</p>\n<table><tr><th>configuration (fig6)</th><th>cycle</th>"
+           "<th>engine</th><th>regularised limit</th><th>observed order</th><th>difference</th><th>reference's error</th></tr>\n";
     Vec3 qs[] = {Vec3(0.0333333333333, 0.0166666666667, 1.7951958020513104), Vec3(0.0166666666667, 0, 2.6927937030769655)};
     int stuck_differ = 0, agree = 0;   // cycles stuck as a whole beyond the reference's error; cycles within it
     for (const Vec3& q : qs) {
@@ -38,14 +39,16 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
         o.tol = 1e-9;
         const LimitCycleSummary lc = limit_cycle(sc, q, o);
         const RegularisedReference r = regularised_reference(sc, q);
-        const bool stuck = lc.start_mode.kind == ModeKind::Stuck ||
-                           std::any_of(lc.mode_events.begin(), lc.mode_events.end(),
-                                       [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
+        const bool stuck =
+            lc.start_mode.kind == ModeKind::Stuck || std::any_of(lc.mode_events.begin(), lc.mode_events.end(),
+                                                                 [](const ModeEvent& e) { return e.to.kind == ModeKind::Stuck; });
         const double held = *std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end());
         c.html << "<tr><td>(" << fmt(q[0], 3) << ", " << fmt(q[1], 3) << ", " << fmt(q[2], 3) << ")</td><td>"
-               << (stuck ? "stuck as a whole " : held > 0 ? "a contact held " : "sliding ") << fmt(100 * held, 3)
-               << "% of the period</td><td>" << fmt(lc.twist[0] / S[0], 7) << ", " << fmt(lc.twist[1] / S[1], 7) << ", "
-               << fmt(lc.twist[2] / S[2], 7) << "</td><td>"
+               << (stuck      ? "stuck as a whole "
+                   : held > 0 ? "a contact held "
+                              : "sliding ")
+               << fmt(100 * held, 3) << "% of the period</td><td>" << fmt(lc.twist[0] / S[0], 7) << ", "
+               << fmt(lc.twist[1] / S[1], 7) << ", " << fmt(lc.twist[2] / S[2], 7) << "</td><td>"
                << (r.ok ? fmt(r.twist[0] / S[0], 7) + ", " + fmt(r.twist[1] / S[1], 7) + ", " + fmt(r.twist[2] / S[2], 7)
                         : esc(r.failure))
                << "</td><td>" << fmt(r.order, 3) << "</td><td>"
@@ -94,7 +97,8 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
            << "configuration within 3 cm of the centre each; <code>sticking_random_scene</code>), the engine at its default "
            << "options (rtol " << fmt(LimitCycleOptions{}.integration.rtol, 1) << ", cycles to " << fmt(tol, 1)
            << " v<sub>ref</sub>): " << converged << " cycles found";
-    if (flew > 0) c.html << ", " << flew << " left the model (a contact's normal force reached zero: the part would fly; said so)";
+    if (flew > 0)
+        c.html << ", " << flew << " left the model (a contact's normal force reached zero: the part would fly; said so)";
     c.html << "; " << held << " of them hold a contact for part of the period or longer, " << stuck << " all period. ";
     if (!diffs.empty())
         c.html << "The reference found a cycle on " << diffs.size() << " (its own error estimate: median "
@@ -107,7 +111,7 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
     c.html << ".</p>\n";
 }
 
-}  // namespace
+}   // namespace
 
 void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     c.html << "<h2>6. The paper's fields</h2>\n";
@@ -128,7 +132,10 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const Scene sc = load_scene((src / "scenes" / (std::string(f.scene) + ".json")).string());
         GridSpec g;
         if (opt.quick) g.nx = g.ny = g.nth = 4;
-        if (std::string(f.scene) == "fig5") { g.x0 = -0.03; g.x1 = 0.03; }
+        if (std::string(f.scene) == "fig5") {
+            g.x0 = -0.03;
+            g.x1 = 0.03;
+        }
         Field field;
         FixedPoints fp;
         Trajectory tr;
@@ -147,14 +154,15 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             const double dx = std::max(g.dx(), 1e-9), dy = std::max(g.dy(), 1e-9), dth = g.dth();
             for (const auto& p : field.points)
                 if (p.converged)
-                    lmax = std::max({lmax, std::abs(p.twist[0]) / dx, std::abs(p.twist[1]) / dy, pt ? 0.0 : std::abs(p.twist[2]) / dth});
+                    lmax = std::max(
+                        {lmax, std::abs(p.twist[0]) / dx, std::abs(p.twist[1]) / dy, pt ? 0.0 : std::abs(p.twist[2]) / dth});
             const double k = lmax > 0 ? 0.8 / lmax : 0;
             auto o = c.data(n + "_field.dat");
             for (const auto& p : field.points) {
                 if (!p.converged) continue;
                 o << p.q[0] << ' ' << p.q[1] << ' ' << wrap_angle(p.q[2]) << ' ' << k * p.twist[0] << ' ' << k * p.twist[1] << ' '
-                  << (pt ? 0.0 : k * p.twist[2]) << ' '
-                  << *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) << '\n';
+                  << (pt ? 0.0 : k * p.twist[2]) << ' ' << *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end())
+                  << '\n';
             }
             auto t = c.data(n + "_traj.dat");
             for (const auto& s : tr.samples) t << s.q[0] << ' ' << s.q[1] << ' ' << wrap_angle(s.q[2]) << '\n';
@@ -162,9 +170,8 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         c.html << scene_heading(f.what, sc.name, n + ".json") << "\n<p>Field on " << field.grid.nx << "×" << field.grid.ny
                << (pt ? "" : "×" + std::to_string(field.grid.nth)) << " configurations (" << fmt(field.seconds, 3)
                << " s); red: full-dynamics run from rest at (" << f.start[0] << ", " << f.start[1]
-               << (pt ? "" : ", " + fmt(f.start[2], 3)) << ") for " << (tr.samples.empty() ? 0.0 : tr.samples.back().t)
-               << " s" << (tr.stop.reason != StopReason::None ? " — stopped: " + esc(tr.stop.describe()) : std::string())
-               << ".</p>\n";
+               << (pt ? "" : ", " + fmt(f.start[2], 3)) << ") for " << (tr.samples.empty() ? 0.0 : tr.samples.back().t) << " s"
+               << (tr.stop.reason != StopReason::None ? " — stopped: " + esc(tr.stop.describe()) : std::string()) << ".</p>\n";
         {
             // A paper figure's run must reach its full duration (a run that stops at once draws a dot).
             const double want = opt.quick ? std::min(f.duration, 4.0) : f.duration;
@@ -178,18 +185,26 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const std::string arrows = " w vec head size 0.004,20 lc rgb '#777777' notitle";
         const std::string kFieldSize = "800,640";   // field figures: large enough to read the arrows
         if (pt) {
-            c.plot(n + "_xy", "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
-                                  " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
+            c.plot(n + "_xy",
+                   "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
+                       " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
                    std::string(f.what) + ": s_x–s_y", kFieldSize);
         } else {
-            c.plot(n + "_3d", "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nsplot " + F + " u 1:2:3:4:5:6" + arrows +
-                                  ", " + T + " u 1:2:3 w l lw 2 lc rgb '#c02020' notitle\n",
+            c.plot(n + "_3d",
+                   "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nsplot " + F + " u 1:2:3:4:5:6" + arrows +
+                       ", " + T + " u 1:2:3 w l lw 2 lc rgb '#c02020' notitle\n",
                    std::string(f.what) + ": (s_x, s_y, θ)", kFieldSize);
-            c.plot(n + "_xy", "set xlabel 's_x'\nset ylabel 's_y'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T + " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
+            c.plot(n + "_xy",
+                   "set xlabel 's_x'\nset ylabel 's_y'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
+                       " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
                    "s_x–s_y projection", kFieldSize);
-            c.plot(n + "_xt", "set xlabel 's_x'\nset ylabel 'θ'\nplot " + F + " u 1:3:4:6" + arrows + ", " + T + " u 1:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
+            c.plot(n + "_xt",
+                   "set xlabel 's_x'\nset ylabel 'θ'\nplot " + F + " u 1:3:4:6" + arrows + ", " + T +
+                       " u 1:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
                    "s_x–θ projection", kFieldSize);
-            c.plot(n + "_yt", "set xlabel 's_y'\nset ylabel 'θ'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T + " u 2:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
+            c.plot(n + "_yt",
+                   "set xlabel 's_y'\nset ylabel 'θ'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T +
+                       " u 2:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
                    "s_y–θ projection", kFieldSize);
         }
         int stuck = 0, lost = 0, sticks = 0, held_all = 0;
@@ -197,7 +212,8 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             stuck += p.stop == StopReason::Sticking;
             lost += p.stop == StopReason::ContactLost;
             sticks += p.converged && *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) > 0;
-            held_all += p.converged && *std::min_element(p.stick_fraction.begin(), p.stick_fraction.begin() + sc.part.contacts()) >= 1;
+            held_all +=
+                p.converged && *std::min_element(p.stick_fraction.begin(), p.stick_fraction.begin() + sc.part.contacts()) >= 1;
         }
         c.html << "<p>Configurations where the twist is undefined: " << stuck << " sticking, " << lost << " contact lost. "
                << "Configurations whose cycle sticks (a contact held for part of the period): " << sticks << " of "
@@ -205,24 +221,28 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         if (sticks > 0) {
             // The largest stick fraction of the three contacts over the cycle, per configuration.
             const std::string SF = "'data/" + n + "_field.dat'";
-            c.plot(n + "_stick", pt ? "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nset cblabel 'stick fraction'\nset cbrange [0:1]\n"
-                                      "plot " + SF + " u 1:2:7 w p pt 5 ps 2 palette notitle\n"
-                                    : "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nset cblabel 'stick fraction'\n"
-                                      "set cbrange [0:1]\nsplot " + SF + " u 1:2:3:7 w p pt 7 ps 1 palette notitle\n",
+            c.plot(n + "_stick",
+                   pt ? "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nset cblabel 'stick fraction'\nset cbrange [0:1]\n"
+                        "plot " +
+                            SF + " u 1:2:7 w p pt 5 ps 2 palette notitle\n"
+                      : "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nset cblabel 'stick fraction'\n"
+                        "set cbrange [0:1]\nsplot " +
+                            SF + " u 1:2:3:7 w p pt 7 ps 1 palette notitle\n",
                    std::string(f.what) + ": fraction of the cycle a contact is held (largest of the contacts)", kFieldSize);
         }
-        c.html << "<table><tr><th>fixed point / line</th><th>at (from … to)</th><th>stability</th><th>eigenvalues (real parts)</th></tr>\n";
+        c.html << "<table><tr><th>fixed point / line</th><th>at (from … to)</th><th>stability</th><th>eigenvalues (real "
+                  "parts)</th></tr>\n";
         for (const auto& p : fp.points) {
-            c.html << "<tr><td>point</td><td>(" << fmt(p.q[0], 3) << ", " << fmt(p.q[1], 3) << (pt ? "" : ", " + fmt(p.q[2], 4)) << ")</td><td>"
-                   << stability_name(p.stability) << "</td><td>";
+            c.html << "<tr><td>point</td><td>(" << fmt(p.q[0], 3) << ", " << fmt(p.q[1], 3) << (pt ? "" : ", " + fmt(p.q[2], 4))
+                   << ")</td><td>" << stability_name(p.stability) << "</td><td>";
             for (int i = 0; i < (pt ? 2 : 3); ++i) c.html << fmt(p.eigenvalues[i].real(), 3) << " ";
             c.html << "</td></tr>\n";
         }
         for (const auto& l : fp.lines) {
             const Vec3 &a = l.points.front(), &b = l.points.back();
-            c.html << "<tr><td>line</td><td>(" << fmt(a[0], 3) << ", " << fmt(a[1], 3) << (pt ? "" : ", " + fmt(a[2], 3)) << ") … ("
-                   << fmt(b[0], 3) << ", " << fmt(b[1], 3) << (pt ? "" : ", " + fmt(b[2], 3)) << ")</td><td>" << stability_name(l.stability)
-                   << "</td><td>";
+            c.html << "<tr><td>line</td><td>(" << fmt(a[0], 3) << ", " << fmt(a[1], 3) << (pt ? "" : ", " + fmt(a[2], 3))
+                   << ") … (" << fmt(b[0], 3) << ", " << fmt(b[1], 3) << (pt ? "" : ", " + fmt(b[2], 3)) << ")</td><td>"
+                   << stability_name(l.stability) << "</td><td>";
             for (int i = 0; i < (pt ? 2 : 3); ++i) c.html << fmt(l.eigenvalues[i].real(), 3) << " ";
             c.html << "</td></tr>\n";
         }
@@ -231,4 +251,4 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     section_stick_reference(c, src, opt.quick);
 }
 
-}  // namespace plate::report
+}   // namespace plate::report

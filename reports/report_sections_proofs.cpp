@@ -29,7 +29,8 @@ void section_derivation(Ctx& c) {
         differ += !f.agrees;
         c.html << "<tr><td>" << esc(f.equation) << "</td><td>"
                << (f.agrees ? "<span class=\"pass\">agrees</span>" : "<span class=\"fail\">differs</span>") << "</td><td><code>"
-               << esc(f.printed) << "</code></td><td><code>" << esc(f.derived) << "</code></td><td>" << esc(f.reason) << "</td></tr>\n";
+               << esc(f.printed) << "</code></td><td><code>" << esc(f.derived) << "</code></td><td>" << esc(f.reason)
+               << "</td></tr>\n";
     }
     c.html << "</table>\n<p>" << d.findings.size() << " comparisons, " << differ << " differ.</p>\n<h3>Derived equations</h3>\n";
     std::istringstream in(symbolic::latex_report(d));
@@ -39,8 +40,7 @@ void section_derivation(Ctx& c) {
         const auto close = line.find("}");
         const std::string title = line.substr(11, close - 11);
         const auto a = line.find('$', close), b = line.rfind('$');
-        c.html << "<h4>" << esc(title) << "</h4><div class=\"math\">$$" << esc(line.substr(a + 1, b - a - 1))
-               << "$$</div>\n";
+        c.html << "<h4>" << esc(title) << "</h4><div class=\"math\">$$" << esc(line.substr(a + 1, b - a - 1)) << "$$</div>\n";
     }
 }
 
@@ -61,14 +61,14 @@ void section_kernels(Ctx& c, std::uint64_t seed) {
             accelerations(sc, Dynamics::U, q, qd, ps, g);
             accelerations_reference(sc, Dynamics::U, q, qd, ps, f);
             const double mg = sc.part.m * sc.g;
-            worst = std::max({worst, (g.qdd - f.qdd).head<2>().norm() / sc.g, std::abs(g.qdd[2] - f.qdd[2]) * sc.part.rho() / sc.g,
-                              (g.n - f.n).norm() / mg});
+            worst = std::max({worst, (g.qdd - f.qdd).head<2>().norm() / sc.g,
+                              std::abs(g.qdd[2] - f.qdd[2]) * sc.part.rho() / sc.g, (g.n - f.n).norm() / mg});
         }
     }
     c.html << "<h2>2. Generated kernels against the hand-written reference</h2>\n<table><tr><th>states</th><th>parts</th>"
               "<th>worst difference (relative to g, m g)</th><th>bound</th><th>verdict</th></tr><tr><td>"
-           << n << "</td><td>thick, thin, point</td><td>" << fmt(worst, 3) << "</td><td>1e-12</td><td>"
-           << verdict(worst < 1e-12) << "</td></tr></table>\n";
+           << n << "</td><td>thick, thin, point</td><td>" << fmt(worst, 3) << "</td><td>1e-12</td><td>" << verdict(worst < 1e-12)
+           << "</td></tr></table>\n";
 }
 
 namespace {
@@ -96,8 +96,9 @@ void plot_V(Ctx& c, const proofs::ContractionSummary& thin, const proofs::Contra
         s += std::string(i ? ", " : "") + "'data/V.dat' u 1:" + std::to_string(i + 2) + " w lp pt 7 ps 0.4 t '" +
              (i + 1 == cols && show.back()->seed == thick.worst_seed ? "thick, seed " : "thin, seed ") +
              std::to_string(show[i]->seed) + "'";
-    c.plot("lyapunov_V", s + "\n", "V(t) = ½|ξ<sub>rel</sub>|² at period boundaries, log scale: thin parts contract "
-                                   "geometrically; the worst thick case shown last.");
+    c.plot("lyapunov_V", s + "\n",
+           "V(t) = ½|ξ<sub>rel</sub>|² at period boundaries, log scale: thin parts contract "
+           "geometrically; the worst thick case shown last.");
 }
 
 // Theorem 1 on thin parts and the same campaign beyond it on thick ones: the table, the tie to the
@@ -127,16 +128,24 @@ void proofs_contraction(Ctx& c, const ReportOptions& opt, int n_thin, int n_thic
     bool theorem = true;
     auto row = [&](const char* name, const proofs::ContractionSummary& s) {
         std::string ce;
-        for (std::size_t i = 0; i < s.counterexamples.size() && i < 8; ++i) ce += (i ? ", " : "") + std::to_string(s.counterexamples[i]);
+        for (std::size_t i = 0; i < s.counterexamples.size() && i < 8; ++i)
+            ce += (i ? ", " : "") + std::to_string(s.counterexamples[i]);
         if (s.counterexamples.size() > 8) ce += ", …";
         const bool observation1 = s.valid > 0 && s.converged == s.valid && s.unique == s.valid && s.floquet_below_one == s.valid;
         c.html << "<tr><td>" << name << "</td><td>" << s.cases << "</td><td>" << s.valid << "</td><td>" << s.monotone
-               << "</td><td>" << (s.worst_increase > 0 ? fmt(s.worst_increase, 3) + " (seed " + std::to_string(s.worst_seed) + ")" : "none")
-               << "</td><td>" << s.converged << "</td><td>" << fmt(s.median_rate, 3) << "</td><td>" << fmt(s.max_spectral_radius, 3)
-               << "</td><td>" << s.unique << "</td><td>" << (ce.empty() ? "none" : ce) << "</td><td>";
-        if (theorem) c.html << "Theorem 1: " << verdict(s.passed());
-        else c.html << "V monotone: " << (s.monotone == s.valid ? verdict(true) : "<span class=\"fail\">no, " + std::to_string(s.valid - s.monotone) + " cases</span>")
-                    << "; Observation 1: " << verdict(observation1);
+               << "</td><td>"
+               << (s.worst_increase > 0 ? fmt(s.worst_increase, 3) + " (seed " + std::to_string(s.worst_seed) + ")" : "none")
+               << "</td><td>" << s.converged << "</td><td>" << fmt(s.median_rate, 3) << "</td><td>"
+               << fmt(s.max_spectral_radius, 3) << "</td><td>" << s.unique << "</td><td>" << (ce.empty() ? "none" : ce)
+               << "</td><td>";
+        if (theorem)
+            c.html << "Theorem 1: " << verdict(s.passed());
+        else
+            c.html << "V monotone: "
+                   << (s.monotone == s.valid
+                           ? verdict(true)
+                           : "<span class=\"fail\">no, " + std::to_string(s.valid - s.monotone) + " cases</span>")
+                   << "; Observation 1: " << verdict(observation1);
         c.html << "</td></tr>\n";
     };
     theorem = true;
@@ -144,9 +153,12 @@ void proofs_contraction(Ctx& c, const ReportOptions& opt, int n_thin, int n_thic
     theorem = false;
     row("thick (beyond it)", thick);
     c.html << "</table>\n<p>These checks hold for any Coulomb friction with velocity-independent normal forces: they are "
-              "tied to the dynamics at " << thin.tie.samples << " sampled states of the thin parts, where the normal forces must "
+              "tied to the dynamics at "
+           << thin.tie.samples
+           << " sampled states of the thin parts, where the normal forces must "
               "equal an independent solve of the part's statics and m q'' + b~ the limit-surface wrench (39) of the relative "
-              "twist, both to " << fmt(proofs::kTieTolerance, 1) << " m g: worst " << fmt(thin.tie.worst_statics, 2) << " and "
+              "twist, both to "
+           << fmt(proofs::kTieTolerance, 1) << " m g: worst " << fmt(thin.tie.worst_statics, 2) << " and "
            << fmt(thin.tie.worst_wrench, 2) << " m g, "
            << (thin.tie.passed() ? verdict(true) : "<span class=\"fail\">" + esc(thin.tie.failure) + "</span>")
            << " (a wrong normal force, a swapped lever arm and a wrong mu on one contact each fail it: test).</p>\n";
@@ -184,8 +196,9 @@ void proofs_periodicity(Ctx& c, const ReportOptions& opt) {
     }
     c.html << "<h3>Periodicity (Appendix D)</h3>\n<table><tr><th>converged cycles (thin and thick)</th><th>worst "
               "|P(x*) − x*| / v<sub>ref</sub></th><th>worst |P²(x*) − x*| / v<sub>ref</sub></th><th>tolerance</th>"
-              "<th>verdict</th></tr><tr><td>" << n << "</td><td>" << fmt(worst1, 3) << "</td><td>" << fmt(worst2, 3)
-           << "</td><td>1e-8</td><td>" << verdict(n > 0 && ok == n) << "</td></tr></table>\n";
+              "<th>verdict</th></tr><tr><td>"
+           << n << "</td><td>" << fmt(worst1, 3) << "</td><td>" << fmt(worst2, 3) << "</td><td>1e-8</td><td>"
+           << verdict(n > 0 && ok == n) << "</td></tr></table>\n";
 }
 
 // Limit surfaces (Appendix B): the campaign's table and one thin part's surface.
@@ -195,18 +208,23 @@ void proofs_limit_surfaces(Ctx& c, const ReportOptions& opt, int n_surf) {
     c.html << "<h2>4. Limit surfaces (Appendix B)</h2>\n<p>Wrenches of random thin parts sampled on 300 twist directions; "
               "all pairs tested. Maximum work: ξ<sub>i</sub>·w<sub>j</sub> ≥ ξ<sub>i</sub>·w<sub>i</sub> (convex surface, twist "
               "normal to it); (40): (ξ<sub>i</sub>−ξ<sub>j</sub>)·(w<sub>i</sub>−w<sub>j</sub>) ≤ 0; no vertices: distinct "
-              "directions give distinct wrenches; no flat faces: the max-work inequality is strict between distinct directions.</p>\n"
+              "directions give distinct wrenches; no flat faces: the max-work inequality is strict between distinct "
+              "directions.</p>\n"
               "<table><tr><th>parts</th><th>convex and normal</th><th>strictly convex</th><th>worst max-work "
-              "violation</th><th>worst (40) violation</th><th>smallest strict margin</th><th>smallest wrench separation</th><th>verdict</th></tr><tr><td>"
-           << ls.parts << "</td><td>" << ls.convex << "</td><td>" << ls.strict << "</td><td>" << fmt(ls.worst_max_work, 3) << "</td><td>"
-           << fmt(ls.worst_monotonicity, 3) << "</td><td>" << fmt(ls.min_strict_margin, 3) << "</td><td>" << fmt(ls.min_separation, 3)
-           << "</td><td>" << verdict(ls.passed()) << "</td></tr></table>\n<p>The first two inequalities hold for any wrench of "
-              "the form −Σ c<sub>i</sub> G<sub>i</sub> v<sub>i</sub>/|v<sub>i</sub>| with c<sub>i</sub> ≥ 0 (Cauchy-Schwarz), so a kernel "
+              "violation</th><th>worst (40) violation</th><th>smallest strict margin</th><th>smallest wrench "
+              "separation</th><th>verdict</th></tr><tr><td>"
+           << ls.parts << "</td><td>" << ls.convex << "</td><td>" << ls.strict << "</td><td>" << fmt(ls.worst_max_work, 3)
+           << "</td><td>" << fmt(ls.worst_monotonicity, 3) << "</td><td>" << fmt(ls.min_strict_margin, 3) << "</td><td>"
+           << fmt(ls.min_separation, 3) << "</td><td>" << verdict(ls.passed())
+           << "</td></tr></table>\n<p>The first two inequalities hold for any wrench of "
+              "the form −Σ c<sub>i</sub> G<sub>i</sub> v<sub>i</sub>/|v<sub>i</sub>| with c<sub>i</sub> ≥ 0 (Cauchy-Schwarz), so "
+              "a kernel "
               "fed a wrong μ or lever arm passes them. What can fail: each part's friction set built independently (every "
               "force of magnitude ≤ μ<sub>i</sub>N<sub>i</sub> at each contact, N from the part's statics, each disk's rim "
               "sampled at 720 points): the kernel's wrench for ξ must be the set's support point in −ξ and inside the set. "
            << ls.on_set << " of " << ls.parts << " parts: worst support-point error " << fmt(ls.worst_support, 2)
-           << ", worst excursion outside " << fmt(ls.worst_outside, 2) << " (of Σ μN; 1e-12 passes; a wrong μ or lever arm "
+           << ", worst excursion outside " << fmt(ls.worst_outside, 2)
+           << " (of Σ μN; 1e-12 passes; a wrong μ or lever arm "
               "fails it: test).</p>\n<p>Each part's dynamics tied to its surface at "
            << ls.tie.samples << " states (statics and wrench, as above): worst " << fmt(ls.tie.worst_statics, 2) << " and "
            << fmt(ls.tie.worst_wrench, 2) << " m g"
@@ -224,8 +242,9 @@ void proofs_limit_surfaces(Ctx& c, const ReportOptions& opt, int n_surf) {
             o << x[0] << ' ' << x[1] << ' ' << x[2] << '\n';
         }
         o.close();
-        c.plot("limit_surface", "set xlabel 'F_x / Σ μN'\nset ylabel 'F_y / Σ μN'\nset zlabel 'τ/(ρ Σ μN)'\nset view 60,30\n"
-                                "splot 'data/surface.dat' w p pt 7 ps 0.25 lc rgb '#3060a0' notitle\n",
+        c.plot("limit_surface",
+               "set xlabel 'F_x / Σ μN'\nset ylabel 'F_y / Σ μN'\nset zlabel 'τ/(ρ Σ μN)'\nset view 60,30\n"
+               "splot 'data/surface.dat' w p pt 7 ps 0.25 lc rgb '#3060a0' notitle\n",
                "Limit surface of a random thin part: the wrench −∇P(ξ) for 2500 twist directions.");
     }
 }
@@ -259,13 +278,14 @@ void proofs_collinear(Ctx& c, const ReportOptions& opt) {
         } else {
             singular = cond.min_singular;
         }
-        c.html << "<tr><td>" << e << "</td><td>" << (e > 0 ? fmt(cond.max_condition, 3) : "singular (σ_min/σ_max = " + fmt(cond.min_singular, 2) + ")")
+        c.html << "<tr><td>" << e << "</td><td>"
+               << (e > 0 ? fmt(cond.max_condition, 3) : "singular (σ_min/σ_max = " + fmt(cond.min_singular, 2) + ")")
                << "</td><td>" << gap << "</td><td>" << cv << "</td></tr>\n";
     }
     c.html << "</table>\n<p>" << esc(collinear_sentence(conds, gaps, singular)) << "</p>\n";
 }
 
-}  // namespace
+}   // namespace
 
 void section_proofs(Ctx& c, const ReportOptions& opt) {
     const int n_thin = opt.quick ? 24 : 10000, n_thick = opt.quick ? 8 : 1000, n_surf = opt.quick ? 4 : 200;
@@ -294,10 +314,12 @@ void section_fig3(Ctx& c, const fs::path& src) {
     }
     c.html << "<h2>5. Observation 1 (Fig. 3)</h2>\n<p>Scene <code>fig3_random</code> at (0.01, −0.01, 0.5): two initial "
               "twists, ten periods of the reduced U-dynamics; open circles every T.</p>\n";
-    c.plot("fig3", "set xlabel 'ṡ_x'\nset ylabel 'ṡ_y'\nset zlabel 'θ̇'\nset view 60,40\n"
-                   "splot 'data/fig3a.dat' u 1:2:3 w l lc rgb '#c03030' t 'start 1', 'data/fig3b.dat' u 1:2:3 w l lc rgb '#3050c0' t 'start 2', "
-                   "'data/fig3a_T.dat' w p pt 6 lc rgb '#c03030' notitle, 'data/fig3b_T.dat' w p pt 6 lc rgb '#3050c0' notitle\n",
+    c.plot("fig3",
+           "set xlabel 'ṡ_x'\nset ylabel 'ṡ_y'\nset zlabel 'θ̇'\nset view 60,40\n"
+           "splot 'data/fig3a.dat' u 1:2:3 w l lc rgb '#c03030' t 'start 1', 'data/fig3b.dat' u 1:2:3 w l lc rgb '#3050c0' t "
+           "'start 2', "
+           "'data/fig3a_T.dat' w p pt 6 lc rgb '#c03030' notitle, 'data/fig3b_T.dat' w p pt 6 lc rgb '#3050c0' notitle\n",
            "Two initial twists converging to one limit cycle (twist space).");
 }
 
-}  // namespace plate::report
+}   // namespace plate::report

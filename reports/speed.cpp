@@ -20,8 +20,8 @@ using namespace html;
 
 namespace {
 
-constexpr double kTarget = 1e-6;       // the accuracy at which costs are compared
-constexpr double kWrong = 1e-2;        // an answer this far off (relative) is a wrong answer
+constexpr double kTarget = 1e-6;   // the accuracy at which costs are compared
+constexpr double kWrong = 1e-2;    // an answer this far off (relative) is a wrong answer
 
 struct Line {
     Solver solver;
@@ -49,7 +49,8 @@ RunResult timed_run(F&& f) {
 // (the field is deterministic: only the time differs between the runs).
 Field timed_field(const Scene& sc, const FieldOptions& fo) {
     Field best = compute_field(sc, GridSpec{}, fo);
-    for (int i = 0; i < 2 && best.seconds < 0.2; ++i) best.seconds = std::min(best.seconds, compute_field(sc, GridSpec{}, fo).seconds);
+    for (int i = 0; i < 2 && best.seconds < 0.2; ++i)
+        best.seconds = std::min(best.seconds, compute_field(sc, GridSpec{}, fo).seconds);
     return best;
 }
 
@@ -66,8 +67,7 @@ std::pair<double, double> cost_at_target(const Line& l) {
 
 // Two log-log charts (error against seconds and against evaluations), failed runs marked at the
 // chart's top edge; a table of the cost at kTarget and of every failure.
-void work_precision(Ctx& c, const std::string& id, const std::string& title, const std::vector<Line>& lines,
-                    bool path_errors) {
+void work_precision(Ctx& c, const std::string& id, const std::string& title, const std::vector<Line>& lines, bool path_errors) {
     c.html << "<h3>" << esc(title) << "</h3>\n";
     std::vector<std::string> files;
     double ceiling = 1;
@@ -75,8 +75,9 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
         const std::string f = id + "_" + slug(l.solver.label()) + ".dat";
         auto o = c.data(f);
         for (const auto& r : l.runs)
-            if (r.ok) o << r.seconds << " " << r.rhs_evals << " " << std::max(r.error, 1e-16) << " "
-                        << std::max(r.error_max, 1e-16) << "\n";
+            if (r.ok)
+                o << r.seconds << " " << r.rhs_evals << " " << std::max(r.error, 1e-16) << " " << std::max(r.error_max, 1e-16)
+                  << "\n";
         auto fo = c.data(id + "_" + slug(l.solver.label()) + "_failed.dat");
         for (const auto& r : l.runs)
             if (!r.ok) fo << r.seconds << " " << r.rhs_evals << " " << ceiling << " " << ceiling << "\n";
@@ -93,15 +94,16 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
             const std::string base = "data/" + id + "_" + slug(lines[i].solver.label());
             // gnuplot cycles 8 colours: the dash pattern tells lines of one colour apart.
             gp << (i ? ", " : "") << "'" << base << ".dat' u " << xcol << ":" << ycol << " w lp lw "
-               << (lines[i].solver.engine ? 3 : 1) << " lt " << (i % 8 + 1) << " dt " << (i / 8 + 1) << " pt "
-               << (i % 12 + 1) << " title '" << lines[i].solver.label() << "'";
+               << (lines[i].solver.engine ? 3 : 1) << " lt " << (i % 8 + 1) << " dt " << (i / 8 + 1) << " pt " << (i % 12 + 1)
+               << " title '" << lines[i].solver.label() << "'";
             gp << ", '" << base << "_failed.dat' u " << xcol << ":" << ycol << " w p pt 2 ps 1.5 lc rgb 'red' notitle";
         }
         gp << "\n";
         c.plot(name, gp.str(), cap, "900,520");
     };
     const std::string ey = path_errors ? "final-configuration error" : "twist error (relative to v_{ref})";
-    chart(id + "_time", 1, 3, "wall time [s]", ey, esc(title) + ": error against wall time. Red crosses at the top: failed runs.");
+    chart(id + "_time", 1, 3, "wall time [s]", ey,
+          esc(title) + ": error against wall time. Red crosses at the top: failed runs.");
     chart(id + "_evals", 2, 3, "right-hand-side evaluations", ey, esc(title) + ": error against right-hand-side evaluations.");
     if (path_errors)
         chart(id + "_max", 2, 4, "right-hand-side evaluations", "largest error along the path",
@@ -112,7 +114,10 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
     double engine_s = fastest;
     for (const auto& l : lines) {
         const double s = cost_at_target(l).first;
-        if (s < fastest) { fastest = s; fastest_name = l.solver.label(); }
+        if (s < fastest) {
+            fastest = s;
+            fastest_name = l.solver.label();
+        }
         if (l.solver.engine) engine_s = s;
     }
     c.html << "<table><tr><th>solver</th><th>runs</th><th>failed</th><th>best error</th><th>cost at error &le; "
@@ -125,16 +130,18 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
             failed += !r.ok;
             if (r.ok) best = std::min(best, r.error);
         }
-        c.html << "<tr><td>" << (l.solver.engine ? "<b>" : "") << esc(l.solver.label()) << (l.solver.engine ? " (default)</b>" : "")
-               << "</td><td>" << l.runs.size() << "</td><td>" << failed << "</td><td>" << fmt(best, 2) << "</td><td>"
-               << (std::isfinite(s) ? fmt(s, 3) : "never") << "</td><td>" << (std::isfinite(e) ? fmt(e, 3) : "-")
-               << "</td><td>" << (std::isfinite(s) ? fmt(s / fastest, 3) : "-") << "</td></tr>\n";
+        c.html << "<tr><td>" << (l.solver.engine ? "<b>" : "") << esc(l.solver.label())
+               << (l.solver.engine ? " (default)</b>" : "") << "</td><td>" << l.runs.size() << "</td><td>" << failed
+               << "</td><td>" << fmt(best, 2) << "</td><td>" << (std::isfinite(s) ? fmt(s, 3) : "never") << "</td><td>"
+               << (std::isfinite(e) ? fmt(e, 3) : "-") << "</td><td>" << (std::isfinite(s) ? fmt(s / fastest, 3) : "-")
+               << "</td></tr>\n";
     }
     c.html << "</table>\n<p>Fastest at " << fmt(kTarget, 2) << ": " << esc(fastest_name) << " (" << fmt(fastest, 3)
-           << " s). The default (engine) costs " << fmt(engine_s / fastest, 3) << "&times; that: "
-           << verdict(engine_s <= 2 * fastest) << " (target: within 2&times;).</p>\n";
-    c.html << "<details><summary>Failed runs (marked, not dropped)</summary><table><tr><th>solver</th><th>setting</th><th>why</th>"
-              "<th>evaluations</th></tr>\n";
+           << " s). The default (engine) costs " << fmt(engine_s / fastest, 3)
+           << "&times; that: " << verdict(engine_s <= 2 * fastest) << " (target: within 2&times;).</p>\n";
+    c.html
+        << "<details><summary>Failed runs (marked, not dropped)</summary><table><tr><th>solver</th><th>setting</th><th>why</th>"
+           "<th>evaluations</th></tr>\n";
     for (const auto& l : lines)
         for (const auto& r : l.runs)
             if (!r.ok)
@@ -240,11 +247,13 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
     const double agree = twist_error(sc, ref.value, {rr.twist[0], rr.twist[1], rr.twist[2]});
     c.html << "<p>Reference: engine at rtol 1e-12, cycle tolerance 1e-12; a contact is held " << fmt(100 * held, 2)
            << "% of the period. ";
-    if (!rr.ok) c.html << "The regularised-friction limit failed here (" << esc(rr.failure) << ").</p>\n";
+    if (!rr.ok)
+        c.html << "The regularised-friction limit failed here (" << esc(rr.failure) << ").</p>\n";
     else
         c.html << "The regularised-friction limit (eps &rarr; 0 by Richardson with the observed order " << fmt(rr.order, 2)
-               << ", bsimp at 1e-12; nothing of the engine) " << (agree <= 1e-7 + rr.error ? "agrees with it: " : "differs from it: ")
-               << fmt(agree, 2) << " against its own error " << fmt(rr.error, 2) << ".</p>\n";
+               << ", bsimp at 1e-12; nothing of the engine) "
+               << (agree <= 1e-7 + rr.error ? "agrees with it: " : "differs from it: ") << fmt(agree, 2)
+               << " against its own error " << fmt(rr.error, 2) << ".</p>\n";
     std::vector<Line> lines;
     // The engine's cycle tolerance follows its rtol; the regularised runs' is 1e-8 (their error
     // floors far above it at every eps charted, and a tighter one is lost in bsimp's noise: not
@@ -287,13 +296,19 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
     std::string best;
     for (std::size_t i = 1; i < lines.size(); ++i) {
         const double t = cost_at_target(lines[i]).first;
-        if (t < tr) { tr = t; best = lines[i].solver.label(); }
+        if (t < tr) {
+            tr = t;
+            best = lines[i].solver.label();
+        }
     }
     c.html << "<p>At " << fmt(kTarget, 1) << " v_ref: ";
-    if (!std::isfinite(te)) c.html << "the engine did not reach it";
-    else if (!std::isfinite(tr)) c.html << "the engine takes " << fmt(1e3 * te, 3) << " ms; no other run here reaches it";
-    else c.html << "the engine takes " << fmt(1e3 * te, 3) << " ms, the cheapest other run (" << esc(best) << ") "
-                << fmt(1e3 * tr, 3) << " ms: " << fmt(tr / te, 2) << "x the engine's time";
+    if (!std::isfinite(te))
+        c.html << "the engine did not reach it";
+    else if (!std::isfinite(tr))
+        c.html << "the engine takes " << fmt(1e3 * te, 3) << " ms; no other run here reaches it";
+    else
+        c.html << "the engine takes " << fmt(1e3 * te, 3) << " ms, the cheapest other run (" << esc(best) << ") "
+               << fmt(1e3 * tr, 3) << " ms: " << fmt(tr / te, 2) << "x the engine's time";
     c.html << ". (Why a regularised line cannot go below some level: the law itself differs from Coulomb's by about "
               "eps near a stick, whatever the integrator; and fixed steps must resolve its time scale eps/(mu g).)</p>\n";
 }
@@ -302,20 +317,41 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
 // cycle_SLUG.dat and cycle_SLUG_tol1.dat) and the RK4 baseline (cycle_rk4.dat).
 void plot_cycle_solvers(Ctx& c, const std::vector<std::string>& names) {
     std::ostringstream gp;
-    gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the field'\n"
-          "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first " << kTarget << " to graph 1, first "
-       << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
+    gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the "
+          "field'\n"
+          "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first "
+       << kTarget << " to graph 1, first " << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
     int i = 0;
     for (const std::string& name : names) {
-        gp << (i ? ", " : "") << "'data/cycle_" << slug(name) << ".dat' u 1:3 w lp lt " << i + 1 << " pt " << i + 1
-           << " title '" << name << "', 'data/cycle_" << slug(name) << "_tol1.dat' u 1:3 w p lt " << i + 1 << " pt " << i + 1
-           << " notitle";
+        gp << (i ? ", " : "") << "'data/cycle_" << slug(name) << ".dat' u 1:3 w lp lt " << i + 1 << " pt " << i + 1 << " title '"
+           << name << "', 'data/cycle_" << slug(name) << "_tol1.dat' u 1:3 w p lt " << i + 1 << " pt " << i + 1 << " notitle";
         ++i;
     }
     gp << ", 'data/cycle_rk4.dat' u 1:3 w lp pt 7 lc rgb 'black' title 'RK4 period by period'\n";
-    c.plot("cycle_solvers", gp.str(), "fig4 field (343 configurations): maximum twist error against wall time for each "
-                                      "limit-cycle solver (engine rtol swept; lines: cycle tolerance 10 rtol, points of the "
-                                      "same colour: cycle tolerance = rtol) and the RK4 baseline.");
+    c.plot("cycle_solvers", gp.str(),
+           "fig4 field (343 configurations): maximum twist error against wall time for each "
+           "limit-cycle solver (engine rtol swept; lines: cycle tolerance 10 rtol, points of the "
+           "same colour: cycle tolerance = rtol) and the RK4 baseline.");
+}
+
+// "a, b, c", each to three digits.
+std::string three_digits(const std::vector<double>& v) {
+    std::string r;
+    for (std::size_t i = 0; i < v.size(); ++i) r += (i ? ", " : "") + fmt(v[i], 3);
+    return r;
+}
+
+// The default cycle solver's time against the fastest solver's, each its best (target: within 2x);
+// empty where the default did not run.
+std::string default_against_fastest(const std::map<std::string, double>& best_by) {
+    double fastest = std::numeric_limits<double>::infinity();
+    for (const auto& [n, s] : best_by) fastest = std::min(fastest, s);
+    const auto def = best_by.find("shooting + warm");
+    if (def == best_by.end()) return "";
+    std::ostringstream o;
+    o << " The default (shooting with predicted warm starts) is " << fmt(def->second / fastest, 3)
+      << "&times; the fastest solver: " << verdict(def->second <= 2 * fastest) << " (target: within 2&times;).";
+    return o.str();
 }
 
 // Limit-cycle solvers on fig4's 343-configuration field, and the ratio against period-by-period RK4.
@@ -336,10 +372,10 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
         std::string name() const { return std::string(cycle_solver_name(s)) + (warm ? " + warm" : ""); }
     };
     std::vector<Cfg> cfgs{{CycleSolver::PeriodByPeriod, false}, {CycleSolver::PeriodByPeriod, true},
-                          {CycleSolver::Anderson, false}, {CycleSolver::Anderson, true}, {CycleSolver::Newton, true},
-                          {CycleSolver::Shooting, true}};
-    std::vector<double> rtols = full ? std::vector<double>{1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10}
-                                     : std::vector<double>{1e-6, 3e-7, 1e-7, 3e-8, 1e-8};
+                          {CycleSolver::Anderson, false},       {CycleSolver::Anderson, true},
+                          {CycleSolver::Newton, true},          {CycleSolver::Shooting, true}};
+    std::vector<double> rtols =
+        full ? std::vector<double>{1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10} : std::vector<double>{1e-6, 3e-7, 1e-7, 3e-8, 1e-8};
     c.html << "<table><tr><th>cycle solver</th><th>warm starts</th><th>rtol</th><th>cycle tol</th><th>max error</th>"
               "<th>not converged</th><th>periods / configuration</th><th>evaluations</th><th>seconds</th></tr>\n";
     double best_s = std::numeric_limits<double>::infinity();
@@ -387,16 +423,27 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     // step costs the same everywhere, and evaluations do not jitter as times do).
     Solver rk;
     rk.method = Method::RK4;
-    struct RkSetting { int n = 0; double ct = 0; long evals = std::numeric_limits<long>::max(); };
+    struct RkSetting {
+        int n = 0;
+        double ct = 0;
+        long evals = std::numeric_limits<long>::max();
+    };
     RkSetting rk_best;
-    struct RkSweep { double seconds = 0, max_error = 0; int failed = 0; long evals = 0; };
+    struct RkSweep {
+        double seconds = 0, max_error = 0;
+        int failed = 0;
+        long evals = 0;
+    };
     auto rk_sweep = [&](int n, double ct) {
         RkSweep out;
         for (const auto& p : ref.points) {
             const RunResult r = timed_run([&] { return twist_run(sc, p.q, rk, n, ct); });
             out.seconds += r.seconds;
             out.evals += r.rhs_evals;
-            if (!r.ok) { ++out.failed; continue; }
+            if (!r.ok) {
+                ++out.failed;
+                continue;
+            }
             if (p.converged)
                 out.max_error = std::max(out.max_error, twist_error(sc, r.value, {p.twist[0], p.twist[1], p.twist[2]}));
         }
@@ -447,26 +494,20 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
            << rk_best.n << " steps per period, cycle tolerance " << fmt(rk_best.ct, 2) << " (" << rk_best.evals
            << " evaluations). Head to head, alternately, five rounds (seconds, each the fastest of three runs; RK4 "
               "per configuration): fields ";
-    for (std::size_t i = 0; i < fs.size(); ++i) c.html << (i ? ", " : "") << fmt(fs[i], 3);
-    c.html << "; RK4 ";
-    for (std::size_t i = 0; i < rs.size(); ++i) c.html << (i ? ", " : "") << fmt(rs[i], 3);
-    c.html << "; ratios ";
-    for (std::size_t i = 0; i < ratios.size(); ++i) c.html << (i ? ", " : "") << fmt(ratios[i], 3);
+    c.html << three_digits(fs) << "; RK4 " << three_digits(rs) << "; ratios " << three_digits(ratios);
     c.html << ". Median ratio <b>" << fmt(ratio, 3) << "&times;</b> " << verdict(ratio >= 20) << " (target &ge; 20&times;).";
-    double fastest = std::numeric_limits<double>::infinity();
-    for (const auto& [n, s] : best_by) fastest = std::min(fastest, s);
-    const std::string def = "shooting + warm";
-    if (best_by.count(def))
-        c.html << " The default (shooting with predicted warm starts) is " << fmt(best_by[def] / fastest, 3)
-               << "&times; the fastest solver: " << verdict(best_by[def] <= 2 * fastest) << " (target: within 2&times;).";
-    c.html << "</p>\n";
+    c.html << default_against_fastest(best_by) << "</p>\n";
 }
 
 // Where methods and the model fail: sweeps of one scene parameter at a time.
 void failure_map(Ctx& c, const Scene& base, bool full) {
     const Vec3 q0(0.02, -0.01, 0.5);
     enum Kind { Mu, Horizontal, Vertical, Collinear };
-    struct Sweep { Kind kind; std::string name, param; std::vector<double> values; };
+    struct Sweep {
+        Kind kind;
+        std::string name, param;
+        std::vector<double> values;
+    };
     const double mu0 = base.part.mu[0];
     std::vector<Sweep> sweeps{
         {Mu, "friction rising toward sticking", "mu", {0.1, 0.3, 0.6, 1.0, 1.5, 2.0}},
@@ -492,7 +533,8 @@ void failure_map(Ctx& c, const Scene& base, bool full) {
     }
     c.html << "<p>fig4's part at q = (0.02, -0.01, 0.5); each cell is one run at tolerance 1e-8 (RK4: 200 steps per "
               "period) compared with the engine at 1e-11. Every method starts at rest and, where its run loses contact, "
-              "starts again from the engine's other twists (the same restart rule). <span style=\"background:#cfc\">ok</span>: error &le; 1e-5; "
+              "starts again from the engine's other twists (the same restart rule). <span style=\"background:#cfc\">ok</span>: "
+              "error &le; 1e-5; "
               "<span style=\"background:#ffc\">detected</span>: the run stopped and said why (sticking, contact lost); "
               "<span style=\"background:#fcc\">wrong</span>: a twist returned where the model fails, or off by more than "
               "1e-5; <span style=\"background:#ddd\">method failed</span>: tiny steps, budget, no convergence. Each cell "
@@ -505,7 +547,8 @@ void failure_map(Ctx& c, const Scene& base, bool full) {
         c.html << "</tr>\n";
         for (double v : sw.values) {
             Scene sc = base;
-            if (sw.kind == Mu) sc.part.mu = Vec3::Constant(v);
+            if (sw.kind == Mu)
+                sc.part.mu = Vec3::Constant(v);
             else if (sw.kind == Horizontal) {
                 const double scale = v * mu0 * sc.g / sc.plate.horizontal_amplitude();
                 for (auto& h : sc.plate.harmonics)
@@ -533,11 +576,11 @@ void failure_map(Ctx& c, const Scene& base, bool full) {
                                      : "slides")
                    << "</small></td>";
             for (const auto& s : solvers) {
-                const RunResult r = twist_run(sc, q0, s, s.method == Method::RK4 && !s.engine ? 200 : 1e-8, 1e-7,
-                                              full ? 20'000'000 : 3'000'000);
+                const RunResult r =
+                    twist_run(sc, q0, s, s.method == Method::RK4 && !s.engine ? 200 : 1e-8, 1e-7, full ? 20'000'000 : 3'000'000);
                 std::string cls, text;
-                const bool detected = !r.ok && (r.failure.find("stick") != std::string::npos ||
-                                                r.failure.find("contact") != std::string::npos);
+                const bool detected =
+                    !r.ok && (r.failure.find("stick") != std::string::npos || r.failure.find("contact") != std::string::npos);
                 if (r.ok && !ref.ok) {
                     cls = "#fcc";
                     text = "wrong: returned a twist; the model fails here (" + ref.failure + ")";
@@ -571,7 +614,11 @@ void hierarchy(Ctx& c, const fs::path& src, bool full) {
               "<table><tr><th>scene</th><th>q0</th><th>duration</th><th>rung</th><th>error</th><th>predicted</th><th>seconds</th>"
               "<th>auto at 1e-2</th><th>cheapest measured within 1e-2</th><th>within 1e-3</th></tr>\n";
     int bounded = 0, compared = 0;
-    struct Q { const char* scene; Vec3 q0; double dur; };
+    struct Q {
+        const char* scene;
+        Vec3 q0;
+        double dur;
+    };
     const std::vector<Q> qs{{"fig4", Vec3(0.04, -0.04, 1.0), full ? 20.0 : 5.0},
                             {"fig5", Vec3(0.02, -0.01, 0.5), 2.0},
                             {"fig3_random", Vec3(0.02, -0.01, 0.5), 2.0},
@@ -594,13 +641,13 @@ void hierarchy(Ctx& c, const fs::path& src, bool full) {
                 ++compared;
                 bounded += pred >= r.error;
             }
-            c.html << "<tr><td>" << (first ? q.scene : "") << "</td><td>" << (first ? "(" + fmt(q.q0[0], 3) + ", " + fmt(q.q0[1], 3) + ", " + fmt(q.q0[2], 3) + ")" : "")
-                   << "</td><td>" << (first ? fmt(q.dur, 3) + " s" : "") << "</td><td>" << esc(r.name()) << "</td><td>"
+            c.html << "<tr><td>" << (first ? q.scene : "") << "</td><td>"
+                   << (first ? "(" + fmt(q.q0[0], 3) + ", " + fmt(q.q0[1], 3) + ", " + fmt(q.q0[2], 3) + ")" : "") << "</td><td>"
+                   << (first ? fmt(q.dur, 3) + " s" : "") << "</td><td>" << esc(r.name()) << "</td><td>"
                    << (r.ok ? fmt(r.error, 3) : esc(r.note)) << "</td><td>" << (ref ? "0" : fmt(pred, 3))
                    << (!ref && r.ok && est.ok && pred < r.error ? " <span class=\"fail\">below</span>" : "") << "</td><td>"
                    << fmt(r.seconds, 3) << "</td><td>" << (r.part == ap && r.dynamics == ad ? "&#10003;" : "") << "</td><td>"
-                   << (&r == &picked2 ? "&#10003;" : "") << "</td><td>" << (&r == &picked3 ? "&#10003;" : "")
-                   << "</td></tr>\n";
+                   << (&r == &picked2 ? "&#10003;" : "") << "</td><td>" << (&r == &picked3 ? "&#10003;" : "") << "</td></tr>\n";
             first = false;
         }
         progress_line("bench: hierarchy %s done\n", q.scene);
@@ -609,7 +656,7 @@ void hierarchy(Ctx& c, const fs::path& src, bool full) {
            << " rungs here (the validation on seeded random scenes is a test: at least 95%).</p>\n";
 }
 
-}  // namespace
+}   // namespace
 
 void write_speed_study(const SpeedOptions& opt) {
     if (opt.out.empty()) throw std::runtime_error("bench: no output folder");
@@ -620,8 +667,8 @@ void write_speed_study(const SpeedOptions& opt) {
     auto scene = [&](const char* n) { return load_scene((src / "scenes" / (std::string(n) + ".json")).string()); };
     const Scene fig4 = scene("fig4"), fig6 = scene("fig6");
     const auto t0 = std::chrono::steady_clock::now();
-    c.html << "<h2>Speed and accuracy</h2>\n<p>Written by <code>plate bench" << (opt.full ? " --full" : "")
-           << "</code> on " << esc(machine_description()) << ". Errors are relative: twists to v_ref (angular rates "
+    c.html << "<h2>Speed and accuracy</h2>\n<p>Written by <code>plate bench" << (opt.full ? " --full" : "") << "</code> on "
+           << esc(machine_description()) << ". Errors are relative: twists to v_ref (angular rates "
            << "times rho), configurations to rho and radians. Each chart has one line per solver: the engine (the "
               "project's default: Dormand-Prince 5(4) with located contact events), every general method with exact "
               "Coulomb friction, and regularised friction (tanh, linear; width relative to v_ref).</p>\n";
@@ -654,8 +701,8 @@ void write_speed_study(const SpeedOptions& opt) {
     });
     c.timed("work-precision (d)", [&] {
         const Vec3 q(-0.05 + 1.0 / 60, 1.0 / 60, 2 * kPi * 5 / 7);
-        c.html << "<h3>(d) fig6: a cycle through stick-slip at (" << fmt(q[0], 4) << ", " << fmt(q[1], 4) << ", "
-               << fmt(q[2], 4) << ")</h3>\n";
+        c.html << "<h3>(d) fig6: a cycle through stick-slip at (" << fmt(q[0], 4) << ", " << fmt(q[1], 4) << ", " << fmt(q[2], 4)
+               << ")</h3>\n";
         stickslip_chart(c, fig6, q, opt.full);
     });
     c.timed("limit-cycle solvers", [&] {
@@ -690,9 +737,10 @@ void write_speed_study(const SpeedOptions& opt) {
         page = page.substr(0, b + std::string(kSpeedBegin).size()) + c.html.str() + page.substr(e);
     } else {
         page = std::string("<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>plate: speed and accuracy</title>\n") +
-               kErrorTrap + kStyle + "</head><body>\n" + kSpeedBegin + c.html.str() + kSpeedEnd + "\n" + kPageCheck + "</body></html>\n";
+               kErrorTrap + kStyle + "</head><body>\n" + kSpeedBegin + c.html.str() + kSpeedEnd + "\n" + kPageCheck +
+               "</body></html>\n";
     }
     write_file_atomic(index.string(), [&](std::ostream& o) { o << page; });
 }
 
-}  // namespace plate::report
+}   // namespace plate::report

@@ -15,7 +15,7 @@ std::string text(const numeric& x) {
     o << x;
     return o.str();
 }
-}  // namespace
+}   // namespace
 
 std::string double_literal(const numeric& x) {
     if (!x.is_rational()) throw std::invalid_argument("codegen: non-rational number");
@@ -70,22 +70,22 @@ namespace {
 
 std::string latex_symbol(const std::string& n) {
     static const std::map<std::string, std::string> special = {
-        {"ct", "\\cos\\theta"}, {"st", "\\sin\\theta"}, {"thd", "\\dot\\theta"}, {"thdd", "\\ddot\\theta"},
-        {"sxd", "\\dot s_x"}, {"syd", "\\dot s_y"}, {"sxdd", "\\ddot s_x"}, {"sydd", "\\ddot s_y"},
-        {"wx", "\\omega_{1x}"}, {"wy", "\\omega_{1y}"}, {"wz", "\\omega_{1z}"},
-        {"wdx", "\\dot\\omega_{1x}"}, {"wdy", "\\dot\\omega_{1y}"}, {"wdz", "\\dot\\omega_{1z}"},
-        {"pddx", "\\ddot p_x"}, {"pddy", "\\ddot p_y"}, {"pddz", "\\ddot p_z"}, {"xith", "\\xi_\\theta"},
-        {"rho", "\\rho"}, {"cz", "c_z"}};
+        {"ct", "\\cos\\theta"},       {"st", "\\sin\\theta"},       {"thd", "\\dot\\theta"}, {"thdd", "\\ddot\\theta"},
+        {"sxd", "\\dot s_x"},         {"syd", "\\dot s_y"},         {"sxdd", "\\ddot s_x"},  {"sydd", "\\ddot s_y"},
+        {"wx", "\\omega_{1x}"},       {"wy", "\\omega_{1y}"},       {"wz", "\\omega_{1z}"},  {"wdx", "\\dot\\omega_{1x}"},
+        {"wdy", "\\dot\\omega_{1y}"}, {"wdz", "\\dot\\omega_{1z}"}, {"pddx", "\\ddot p_x"},  {"pddy", "\\ddot p_y"},
+        {"pddz", "\\ddot p_z"},       {"xith", "\\xi_\\theta"},     {"rho", "\\rho"},        {"cz", "c_z"}};
     const auto it = special.find(n);
     if (it != special.end()) return it->second;
     if (n.size() >= 2 && (n[0] == 'J' || n[0] == 's' || n[0] == 'v')) return n.substr(0, 1) + "_{" + n.substr(1) + "}";
     if (n.rfind("mu", 0) == 0) return "\\mu_{" + n.substr(2) + "}";
-    if (n.size() == 3 && (n[0] == 'c' || n[0] == 'u' || n[0] == 'r' || n[0] == 'R')) return n.substr(0, 1) + "_{" + n.substr(1) + "}";
+    if (n.size() == 3 && (n[0] == 'c' || n[0] == 'u' || n[0] == 'r' || n[0] == 'R'))
+        return n.substr(0, 1) + "_{" + n.substr(1) + "}";
     if (n.size() == 2 && n[0] == 'N') return "N_{" + n.substr(1) + "}";
     return n;
 }
 
-}  // namespace
+}   // namespace
 
 std::string latex_text(const ex& e) {
     if (is_a<numeric>(e)) {
@@ -98,15 +98,20 @@ std::string latex_text(const ex& e) {
         std::string s;
         for (const ex& t : sorted_operands(e)) {
             std::string term = latex_text(t);
-            if (!s.empty() && !term.empty() && term[0] == '-') s += " - " + term.substr(1);
-            else s += (s.empty() ? "" : " + ") + term;
+            if (!s.empty() && !term.empty() && term[0] == '-')
+                s += " - " + term.substr(1);
+            else
+                s += (s.empty() ? "" : " + ") + term;
         }
         return s;
     }
     if (is_a<mul>(e)) {
         std::string s, sign;
         for (const ex& f : sorted_operands(e)) {
-            if (is_a<numeric>(f) && ex_to<numeric>(f).is_equal(-1)) { sign = "-"; continue; }
+            if (is_a<numeric>(f) && ex_to<numeric>(f).is_equal(-1)) {
+                sign = "-";
+                continue;
+            }
             std::string t = latex_text(f);
             if (is_a<add>(f) || (is_a<numeric>(f) && ex_to<numeric>(f) < 0)) t = "\\left(" + t + "\\right)";
             s += (s.empty() ? "" : " ") + t;
@@ -270,4 +275,4 @@ void Emitter::assign(const std::string& target, const ex& e) {
     body_ << "    " << target << " = " << v << ";\n";
 }
 
-}  // namespace plate::symbolic
+}   // namespace plate::symbolic

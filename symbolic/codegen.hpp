@@ -70,4 +70,4 @@ std::vector<GiNaC::ex> sorted_operands(const GiNaC::ex& e);
 // LaTeX with the canonical order (symbols printed by name, u1x -> u_{1x}, ...).
 std::string latex_text(const GiNaC::ex& e);
 
-}  // namespace plate::symbolic
+}   // namespace plate::symbolic

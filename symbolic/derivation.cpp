@@ -19,8 +19,8 @@ using namespace detail;
 namespace {
 
 std::vector<realsymbol> all_symbols(const Symbols& S) {
-    std::vector<realsymbol> v = {S.m,  S.g,   S.Jxx, S.Jxy, S.Jxz, S.Jyy, S.Jyz, S.Jzz, S.cz,  S.thd, S.thdd,
-                                 S.sx, S.sy,  S.sz,  S.sxd, S.syd, S.sxdd, S.sydd, S.vx, S.vy, S.xith, S.rho};
+    std::vector<realsymbol> v = {S.m,  S.g,  S.Jxx, S.Jxy, S.Jxz, S.Jyy,  S.Jyz,  S.Jzz, S.cz, S.thd,  S.thdd,
+                                 S.sx, S.sy, S.sz,  S.sxd, S.syd, S.sxdd, S.sydd, S.vx,  S.vy, S.xith, S.rho};
     for (int i = 0; i < 3; ++i) {
         for (const auto* a : {&S.cx, &S.cy, &S.mu, &S.N, &S.ux, &S.uy, &S.p, &S.pd, &S.pdd, &S.w, &S.wd, &S.rx, &S.ry})
             v.push_back((*a)[i]);
@@ -28,13 +28,38 @@ std::vector<realsymbol> all_symbols(const Symbols& S) {
     return v;
 }
 
-}  // namespace
+}   // namespace
 
 Symbols::Symbols()
-    : m("m"), g("g"), Jxx("Jxx"), Jxy("Jxy"), Jxz("Jxz"), Jyy("Jyy"), Jyz("Jyz"), Jzz("Jzz"), cz("cz"),
-      ct("ct"), st("st"), thd("thd"), thdd("thdd"), sx("sx"), sy("sy"), sz("sz"), sxd("sxd"), syd("syd"),
-      sxdd("sxdd"), sydd("sydd"), vx("vx"), vy("vy"), xith("xith"), rho("rho"), fx("fx"), fy("fy"), Fx("Fx"),
-      Fy("Fy"), tauz("tauz") {
+    : m("m"),
+      g("g"),
+      Jxx("Jxx"),
+      Jxy("Jxy"),
+      Jxz("Jxz"),
+      Jyy("Jyy"),
+      Jyz("Jyz"),
+      Jzz("Jzz"),
+      cz("cz"),
+      ct("ct"),
+      st("st"),
+      thd("thd"),
+      thdd("thdd"),
+      sx("sx"),
+      sy("sy"),
+      sz("sz"),
+      sxd("sxd"),
+      syd("syd"),
+      sxdd("sxdd"),
+      sydd("sydd"),
+      vx("vx"),
+      vy("vy"),
+      xith("xith"),
+      rho("rho"),
+      fx("fx"),
+      fy("fy"),
+      Fx("Fx"),
+      Fy("Fy"),
+      tauz("tauz") {
     const char* ax[] = {"x", "y", "z"};
     for (int i = 0; i < 3; ++i) {
         cx[i] = realsymbol(idx("c", i, "x"));
@@ -94,9 +119,9 @@ Frames frames(Derivation& d) {
     matrix R1(3, 3);
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) R1(i, j) = S.R[i][j];
-    const matrix R2{{S.ct, -S.st, 0}, {S.st, S.ct, 0}, {0, 0, 1}};                 // (2)
+    const matrix R2{{S.ct, -S.st, 0}, {S.st, S.ct, 0}, {0, 0, 1}};   // (2)
     const matrix w1 = col(S.w[0], S.w[1], S.w[2]), wd1 = col(S.wd[0], S.wd[1], S.wd[2]);
-    const matrix w2 = col(0, 0, S.thd);                                                // (5)
+    const matrix w2 = col(0, 0, S.thd);   // (5)
     const matrix ez = col(0, 0, 1);
     Jet J;
     for (int i = 0; i < 3; ++i) {
@@ -104,7 +129,7 @@ Frames frames(Derivation& d) {
         J.rules.push_back({S.pd[i], S.pdd[i]});
         J.rules.push_back({S.w[i], S.wd[i]});
     }
-    const matrix R1dot = hat(w1).mul(R1);                                              // (7)
+    const matrix R1dot = hat(w1).mul(R1);   // (7)
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) J.rules.push_back({S.R[i][j], R1dot(i, j)});
     J.rules.push_back({S.sx, S.sxd});
@@ -130,7 +155,7 @@ void contacts(Derivation& d, Frames& F) {
     const matrix s = col(S.sx, S.sy, S.sz), sd = col(S.sxd, S.syd, 0);
     for (int i = 0; i < 3; ++i) {
         const matrix ci = col(S.cx[i], S.cy[i], S.cz);
-        d.slip[i] = expand_all(J.D(s.add(R2.mul(ci))));     // velocity of c_i relative to the plate, in P
+        d.slip[i] = expand_all(J.D(s.add(R2.mul(ci))));   // velocity of c_i relative to the plate, in P
         const matrix printed = sd.add(hat(w2).mul(R2).mul(ci));
         if (i == 0)
             add_finding(d, "text after (14)", is_zero(sub(d.slip[i], printed)), "P c_i' = s' + w2^ R2 c_i",
@@ -162,15 +187,17 @@ void euler_angular_velocity(Derivation& d, Frames& F) {
     const matrix omega3_raw = vee(X.sub(X.transpose()).mul_scalar(numeric(1, 2)));
     // With Q^T a^ Q = (Q^T a)^ for Q in SO(3): R^T R' = (R2^T R1^T w1)^ + (R2^T w2)^, and
     // R2^T w2 = w2 (w2 lies along the rotation axis of R2).
-    d.omega3 = expand_all(R2.transpose().mul(R1.transpose()).mul(w1).add(w2));            // (27)
+    d.omega3 = expand_all(R2.transpose().mul(R1.transpose()).mul(w1).add(w2));   // (27)
     const bool omega_ok = vanishes_on_rotations(to_ex(sub(omega3_raw, d.omega3)), S);
     add_finding(d, "(27)", omega_ok && is_zero(sub(d.omega3, w2.add(R2.transpose().mul(R1.transpose()).mul(w1)))),
                 "w3 = w2 + R2^T R1^T w1", "vee(R^T R'), R = R1 R2, on SO(3)", "agrees (checked exactly on rational rotations)");
     d.omega3_dot = J.D(d.omega3);
     {
         const matrix w2dot = col(0, 0, S.thdd);
-        const matrix printed = w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
-        const matrix corrected = w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
+        const matrix printed =
+            w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
+        const matrix corrected =
+            w2dot.sub(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1)).add(R2.transpose().mul(R1.transpose()).mul(wd1));
         const bool printed_ok = vanishes_on_rotations(to_ex(sub(d.omega3_dot, printed)), S);
         const bool corrected_ok = is_zero(sub(d.omega3_dot, corrected));
         add_finding(d, "(28)", printed_ok, "w3' = w2' - R2^T w2^ R1 w1 + R2^T R1^T w1'",
@@ -183,7 +210,7 @@ void euler_angular_velocity(Derivation& d, Frames& F) {
     F.Jm = Jm;
 }
 
-}  // namespace
+}   // namespace
 
 namespace detail {
 
@@ -196,7 +223,7 @@ matrix newton_euler(const Derivation& d, const Frames& F, const std::array<matri
     matrix Fsum = col(0, 0, 0), torque = col(0, 0, 0);
     for (int i = 0; i < 3; ++i) {
         const matrix Fi = ez.mul_scalar(S.N[i]).add(f[i]);
-        Fsum = Fsum.add(Fi);                                                             // (14)
+        Fsum = Fsum.add(Fi);                                                               // (14)
         torque = torque.add(cross(col(S.cx[i], S.cy[i], S.cz), R2.transpose().mul(Fi)));   // (21) left side
     }
     const matrix EN = Fsum.sub(R1.transpose().mul(Wsdd.mul_scalar(S.m).add(ez.mul_scalar(S.m * S.g))));
@@ -209,7 +236,7 @@ matrix newton_euler(const Derivation& d, const Frames& F, const std::array<matri
     return E;
 }
 
-}  // namespace detail
+}   // namespace detail
 
 namespace {
 
@@ -250,8 +277,7 @@ void linear_system(Derivation& d, const matrix& Eq) {
 // A (31), f_dagger (19) and tau_dagger (30) compared with their printed forms.
 void compare_printed_dynamics(Derivation& d, const Frames& F) {
     const Symbols& S = d.S;
-    const matrix &R1 = F.R1, &R2 = F.R2, &w1 = F.w1, &wd1 = F.wd1, &w2 = F.w2, &ez = F.ez, &s = F.s, &sd = F.sd,
-                 &Jm = F.Jm;
+    const matrix &R1 = F.R1, &R2 = F.R2, &w1 = F.w1, &wd1 = F.wd1, &w2 = F.w2, &ez = F.ez, &s = F.s, &sd = F.sd, &Jm = F.Jm;
     // (31) as printed: [-M' D; -J' H], h_i = c_i^ R2^T d_i (23).
     matrix Ap(6, 6);
     Ap(0, 0) = -S.m;
@@ -286,10 +312,15 @@ void compare_printed_dynamics(Derivation& d, const Frames& F) {
                 "twice d/dt of W s = p + R1 s with R1' = w1^ R1", "agrees");
     // (30)
     const matrix A2 = R2.transpose().mul(R1.transpose()).mul(w1);
-    const matrix t30 = Jm.mul(R2.transpose().mul(hat(w2)).mul(R1.transpose()).mul(w1).mul_scalar(-1)
+    const matrix t30 = Jm.mul(R2.transpose()
+                                  .mul(hat(w2))
+                                  .mul(R1.transpose())
+                                  .mul(w1)
+                                  .mul_scalar(-1)
                                   .add(R2.transpose().mul(R1.transpose()).mul(wd1)))
                            .add(hat(w2).add(hat(A2)).mul(Jm).mul(w2.add(A2)));
-    add_finding(d, "(30)", is_zero(sub(bE, t30)), "tau = J(-R2^T w2^ R1^T w1 + R2^T R1^T w1') + (w2^ + (R2^T R1^T w1)^) J (w2 + R2^T R1^T w1)",
+    add_finding(d, "(30)", is_zero(sub(bE, t30)),
+                "tau = J(-R2^T w2^ R1^T w1 + R2^T R1^T w1') + (w2^ + (R2^T R1^T w1)^) J (w2 + R2^T R1^T w1)",
                 "J w3'|theta''=0 + w3^ J w3", "agrees (with R1^T in the first term, unlike (28))");
 }
 
@@ -330,30 +361,30 @@ void u_dynamics(Derivation& d, const Frames& F) {
                 "(it vanishes when J_xz = J_yz = 0)");
 }
 
-}  // namespace
+}   // namespace
 
 // The stages in the paper's order (and in the order in which they create symbols).
 Derivation derive() {
     Derivation d;
     for (int i = 0; i < 6; ++i) d.bsym[i] = realsymbol("b" + std::to_string(i));
-    Frames F = frames(d);                                  // (1)-(9)
-    contacts(d, F);                                        // text after (14)
-    newton_acceleration(d.S, F);                           // (15)
-    euler_angular_velocity(d, F);                          // (21), (27), (28)
+    Frames F = frames(d);                                          // (1)-(9)
+    contacts(d, F);                                                // text after (14)
+    newton_acceleration(d.S, F);                                   // (15)
+    euler_angular_velocity(d, F);                                  // (21), (27), (28)
     const std::array<matrix, 3> kinetic = kinetic_friction(d.S);   // (17)
     const matrix Eq = newton_euler(d, F, kinetic);
-    linear_system(d, Eq);                                  // (31)
-    compare_printed_dynamics(d, F);                        // (31), (19), (30)
-    pivot_modes(d, F, kinetic);                            // stick-slip modes
+    linear_system(d, Eq);             // (31)
+    compare_printed_dynamics(d, F);   // (31), (19), (30)
+    pivot_modes(d, F, kinetic);       // stick-slip modes
     stuck_mode(d, F);
     support_function(d);
-    u_dynamics(d, F);                                      // (32)-(34)
+    u_dynamics(d, F);   // (32)-(34)
     point_part(d, F);
     thick_reduction(d);
-    staged_reduction(d, F);                                // for code generation
+    staged_reduction(d, F);   // for code generation
     staged_plate_frame_b(d, F);
-    thin_part(d, F);                                       // Appendix A, (37), (38)
-    limit_surface(d);                                      // Appendix B
+    thin_part(d, F);    // Appendix A, (37), (38)
+    limit_surface(d);   // Appendix B
     return d;
 }
 
@@ -379,7 +410,8 @@ std::string latex_report(const Derivation& d) {
     o << "\\paragraph{(33)-(34) U-dynamics right-hand side.} $\\tilde b = " << mat(d.b_U) << "$\n\n";
     o << "\\paragraph{Appendix A: thin part, rows 3 and 6 swapped.} $" << mat(d.A_thin_swapped) << "$\n\n";
     o << "\\paragraph{(38) normal forces of a thin part.} $" << mat(d.M38) << " n = " << mat(d.r38_U) << "$\n\n";
-    o << "\\paragraph{Point part.} $\\begin{pmatrix}\\ddot s_x\\\\ \\ddot s_y\\\\ N\\end{pmatrix} = " << mat(d.point_solution) << "$\n\n";
+    o << "\\paragraph{Point part.} $\\begin{pmatrix}\\ddot s_x\\\\ \\ddot s_y\\\\ N\\end{pmatrix} = " << mat(d.point_solution)
+      << "$\n\n";
     return o.str();
 }
 
@@ -388,9 +420,9 @@ std::string findings_markdown(const Derivation& d) {
     o << "<!-- GENERATED by symbolic/derive (plate) from the symbolic derivation. Do not edit. -->\n";
     o << "| equation | verdict | printed | derived | why |\n|---|---|---|---|---|\n";
     for (const auto& f : d.findings)
-        o << "| " << f.equation << " | " << (f.agrees ? "agrees" : "**differs**") << " | `" << f.printed << "` | `"
-          << f.derived << "` | " << f.reason << " |\n";
+        o << "| " << f.equation << " | " << (f.agrees ? "agrees" : "**differs**") << " | `" << f.printed << "` | `" << f.derived
+          << "` | " << f.reason << " |\n";
     return o.str();
 }
 
-}  // namespace plate::symbolic
+}   // namespace plate::symbolic

@@ -25,16 +25,16 @@ struct Symbols {
     Symbols();
     realsymbol m, g;
     realsymbol Jxx, Jxy, Jxz, Jyy, Jyz, Jzz;
-    std::array<realsymbol, 3> cx, cy;     // contacts c_i in S
-    realsymbol cz;                        // their common z
+    std::array<realsymbol, 3> cx, cy;   // contacts c_i in S
+    realsymbol cz;                      // their common z
     std::array<realsymbol, 3> mu;
-    realsymbol ct, st, thd, thdd;         // cos theta, sin theta, theta', theta''
+    realsymbol ct, st, thd, thdd;   // cos theta, sin theta, theta', theta''
     realsymbol sx, sy, sz, sxd, syd, sxdd, sydd;
     std::array<realsymbol, 3> N;
-    std::array<realsymbol, 3> ux, uy;     // unit slip directions (inputs, so entries stay polynomial)
-    std::array<realsymbol, 3> p, pd, pdd; // plate position, velocity, acceleration (W)
+    std::array<realsymbol, 3> ux, uy;             // unit slip directions (inputs, so entries stay polynomial)
+    std::array<realsymbol, 3> p, pd, pdd;         // plate position, velocity, acceleration (W)
     std::array<std::array<realsymbol, 3>, 3> R;   // R1 entries
-    std::array<realsymbol, 3> w, wd;      // omega1, omega1' (W)
+    std::array<realsymbol, 3> w, wd;              // omega1, omega1' (W)
     // limit surface: twist relative to the plate in scaled coordinates, contact positions in P
     realsymbol vx, vy, xith, rho;
     std::array<realsymbol, 3> rx, ry;
@@ -48,25 +48,25 @@ struct Symbols {
 struct Finding {
     std::string equation;   // e.g. "(28)"
     bool agrees = false;
-    std::string printed;    // the printed form (text)
-    std::string derived;    // the derived / corrected form (text)
+    std::string printed;   // the printed form (text)
+    std::string derived;   // the derived / corrected form (text)
     std::string reason;
 };
 
 struct Derivation {
     Symbols S;
-    matrix slip[3];           // sliding velocity s' + w2^ R2 c_i of each contact (P frame), 3x1
-    matrix A;                 // 6x6, (31): rows Newton x y z, Euler x y z; columns s_x'', s_y'', theta'', N1..3
-    matrix b_full;            // 6x1, [f_dagger (19); tau_dagger (30)]
-    matrix b_U;               // 6x1, [f~_dagger (33); tau~_dagger (34)]
-    matrix omega3, omega3_dot;  // (27), (28) as derived
+    matrix slip[3];              // sliding velocity s' + w2^ R2 c_i of each contact (P frame), 3x1
+    matrix A;                    // 6x6, (31): rows Newton x y z, Euler x y z; columns s_x'', s_y'', theta'', N1..3
+    matrix b_full;               // 6x1, [f_dagger (19); tau_dagger (30)]
+    matrix b_U;                  // 6x1, [f~_dagger (33); tau~_dagger (34)]
+    matrix omega3, omega3_dot;   // (27), (28) as derived
     // Point part: z = [s_x'', s_y'', N], A_point z = b (first three rows of b with s_z = 0).
-    matrix A_point;           // 3x3
-    matrix point_solution;    // 3x1: s_x'', s_y'', N in terms of b0..b2 symbols
+    matrix A_point;                   // 3x3
+    matrix point_solution;            // 3x1: s_x'', s_y'', N in terms of b0..b2 symbols
     std::array<realsymbol, 6> bsym;   // symbols standing for b entries in solutions
     // Thick part: Schur reduction of A z = b to a 3x3 system M n = r (rows 1-2 and 6 eliminated).
-    matrix M_reduced, r_reduced;        // r in terms of bsym
-    matrix back_substitution;           // q'' in terms of n (N symbols) and bsym
+    matrix M_reduced, r_reduced;   // r in terms of bsym
+    matrix back_substitution;      // q'' in terms of n (N symbols) and bsym
     // The same, staged for code generation: in terms of placeholders a_rk for A's non-constant
     // entries (A_placeholders lists them with their expressions).
     matrix M_staged, r_staged, back_staged;
@@ -77,13 +77,13 @@ struct Derivation {
     std::vector<std::pair<realsymbol, ex>> plate_frame_placeholders;
     // Thin part (Appendix A): A after swapping rows 3 and 6, and the normal-force system (38).
     matrix A_thin_swapped;
-    matrix M38, r38_U;                  // (38): M38 n = r38 (U-dynamics right-hand side)
+    matrix M38, r38_U;   // (38): M38 n = r38 (U-dynamics right-hand side)
     // Thick part: the coupling that the thin part loses.
     matrix A_thick_swapped;
     // Limit surface (Appendix B): frictional wrench on a thin part from its relative twist,
     // scaled: xi = (v_x, v_y, rho omega), w = (F_x, F_y, tau / rho); and its dissipation power.
-    matrix wrench;                      // 3x1
-    ex power;                           // sum mu_i N_i |v_i| (the wrench is -grad of it)
+    matrix wrench;   // 3x1
+    ex power;        // sum mu_i N_i |v_i| (the wrench is -grad of it)
     // Stick-slip modes (modes.hpp). Pivot k, unknowns z = (s_x'', s_y'', theta'', N1..3, f_x, f_y):
     // pivot_A[k] z = [b; pivot_c[k]], rows Newton x y z, Euler x y z, then contact k's relative
     // acceleration s'' + theta'' e_z x r_k - theta'^2 r_k = 0; pivot_c[k] = theta'^2 r_k (turning
@@ -110,4 +110,4 @@ std::string latex_report(const Derivation& d);
 // The findings as Markdown.
 std::string findings_markdown(const Derivation& d);
 
-}  // namespace plate::symbolic
+}   // namespace plate::symbolic

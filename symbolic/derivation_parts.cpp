@@ -36,7 +36,7 @@ Reduced reduce(const matrix& A, const std::array<realsymbol, 6>& b, const std::a
     return out;
 }
 
-}  // namespace
+}   // namespace
 
 // --- Stick-slip modes (numeric/include/plate/modes.hpp) -------------------------------------
 // Pivot k: contact k carries an unknown static friction f = (f_x, f_y) (P frame) instead of
@@ -93,8 +93,8 @@ void pivot_modes(Derivation& d, const Frames& F, const std::array<matrix, 3>& ki
     // The constraint is s'' + theta'' e_z x r_k - theta'^2 r_k = 0 (r_k = R2 c_k): check it.
     {
         const matrix rk = F.R2.mul(col(S.cx[0], S.cy[0], S.cz));
-        const matrix expect = col(S.sxdd - S.thdd * rk(1, 0) - S.thd * S.thd * rk(0, 0),
-                                  S.sydd + S.thdd * rk(0, 0) - S.thd * S.thd * rk(1, 0), 0);
+        const matrix expect =
+            col(S.sxdd - S.thdd * rk(1, 0) - S.thd * S.thd * rk(0, 0), S.sydd + S.thdd * rk(0, 0) - S.thd * S.thd * rk(1, 0), 0);
         add_finding(d, "pivot constraint", is_zero(sub(J.D(d.slip[0]), expect)), "(not in the paper)",
                     "d/dt (s' + w2^ R2 c_k) = s'' + theta'' e_z x r_k - theta'^2 r_k = 0",
                     "a contact held by static friction does not accelerate relative to the plate; the centripetal "
@@ -159,8 +159,9 @@ void stuck_mode(Derivation& d, const Frames& F) {
     const ex sol = lsolve(eqs, lst{S.N[0], S.N[1], S.N[2], S.Fx, S.Fy, S.tauz});
     // Written over the contacts' determinant (fixed here: normal() picks the sign of a
     // denominator from GiNaC's run-dependent term order).
-    d.stuck_det = (S.cx[1] * S.cy[2] - S.cx[2] * S.cy[1] - S.cx[0] * S.cy[2] + S.cx[2] * S.cy[0] +
-                   S.cx[0] * S.cy[1] - S.cx[1] * S.cy[0]).expand();
+    d.stuck_det =
+        (S.cx[1] * S.cy[2] - S.cx[2] * S.cy[1] - S.cx[0] * S.cy[2] + S.cx[2] * S.cy[0] + S.cx[0] * S.cy[1] - S.cx[1] * S.cy[0])
+            .expand();
     d.stuck_solution = matrix(6, 1);
     for (int r = 0; r < 6; ++r) {
         const ex num = (sol.op(r).rhs() * d.stuck_det).normal().expand();
@@ -278,15 +279,14 @@ void staged_reduction(Derivation& d, const Frames& F) {
 // ap = R1^T p'', ga = R1^T e_z, checked against b on SO(3).
 void staged_plate_frame_b(Derivation& d, const Frames& F) {
     const Symbols& S = d.S;
-    const matrix &R1 = F.R1, &R2 = F.R2, &w1 = F.w1, &wd1 = F.wd1, &w2 = F.w2, &ez = F.ez, &s = F.s, &sd = F.sd,
-                 &Jm = F.Jm;
+    const matrix &R1 = F.R1, &R2 = F.R2, &w1 = F.w1, &wd1 = F.wd1, &w2 = F.w2, &ez = F.ez, &s = F.s, &sd = F.sd, &Jm = F.Jm;
     const char* ax[] = {"x", "y", "z"};
     matrix Om(3, 1), al(3, 1), ap(3, 1), ga(3, 1);
     const matrix R1tw = R1.transpose().mul(w1), R1twd = R1.transpose().mul(wd1);
     const matrix R1tp = R1.transpose().mul(col(S.pdd[0], S.pdd[1], S.pdd[2])), R1tez = R1.transpose().mul(ez);
     for (int i = 0; i < 3; ++i) {
-        const realsymbol o(std::string("Om") + ax[i]), a(std::string("al") + ax[i]),
-            p(std::string("ap") + ax[i]), gm(std::string("ga") + ax[i]);
+        const realsymbol o(std::string("Om") + ax[i]), a(std::string("al") + ax[i]), p(std::string("ap") + ax[i]),
+            gm(std::string("ga") + ax[i]);
         d.plate_frame_placeholders.push_back({o, R1tw(i, 0)});
         d.plate_frame_placeholders.push_back({a, R1twd(i, 0)});
         d.plate_frame_placeholders.push_back({p, R1tp(i, 0)});
@@ -297,8 +297,11 @@ void staged_plate_frame_b(Derivation& d, const Frames& F) {
         ga(i, 0) = gm;
     }
     // R1^T (w^ w^ R1 s) = Om^ Om^ s, R1^T (w'^ R1 s) = al^ s, R1^T (w^ R1 s') = Om^ s'.
-    const matrix f = ap.add(cross(Om, cross(Om, s))).add(cross(al, s)).add(cross(Om, sd).mul_scalar(2))
-                         .add(ga.mul_scalar(S.g)).mul_scalar(S.m);
+    const matrix f = ap.add(cross(Om, cross(Om, s)))
+                         .add(cross(al, s))
+                         .add(cross(Om, sd).mul_scalar(2))
+                         .add(ga.mul_scalar(S.g))
+                         .mul_scalar(S.m);
     const matrix R2t = R2.transpose();
     const matrix w3 = w2.add(R2t.mul(Om));
     const matrix tau = Jm.mul(R2t.mul(cross(w2, Om)).mul_scalar(-1).add(R2t.mul(al))).add(cross(w3, Jm.mul(w3)));
@@ -340,8 +343,7 @@ void thin_part(Derivation& d, const Frames& F) {
         for (int k = 0; k < 3; ++k) lower_zero = lower_zero && d.A_thin_swapped(r, k).is_zero();
     for (int r = 0; r < 3; ++r)
         for (int k = 3; k < 6; ++k) upper_nonzero = upper_nonzero || !d.A_thin_swapped(r, k).is_zero();
-    add_finding(d, "Appendix A (block diagonal)", lower_zero && !upper_nonzero,
-                "swapping rows 3 and 6 makes A block diagonal",
+    add_finding(d, "Appendix A (block diagonal)", lower_zero && !upper_nonzero, "swapping rows 3 and 6 makes A block diagonal",
                 "swapping rows 3 and 6 makes A block upper triangular: [[-m I, -, D_xy], [0, -J_zz, h_z], [0, 0, M38]]",
                 "the lower-left block vanishes, so n decouples (M38 n = r38), but the upper-right block "
                 "holds the friction terms d_i,xy and h_i,z, which are not zero; the claim that matters, "
@@ -376,7 +378,8 @@ void thin_part(Derivation& d, const Frames& F) {
             P37(4, 3 + i) = -S.cx[i];
             P37(5, 3 + i) = At(5, 3 + i);
         }
-        add_finding(d, "(37)", is_zero(sub(At, P37)), "thin-part A: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1], [0 0 0 c_y], [0 0 0 -c_x], [0 0 -J_zz h_z]",
+        add_finding(d, "(37)", is_zero(sub(At, P37)),
+                    "thin-part A: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1], [0 0 0 c_y], [0 0 0 -c_x], [0 0 -J_zz h_z]",
                     "A with c_z = 0, J_xz = J_yz = 0", "agrees: h_i = [c_i,y, -c_i,x, h_i,z]");
     }
 }
@@ -390,7 +393,7 @@ void limit_surface(Derivation& d) {
     d.power = 0;
     ex Fx = 0, Fy = 0, tau = 0;
     for (int i = 0; i < 3; ++i) {
-        const ex om = S.xith / S.rho;                       // xi_theta = rho omega
+        const ex om = S.xith / S.rho;   // xi_theta = rho omega
         const ex vix = S.vx - om * S.ry[i], viy = S.vy + om * S.rx[i];
         const ex speed = sqrt(vix * vix + viy * viy);
         const ex fx = -S.mu[i] * S.N[i] * vix / speed, fy = -S.mu[i] * S.N[i] * viy / speed;
@@ -403,7 +406,7 @@ void limit_surface(Derivation& d) {
     // term order (which decides, e.g., where a sign is pulled out of a sum).
     d.wrench(0, 0) = Fx.expand();
     d.wrench(1, 0) = Fy.expand();
-    d.wrench(2, 0) = (tau / S.rho).expand();                 // w_theta = tau / rho
+    d.wrench(2, 0) = (tau / S.rho).expand();   // w_theta = tau / rho
     const ex n0 = (d.wrench(0, 0) + d.power.diff(S.vx)).normal();
     const ex n1 = (d.wrench(1, 0) + d.power.diff(S.vy)).normal();
     const ex n2 = (d.wrench(2, 0) + d.power.diff(S.xith)).normal();
@@ -415,4 +418,4 @@ void limit_surface(Derivation& d) {
                 "normal to the level set (the limit surface) in wrench space");
 }
 
-}  // namespace plate::symbolic::detail
+}   // namespace plate::symbolic::detail

@@ -32,7 +32,9 @@ inline matrix map(const matrix& M, const std::function<ex(const ex&)>& f) {
         for (unsigned j = 0; j < M.cols(); ++j) out(i, j) = f(M(i, j));
     return out;
 }
-inline matrix expand_all(const matrix& M) { return map(M, [](const ex& e) { return e.expand(); }); }
+inline matrix expand_all(const matrix& M) {
+    return map(M, [](const ex& e) { return e.expand(); });
+}
 inline matrix sub(const matrix& a, const matrix& b) { return a.sub(b); }
 inline bool is_zero(const matrix& M) {
     for (unsigned i = 0; i < M.rows(); ++i)
@@ -53,7 +55,9 @@ struct Jet {
         }
         return r.expand();
     }
-    matrix D(const matrix& M) const { return map(M, [this](const ex& e) { return D(e); }); }
+    matrix D(const matrix& M) const {
+        return map(M, [this](const ex& e) { return D(e); });
+    }
 };
 
 // What the stages share: the frames (1)-(9), the jet rule, the part's position and velocity in P,
@@ -62,10 +66,10 @@ struct Frames {
     matrix R1, R2;        // plate and part rotations, (2)
     matrix w1, wd1, w2;   // omega1, omega1', omega2 = theta' e_z (5)
     matrix ez;
-    Jet J;                // the total time derivative
-    matrix s, sd;         // s and s' (s_z constant, assumption 1)
-    matrix Wsdd;          // second time derivative of W s = p + R1 s
-    matrix Jm;            // J in S
+    Jet J;          // the total time derivative
+    matrix s, sd;   // s and s' (s_z constant, assumption 1)
+    matrix Wsdd;    // second time derivative of W s = p + R1 s
+    matrix Jm;      // J in S
 };
 
 // Records a comparison of a derived equation with the paper's printed form.
@@ -80,13 +84,13 @@ matrix newton_euler(const Derivation& d, const Frames& F, const std::array<matri
 
 // The stages of derivation_parts.cpp, in the order derive() runs them.
 void pivot_modes(Derivation& d, const Frames& F, const std::array<matrix, 3>& kinetic);   // stick-slip: pivots
-void stuck_mode(Derivation& d, const Frames& F);           // stick-slip: stuck
-void support_function(Derivation& d);                      // the friction set's support function
-void point_part(Derivation& d, const Frames& F);           // one contact at the centre of mass
-void thick_reduction(Derivation& d);                       // A z = b reduced to 3x3 in n
-void staged_reduction(Derivation& d, const Frames& F);     // the same with placeholders, for codegen
-void staged_plate_frame_b(Derivation& d, const Frames& F); // b in plate-frame vectors, for codegen
-void thin_part(Derivation& d, const Frames& F);            // Appendix A, (37), (38)
-void limit_surface(Derivation& d);                         // Appendix B
+void stuck_mode(Derivation& d, const Frames& F);                                          // stick-slip: stuck
+void support_function(Derivation& d);                                                     // the friction set's support function
+void point_part(Derivation& d, const Frames& F);                                          // one contact at the centre of mass
+void thick_reduction(Derivation& d);                                                      // A z = b reduced to 3x3 in n
+void staged_reduction(Derivation& d, const Frames& F);       // the same with placeholders, for codegen
+void staged_plate_frame_b(Derivation& d, const Frames& F);   // b in plate-frame vectors, for codegen
+void thin_part(Derivation& d, const Frames& F);              // Appendix A, (37), (38)
+void limit_surface(Derivation& d);                           // Appendix B
 
-}  // namespace plate::symbolic::detail
+}   // namespace plate::symbolic::detail

@@ -28,13 +28,12 @@ const char* kBanner =
     "// DO NOT EDIT: regenerate with `cmake --build build --target kernels`. A test fails when this\n"
     "// file differs from a fresh generation.\n";
 
-const char* kInputFields[] = {"m",   "g",   "Jxx", "Jxy", "Jxz", "Jyy", "Jyz", "Jzz", "c1x", "c1y", "c2x",
-                              "c2y", "c3x", "c3y", "cz",  "mu1", "mu2", "mu3", "ct",  "st",  "thd", "sx",
-                              "sy",  "sz",  "sxd", "syd", "u1x", "u1y", "u2x", "u2y", "u3x", "u3y", "pddx",
-                              "pddy", "pddz", "wx", "wy",  "wz",  "wdx", "wdy", "wdz", "R11", "R12", "R13",
-                              "R21", "R22", "R23", "R31", "R32", "R33"};
-const char* kWrenchFields[] = {"N1", "N2", "N3", "r1x", "r1y", "r2x", "r2y", "r3x", "r3y", "mu1", "mu2", "mu3",
-                               "rho", "vx", "vy", "xith"};
+const char* kInputFields[] = {"m",   "g",   "Jxx", "Jxy", "Jxz", "Jyy", "Jyz",  "Jzz",  "c1x",  "c1y", "c2x", "c2y", "c3x",
+                              "c3y", "cz",  "mu1", "mu2", "mu3", "ct",  "st",   "thd",  "sx",   "sy",  "sz",  "sxd", "syd",
+                              "u1x", "u1y", "u2x", "u2y", "u3x", "u3y", "pddx", "pddy", "pddz", "wx",  "wy",  "wz",  "wdx",
+                              "wdy", "wdz", "R11", "R12", "R13", "R21", "R22",  "R23",  "R31",  "R32", "R33"};
+const char* kWrenchFields[] = {"N1",  "N2",  "N3",  "r1x", "r1y", "r2x", "r2y", "r3x",
+                               "r3y", "mu1", "mu2", "mu3", "rho", "vx",  "vy",  "xith"};
 
 Inputs inputs(const std::vector<std::string>& fields, const std::string& prefix) {
     Inputs m;
@@ -78,7 +77,9 @@ std::string emit(const Kernel& k) {
     std::string sig = k.signature;
     for (const char* from : {"const KernelInput& in", "const WrenchInput& in"}) {
         const auto p = sig.find(from);
-        if (p != std::string::npos) sig.replace(p, std::string(from).size(), std::string(from).replace(std::string(from).find("& in"), 4, "& __restrict in"));
+        if (p != std::string::npos)
+            sig.replace(p, std::string(from).size(),
+                        std::string(from).replace(std::string(from).find("& in"), 4, "& __restrict in"));
     }
     for (std::size_t p = 0; (p = sig.find("double* ", p)) != std::string::npos; p += 19) sig.replace(p, 8, "double* __restrict ");
     o << k.comment << "inline void " << sig << " {\n" << em.code() << "}\n\n";
@@ -98,8 +99,7 @@ ex thin_normal_force(int c, const matrix& b) {
 // Binds M's non-numeric entries m_ic and r_i, the cofactors k_ic, detM, idet = 1/detM and N_c;
 // returns detM, and (if asked) M^-1 = idet K^T in the bound symbols, for solves with other
 // right-hand sides.
-ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, const Symbols& S,
-                       matrix* inverse = nullptr) {
+ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, const Symbols& S, matrix* inverse = nullptr) {
     matrix Mg(3, 3);
     ex rg[3];
     for (int i = 0; i < 3; ++i) {
@@ -154,8 +154,8 @@ ex bind_cofactor_solve(Kernel& k, const matrix& M, const std::array<ex, 3>& r, c
 // M(u) N = r (r does not depend on u), dN/du_j = -M^-1 (dM/du_j) N; then
 // d q''_r/du_j = d back_r/du_j + sum_k d back_r/dN_k dN_k/du_j. For a thin or point part N does not
 // depend on u (minv empty), and only the first term remains.
-void bind_slip_jacobian(Kernel& k, const std::array<ex, 3>& back, const matrix* M, const matrix* minv,
-                        const Symbols& S, int contacts) {
+void bind_slip_jacobian(Kernel& k, const std::array<ex, 3>& back, const matrix* M, const matrix* minv, const Symbols& S,
+                        int contacts) {
     for (int j = 0; j < 2 * contacts; ++j) {
         const ex u = j % 2 == 0 ? S.ux[j / 2] : S.uy[j / 2];
         std::array<ex, 3> dN{0, 0, 0};
@@ -198,7 +198,8 @@ void write(const std::filesystem::path& p, const std::string& text) {
 std::optional<int> parse_options(int argc, char** argv, std::filesystem::path& root) {
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        if (a == "--out" && i + 1 < argc) root = argv[++i];
+        if (a == "--out" && i + 1 < argc)
+            root = argv[++i];
         else if (a == "--help") {
             std::cout << "usage: derive --out ROOT\n";
             return 0;
@@ -221,31 +222,45 @@ std::optional<int> parse_options(int argc, char** argv, std::filesystem::path& r
 void dynamics_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& kernels) {
     const Symbols& S = d.S;
     {
-        Kernel k{"// A of (31)/(32), row-major 6x6: rows Newton x y z, Euler x y z; columns s_x'', s_y'',\n"
-                 "// theta'', N1, N2, N3. Slip directions enter as unit vectors u_i.\n",
-                 "thick_A(const KernelInput& in, double* A)", in, {}, {}};
+        Kernel k{
+            "// A of (31)/(32), row-major 6x6: rows Newton x y z, Euler x y z; columns s_x'', s_y'',\n"
+            "// theta'', N1, N2, N3. Slip directions enter as unit vectors u_i.\n",
+            "thick_A(const KernelInput& in, double* A)",
+            in,
+            {},
+            {}};
         for (int r = 0; r < 6; ++r)
             for (int c = 0; c < 6; ++c) k.outputs.push_back({"A[" + std::to_string(6 * r + c) + "]", d.A(r, c)});
         kernels.push_back(k);
     }
     {
         Kernel k{"// b~ of (32): [f~ (33); tau~ (34)] (U- and reduced U-dynamics). A point part uses b[0..2], s_z = 0.\n",
-                 "b_U(const KernelInput& in, double* b)", in, {}, {}};
+                 "b_U(const KernelInput& in, double* b)",
+                 in,
+                 {},
+                 {}};
         for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.b_U(r, 0)});
         kernels.push_back(k);
     }
     {
-        Kernel k{"// b of (31): [f_dagger (19); tau_dagger (30)] (full dynamics; R1 entries R_ij, omega1 = w),\n"
-                 "// through the plate-frame vectors Om = R1^T w, al = R1^T w', ap = R1^T p'', ga = R1^T e_z.\n",
-                 "b_full(const KernelInput& in, double* b)", in, {}, {d.plate_frame_placeholders.begin(), d.plate_frame_placeholders.end()}};
+        Kernel k{
+            "// b of (31): [f_dagger (19); tau_dagger (30)] (full dynamics; R1 entries R_ij, omega1 = w),\n"
+            "// through the plate-frame vectors Om = R1^T w, al = R1^T w', ap = R1^T p'', ga = R1^T e_z.\n",
+            "b_full(const KernelInput& in, double* b)",
+            in,
+            {},
+            {d.plate_frame_placeholders.begin(), d.plate_frame_placeholders.end()}};
         for (int r = 0; r < 6; ++r) k.outputs.push_back({"b[" + std::to_string(r) + "]", d.b_full_staged(r, 0)});
         kernels.push_back(k);
     }
     {
-        Kernel k{"// A z = b reduced to M n = r (3x3, row-major): rows 1, 2 of (31) give s'', row 6 gives theta'',\n"
-                 "// eliminated from rows 3, 4, 5. Solve M n = r, then back_substitution.\n",
-                 "thick_reduced(const KernelInput& in, const double* b, double* M, double* r)",
-                 with(in, "b", "b", 6), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
+        Kernel k{
+            "// A z = b reduced to M n = r (3x3, row-major): rows 1, 2 of (31) give s'', row 6 gives theta'',\n"
+            "// eliminated from rows 3, 4, 5. Solve M n = r, then back_substitution.\n",
+            "thick_reduced(const KernelInput& in, const double* b, double* M, double* r)",
+            with(in, "b", "b", 6),
+            {},
+            {d.A_placeholders.begin(), d.A_placeholders.end()}};
         for (int i = 0; i < 3; ++i) {
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"M[" + std::to_string(3 * i + c) + "]", d.M_staged(i, c)});
             k.outputs.push_back({"r[" + std::to_string(i) + "]", d.r_staged(i, 0)});
@@ -255,7 +270,9 @@ void dynamics_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>
     {
         Kernel k{"// q'' = (s_x'', s_y'', theta'') from the normal forces n and b (rows 1, 2, 6 of (31)).\n",
                  "back_substitution(const KernelInput& in, const double* b, const double* n, double* qdd)",
-                 with(with(in, "b", "b", 6), "N", "n", 3), {}, {}};
+                 with(with(in, "b", "b", 6), "N", "n", 3),
+                 {},
+                 {}};
         k.bindings.assign(d.A_placeholders.begin(), d.A_placeholders.end());   // emit() keeps the ones used
         for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
         kernels.push_back(k);
@@ -264,10 +281,13 @@ void dynamics_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>
         // One kernel for a thick part: A's entries, the reduced 3x3 system, its solution by
         // cofactors (det returned, so the caller can fall back to a pivoted LU when the
         // system is near singular), and the back substitution.
-        Kernel k{"// Thick part, all of A z = b: n by cofactors of the reduced 3x3 system M n = r, then q''.\n"
-                 "// det = det M (near zero only for near-collinear contacts).\n",
-                 "thick_solve(const KernelInput& in, const double* b, double* n, double* qdd, double* det)",
-                 with(in, "b", "b", 6), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
+        Kernel k{
+            "// Thick part, all of A z = b: n by cofactors of the reduced 3x3 system M n = r, then q''.\n"
+            "// det = det M (near zero only for near-collinear contacts).\n",
+            "thick_solve(const KernelInput& in, const double* b, double* n, double* qdd, double* det)",
+            with(in, "b", "b", 6),
+            {},
+            {d.A_placeholders.begin(), d.A_placeholders.end()}};
         const ex dsym = bind_cofactor_solve(k, d.M_staged, {d.r_staged(0, 0), d.r_staged(1, 0), d.r_staged(2, 0)}, S);
         for (int c = 0; c < 3; ++c) k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
         for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", d.back_staged(i, 0)});
@@ -282,10 +302,13 @@ void thin_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& ke
     {
         // Specialised to the thin part (c_z = 0, J_xz = J_yz = 0, s_z = 0): b~ and the solve.
         const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};
-        Kernel k{"// Thin part, U-dynamics: b~ (33)-(34), n = M38^-1 (b[3], b[4], b[2]) (38) with the part's constant\n"
-                 "// inverse Minv (row-major), then q''. Specialised to c_z = 0, J_xz = J_yz = 0.\n",
-                 "thin_solve_U(const KernelInput& in, const double* Minv, double* b, double* n, double* qdd)",
-                 with(in, "Minv", "Minv", 9), {}, {}};
+        Kernel k{
+            "// Thin part, U-dynamics: b~ (33)-(34), n = M38^-1 (b[3], b[4], b[2]) (38) with the part's constant\n"
+            "// inverse Minv (row-major), then q''. Specialised to c_z = 0, J_xz = J_yz = 0.\n",
+            "thin_solve_U(const KernelInput& in, const double* Minv, double* b, double* n, double* qdd)",
+            with(in, "Minv", "Minv", 9),
+            {},
+            {}};
         matrix bs(6, 1);
         for (int r = 0; r < 6; ++r) bs(r, 0) = d.bsym[r];
         for (int r = 0; r < 6; ++r) k.bindings.push_back({d.bsym[r], d.b_U(r, 0).subs(thin)});
@@ -299,7 +322,9 @@ void thin_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& ke
     {
         Kernel k{"// Thin part, any b: n = M38^-1 (b[3], b[4], b[2]) (38), then q''.\n",
                  "thin_solve(const KernelInput& in, const double* b, const double* Minv, double* n, double* qdd)",
-                 with(with(in, "b", "b", 6), "Minv", "Minv", 9), {}, {d.A_placeholders.begin(), d.A_placeholders.end()}};
+                 with(with(in, "b", "b", 6), "Minv", "Minv", 9),
+                 {},
+                 {d.A_placeholders.begin(), d.A_placeholders.end()}};
         matrix bs(6, 1);
         for (int r = 0; r < 6; ++r) bs(r, 0) = d.bsym[r];
         for (int c = 0; c < 3; ++c) k.bindings.push_back({S.N[c], thin_normal_force(c, bs)});
@@ -313,9 +338,12 @@ void thin_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& ke
 // slot count among the header's constants.
 Kernel config_kernel(const std::string& name, const std::string& what, const Staging& st, const std::string& extra_sig,
                      Inputs cin, std::vector<std::string>& constants) {
-    Kernel k{"// " + what + ": the per-configuration slots C of " + name + " (" +
-                 std::to_string(st.slots().size()) + " values).\n",
-             name + "_config(const KernelInput& in, " + extra_sig + "double* C)", std::move(cin), {}, {}};
+    Kernel k{
+        "// " + what + ": the per-configuration slots C of " + name + " (" + std::to_string(st.slots().size()) + " values).\n",
+        name + "_config(const KernelInput& in, " + extra_sig + "double* C)",
+        std::move(cin),
+        {},
+        {}};
     for (std::size_t i = 0; i < st.slots().size(); ++i)
         k.outputs.push_back({"C[" + std::to_string(i) + "]", st.slots()[i].second});
     constants.push_back("constexpr int " + name + "_slots = " + std::to_string(st.slots().size()) + ";");
@@ -328,11 +356,14 @@ void reduced_U_thick_kernels(const Derivation& d, const Inputs& in, const std::v
                              std::vector<Kernel>& kernels, std::vector<std::string>& constants) {
     const Symbols& S = d.S;
     Staging st(fast, "C");
-    Kernel k{"// Thick part, reduced U-dynamics (35), one evaluation from the slots C of\n"
-             "// reduced_U_thick_config: M n = r by cofactors, det = det M (near zero only for\n"
-             "// near-collinear contacts: the caller then falls back to thick_reduced and a pivoted LU).\n",
-             "reduced_U_thick(const KernelInput& in, const double* C, double* n, double* qdd, double* det)", in,
-             {}, {}};
+    Kernel k{
+        "// Thick part, reduced U-dynamics (35), one evaluation from the slots C of\n"
+        "// reduced_U_thick_config: M n = r by cofactors, det = det M (near zero only for\n"
+        "// near-collinear contacts: the caller then falls back to thick_reduced and a pivoted LU).\n",
+        "reduced_U_thick(const KernelInput& in, const double* C, double* n, double* qdd, double* det)",
+        in,
+        {},
+        {}};
     matrix M(3, 3);
     std::array<ex, 3> r;
     for (int i = 0; i < 3; ++i) {
@@ -346,10 +377,14 @@ void reduced_U_thick_kernels(const Derivation& d, const Inputs& in, const std::v
     for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", back[i]});
     k.outputs.push_back({"det[0]", dsym});
     // The same evaluation with d q''/d u (variational equations, implicit methods).
-    Kernel kj{"// Thick part, reduced U-dynamics: reduced_U_thick and dqdd[6 r + j] = d q''_r / d u_j\n"
-              "// (u = u1x, u1y, u2x, u2y, u3x, u3y; dN/du = -M^-1 (dM/du) N by the same cofactors).\n",
-              "reduced_U_thick_du(const KernelInput& in, const double* C, double* n, double* qdd, double* det, "
-              "double* dqdd)", in, {}, {}};
+    Kernel kj{
+        "// Thick part, reduced U-dynamics: reduced_U_thick and dqdd[6 r + j] = d q''_r / d u_j\n"
+        "// (u = u1x, u1y, u2x, u2y, u3x, u3y; dN/du = -M^-1 (dM/du) N by the same cofactors).\n",
+        "reduced_U_thick_du(const KernelInput& in, const double* C, double* n, double* qdd, double* det, "
+        "double* dqdd)",
+        in,
+        {},
+        {}};
     matrix minv;
     bind_cofactor_solve(kj, M, r, S, &minv);
     kj.outputs = k.outputs;
@@ -368,9 +403,13 @@ void reduced_U_thin_kernels(const Derivation& d, const Inputs& in, const std::ve
     const Symbols& S = d.S;
     const exmap thin{{S.cz, 0}, {S.Jxz, 0}, {S.Jyz, 0}, {S.sz, 0}};
     Staging st(fast, "C");
-    Kernel k{"// Thin part, reduced U-dynamics (35), one evaluation from the slots C of\n"
-             "// reduced_U_thin_config: n (38) affine in the plate's acceleration, then q''.\n",
-             "reduced_U_thin(const KernelInput& in, const double* C, double* n, double* qdd)", in, {}, {}};
+    Kernel k{
+        "// Thin part, reduced U-dynamics (35), one evaluation from the slots C of\n"
+        "// reduced_U_thin_config: n (38) affine in the plate's acceleration, then q''.\n",
+        "reduced_U_thin(const KernelInput& in, const double* C, double* n, double* qdd)",
+        in,
+        {},
+        {}};
     for (int c = 0; c < 3; ++c) {
         k.bindings.push_back({S.N[c], st(thin_normal_force(c, d.b_U).subs(thin))});
         k.outputs.push_back({"n[" + std::to_string(c) + "]", S.N[c]});
@@ -378,15 +417,16 @@ void reduced_U_thin_kernels(const Derivation& d, const Inputs& in, const std::ve
     std::array<ex, 3> back;
     for (int i = 0; i < 3; ++i) back[i] = st(d.back_substitution(i, 0).subs(b_of).subs(thin));
     for (int i = 0; i < 3; ++i) k.outputs.push_back({"qdd[" + std::to_string(i) + "]", back[i]});
-    Kernel kj{"// Thin part, reduced U-dynamics: reduced_U_thin and dqdd[6 r + j] = d q''_r / d u_j\n"
-              "// (u = u1x, u1y, u2x, u2y, u3x, u3y; the normal forces (38) do not depend on u).\n",
-              "reduced_U_thin_du(const KernelInput& in, const double* C, double* n, double* qdd, double* dqdd)", in,
-              k.outputs, k.bindings};
+    Kernel kj{
+        "// Thin part, reduced U-dynamics: reduced_U_thin and dqdd[6 r + j] = d q''_r / d u_j\n"
+        "// (u = u1x, u1y, u2x, u2y, u3x, u3y; the normal forces (38) do not depend on u).\n",
+        "reduced_U_thin_du(const KernelInput& in, const double* C, double* n, double* qdd, double* dqdd)", in, k.outputs,
+        k.bindings};
     bind_slip_jacobian(kj, back, nullptr, nullptr, S, 3);
     st.add_inputs(k.in);
     st.add_inputs(kj.in);
-    kernels.push_back(config_kernel("reduced_U_thin", "Thin part, reduced U-dynamics", st,
-                                    "const double* Minv, ", with(in, "Minv", "Minv", 9), constants));
+    kernels.push_back(config_kernel("reduced_U_thin", "Thin part, reduced U-dynamics", st, "const double* Minv, ",
+                                    with(in, "Minv", "Minv", 9), constants));
     kernels.push_back(k);
     kernels.push_back(kj);
 }
@@ -397,15 +437,22 @@ void reduced_U_point_kernels(const Derivation& d, const Inputs& in, const std::v
     const Symbols& S = d.S;
     Staging st(fast, "C");
     Kernel k{"// Point part, reduced U-dynamics (35): (s_x'', s_y'', N) from the slots C of reduced_U_point_config.\n",
-             "reduced_U_point(const KernelInput& in, const double* C, double* z)", in, {}, {}};
+             "reduced_U_point(const KernelInput& in, const double* C, double* z)",
+             in,
+             {},
+             {}};
     std::array<ex, 3> z;
     for (int i = 0; i < 3; ++i) {
         z[i] = st(d.point_solution(i, 0).subs(b_of).subs(S.sz == 0));
         k.outputs.push_back({"z[" + std::to_string(i) + "]", z[i]});
     }
-    Kernel kj{"// Point part, reduced U-dynamics: reduced_U_point and dqdd[2 r + j] = d s''_r / d u1_j (r, j = x, y;\n"
-              "// N does not depend on u).\n",
-              "reduced_U_point_du(const KernelInput& in, const double* C, double* z, double* dqdd)", in, k.outputs, {}};
+    Kernel kj{
+        "// Point part, reduced U-dynamics: reduced_U_point and dqdd[2 r + j] = d s''_r / d u1_j (r, j = x, y;\n"
+        "// N does not depend on u).\n",
+        "reduced_U_point_du(const KernelInput& in, const double* C, double* z, double* dqdd)",
+        in,
+        k.outputs,
+        {}};
     bind_slip_jacobian(kj, z, nullptr, nullptr, S, 1);
     st.add_inputs(k.in);
     st.add_inputs(kj.in);
@@ -418,11 +465,10 @@ void reduced_U_point_kernels(const Derivation& d, const Inputs& in, const std::v
 // the part) alone is computed once per configuration by a *_config kernel into the slots C,
 // and an evaluation does only what changes: the unit slip directions u_i and the plate's
 // acceleration (p'', w1'), both entering polynomially (Staging).
-void reduced_U_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& kernels,
-                       std::vector<std::string>& constants) {
+void reduced_U_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& kernels, std::vector<std::string>& constants) {
     const Symbols& S = d.S;
-    const std::vector<ex> fast{S.ux[0], S.uy[0], S.ux[1], S.uy[1], S.ux[2], S.uy[2], S.pdd[0], S.pdd[1],
-                                   S.pdd[2], S.wd[0], S.wd[1], S.wd[2], S.N[0], S.N[1], S.N[2]};
+    const std::vector<ex> fast{S.ux[0],  S.uy[0], S.ux[1], S.uy[1], S.ux[2], S.uy[2], S.pdd[0], S.pdd[1],
+                               S.pdd[2], S.wd[0], S.wd[1], S.wd[2], S.N[0],  S.N[1],  S.N[2]};
     exmap b_of;
     for (int r = 0; r < 6; ++r) b_of[d.bsym[r]] = d.b_U(r, 0);
     reduced_U_thick_kernels(d, in, fast, b_of, kernels, constants);
@@ -437,9 +483,13 @@ void jacobian_and_part_kernels(const Derivation& d, const Inputs& in, std::vecto
         // For implicit methods (Rosenbrock, BDF): A depends on the twist only through the unit slip
         // directions u_i, and b~ (33)-(34) not at all, so d z/d q' = -A^-1 (dA/du_i n) (du_i/dv_i)
         // (dv_i/dq'). These two kernels are the derived factors; du_i/dv_i is the friction law's.
-        Kernel k{"// Jacobian factor: D[6 r + 2 i + j] = N_i d A(r, 3 + i) / d u_i[j] (j = x, y): how the\n"
-                 "// friction columns of A z move with the unit slip direction of contact i.\n",
-                 "dA_du(const KernelInput& in, const double* n, double* D)", with(in, "N", "n", 3), {}, {}};
+        Kernel k{
+            "// Jacobian factor: D[6 r + 2 i + j] = N_i d A(r, 3 + i) / d u_i[j] (j = x, y): how the\n"
+            "// friction columns of A z move with the unit slip direction of contact i.\n",
+            "dA_du(const KernelInput& in, const double* n, double* D)",
+            with(in, "N", "n", 3),
+            {},
+            {}};
         for (int r = 0; r < 6; ++r)
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 2; ++j)
@@ -448,9 +498,13 @@ void jacobian_and_part_kernels(const Derivation& d, const Inputs& in, std::vecto
         kernels.push_back(k);
     }
     {
-        Kernel k{"// Jacobian factor: V[3 (2 i + j) + k] = d v_i[j] / d q'[k], the sliding velocity of contact i\n"
-                 "// (text after (14)) against the twist q' = (s_x', s_y', theta').\n",
-                 "dslip_dqd(const KernelInput& in, double* V)", in, {}, {}};
+        Kernel k{
+            "// Jacobian factor: V[3 (2 i + j) + k] = d v_i[j] / d q'[k], the sliding velocity of contact i\n"
+            "// (text after (14)) against the twist q' = (s_x', s_y', theta').\n",
+            "dslip_dqd(const KernelInput& in, double* V)",
+            in,
+            {},
+            {}};
         const realsymbol qd[3] = {S.sxd, S.syd, S.thd};
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 2; ++j)
@@ -459,16 +513,23 @@ void jacobian_and_part_kernels(const Derivation& d, const Inputs& in, std::vecto
         kernels.push_back(k);
     }
     {
-        Kernel k{"// (38): the thin part's normal-force matrix (rows: torque x, torque y, force z), constant for\n"
-                 "// a part; n = M38^-1 (b[3], b[4], b[2]) for any b, independent of the part's velocity.\n",
-                 "thin_M38(const KernelInput& in, double* M)", in, {}, {}};
+        Kernel k{
+            "// (38): the thin part's normal-force matrix (rows: torque x, torque y, force z), constant for\n"
+            "// a part; n = M38^-1 (b[3], b[4], b[2]) for any b, independent of the part's velocity.\n",
+            "thin_M38(const KernelInput& in, double* M)",
+            in,
+            {},
+            {}};
         for (int i = 0; i < 3; ++i)
             for (int c = 0; c < 3; ++c) k.outputs.push_back({"M[" + std::to_string(3 * i + c) + "]", d.M38(i, c)});
         kernels.push_back(k);
     }
     {
         Kernel k{"// Point part: (s_x'', s_y'', N) from b[0..2] (one contact at the centre of mass).\n",
-                 "point_solve(const KernelInput& in, const double* b, double* z)", with(in, "b", "b", 3), {}, {}};
+                 "point_solve(const KernelInput& in, const double* b, double* z)",
+                 with(in, "b", "b", 3),
+                 {},
+                 {}};
         for (int i = 0; i < 3; ++i) k.outputs.push_back({"z[" + std::to_string(i) + "]", d.point_solution(i, 0)});
         kernels.push_back(k);
     }
@@ -478,23 +539,34 @@ void jacobian_and_part_kernels(const Derivation& d, const Inputs& in, std::vecto
 void mode_kernels(const Derivation& d, const Inputs& in, std::vector<Kernel>& kernels) {
     for (int k = 0; k < 3; ++k) {
         const std::string K = std::to_string(k + 1);
-        Kernel kp{"// Pivot about contact " + K + ": the system A z = [b; c] (8x8, row-major) of the mode, unknowns\n"
-                  "// z = (s_x'', s_y'', theta'', N1, N2, N3, f_x, f_y), f the static friction of contact " + K + " (P frame);\n"
-                  "// rows Newton x y z, Euler x y z, then the contact's relative acceleration\n"
-                  "// s'' + theta'' e_z x r_" + K + " - theta'^2 r_" + K + " = 0, c = theta'^2 r_" + K +
+        Kernel kp{"// Pivot about contact " + K +
+                      ": the system A z = [b; c] (8x8, row-major) of the mode, unknowns\n"
+                      "// z = (s_x'', s_y'', theta'', N1, N2, N3, f_x, f_y), f the static friction of contact " +
+                      K +
+                      " (P frame);\n"
+                      "// rows Newton x y z, Euler x y z, then the contact's relative acceleration\n"
+                      "// s'' + theta'' e_z x r_" +
+                      K + " - theta'^2 r_" + K + " = 0, c = theta'^2 r_" + K +
                       " (zero in the reduced U-dynamics (35)).\n"
-                  "// The other contacts slide along their unit directions u_i.\n",
-                  "pivot" + K + "_system(const KernelInput& in, double* A, double* c)", in, {}, {}};
+                      "// The other contacts slide along their unit directions u_i.\n",
+                  "pivot" + K + "_system(const KernelInput& in, double* A, double* c)",
+                  in,
+                  {},
+                  {}};
         for (int r = 0; r < 8; ++r)
             for (int j = 0; j < 8; ++j) kp.outputs.push_back({"A[" + std::to_string(8 * r + j) + "]", d.pivot_A[k](r, j)});
         for (int r = 0; r < 2; ++r) kp.outputs.push_back({"c[" + std::to_string(r) + "]", d.pivot_c[k](r, 0)});
         kernels.push_back(kp);
     }
     {
-        Kernel k{"// Stuck (q'' = 0): the normal forces n and the friction wrench the part needs, w = (F_x, F_y, tau_z)\n"
-                 "// (P frame; tau_z about the centre of mass), from b (any dynamics level). Determinate although\n"
-                 "// the friction distribution is not (the derivation checks it).\n",
-                 "stuck_solve(const KernelInput& in, const double* b, double* n, double* w)", with(in, "b", "b", 6), {}, {}};
+        Kernel k{
+            "// Stuck (q'' = 0): the normal forces n and the friction wrench the part needs, w = (F_x, F_y, tau_z)\n"
+            "// (P frame; tau_z about the centre of mass), from b (any dynamics level). Determinate although\n"
+            "// the friction distribution is not (the derivation checks it).\n",
+            "stuck_solve(const KernelInput& in, const double* b, double* n, double* w)",
+            with(in, "b", "b", 6),
+            {},
+            {}};
         // det bound first: 1/(a sum) would let GiNaC pull a sign out in a run-dependent way.
         const realsymbol det("contacts_det"), inv("inv_det");
         k.bindings.push_back({det, d.stuck_det});
@@ -510,11 +582,15 @@ void wrench_kernels(const Derivation& d, std::vector<Kernel>& kernels) {
     const Symbols& S = d.S;
     {
         std::vector<std::string> wf(std::begin(kWrenchFields), std::end(kWrenchFields));
-        Kernel k{"// Support function of the friction set (the break-away test of a stuck part): for each contact,\n"
-                 "// s[i] = |G_i^T d|, the term mu_i N_i |G_i^T d|, its gradient g[3 i + j] and Hessian\n"
-                 "// H[6 i + (xx, xy, xt, yy, yt, tt)] in d = (vx, vy, xith) (scaled twist, Appendix B).\n"
-                 "// Undefined where s[i] = 0 (a kink of P): the caller tests s[i] first.\n",
-                 "friction_support(const WrenchInput& in, double* s, double* t, double* g, double* H)", inputs(wf, "in."), {}, {}};
+        Kernel k{
+            "// Support function of the friction set (the break-away test of a stuck part): for each contact,\n"
+            "// s[i] = |G_i^T d|, the term mu_i N_i |G_i^T d|, its gradient g[3 i + j] and Hessian\n"
+            "// H[6 i + (xx, xy, xt, yy, yt, tt)] in d = (vx, vy, xith) (scaled twist, Appendix B).\n"
+            "// Undefined where s[i] = 0 (a kink of P): the caller tests s[i] first.\n",
+            "friction_support(const WrenchInput& in, double* s, double* t, double* g, double* H)",
+            inputs(wf, "in."),
+            {},
+            {}};
         const realsymbol dv[3] = {S.vx, S.vy, S.xith};
         for (int i = 0; i < 3; ++i) {
             const std::string I = std::to_string(i);
@@ -524,17 +600,20 @@ void wrench_kernels(const Derivation& d, std::vector<Kernel>& kernels) {
             for (int a = 0; a < 3; ++a) {
                 const ex ga = d.support_term[i].diff(dv[a]);
                 k.outputs.push_back({"g[" + std::to_string(3 * i + a) + "]", ga});
-                for (int b2 = a; b2 < 3; ++b2)
-                    k.outputs.push_back({"H[" + std::to_string(6 * i + h++) + "]", ga.diff(dv[b2])});
+                for (int b2 = a; b2 < 3; ++b2) k.outputs.push_back({"H[" + std::to_string(6 * i + h++) + "]", ga.diff(dv[b2])});
             }
         }
         kernels.push_back(k);
     }
     {
         std::vector<std::string> wf(std::begin(kWrenchFields), std::end(kWrenchFields));
-        Kernel k{"// Appendix B: frictional wrench (F_x, F_y, tau/rho) on a thin part sliding with relative twist\n"
-                 "// (v_x, v_y, xith = rho omega); contacts at r_i from the centre of mass (plate frame).\n",
-                 "thin_wrench(const WrenchInput& in, double* w)", inputs(wf, "in."), {}, {}};
+        Kernel k{
+            "// Appendix B: frictional wrench (F_x, F_y, tau/rho) on a thin part sliding with relative twist\n"
+            "// (v_x, v_y, xith = rho omega); contacts at r_i from the centre of mass (plate frame).\n",
+            "thin_wrench(const WrenchInput& in, double* w)",
+            inputs(wf, "in."),
+            {},
+            {}};
         for (int i = 0; i < 3; ++i) k.outputs.push_back({"w[" + std::to_string(i) + "]", d.wrench(i, 0)});
         kernels.push_back(k);
     }
@@ -585,7 +664,7 @@ void print_findings(const Derivation& d) {
     std::cout << d.findings.size() << " comparisons with the printed paper, " << differ << " differ\n";
 }
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     std::filesystem::path root;

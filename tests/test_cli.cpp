@@ -63,7 +63,7 @@ std::string fig4_with(const std::string& from, const std::string& to) {
     return s.replace(p, from.size(), to);
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     const Run r = run("twist " + kScenes + "fig4.json --at 0.02 0.01 0.5");
@@ -103,8 +103,7 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     CHECK(nlohmann::json::parse(r.out)["lines"].size() == 1);
 }
 
-TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twist reports its stick fractions",
-          "[cli][stick]") {
+TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twist reports its stick fractions", "[cli][stick]") {
     // Issue 14's first check: Fig. 1(a)'s run from rest used to stop at t = 0.00077 s.
     const fs::path sim = tmpdir() / "fig1.csv";
     Run r = run("simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 20 --out " + sim.string());
@@ -113,7 +112,10 @@ TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twi
     std::istringstream in(slurp(sim));
     std::string line, last;
     int rows = 0;
-    while (std::getline(in, line)) { last = line; ++rows; }
+    while (std::getline(in, line)) {
+        last = line;
+        ++rows;
+    }
     CHECK(rows == 1 + 1601);   // every sample of T/4 up to 20 s
     // It ends near a stable line of Fig. 1: (0, s_y, 0) or (0, s_y, pi).
     std::vector<double> v;
@@ -142,7 +144,10 @@ TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the t
         std::istringstream in(csv);
         std::string line, last;
         int rows = 0;
-        while (std::getline(in, line)) { last = line; ++rows; }
+        while (std::getline(in, line)) {
+            last = line;
+            ++rows;
+        }
         std::vector<std::string> cells;
         std::istringstream ls(last);
         for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
@@ -161,7 +166,8 @@ TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the t
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    for (const char* c : {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench ", "design ", "proofs ", "report "}) {
+    for (const char* c :
+         {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench ", "design ", "proofs ", "report "}) {
         const Run r = run(std::string(c) + "--help");
         CHECK(r.code == 0);
         CHECK(r.out.find("usage") != std::string::npos);
@@ -194,8 +200,8 @@ TEST_CASE("bad input: exit code 2, the file and the field named, no output file"
         std::ofstream(scene) << c.scene;
         const fs::path out = tmpdir() / "must-not-exist.json";
         fs::remove(out);
-        for (const std::string& cmd : {"field " + scene.string() + " --grid 2 --out " + out.string(),
-                                      "twist " + scene.string() + " --at 0 0 0"}) {
+        for (const std::string& cmd :
+             {"field " + scene.string() + " --grid 2 --out " + out.string(), "twist " + scene.string() + " --at 0 0 0"}) {
             const Run r = run(cmd);
             INFO(cmd << "\n" << r.err);
             CHECK(r.code == 2);
@@ -246,8 +252,9 @@ TEST_CASE("a simulation that leaves the model stops with exit code 3 and says wh
 
 TEST_CASE("plate simulate --dynamics auto states its choice, decided up front, and --verify measures it", "[cli][hierarchy]") {
     const fs::path out = tmpdir() / "auto.csv";
-    const Run r = run("simulate " + kScenes + "fig4.json --dynamics auto --model-tol 0.05 --from 0.04 -0.04 1.0 --time 0.5 --verify --out " +
-                      out.string());
+    const Run r =
+        run("simulate " + kScenes +
+            "fig4.json --dynamics auto --model-tol 0.05 --from 0.04 -0.04 1.0 --time 0.5 --verify --out " + out.string());
     INFO(r.err);
     CHECK(r.code == 0);
     CHECK(r.err.find("auto model, decided up front (tolerance 0.05): picked") != std::string::npos);
@@ -349,8 +356,8 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
     const Job jobs[] = {
         {"field " + kScenes + "fig4.json --grid 3 --out " + (d / "field.json").string(), d / "field.json"},
         {"fixed-points " + kScenes + "fig4.json --grid 3 --out " + (d / "fp.json").string(), d / "fp.json"},
-        {"simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 1 --out " +
-             (d / "traj.csv").string(), d / "traj.csv"},
+        {"simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 1 --out " + (d / "traj.csv").string(),
+         d / "traj.csv"},
         {"proofs --thin 4 --thick 2 --surfaces 2 --out " + (d / "proofs.json").string(), d / "proofs.json"},
         {"random-scene --seed 3 --out " + (d / "scene.json").string(), d / "scene.json"},
         {"report --quick --sections fig3 --out " + (d / "report").string(), d / "report" / "index.html"},
@@ -364,10 +371,10 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
             // file in the child, which may not have run yet (a fast machine signalled a job before it started).
             fs::remove(err);
             // bash: start, wait (up to 10 min) for the pause, signal, reap; prints the exit status.
-            const std::string script =
-                "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " " + j.args + " > /dev/null 2> " +
-                err.string() + " & p=$!; for i in $(seq 6000); do grep -qs 'paused before rename' " + err.string() +
-                " && break; sleep 0.1; done; kill -" + sig + " $p; wait $p; echo $?";
+            const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " " + j.args +
+                                       " > /dev/null 2> " + err.string() +
+                                       " & p=$!; for i in $(seq 6000); do grep -qs 'paused before rename' " + err.string() +
+                                       " && break; sleep 0.1; done; kill -" + sig + " $p; wait $p; echo $?";
             const fs::path status = tmpdir() / "status", sh = tmpdir() / "interrupt.sh";
             std::ofstream(sh) << script << "\n";
             REQUIRE(std::system(("bash " + sh.string() + " > " + status.string()).c_str()) == 0);
@@ -384,9 +391,9 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
     REQUIRE(run("report --quick --sections fig3 --out " + (d / "report").string()).code == 0);
     REQUIRE(fs::exists(d / "report" / "index.html"));
     fs::remove(err);
-    const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) + " report --quick --sections fig3 --out " +
-                               (d / "report").string() + " > /dev/null 2> " + err.string() +
-                               " & p=$!; for i in $(seq 6000); do grep -qs paused " + err.string() +
+    const std::string script = "PLATE_TEST_PAUSE_BEFORE_RENAME=600 " + std::string(PLATE_EXE) +
+                               " report --quick --sections fig3 --out " + (d / "report").string() + " > /dev/null 2> " +
+                               err.string() + " & p=$!; for i in $(seq 6000); do grep -qs paused " + err.string() +
                                " && break; sleep 0.1; done; kill -KILL $p; wait $p";
     std::ofstream(tmpdir() / "interrupt.sh") << script << "\n";
     CHECK(std::system(("bash " + (tmpdir() / "interrupt.sh").string()).c_str()) != -1);
@@ -397,14 +404,16 @@ TEST_CASE("a report folder whose name holds quotes and a shell command is only a
     const fs::path d = tmpdir() / "rep'; touch PWNED; echo 'x";
     const fs::path witness = fs::current_path() / "PWNED";
     fs::remove(witness);
-    const std::string cmd = std::string(PLATE_EXE) + " report --quick --sections fig3 --out \"" + d.string() + "\" > /dev/null 2>&1";
+    const std::string cmd =
+        std::string(PLATE_EXE) + " report --quick --sections fig3 --out \"" + d.string() + "\" > /dev/null 2>&1";
     CHECK(std::system(cmd.c_str()) == 0);
     CHECK(fs::exists(d / "index.html"));
     CHECK_FALSE(fs::exists(witness));
     CHECK_FALSE(fs::exists(d.parent_path() / "PWNED"));
     // A relative folder: gnuplot's messages still go to each figure's log (data/NAME.log), not the terminal.
     fs::remove_all(tmpdir() / "relative-report");
-    const std::string rel = "cd " + tmpdir().string() + " && " + PLATE_EXE + " report --quick --sections fig3 --out relative-report > /dev/null 2>&1";
+    const std::string rel =
+        "cd " + tmpdir().string() + " && " + PLATE_EXE + " report --quick --sections fig3 --out relative-report > /dev/null 2>&1";
     CHECK(std::system(rel.c_str()) == 0);
     CHECK(fs::exists(tmpdir() / "relative-report" / "data" / "fig3.log"));
 }
@@ -453,17 +462,22 @@ TEST_CASE("progress lines only for a person watching: quiet when stderr is not a
     const Run asked = run(cmd + " PLATE_PROGRESS=1");   // (an argument: must be refused, see below)
     CHECK(asked.code == 2);
     const fs::path o = tmpdir() / "stdout", e = tmpdir() / "stderr";
-    const std::string forced = "PLATE_PROGRESS=1 " + std::string(PLATE_EXE) + " " + cmd + " > " + o.string() + " 2> " + e.string();
+    const std::string forced =
+        "PLATE_PROGRESS=1 " + std::string(PLATE_EXE) + " " + cmd + " > " + o.string() + " 2> " + e.string();
     REQUIRE(std::system(forced.c_str()) == 0);
     CHECK(slurp(e).find("field: ") != std::string::npos);
 }
 
-TEST_CASE("plate design: a verified sink is a scene whose own field has its one stable fixed point at the target, "
-          "and a failed design exits 4 and writes nothing", "[cli][design]") {
+TEST_CASE(
+    "plate design: a verified sink is a scene whose own field has its one stable fixed point at the target, "
+    "and a failed design exits 4 and writes nothing",
+    "[cli][design]") {
     const fs::path d = tmpdir() / "design";
     fs::create_directories(d);
-    const Run r = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
-                      "--starts 8 --evaluations 200 --out " + (d / "sink.json").string());
+    const Run r = run("design " PLATE_SOURCE_DIR
+                      "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
+                      "--starts 8 --evaluations 200 --out " +
+                      (d / "sink.json").string());
     INFO(r.err);
     REQUIRE(r.code == 0);
     const auto j = nlohmann::json::parse(r.out);
@@ -486,34 +500,41 @@ TEST_CASE("plate design: a verified sink is a scene whose own field has its one 
         }
     CHECK(stable == 1);
 
-    const Run fast = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target transport 2 0 --limits 15 100 "
-                         "--starts 4 --evaluations 100 --out " + (d / "fast.json").string());
+    const Run fast = run("design " PLATE_SOURCE_DIR
+                         "/scenes/fig1_point.json --target transport 2 0 --limits 15 100 "
+                         "--starts 4 --evaluations 100 --out " +
+                         (d / "fast.json").string());
     CHECK(fast.code == 4);
     CHECK(fast.err.find("failed verification") != std::string::npos);
     CHECK(nlohmann::json::parse(fast.out)["verified"] == false);
     CHECK_FALSE(fs::exists(d / "fast.json"));
 
-    const Run bad = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target wobble 0 0 --out " + (d / "x.json").string());
+    const Run bad =
+        run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target wobble 0 0 --out " + (d / "x.json").string());
     CHECK(bad.code == 2);
     CHECK(bad.err.find("--target") != std::string::npos);
 
     // Coning allowed with the hold on: the fastest sink walks off its target, and the hold says so
     // (400 s: over 5 mm for any coning above 7.3e-4 rad/s; tests/design/test_design_sink.cpp, "without the hold").
-    const Run coned = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
-                          "--max-coning 1e9 --hold 400 --out " + (d / "coned.json").string());
+    const Run coned = run("design " PLATE_SOURCE_DIR
+                          "/scenes/fig1_point.json --target sink 0.02 -0.01 --limits 15 100 "
+                          "--max-coning 1e9 --hold 400 --out " +
+                          (d / "coned.json").string());
     CHECK(coned.code == 4);
     CHECK(coned.err.find("released at rest at the target") != std::string::npos);
     CHECK(nlohmann::json::parse(coned.out)["hold"]["end_distance"].get<double>() > 0.005);
     CHECK_FALSE(fs::exists(d / "coned.json"));
-    const Run negative = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0 0 --hold -1 --out " +
-                             (d / "y.json").string());
+    const Run negative =
+        run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target sink 0 0 --hold -1 --out " + (d / "y.json").string());
     CHECK(negative.code == 2);
     CHECK(negative.err.find("--hold") != std::string::npos);
 
     // --axes and --harmonics: the designed scene moves on those alone, and the summary says so; a name
     // that is no axis, or a target whose motion family they empty, is a usage error with no file.
-    const Run along_x = run("design " PLATE_SOURCE_DIR "/scenes/fig1_point.json --target transport 0.02 0 --axes x "
-                            "--harmonics 2 --starts 4 --evaluations 150 --out " + (d / "x_only.json").string());
+    const Run along_x = run("design " PLATE_SOURCE_DIR
+                            "/scenes/fig1_point.json --target transport 0.02 0 --axes x "
+                            "--harmonics 2 --starts 4 --evaluations 150 --out " +
+                            (d / "x_only.json").string());
     INFO(along_x.err);
     REQUIRE(along_x.code == 0);
     const auto jx = nlohmann::json::parse(along_x.out);

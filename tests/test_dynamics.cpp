@@ -7,8 +7,8 @@
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
 
-#include "models.hpp"   // Signal
-#include "so3.hpp"   // dexp_inv, exp_so3, hat
+#include "models.hpp"      // Signal
+#include "so3.hpp"         // dexp_inv, exp_so3, hat
 #include "workspace.hpp"   // detail::StickSlipState
 
 #include <catch2/catch.hpp>
@@ -42,7 +42,7 @@ Vec3 normal_forces_38(const Part& P, const Vec3& rhs) {
 
 double rel(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
 
-}  // namespace
+}   // namespace
 
 // Eigen's fixed-size vectors are not zeroed by value-initialisation ({}): a point part's contacts
 // were garbage, read by Workspace::prepare (thin()), and a point part shaken at mu = 0.29 ran away
@@ -179,8 +179,7 @@ TEST_CASE("a part sliding in pure translation on a resting plate decelerates at 
             Rng r(seed);
             const double a = r.uniform(-kPi, kPi), v = r.uniform(0.01, 1);
             Workspace ws;
-            accelerations(sc, Dynamics::U, Vec3(0.01, -0.02, 0.3), Vec3(v * std::cos(a), v * std::sin(a), 0),
-                          PlateState{}, ws);
+            accelerations(sc, Dynamics::U, Vec3(0.01, -0.02, 0.3), Vec3(v * std::cos(a), v * std::sin(a), 0), PlateState{}, ws);
             // Sum of friction = -mu (sum N) v/|v| and sum N = m g (force balance along z).
             CHECK(std::abs(ws.qdd[0] + 0.3 * sc.g * std::cos(a)) < 1e-12 * sc.g);
             CHECK(std::abs(ws.qdd[1] + 0.3 * sc.g * std::sin(a)) < 1e-12 * sc.g);
@@ -240,8 +239,8 @@ struct WorldResidual {
 };
 
 // f: each contact's friction force in the plate frame (horizontal); n: the normal forces.
-WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                             const Vec3& qdd, const Vec3& n, const std::array<Vec2, 3>& f) {
+WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, const Vec3& qdd, const Vec3& n,
+                             const std::array<Vec2, 3>& f) {
     const Part& P = sc.part;
     const double h = 1e-5;
     auto R1 = [&](double t) { return Mat3(detail::exp_so3(ps.w1 * t + 0.5 * ps.wd * t * t) * ps.R1); };
@@ -266,8 +265,8 @@ WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, con
 }
 
 // Every contact sliding: Coulomb's f_i = -mu_i N_i v_i / |v_i| (17).
-WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                             const Vec3& qdd, const Vec3& n) {
+WorldResidual world_residual(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, const Vec3& qdd,
+                             const Vec3& n) {
     std::array<Vec2, 3> v, f;
     slip_velocities(sc.part, q, qd, v);
     for (int i = 0; i < 3; ++i) f[i] = -sc.part.friction().kinetic(i) * n[i] * v[i].normalized();
@@ -335,7 +334,8 @@ TEST_CASE("pivot and stuck modes (generated from the derivation) satisfy Newton-
             std::array<Vec2, 3> v;
             slip_velocities(P, q, qd, v);
             for (int j = 0; j < 3; ++j)
-                if (j != k) CHECK((ws.f_held[j] + P.friction().kinetic(j) * ws.n[j] * v[j].normalized()).norm() < 1e-12 * P.m * sc.g);
+                if (j != k)
+                    CHECK((ws.f_held[j] + P.friction().kinetic(j) * ws.n[j] * v[j].normalized()).norm() < 1e-12 * P.m * sc.g);
             const double hd = 1e-4;
             auto xk = [&](double t) {
                 const Vec2 s(q[0] + qd[0] * t + 0.5 * ws.qdd[0] * t * t, q[1] + qd[1] * t + 0.5 * ws.qdd[1] * t * t);
@@ -387,8 +387,7 @@ TEST_CASE("the printed (28), with R1 where R1^T belongs, violates Euler's equati
     const Mat3 R2t = Eigen::AngleAxisd(q[2], Vec3::UnitZ()).toRotationMatrix().transpose();
     const Vec3 w2(0, 0, qd[2]);
     Vec6 b_printed = b;
-    b_printed.tail<3>() += sc.part.J * (R2t * w2.cross(ps.R1.transpose() * ps.w1)) -
-                           sc.part.J * (R2t * w2.cross(ps.R1 * ps.w1));
+    b_printed.tail<3>() += sc.part.J * (R2t * w2.cross(ps.R1.transpose() * ps.w1)) - sc.part.J * (R2t * w2.cross(ps.R1 * ps.w1));
     const Vec6 z = ws.A.partialPivLu().solve(b_printed);
     const WorldResidual derived = world_residual(sc, q, qd, ps, ws.qdd, ws.n);
     const WorldResidual printed = world_residual(sc, q, qd, ps, z.head<3>(), z.tail<3>());
@@ -442,7 +441,7 @@ TEST_CASE("stick test: a rigid part held at one contact on a resting plate stick
     // static load is positive; with a large spin the centripetal demand exceeds mu N.
     CHECK(stick_test(sc, Dynamics::U, 0, Vec3::Zero(), Vec3::Zero(), PlateState{}).sticks);
     const Part& P = sc.part;
-    const double w = 200;   // rad/s about contact 0
+    const double w = 200;                                // rad/s about contact 0
     const Vec3 qd(w * P.c[0].y(), -w * P.c[0].x(), w);   // s' = -w e_z x c_0
     const StickTest st = stick_test(sc, Dynamics::U, 0, Vec3::Zero(), qd, PlateState{});
     CHECK_FALSE(st.sticks);
@@ -472,7 +471,10 @@ double brute_gauge(const Part& P, double theta, const Vec3& n, const Vec2& F, do
             const double th = 2 * kPi * a / 120, ph = kPi * (b + 0.5) / 60;
             const Vec3 d(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
             const double r = ratio(d);
-            if (r > best) { best = r; bd = d; }
+            if (r > best) {
+                best = r;
+                bd = d;
+            }
         }
     for (double step = 0.02; step > 1e-12;) {
         bool better = false;
@@ -482,20 +484,25 @@ double brute_gauge(const Part& P, double theta, const Vec3& n, const Vec2& F, do
                 d[k] += sg * step;
                 d.normalize();
                 const double r = ratio(d);
-                if (r > best) { best = r; bd = d; better = true; }
+                if (r > best) {
+                    best = r;
+                    bd = d;
+                    better = true;
+                }
             }
         if (!better) step *= 0.5;
     }
     return best;
 }
 
-}  // namespace
+}   // namespace
 
 // friction_gauge minimises the support function by Newton in the plane d . w = 1; next to a kink (a
 // contact's term near zero) its line search stalled short of the minimum, and the gauge came out low:
 // fig6 at (0.0167, 0, 2.693) stuck at t = 0.01759 s gave 0.967 where the minimum gives 0.992, so the
 // part was held 0.13 ms too long and its cycle's twist was 1.8e-4 v_ref off the regularised reference.
-TEST_CASE("the friction gauge is the support function's optimum: brute force, and fig6 where Newton stalled", "[dynamics][stick]") {
+TEST_CASE("the friction gauge is the support function's optimum: brute force, and fig6 where Newton stalled",
+          "[dynamics][stick]") {
     Workspace ws;
     {
         const Scene sc = load_scene(PLATE_SOURCE_DIR "/scenes/fig6.json");

@@ -26,11 +26,14 @@ bool line_at(const FixedLine& l, double theta, double tol_x, double tol_th) {
 
 double y_span(const FixedLine& l) {
     double lo = 1e9, hi = -1e9;
-    for (const auto& q : l.points) { lo = std::min(lo, q[1]); hi = std::max(hi, q[1]); }
+    for (const auto& q : l.points) {
+        lo = std::min(lo, q[1]);
+        hi = std::max(hi, q[1]);
+    }
     return hi - lo;
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("field: grid, parallel evaluation and warm starts give the single-configuration twist", "[field]") {
     const Scene sc = scene("fig4");
@@ -58,8 +61,7 @@ TEST_CASE("field: grid, parallel evaluation and warm starts give the single-conf
     CHECK(f.threads >= 1);
 }
 
-TEST_CASE("Fig. 1: lines of stable fixed points at (0, s_y, 0) and (0, s_y, pi), unstable at +-pi/2",
-          "[field][paper]") {
+TEST_CASE("Fig. 1: lines of stable fixed points at (0, s_y, 0) and (0, s_y, pi), unstable at +-pi/2", "[field][paper]") {
     const Scene sc = scene("fig1");
     const Field f = compute_field(sc, GridSpec{});
     const FixedPoints fp = find_fixed_points(sc, f);
@@ -72,9 +74,7 @@ TEST_CASE("Fig. 1: lines of stable fixed points at (0, s_y, 0) and (0, s_y, pi),
         CHECK(std::abs(l.direction[1]) > 0.99 * l.direction.norm());
         if (l.stability == Stability::Stable && line_at(l, 0, 1e-5, 1e-3)) ++stable0;
         if (l.stability == Stability::Stable && line_at(l, kPi, 1e-5, 1e-3)) ++stablepi;
-        if (l.stability != Stability::Stable &&
-            (line_at(l, kPi / 2, 1e-5, 1e-3) || line_at(l, -kPi / 2, 1e-5, 1e-3)))
-            ++unstable;
+        if (l.stability != Stability::Stable && (line_at(l, kPi / 2, 1e-5, 1e-3) || line_at(l, -kPi / 2, 1e-5, 1e-3))) ++unstable;
     }
     CHECK(stable0 == 1);
     CHECK(stablepi == 1);
@@ -82,8 +82,7 @@ TEST_CASE("Fig. 1: lines of stable fixed points at (0, s_y, 0) and (0, s_y, pi),
     CHECK(fp.lines.size() == 4u);
 }
 
-TEST_CASE("Fig. 1(b): the point part's velocity field has a stable line of fixed points on s_x = 0",
-          "[field][paper][point]") {
+TEST_CASE("Fig. 1(b): the point part's velocity field has a stable line of fixed points on s_x = 0", "[field][paper][point]") {
     const Scene sc = scene("fig1_point");
     const Field f = compute_field(sc, GridSpec{});
     CHECK(f.point_part);
@@ -160,8 +159,8 @@ TEST_CASE("Fig. 6: the field rotates the part everywhere with no holes and stick
     const Field f = compute_field(sc, GridSpec{});
     int sticking = 0;
     for (const auto& p : f.points) {
-        REQUIRE(p.converged);        // stick-slip: no configuration is undefined because of sticking
-        CHECK(p.twist[2] < 0);       // one sense of rotation everywhere (Section V: "rotates the part")
+        REQUIRE(p.converged);    // stick-slip: no configuration is undefined because of sticking
+        CHECK(p.twist[2] < 0);   // one sense of rotation everywhere (Section V: "rotates the part")
         const double held = std::max({p.stick_fraction[0], p.stick_fraction[1], p.stick_fraction[2]});
         if (held == 0) continue;
         ++sticking;
@@ -300,8 +299,10 @@ TEST_CASE("shooting fields: predicted warm starts, the same field on any number 
     CHECK(periods / g.size() < 3.5);
 }
 
-TEST_CASE("a plate moving only along and about z: the field turns with the part, and its predicted starts keep it "
-          "the same on any number of threads", "[field][shooting][stick]") {
+TEST_CASE(
+    "a plate moving only along and about z: the field turns with the part, and its predicted starts keep it "
+    "the same on any number of threads",
+    "[field][shooting][stick]") {
     // fig6 (z and rz harmonics) looks the same turned about the plate's origin, so the cycle at
     // (R_a s, theta + a) is the one at (s, theta) turned: twist (R_a v, theta'). Checked on cycles solved
     // from rest (no predictor) at a sliding and a sticking configuration, turned by 1 and 2.5 rad: within
@@ -320,7 +321,8 @@ TEST_CASE("a plate moving only along and about z: the field turns with the part,
             REQUIRE(b.converged);
             const Vec2 va = Eigen::Rotation2Dd(turn) * Vec2(a.twist[0], a.twist[1]);
             const double allowed = 2 * (lo.tol + 3e2 * lo.integration.rtol);
-            INFO("at (" << q.transpose() << ") turned by " << turn << "; sticks " << a.stick_fraction[0] << ", " << a.stick_fraction[1] << ", " << a.stick_fraction[2]);
+            INFO("at (" << q.transpose() << ") turned by " << turn << "; sticks " << a.stick_fraction[0] << ", "
+                        << a.stick_fraction[1] << ", " << a.stick_fraction[2]);
             CHECK((Vec2(b.twist[0], b.twist[1]) - va).norm() / v <= allowed);
             CHECK(std::abs(b.twist[2] - a.twist[2]) * rho / v <= allowed);
         }
@@ -343,8 +345,7 @@ TEST_CASE("a plate moving only along and about z: the field turns with the part,
     CHECK(sticking > 0);
 }
 
-TEST_CASE("fixed points: regions where the part is stuck all period are not refined, and work is bounded",
-          "[field][stick]") {
+TEST_CASE("fixed points: regions where the part is stuck all period are not refined, and work is bounded", "[field][stick]") {
     // heave_yaw_point: the point part is stuck all period at 9 of 49 configurations (twist exactly 0:
     // every such configuration is fixed). Their cells are counted and said, not searched by Newton.
     const Scene hp = scene("heave_yaw_point");
@@ -376,17 +377,18 @@ namespace {
 struct Recorder {
     std::vector<std::vector<std::string>> calls;   // per runner call, per task
     TaskRunner record() {
-        return [this](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
-            calls.emplace_back(static_cast<std::size_t>(n));
-            for (int i = n - 1; i >= 0; --i) {
-                calls.back()[static_cast<std::size_t>(i)] = work(i);
-                done(i, calls.back()[static_cast<std::size_t>(i)]);
-            }
-        };
+        return
+            [this](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
+                calls.emplace_back(static_cast<std::size_t>(n));
+                for (int i = n - 1; i >= 0; --i) {
+                    calls.back()[static_cast<std::size_t>(i)] = work(i);
+                    done(i, calls.back()[static_cast<std::size_t>(i)]);
+                }
+            };
     }
     TaskRunner replay() {
         return [this, call = std::size_t{0}](int n, const std::function<std::string(int)>&,
-                                              const std::function<void(int, const std::string&)>& done) mutable {
+                                             const std::function<void(int, const std::string&)>& done) mutable {
             REQUIRE(call < calls.size());
             REQUIRE(calls[call].size() == static_cast<std::size_t>(n));
             for (int i = 0; i < n; ++i) done(i, calls[call][static_cast<std::size_t>(i)]);
@@ -417,7 +419,7 @@ void require_same_field(const Field& a, const Field& b) {
     CHECK(a.rhs_evals == b.rhs_evals);
 }
 
-}  // namespace
+}   // namespace
 
 // Issue 20: a field shared over processes (plate field under mpirun) is the field of one process,
 // bit for bit, because every task's points are solved from the same inputs wherever it runs and
@@ -432,7 +434,8 @@ TEST_CASE("field: its tasks, run anywhere and sent as text, give the one-process
         o.cycle.solver = solver;
         const Field one = compute_field(sc, g, o);
         bool sticks = false;
-        for (const auto& p : one.points) sticks = sticks || p.stick_fraction[0] > 0 || p.stick_fraction[1] > 0 || p.stick_fraction[2] > 0;
+        for (const auto& p : one.points)
+            sticks = sticks || p.stick_fraction[0] > 0 || p.stick_fraction[1] > 0 || p.stick_fraction[2] > 0;
         REQUIRE(sticks);   // (the texts must carry stick fractions)
         Recorder rec;
         o.tasks = rec.record();
@@ -449,8 +452,7 @@ TEST_CASE("field: its tasks, run anywhere and sent as text, give the one-process
 }
 
 TEST_CASE("exact_text reads back to the same double, nan and infinities included", "[tasks]") {
-    for (double x : {0.1, -1.0 / 3, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, -0.0, 1e-17})
-    {
+    for (double x : {0.1, -1.0 / 3, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, -0.0, 1e-17}) {
         const double y = exact_value(exact_text(x));
         CHECK(std::memcmp(&x, &y, sizeof x) == 0);
     }

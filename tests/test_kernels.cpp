@@ -4,7 +4,7 @@
 #include "plate/dynamics.hpp"
 #include "plate/random_scene.hpp"
 
-#include "so3.hpp"   // exp_so3
+#include "so3.hpp"         // exp_so3
 #include "workspace.hpp"   // detail::kernels (numeric/src)
 
 #include <catch2/catch.hpp>
@@ -87,7 +87,7 @@ void random_input(Rng& r, const symbolic::Symbols& S, gen::KernelInput& in, GiNa
         for (int j = 0; j < 3; ++j) set(*Rf[3 * i + j], S.R[i][j], R1(i, j));
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("generated kernels equal the reference implementation on 10^4 random states", "[kernels]") {
     // Both solve the same linear system in floating point (3x3 reduced vs 6x6 LU): they differ by
@@ -129,8 +129,8 @@ TEST_CASE("generated kernels equal the reference implementation on 10^4 random s
         CHECK(detail::kernels(gen).thin == (kind == 1));
     }
     CHECK(count[0] + count[1] + count[2] >= 10000);
-    WARN("generated vs reference: worst difference " << worst << " (thick " << count[0] << ", thin " << count[1]
-                                                     << ", point " << count[2] << " states)");
+    WARN("generated vs reference: worst difference " << worst << " (thick " << count[0] << ", thin " << count[1] << ", point "
+                                                     << count[2] << " states)");
 }
 
 TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions", "[kernels][symbolic]") {
@@ -157,15 +157,16 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
         // Solutions: reduced system and back substitution against GiNaC's solve of A z = b.
         double M[9], rr[3], qdd[3];
         gen::thick_reduced(in, bU, M, rr);
-        const Vec3 n = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(
-            Eigen::Map<const Vec3>(rr));
+        const Vec3 n =
+            Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(Eigen::Map<const Vec3>(rr));
         gen::back_substitution(in, bU, n.data(), qdd);
         matrix An(6, 6), bn(6, 1);
         for (int i = 0; i < 6; ++i) {
             for (int k = 0; k < 6; ++k) An(i, k) = d.A(i, k).subs(sub).evalf();
             bn(i, 0) = d.b_U(i, 0).subs(sub).evalf();
         }
-        const matrix z = An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
+        const matrix z =
+            An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
         double n2[3], qdd2[3], det;
         gen::thick_solve(in, bU, n2, qdd2, &det);
         for (int i = 0; i < 3; ++i) {
@@ -211,7 +212,8 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
                 pivot[k](in, Ap, cp);
                 for (int i = 0; i < 8; ++i)
                     for (int j = 0; j < 8; ++j) {
-                        INFO("pivot " << k << " A(" << i << "," << j << ") " << Ap[8 * i + j] << " vs " << value(d.pivot_A[k](i, j)));
+                        INFO("pivot " << k << " A(" << i << "," << j << ") " << Ap[8 * i + j] << " vs "
+                                      << value(d.pivot_A[k](i, j)));
                         CHECK(close(Ap[8 * i + j], value(d.pivot_A[k](i, j)), 1e-6));
                     }
                 for (int i = 0; i < 2; ++i) CHECK(close(cp[i], value(d.pivot_c[k](i, 0)), 1e-3));
@@ -236,14 +238,16 @@ TEST_CASE("generated kernels equal GiNaC's evaluation of the derived expressions
         tsub[S.Jyz] = 0;
         double M38[9];
         gen::thin_M38(tin, M38);
-        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> Minv = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M38).inverse();
+        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> Minv =
+            Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M38).inverse();
         double bt[6], nt[3], qt[3];
         gen::thin_solve_U(tin, Minv.data(), bt, nt, qt);
         for (int i = 0; i < 6; ++i) {
             for (int k = 0; k < 6; ++k) An(i, k) = d.A(i, k).subs(tsub).evalf();
             bn(i, 0) = d.b_U(i, 0).subs(tsub).evalf();
         }
-        const matrix zt = An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
+        const matrix zt =
+            An.solve(matrix{{symbol("z0")}, {symbol("z1")}, {symbol("z2")}, {symbol("z3")}, {symbol("z4")}, {symbol("z5")}}, bn);
         double Ct[gen::reduced_U_thin_slots], nts[3], qts[3];
         gen::reduced_U_thin_config(tin, Minv.data(), Ct);
         gen::reduced_U_thin(tin, Ct, nts, qts);

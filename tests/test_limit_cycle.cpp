@@ -22,7 +22,7 @@ PlateMotion circle(double Aw2, double T) {
     return u;
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("circular plate translation: the cycle is a circle of speed mu g / w lagging arccos(mu g / A w^2)",
           "[limit_cycle][closed_form]") {
@@ -59,7 +59,7 @@ TEST_CASE("circular plate translation: the cycle is a circle of speed mu g / w l
             if (s.t < t_end - T) continue;
             Vec3 pd, w1;
             sc->plate.velocity(s.t, pd, w1);
-            const Vec2 v = s.qd.head<2>() + pd.head<2>();     // absolute velocity
+            const Vec2 v = s.qd.head<2>() + pd.head<2>();   // absolute velocity
             CHECK(std::abs(v.norm() - speed) < 1e-6 * speed);
             const double dphi = std::remainder(std::atan2(pd.y(), pd.x()) - std::atan2(v.y(), v.x()), 2 * kPi);
             CHECK(std::abs(dphi - lag) < 1e-6 * lag);
@@ -90,46 +90,48 @@ TEST_CASE("a circular drive just above mu g: the part slides at the rim from res
     // velocity (not turning within a step) 43 steps and 2.2e-7 m/s off; now 26 steps, 8.7e-10 m/s.
     const double T = 0.05, mu = 0.3, g = 9.81;
     for (bool rigid : {false, true})
-    for (double delta : {1e-6, 3e-8}) {
-        const double excess = mu * g * delta;
-        Scene sc;
-        if (rigid) {
-            sc = scene("fig4");
-        } else {
-            sc.part.point = true;
-            sc.part.m = 0.02;
+        for (double delta : {1e-6, 3e-8}) {
+            const double excess = mu * g * delta;
+            Scene sc;
+            if (rigid) {
+                sc = scene("fig4");
+            } else {
+                sc.part.point = true;
+                sc.part.m = 0.02;
+            }
+            sc.name = "rim";
+            sc.part.mu.setConstant(mu);
+            sc.plate = circle(mu * g + excess, T);
+            const double duration = 0.1;
+            IntegrationOptions io;   // rtol 1e-9
+            const Trajectory tr = simulate(sc, Dynamics::U, Vec3::Zero(), Vec3::Zero(), duration, duration / 20, io);
+            REQUIRE(tr.stop.reason == StopReason::None);
+            INFO((rigid ? "fig4's part" : "point part")
+                 << ", delta " << delta << ": steps " << tr.stats.steps << ", events " << tr.events.size());
+            CHECK(tr.stats.steps < 1000);
+            const double tol = 3e2 * io.rtol * sc.v_ref();
+            int sliding = 0;
+            double worst = 0, across = 0, along = HUGE_VAL;
+            for (const Sample& s : tr.samples) {
+                const Vec2 v = s.qd.head<2>();
+                worst = std::max(worst, std::abs(v.norm() - excess * s.t));
+                sliding += s.t > 0 && s.mode.kind == ModeKind::Slide;
+                // v against -p'': across it only the exact alpha |v| (< 1e-11 m/s) plus the error allowed
+                Vec3 pdd, wd;
+                sc.plate.acceleration(s.t, pdd, wd);
+                const Vec2 e = -pdd.head<2>().normalized();
+                across = std::max(across, std::abs(e.x() * v.y() - e.y() * v.x()));
+                if (s.t > 0) along = std::min(along, e.dot(v));
+                if (rigid) CHECK(std::abs(s.qd[2]) * sc.part.rho() <= tol);   // no spin
+            }
+            INFO("largest | |v| - (A w^2 - mu g) t | " << worst << " m/s, across -p'' " << across << " m/s (allowed " << tol
+                                                       << ")");
+            CHECK(worst <= tol);
+            CHECK(across <= tol);
+            CHECK(along > 0);
+            if (delta > 1e-7) CHECK(excess * duration > 10 * tol);   // (at 1e-6 the allowance is below the motion)
+            CHECK(sliding == 20);
         }
-        sc.name = "rim";
-        sc.part.mu.setConstant(mu);
-        sc.plate = circle(mu * g + excess, T);
-        const double duration = 0.1;
-        IntegrationOptions io;   // rtol 1e-9
-        const Trajectory tr = simulate(sc, Dynamics::U, Vec3::Zero(), Vec3::Zero(), duration, duration / 20, io);
-        REQUIRE(tr.stop.reason == StopReason::None);
-        INFO((rigid ? "fig4's part" : "point part") << ", delta " << delta << ": steps " << tr.stats.steps << ", events " << tr.events.size());
-        CHECK(tr.stats.steps < 1000);
-        const double tol = 3e2 * io.rtol * sc.v_ref();
-        int sliding = 0;
-        double worst = 0, across = 0, along = HUGE_VAL;
-        for (const Sample& s : tr.samples) {
-            const Vec2 v = s.qd.head<2>();
-            worst = std::max(worst, std::abs(v.norm() - excess * s.t));
-            sliding += s.t > 0 && s.mode.kind == ModeKind::Slide;
-            // v against -p'': across it only the exact alpha |v| (< 1e-11 m/s) plus the error allowed
-            Vec3 pdd, wd;
-            sc.plate.acceleration(s.t, pdd, wd);
-            const Vec2 e = -pdd.head<2>().normalized();
-            across = std::max(across, std::abs(e.x() * v.y() - e.y() * v.x()));
-            if (s.t > 0) along = std::min(along, e.dot(v));
-            if (rigid) CHECK(std::abs(s.qd[2]) * sc.part.rho() <= tol);   // no spin
-        }
-        INFO("largest | |v| - (A w^2 - mu g) t | " << worst << " m/s, across -p'' " << across << " m/s (allowed " << tol << ")");
-        CHECK(worst <= tol);
-        CHECK(across <= tol);
-        CHECK(along > 0);
-        if (delta > 1e-7) CHECK(excess * duration > 10 * tol);   // (at 1e-6 the allowance is below the motion)
-        CHECK(sliding == 20);
-    }
 }
 
 TEST_CASE("Observation 1: very different initial twists reach the same limit cycle on the paper's scenes",
@@ -138,7 +140,7 @@ TEST_CASE("Observation 1: very different initial twists reach the same limit cyc
         const char* scene;
         Vec3 q;
     };
-    const Case cases[] = {{"fig1", Vec3(0.02, 0.01, 0.4)}, {"fig1_point", Vec3(0.02, 0.01, 0)},
+    const Case cases[] = {{"fig1", Vec3(0.02, 0.01, 0.4)},  {"fig1_point", Vec3(0.02, 0.01, 0)},
                           {"fig4", Vec3(0.03, -0.02, 1.0)}, {"fig5", Vec3(-0.01, 0.02, 2.5)},
                           {"fig6", Vec3(0.03, 0.03, 1.2)},  {"fig3_random", Vec3(0.01, -0.01, 0.5)}};
     for (const auto& c : cases) {
@@ -168,7 +170,7 @@ TEST_CASE("a block sliding on a resting plate sticks at t = v0 / (mu g) and its 
     sc.part.point = true;
     sc.part.m = 0.1;
     sc.part.mu.setConstant(0.3);
-    sc.plate.T = 0.05;   // no harmonics: the plate rests
+    sc.plate.T = 0.05;                                   // no harmonics: the plate rests
     const double v0 = 0.1, t_star = v0 / (0.3 * sc.g);   // uniform deceleration mu g
     // The trajectory: Slide until t*, then Stuck for good (static friction needs nothing).
     const Trajectory tr = simulate(sc, Dynamics::U, Vec3::Zero(), Vec3(v0, 0, 0), 0.2, 0.01);
@@ -316,11 +318,27 @@ namespace {
 struct StickSlip1D {
     std::vector<double> A, k, phi;
     double w, mug;
-    double a(double t) const { double s = 0; for (std::size_t i = 0; i < A.size(); ++i) s += A[i] * std::sin(k[i] * w * t + phi[i]); return s; }
-    double V(double t) const { double s = 0; for (std::size_t i = 0; i < A.size(); ++i) s -= A[i] / (k[i] * w) * std::cos(k[i] * w * t + phi[i]); return s; }
-    double X(double t) const { double s = 0; for (std::size_t i = 0; i < A.size(); ++i) s -= A[i] / (k[i] * w * k[i] * w) * std::sin(k[i] * w * t + phi[i]); return s; }
-    template <class F> static double root(F&& f, double a, double b) {
-        for (int i = 0; i < 200; ++i) { const double m = 0.5 * (a + b); (f(a) > 0) == (f(m) > 0) ? a = m : b = m; }
+    double a(double t) const {
+        double s = 0;
+        for (std::size_t i = 0; i < A.size(); ++i) s += A[i] * std::sin(k[i] * w * t + phi[i]);
+        return s;
+    }
+    double V(double t) const {
+        double s = 0;
+        for (std::size_t i = 0; i < A.size(); ++i) s -= A[i] / (k[i] * w) * std::cos(k[i] * w * t + phi[i]);
+        return s;
+    }
+    double X(double t) const {
+        double s = 0;
+        for (std::size_t i = 0; i < A.size(); ++i) s -= A[i] / (k[i] * w * k[i] * w) * std::sin(k[i] * w * t + phi[i]);
+        return s;
+    }
+    template <class F>
+    static double root(F&& f, double a, double b) {
+        for (int i = 0; i < 200; ++i) {
+            const double m = 0.5 * (a + b);
+            (f(a) > 0) == (f(m) > 0) ? a = m : b = m;
+        }
         return 0.5 * (a + b);
     }
     void run(double T, int n, double& mean_v, double& stuck_time) const {
@@ -333,25 +351,39 @@ struct StickSlip1D {
             if (stuck) {   // find the break-away
                 double tb = t;
                 while (tb < t_end && std::abs(a(tb)) <= mug) tb += h;
-                if (tb >= t_end) { if (t < n * T) t = n * T; stuck_time += t_end - std::max(t, n * T); t = t_end; break; }
+                if (tb >= t_end) {
+                    if (t < n * T) t = n * T;
+                    stuck_time += t_end - std::max(t, n * T);
+                    t = t_end;
+                    break;
+                }
                 if (tb > t) tb = root([&](double u) { return std::abs(a(u)) - mug; }, tb - h, tb);
                 if (tb > n * T) stuck_time += tb - std::max(t, n * T);
                 if (t < n * T && tb >= n * T) x_n = x;
-                t = tb; t0 = tb; s = a(tb) > 0 ? -1.0 : 1.0; stuck = false;
+                t = tb;
+                t0 = tb;
+                s = a(tb) > 0 ? -1.0 : 1.0;
+                stuck = false;
                 continue;
             }
             auto v = [&](double u) { return -(V(u) - V(t0)) - mug * s * (u - t0); };
             auto dx = [&](double u) { return -(X(u) - X(t0)) + V(t0) * (u - t0) - 0.5 * mug * s * (u - t0) * (u - t0); };
             double ts = t + h;
             while (ts < t_end && v(ts) * s > 0) ts += h;
-            if (ts >= t_end) ts = t_end;
-            else ts = root([&](double u) { return v(u) * s; }, ts - h, ts);
+            if (ts >= t_end)
+                ts = t_end;
+            else
+                ts = root([&](double u) { return v(u) * s; }, ts - h, ts);
             if (t < n * T && ts >= n * T) x_n = x + dx(n * T);
             x += dx(ts);
             t = ts;
             if (t >= t_end) break;
-            if (std::abs(a(t)) <= mug) stuck = true;
-            else { t0 = t; s = -s; }   // a reversal: it slides on the other way
+            if (std::abs(a(t)) <= mug)
+                stuck = true;
+            else {
+                t0 = t;
+                s = -s;
+            }   // a reversal: it slides on the other way
         }
         mean_v = (x - x_n) / T;
     }
@@ -369,7 +401,7 @@ Scene shaken_point(double A1, double A2) {
     return sc;
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("a point part shaken below mu g never slips: zero drift, twist exactly zero", "[limit_cycle][stick]") {
     const Scene sc = shaken_point(0.9 * 0.3 * 9.81, 0);
@@ -387,7 +419,7 @@ TEST_CASE("a point part shaken below mu g never slips: zero drift, twist exactly
     Scene weak = sc;
     weak.part.mu.setConstant(0.15);
     const LimitCycleSummary slips = limit_cycle(weak, Vec3::Zero());
-    REQUIRE(slips.converged);                  // (not stuck because it failed to converge)
+    REQUIRE(slips.converged);   // (not stuck because it failed to converge)
     CHECK_FALSE(slips.stuck_all_period());
     CHECK(slips.stick_fraction[0] < 1);
 }
@@ -398,15 +430,18 @@ TEST_CASE("a point part shaken above mu g: stick-slip cycle against the piecewis
         const Scene sc = shaken_point(1.5 * mug, A2);
         const double T = sc.plate.T;
         StickSlip1D ref{{1.5 * mug}, {1}, {0.0}, sc.plate.omega(), mug};
-        if (A2 != 0) { ref.A.push_back(A2); ref.k.push_back(2); ref.phi.push_back(0.7); }
+        if (A2 != 0) {
+            ref.A.push_back(A2);
+            ref.k.push_back(2);
+            ref.phi.push_back(0.7);
+        }
         double mean_v, stuck;
         ref.run(T, 40, mean_v, stuck);
         LimitCycleOptions o;
         o.tol = 1e-9;
         o.integration.rtol = 1e-10;
         const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), o);
-        INFO("A2 = " << A2 << ": reference mean velocity " << mean_v << " m/s, stuck " << stuck / T << " of T; "
-                     << lc.report());
+        INFO("A2 = " << A2 << ": reference mean velocity " << mean_v << " m/s, stuck " << stuck / T << " of T; " << lc.report());
         REQUIRE(lc.converged);
         // The cycle's average and stick fraction: the method's error (tol 1e-9 v_ref, rtol 1e-10) is far
         // below the bound; the reference's roots are exact to rounding.
@@ -414,15 +449,18 @@ TEST_CASE("a point part shaken above mu g: stick-slip cycle against the piecewis
         CHECK(std::abs(lc.twist[1]) < 1e-12);
         CHECK(lc.stick_fraction[0] == Approx(stuck / T).margin(1e-7));
         CHECK(stuck > 0.05 * T);   // it really sticks for part of the period
-        if (A2 == 0) CHECK(std::abs(mean_v) < 1e-12);   // a_p(t + T/2) = -a_p(t): no drift
-        else CHECK(std::abs(mean_v) > 1e-3);            // the second harmonic drives it
+        if (A2 == 0)
+            CHECK(std::abs(mean_v) < 1e-12);   // a_p(t + T/2) = -a_p(t): no drift
+        else
+            CHECK(std::abs(mean_v) > 1e-3);   // the second harmonic drives it
     }
 }
 
 // Anderson acceleration stalls where the period map's noise matches the residual it extrapolates from
 // (here a sticking cycle of fig6 at tol 1e-5, rtol 1e-6: it hovered at 2e-5 for all 400 periods and
 // reported no cycle, while plain periods converge in 13). A stall hands over to plain periods.
-TEST_CASE("a stalled Anderson iteration hands over to plain periods: fig6's sticking cycle at tol 1e-5", "[limit_cycle][stickslip]") {
+TEST_CASE("a stalled Anderson iteration hands over to plain periods: fig6's sticking cycle at tol 1e-5",
+          "[limit_cycle][stickslip]") {
     const Scene sc = scene("fig6");
     const Vec3 q(-0.05, 0.05 / 3, 2 * kPi * 5 / 7);
     LimitCycleOptions o;

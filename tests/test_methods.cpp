@@ -27,13 +27,16 @@ OdeSystem oscillator() {
         f[1] = -y[0];
     };
     s.jac = [](double, const double*, double* J, double* dfdt) {
-        J[0] = 0; J[1] = 1; J[2] = -1; J[3] = 0;
+        J[0] = 0;
+        J[1] = 1;
+        J[2] = -1;
+        J[3] = 0;
         dfdt[0] = dfdt[1] = 0;
     };
     return s;
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("every fixed-step method converges at its order on a smooth problem", "[methods]") {
     // The pendulum theta'' = -sin theta from theta = 1 at rest, over [0, 6.4]: nonlinear and analytic
@@ -46,7 +49,10 @@ TEST_CASE("every fixed-step method converges at its order on a smooth problem", 
         f[1] = -std::sin(y[0]);
     };
     s.jac = [](double, const double* y, double* J, double* dfdt) {
-        J[0] = 0; J[1] = 1; J[2] = -std::cos(y[0]); J[3] = 0;
+        J[0] = 0;
+        J[1] = 1;
+        J[2] = -std::cos(y[0]);
+        J[3] = 0;
         dfdt[0] = dfdt[1] = 0;
     };
     for (const auto& mi : all_methods()) {
@@ -199,9 +205,12 @@ TEST_CASE("the generated Jacobian of the reduced U-dynamics matches central diff
 }
 
 TEST_CASE("auto never picks a model whose measured error exceeds the tolerance on the shipped scenes", "[hierarchy]") {
-    struct Q { const char* scene; Vec3 q0; };
-    for (const Q& q : {Q{"fig4", Vec3(0.04, -0.04, 1.0)}, Q{"fig5", Vec3(0.02, -0.01, 0.5)},
-                       Q{"fig3_random", Vec3(0.02, -0.01, 0.5)}}) {
+    struct Q {
+        const char* scene;
+        Vec3 q0;
+    };
+    for (const Q& q :
+         {Q{"fig4", Vec3(0.04, -0.04, 1.0)}, Q{"fig5", Vec3(0.02, -0.01, 0.5)}, Q{"fig3_random", Vec3(0.02, -0.01, 0.5)}}) {
         const Scene sc = scene(q.scene);
         for (double tol : {3e-2, 1e-2}) {
             const ModelChoice mc = choose_model(sc, q.q0, 1.0, tol);
@@ -225,8 +234,8 @@ TEST_CASE("auto never picks a model whose measured error exceeds the tolerance o
             REQUIRE(ref.stop.reason == StopReason::None);
             REQUIRE(tr.stop.reason == StopReason::None);
             const Vec3 d = tr.samples.back().q - ref.samples.back().q;
-            const double err = std::max({std::abs(d[0]) / sc.part.rho(), std::abs(d[1]) / sc.part.rho(),
-                                         std::abs(wrap_angle(d[2]))});
+            const double err =
+                std::max({std::abs(d[0]) / sc.part.rho(), std::abs(d[1]) / sc.part.rho(), std::abs(wrap_angle(d[2]))});
             CHECK(err <= tol);
         }
     }

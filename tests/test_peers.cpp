@@ -24,7 +24,7 @@ constexpr double kDrift = 1e-4, kTurn = 1e-3, kDuration = 2;
 
 void require_engines() { REQUIRE(!peers::engines().empty()); }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("peers: on a plate at rest every engine keeps the part at rest", "[peers]") {
     require_engines();
@@ -103,7 +103,8 @@ TEST_CASE("peers: a plate translating harmonically in x drags the part as the 1-
         peers::PeerOptions o;
         o.dt = 1e-4;
         const peers::PeerRun r = e.run(sc, Vec3(0.04, 0, 0), t_end, t_end, o);
-        INFO(r.engine << ": " << r.failure << "; s_x " << r.q.back()[0] << ", the 1-D law's " << s << ", theta " << r.q.back()[2]);
+        INFO(r.engine << ": " << r.failure << "; s_x " << r.q.back()[0] << ", the 1-D law's " << s << ", theta "
+                      << r.q.back()[2]);
         REQUIRE(r.failure.empty());
         const bool soft = r.engine.rfind("MuJoCo", 0) == 0;
         CHECK(std::abs(r.q.back()[0] - s) < (soft ? 1.0 : 0.2) * travel);
@@ -154,7 +155,8 @@ void require_follows_plate(bool pyramid) {
         o.dt = 1e-4;
         o.pyramid = pyramid;
         const peers::PeerRun r = e.run(sc, q0, 1.0, 1.0, o);
-        INFO(r.engine << ": " << r.settings << " " << r.failure << "; end " << r.q.back().transpose() << ", plate's " << end.transpose());
+        INFO(r.engine << ": " << r.settings << " " << r.failure << "; end " << r.q.back().transpose() << ", plate's "
+                      << end.transpose());
         REQUIRE(r.failure.empty());
         CHECK((r.q.back().head<2>() - end.head<2>()).norm() < 0.02 * moved);
         const double t = r.q.back()[2] - q0[2];
@@ -163,7 +165,7 @@ void require_follows_plate(bool pyramid) {
     }
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("peers: fig4 for one second follows plate's full dynamics", "[peers]") {
     require_engines();

@@ -16,8 +16,8 @@ TEST_CASE("Theorem 1: the relative twist of thin parts contracts (V never rises 
     o.cases = 12;
     o.seed = 100;
     const ContractionSummary s = check_contraction(o);
-    INFO("valid " << s.valid << ", worst rise/bound " << s.worst_increase << " (seed " << s.worst_seed
-                  << "), median rate " << s.median_rate << ", max Floquet " << s.max_spectral_radius);
+    INFO("valid " << s.valid << ", worst rise/bound " << s.worst_increase << " (seed " << s.worst_seed << "), median rate "
+                  << s.median_rate << ", max Floquet " << s.max_spectral_radius);
     CHECK(s.valid >= 8);
     CHECK(s.monotone == s.valid);
     CHECK(s.converged == s.valid);
@@ -63,16 +63,15 @@ TEST_CASE("limit surface of a thin part: convex, twist normal to it, (40) holds,
         double scale = 0;
         const WrenchMap w = thin_wrench_map(sc, Vec3(0.01, -0.01, 0.5), 0.01, &scale);
         const LimitSurfaceResult r = check_limit_surface(w, scale, 300);
-        INFO("seed " << seed << ": max-work violation " << r.max_work_violation << ", (40) "
-                     << r.monotonicity_violation << ", separation " << r.min_separation);
+        INFO("seed " << seed << ": max-work violation " << r.max_work_violation << ", (40) " << r.monotonicity_violation
+                     << ", separation " << r.min_separation);
         CHECK(r.convex_and_normal());
         CHECK(r.strictly_convex());   // no flat faces, no vertices
         CHECK(r.min_separation > 1e-3);
     }
 }
 
-TEST_CASE("the limit-surface check catches a non-convex surface (the wrench's sign flipped)",
-          "[proofs][limit_surface][broken]") {
+TEST_CASE("the limit-surface check catches a non-convex surface (the wrench's sign flipped)", "[proofs][limit_surface][broken]") {
     const Scene sc = random_scene(2, RandomSceneOptions{true});
     double scale = 0;
     const WrenchMap w = thin_wrench_map(sc, Vec3::Zero(), 0.0, &scale);
@@ -101,8 +100,8 @@ TEST_CASE("as contacts approach collinear the limit surface gets a vertex and A 
         const double gap = (w(Vec3(0, 1, 0)) - w(Vec3(0, 1, rho * 0.5 / L).normalized())).norm() / scale;
         const Conditioning c = condition_of_A(sc, 20, 5);
         INFO("e = " << e << ": wrench gap " << gap << ", cond(A) " << c.max_condition);
-        CHECK(r.convex_and_normal());     // still convex ...
-        CHECK(gap < 0.2 * last_gap);       // ... but two distinct twists share ever closer wrenches
+        CHECK(r.convex_and_normal());   // still convex ...
+        CHECK(gap < 0.2 * last_gap);    // ... but two distinct twists share ever closer wrenches
         CHECK(c.max_condition > 5 * last_cond);
         last_gap = gap;
         last_cond = c.max_condition;
@@ -214,7 +213,8 @@ TEST_CASE("the limit-surface check against the independent friction set catches 
     CHECK(good.convex_and_normal());
     // The generated kernel, fed from the set with one input edited.
     auto kernel = [&](std::function<void(gen::WrenchInput&)> edit) -> WrenchMap {
-        gen::WrenchInput in = wrench_input(set.r, set.cap.cwiseQuotient(sc.part.friction().kinetic()), sc.part.friction().kinetic(), set.rho);
+        gen::WrenchInput in =
+            wrench_input(set.r, set.cap.cwiseQuotient(sc.part.friction().kinetic()), sc.part.friction().kinetic(), set.rho);
         edit(in);
         return wrench_map(in);
     };
@@ -223,13 +223,17 @@ TEST_CASE("the limit-surface check against the independent friction set catches 
     const std::pair<const char*, std::function<void(gen::WrenchInput&)>> wrong[] = {
         {"mu of contact 3 x 1.1", [](gen::WrenchInput& in) { in.mu3 *= 1.1; }},
         {"contact 1's lever arm with x and y swapped", [](gen::WrenchInput& in) { std::swap(in.r1x, in.r1y); }},
-        {"contact 2's lever arm x 1.1", [](gen::WrenchInput& in) { in.r2x *= 1.1; in.r2y *= 1.1; }},
+        {"contact 2's lever arm x 1.1",
+         [](gen::WrenchInput& in) {
+             in.r2x *= 1.1;
+             in.r2y *= 1.1;
+         }},
     };
     for (const auto& [what, edit] : wrong) {
         INFO(what);
         const LimitSurfaceResult r = check_limit_surface(kernel(edit), scale, 300, 0.2, &set);
         INFO("support " << r.support_violation << ", outside " << r.outside_violation);
-        CHECK(r.convex_and_normal());   // the old checks pass it ...
+        CHECK(r.convex_and_normal());       // the old checks pass it ...
         CHECK_FALSE(r.on_friction_set());   // ... the friction set does not
     }
 }

@@ -45,7 +45,7 @@ void check_refused(const Refused (&cases)[N]) {
     }
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("shipped scenes state the paper's parts and plate motions", "[scene]") {
     const std::string dir = PLATE_SOURCE_DIR "/scenes/";
@@ -81,15 +81,16 @@ TEST_CASE("friction may be one number, a point part has mass and friction only",
     const Scene s = parse_scene(replace(kGood, "[0.3, 0.3, 0.3]", "0.25"), "f.json");
     CHECK(s.part.mu == Vec3::Constant(0.25));
     const Scene p = parse_scene(R"({"name": "p", "gravity": 9.81, "part": {"mass": 1, "friction": 0.2},
-        "plate": {"period": 0.05, "harmonics": []}})", "p.json");
+        "plate": {"period": 0.05, "harmonics": []}})",
+                                "p.json");
     CHECK(p.part.point);
     CHECK(p.part.contacts() == 1);
 }
 
 TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
     const Refused cases[] = {
-        {"{ \"name\": ", "bad.json:1:"},                                                      // malformed
-        {replace(kGood, "\"gravity\": 9.81,", ""), "gravity: missing"},                        // missing
+        {"{ \"name\": ", "bad.json:1:"},                                  // malformed
+        {replace(kGood, "\"gravity\": 9.81,", ""), "gravity: missing"},   // missing
         {replace(kGood, "\"name\": \"t\",", "\"name\": \"t\", \"colour\": 1,"), "colour: unknown field"},
         // a control character in a field name is escaped: the message stays on one line (found by the fuzzer)
         {replace(kGood, "\"name\": \"t\",", "\"name\": \"t\", \"col\\nour\": 1,"), "col\\nour: unknown field"},
@@ -106,15 +107,17 @@ TEST_CASE("bad scenes name the file and the field", "[scene][input]") {
         {replace(kGood, "\"period\": 0.05", "\"period\": 0"), "plate.period: expected a positive number"},
         {replace(kGood, "\"axis\": \"x\"", "\"axis\": \"q\""), "plate.harmonics[0].axis: expected one of"},
         {replace(kGood, "\"n\": 1", "\"n\": 1.5"), "plate.harmonics[0].n: expected a whole number"},
-        {replace(kGood, "\"amp\": 20", "\"amp\": NaN"), "bad.json:"},                       // NaN is not JSON
+        {replace(kGood, "\"amp\": 20", "\"amp\": NaN"), "bad.json:"},   // NaN is not JSON
         {replace(kGood, "\"amp\": 20", "\"amp\": 1e999"), "number overflow parsing '1e999'"},
         {replace(kGood, "\"amp\": 20", "\"amp\": \"20\""), "plate.harmonics[0].amp: expected a number"},
     };
     check_refused(cases);
 }
 
-TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible inertia, collinear contacts, "
-          "friction out of range", "[scene][input][precheck]") {
+TEST_CASE(
+    "physical pre-checks: a part that tips, a unit error, an impossible inertia, collinear contacts, "
+    "friction out of range",
+    "[scene][input][precheck]") {
     // kGood's contacts (0.01, -0.03), (0, 0.03), (-0.01, -0.03): at rest N_i / (m g) are the
     // barycentric coordinates of the origin, 1/4, 1/2, 1/4. Moving contact 1 to x = 0.03 (and 3 to
     // x = 0.02) puts the origin outside the triangle: the line through contacts 2 and 3 passes
@@ -134,7 +137,8 @@ TEST_CASE("physical pre-checks: a part that tips, a unit error, an impossible in
         // a sliver around the centre of mass, (-0.03, -e), (0.03, -e), (0, 2e): cond = 8.5e5 at e = 5e-8
         // (refused), 4.2e5 at e = 1e-7 (accepted, below)
         {replace(replace(replace(kGood, "[0.01, -0.03, -0.002]", "[-0.03, -5e-8, -0.002]"), "[0, 0.03, -0.002]",
-                         "[0.03, -5e-8, -0.002]"), "[-0.01, -0.03, -0.002]", "[0, 1e-7, -0.002]"),
+                         "[0.03, -5e-8, -0.002]"),
+                 "[-0.01, -0.03, -0.002]", "[0, 1e-7, -0.002]"),
          "part.contacts: nearly collinear"},
         // principal moments 1e-6 + 1.09e-5 < 1.2e-5, 0.8% past the triangle's edge (1.1e-5 is accepted, below)
         {replace(replace(kGood, "[[1.084e-5, 0, 0]", "[[1e-6, 0, 0]"), "[0, 1.23e-6, 0]", "[0, 1.09e-5, 0]"),
@@ -189,17 +193,16 @@ TEST_CASE("scene warnings: admissible scenes outside the intended regime", "[sce
     CHECK(has(scene_warnings(parse_scene(replace(kGood, "[0, 0.03, -0.002]", "[0, 0.000303, -0.002]"), "w.json")),
               "close to tipping over"));
     // 9.81 m/s^2 of heave: the downward acceleration reaches g.
-    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"axis\": \"x\", \"n\": 1, \"amp\": 20",
-                                                 "\"axis\": \"z\", \"n\": 1, \"amp\": 9.81"), "w.json")),
-              "at least g"));
+    CHECK(
+        has(scene_warnings(parse_scene(
+                replace(kGood, "\"axis\": \"x\", \"n\": 1, \"amp\": 20", "\"axis\": \"z\", \"n\": 1, \"amp\": 9.81"), "w.json")),
+            "at least g"));
     // v_ref = max(mu g, 20) / omega = 20 / (2 pi / 0.05) = 0.159 m/s; with a 5 s period, v_ref T is
     // 20 * 5^2 / (2 pi) = 79.6 m against a reach of 0.0316 m.
-    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"period\": 0.05", "\"period\": 5"), "w.json")),
-              "times its size"));
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"period\": 0.05", "\"period\": 5"), "w.json")), "times its size"));
     CHECK(scene_warnings(parse_scene(kGood, "ok.json")).empty());
     // Grams typed as kilograms: 21.6 kg with fig4's inertia, ratio 1/42: accepted, but warned about.
-    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"mass\": 0.0216", "\"mass\": 21.6"), "w.json")),
-              "check the units"));
+    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"mass\": 0.0216", "\"mass\": 21.6"), "w.json")), "check the units"));
     // A sliver 2e-7 m wide around the centre of mass: accepted, and friction (mu h = 6e-4 m) can tip it.
     CHECK(has(scene_warnings(parse_scene(replace(replace(replace(kGood, "[0.01, -0.03, -0.002]", "[-0.03, -1e-7, -0.002]"),
                                                          "[0, 0.03, -0.002]", "[0.03, -1e-7, -0.002]"),
@@ -207,7 +210,8 @@ TEST_CASE("scene warnings: admissible scenes outside the intended regime", "[sce
                                          "w.json")),
               "sliding friction can tip the part"));
     // The tilt counts too: rx of 400 rad/s^2 at contacts 0.03 m off the axis gives 12 m/s^2 downward.
-    CHECK(has(scene_warnings(parse_scene(replace(kGood, "\"axis\": \"x\", \"n\": 1, \"amp\": 20",
-                                                 "\"axis\": \"rx\", \"n\": 1, \"amp\": 400"), "w.json")),
-              "at least g"));
+    CHECK(
+        has(scene_warnings(parse_scene(
+                replace(kGood, "\"axis\": \"x\", \"n\": 1, \"amp\": 20", "\"axis\": \"rx\", \"n\": 1, \"amp\": 400"), "w.json")),
+            "at least g"));
 }

@@ -54,8 +54,7 @@ bool breaks_away(const ModeEvent& ev) {
 
 // `sticks_from_sliding`: the engine's run must enter a hold from sliding at least once (else it would
 // test a break-away only); `halving`: the errors must halve with h (then Richardson's check applies).
-void check_against_engine(const Scene& sc, const Vec3& q0, double duration, bool sticks_from_sliding,
-                          bool halving = false) {
+void check_against_engine(const Scene& sc, const Vec3& q0, double duration, bool sticks_from_sliding, bool halving = false) {
     INFO(sc.name << " from (" << q0.transpose() << ") for " << duration << " s");
     REQUIRE(sc.part.J(0, 2) == 0);
     REQUIRE(sc.part.J(1, 2) == 0);
@@ -81,8 +80,8 @@ void check_against_engine(const Scene& sc, const Vec3& q0, double duration, bool
         MoreauJeanOptions opt;
         opt.steps_per_period = n;
         const MoreauJeanSummary s = moreau_jean_u(sc, q0, duration, opt);
-        INFO("T/" << n << ": " << s.solver_failures << " solves of " << s.steps
-                  << " short of 1e-13, the largest error " << s.max_residual);
+        INFO("T/" << n << ": " << s.solver_failures << " solves of " << s.steps << " short of 1e-13, the largest error "
+                  << s.max_residual);
         CHECK(s.max_residual < 1e-11);
         CHECK(s.max_gap < 1e-9);   // the part stays on its three contacts
         q[k] = s.q;
@@ -105,10 +104,9 @@ void check_against_engine(const Scene& sc, const Vec3& q0, double duration, bool
     }
 }
 
-}  // namespace
+}   // namespace
 
-TEST_CASE("Siconos: Moreau-Jean converges at first order to the engine's U-dynamics through stick-slip",
-          "[siconos]") {
+TEST_CASE("Siconos: Moreau-Jean converges at first order to the engine's U-dynamics through stick-slip", "[siconos]") {
     SECTION("fig6's sticking configuration (0.0167, 0, 2.693): slides, stuck, slides every period") {
         check_against_engine(scene("fig6"), Vec3(0.0167, 0, 2.693), 0.2, true, true);
     }

@@ -44,10 +44,9 @@ bool central_monodromy(const Scene& sc, const Vec3& q, const Vec3& x, double h, 
     return true;
 }
 
-}  // namespace
+}   // namespace
 
-TEST_CASE("regularised reference: where nothing sticks it is today's twist at every eps",
-          "[stick][reference]") {
+TEST_CASE("regularised reference: where nothing sticks it is today's twist at every eps", "[stick][reference]") {
     const Scene sc = scene("fig6");
     // (0.05, 0.05, 0): fig6's corner slides all period long (the engine's mode record says so).
     const Vec3 q(0.05, 0.05, 0);
@@ -65,8 +64,7 @@ TEST_CASE("regularised reference: where nothing sticks it is today's twist at ev
     for (const Vec3& t : r.twists) CHECK(twist_distance(sc, lc.twist, t) < 1e-8);
 }
 
-TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-friction limit to 1e-7 v_ref",
-          "[stick][reference]") {
+TEST_CASE("stick-slip: fig6's pivoting cycles agree with the regularised-friction limit to 1e-7 v_ref", "[stick][reference]") {
     // The configurations of fig6's default 7x7x7 grid whose cycle holds a contact (a pivot) but is
     // never stuck as a whole, every fourth in grid order; the engine at rtol 1e-10 with cycles to 1e-9 (at 1e-9 one
     // of them was 2e-7 off with the creep's error budget at 10 rtol v_ref; it is 100 rtol now).
@@ -122,7 +120,7 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         Vec3 q;
         bool full_stick;
     };
-    const Case cases[] = {{"heave_yaw", Vec3(0.03, 0.02, 1.0), true},          // stuck, slides, stuck again
+    const Case cases[] = {{"heave_yaw", Vec3(0.03, 0.02, 1.0), true},                            // stuck, slides, stuck again
                           {"fig6", Vec3(-0.05 + 1.0 / 60, 1.0 / 60, 2 * kPi * 5 / 7), false}};   // pivots about 1
     for (const Case& c : cases) {
         INFO(c.scene);
@@ -152,7 +150,8 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
             LimitCycleOptions fine_plain = plain, fine_shooting;
             fine_plain.integration.rtol = fine_shooting.integration.rtol = 1e-10;
             const LimitCycleSummary ref_fine = limit_cycle(sc, c.q, fine_plain);
-            const LimitCycleSummary sh_fine = limit_cycle(sc, c.q, fine_shooting, ref_fine.qd_start + Vec3(3e-2, -3e-2, 3e-2).cwiseProduct(S));
+            const LimitCycleSummary sh_fine =
+                limit_cycle(sc, c.q, fine_shooting, ref_fine.qd_start + Vec3(3e-2, -3e-2, 3e-2).cwiseProduct(S));
             REQUIRE(ref_fine.converged);
             REQUIRE(sh_fine.converged);
             CHECK(sh_fine.has_monodromy);
@@ -171,8 +170,8 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
         REQUIRE(central_monodromy(sc, c.q, ref.qd_start, 1e-4, IntegrationOptions{}, Mc));
         INFO("shooting M\n" << sh.monodromy << "\ncentral differences\n" << Mc);
         if (c.full_stick) {
-            CHECK(Mc.norm() < 1e-5);          // the period's end forgets its start (measured 1.4e-7)...
-            CHECK(sh.monodromy.isZero(0));    // ...and the solver says so
+            CHECK(Mc.norm() < 1e-5);         // the period's end forgets its start (measured 1.4e-7)...
+            CHECK(sh.monodromy.isZero(0));   // ...and the solver says so
         } else {
             // The bound follows from the period map's own errors (against rtol 1e-11) at the points the
             // two difference quotients use: e_w at the solver's forward differences from the warm start
@@ -198,7 +197,8 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
                 Vec3 d = Vec3::Zero();
                 d[j] = 1e-4 * S[j];
                 e_w = std::max(e_w, error_at(warm + d, solver));
-                e_c = std::max({e_c, error_at(ref.qd_start + d, IntegrationOptions{}), error_at(ref.qd_start - d, IntegrationOptions{})});
+                e_c = std::max(
+                    {e_c, error_at(ref.qd_start + d, IntegrationOptions{}), error_at(ref.qd_start - d, IntegrationOptions{})});
             }
             Mat3 Mc10, Mf10;
             REQUIRE(central_monodromy(sc, c.q, ref.qd_start, 1e-3, fine, Mc10));
@@ -244,8 +244,7 @@ TEST_CASE("shooting through stick-slip: a full stick's monodromy is zero, a pivo
     }
 }
 
-TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's period map has rank one",
-          "[limit_cycle][stick]") {
+TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's period map has rank one", "[limit_cycle][stick]") {
     // Held about contact k, the twist satisfies two constraints (contact k's slip is zero), so it has
     // one free component, theta'; whatever the period's start, its state on leaving the pivot is one
     // number, and the period map's derivative is u v^T: one nonzero singular value (as long as nearby
@@ -264,11 +263,11 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
         Vec3 q;
         bool pivots;
     };
-    const Case cases[] = {{grid(1, 3, 2), true},    // pivots about contact 2 three times a period
-                          {grid(4, 2, 1), true},    // about contact 1, three times
-                          {grid(5, 4, 2), true},    // about contact 1, twice
-                          {grid(0, 0, 6), true},    // about contact 1, once (the noisiest)
-                          {Vec3(1.0 / 60, 1.0 / 60, 1.0), false},    // slides all period long
+    const Case cases[] = {{grid(1, 3, 2), true},                    // pivots about contact 2 three times a period
+                          {grid(4, 2, 1), true},                    // about contact 1, three times
+                          {grid(5, 4, 2), true},                    // about contact 1, twice
+                          {grid(0, 0, 6), true},                    // about contact 1, once (the noisiest)
+                          {Vec3(1.0 / 60, 1.0 / 60, 1.0), false},   // slides all period long
                           {Vec3(-0.025, 0.025, 1.5 * kPi), false}};
     IntegrationOptions io;
     io.rtol = 1e-11;
@@ -288,8 +287,10 @@ TEST_CASE("a pivot leaves the twist one degree of freedom: a pivoting cycle's pe
         const Vec3 sigma = Eigen::JacobiSVD<Mat3>(M).singularValues();
         INFO("singular values " << sigma.transpose());
         CHECK(sigma[0] > 1e-2);   // the start matters (no full stick)
-        if (c.pivots) CHECK(sigma[1] <= 1e-4 * sigma[0]);
-        else CHECK(sigma[1] > 1e-1 * sigma[0]);
+        if (c.pivots)
+            CHECK(sigma[1] <= 1e-4 * sigma[0]);
+        else
+            CHECK(sigma[1] > 1e-1 * sigma[0]);
         if (!c.pivots) continue;
         // The shooting solver uses it (limit_cycle.cpp): from a start 0.1 of the scales off, a plain
         // period puts x on the map's image curve, one difference along the residual gives lambda and
@@ -347,8 +348,8 @@ TEST_CASE("a slip that stays at the disk's rim creeps: cheap, and the regularise
     CHECK(pl.error_estimate >= pl.residual);
     const RegularisedReference r = regularised_reference(sc, q);
     REQUIRE(r.ok);
-    INFO("engine " << lc.twist.transpose() << ", reference " << r.twist.transpose() << " (order " << r.order
-                   << ", error " << r.error << ")");
+    INFO("engine " << lc.twist.transpose() << ", reference " << r.twist.transpose() << " (order " << r.order << ", error "
+                   << r.error << ")");
     CHECK(twist_distance(sc, lc.twist, r.twist) <= 1e-7 + 60 * 1e-8 + r.error);
     CHECK(r.error < 1e-6);
 }
@@ -367,7 +368,7 @@ TEST_CASE("heave_yaw as shipped: its sticking cycles are the regularised limit's
         const LimitCycleSummary lc = limit_cycle(sc, q, o);
         REQUIRE(lc.converged);
         const double held = *std::max_element(lc.stick_fraction.begin(), lc.stick_fraction.end());
-        CHECK(held > 0.05);    // it sticks for part of the period
+        CHECK(held > 0.05);   // it sticks for part of the period
         CHECK(!lc.stuck_all_period());
         const RegularisedReference r = regularised_reference(sc, q);
         REQUIRE(r.ok);
@@ -392,8 +393,8 @@ TEST_CASE("a cycle with a full stick is the regularised reference's: fig6 at (0.
     REQUIRE(enters(lc, ModeKind::Stuck));
     const RegularisedReference r = regularised_reference(sc, q);
     REQUIRE(r.ok);
-    INFO("engine " << lc.twist.transpose() << ", reference " << r.twist.transpose() << " (order " << r.order
-                   << ", error " << r.error << ")");
+    INFO("engine " << lc.twist.transpose() << ", reference " << r.twist.transpose() << " (order " << r.order << ", error "
+                   << r.error << ")");
     CHECK(twist_distance(sc, lc.twist, r.twist) <= 1e-7 + r.error);
 }
 
@@ -453,7 +454,8 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
         double broke = -HUGE_VAL;   // the last break-away of a pivot
         for (const ModeEvent& e : c.back().mode_events) {
             if (e.from.kind == ModeKind::Slide && e.to.kind == ModeKind::Slide) {
-                INFO("rtol " << rtol << ": a reversal at " << e.t / sc.plate.T << " T, the last break-away at " << broke / sc.plate.T);
+                INFO("rtol " << rtol << ": a reversal at " << e.t / sc.plate.T << " T, the last break-away at "
+                             << broke / sc.plate.T);
                 CHECK(e.t - broke <= 1e-5 * sc.plate.T);
                 if (reversals++ == 0) first_reversal.push_back(e.t);
             } else {
@@ -478,13 +480,13 @@ TEST_CASE("no chattering at the noise floor: a cycle's mode sequence is the same
     }
     // And the sequence is the physical one, not merely the same at each tolerance (with stick detection
     // off there would be no events at all, and the comparisons above would hold) (measured at all three).
-    const std::vector<Mode> expected = {{ModeKind::Pivot, 1}, {ModeKind::Slide, -1}, {ModeKind::Pivot, 1},
-                                        {ModeKind::Stuck, -1}, {ModeKind::Pivot, 2}, {ModeKind::Slide, -1},
-                                        {ModeKind::Pivot, 2}, {ModeKind::Stuck, -1}};
+    const std::vector<Mode> expected = {{ModeKind::Pivot, 1}, {ModeKind::Slide, -1}, {ModeKind::Pivot, 1}, {ModeKind::Stuck, -1},
+                                        {ModeKind::Pivot, 2}, {ModeKind::Slide, -1}, {ModeKind::Pivot, 2}, {ModeKind::Stuck, -1}};
     REQUIRE(holds[0].size() == expected.size());
     for (std::size_t e = 0; e < expected.size(); ++e) CHECK(holds[0][e].to == expected[e]);
     // Each contact has zero slip about three quarters of the period (measured 0.747, 0.782, 0.784).
-    for (int i = 0; i < 3; ++i) CHECK(c[0].stick_fraction[i] == Approx(std::array<double, 3>{0.747, 0.782, 0.784}[i]).margin(1e-3));
+    for (int i = 0; i < 3; ++i)
+        CHECK(c[0].stick_fraction[i] == Approx(std::array<double, 3>{0.747, 0.782, 0.784}[i]).margin(1e-3));
 }
 
 TEST_CASE("stick-slip on scenes nobody tuned: 36 seeded random sticking scenes agree with the regularised limit",
@@ -553,7 +555,10 @@ TEST_CASE("slips at the rim of the disk and grazing contacts: random scenes that
     LimitCycleOptions tight;
     tight.integration.rtol = 1e-11;
     tight.tol = 1e-10;
-    struct Case { std::uint64_t seed; std::vector<double> rtols; };
+    struct Case {
+        std::uint64_t seed;
+        std::vector<double> rtols;
+    };
     for (const Case& c : {Case{2512, {1e-8, 1e-9}}, Case{3121, {1e-8}}, Case{495, {1e-9, 1e-10}}}) {
         Vec3 q0;
         const Scene sc = sticking_random_scene(c.seed, q0);
@@ -567,8 +572,7 @@ TEST_CASE("slips at the rim of the disk and grazing contacts: random scenes that
             CHECK(ref.converged);
             CHECK(lc.stop.reason != StopReason::ContactLost);
             CHECK(lc.converged);
-            if (ref.converged && lc.converged)
-                CHECK(twist_distance(sc, lc.twist, ref.twist) <= 3e2 * rtol + o.tol + tight.tol);
+            if (ref.converged && lc.converged) CHECK(twist_distance(sc, lc.twist, ref.twist) <= 3e2 * rtol + o.tol + tight.tol);
         }
     }
 }
@@ -630,12 +634,11 @@ TEST_CASE("a cycle stuck as a whole once a period is accepted when its return is
 TEST_CASE("full dynamics through stick-slip on random scenes: the regularised trajectories converge to the engine's",
           "[stick][reference][random][full]") {
     // Five sticking_random_scene seeds (two thick, two thin, one point part) whose full-dynamics run from
-    // rest holds a contact again after its break-away (1 to 11 times in the 0.5 s). Both methods from the break-away for 0.5 s (trajectory_run,
-    // study.hpp: the engine at rtol 1e-10; GSL's bsimp with f = -mu N v / sqrt(|v|^2 + eps^2) at
-    // eps = 1e-4, 1e-5, 1e-6 v_ref, tol 1e-10), the configuration's difference at 0.5 s (relative to
-    // rho, rho, 1 rad). Where the engine is the eps -> 0 limit the difference shrinks like eps^p, p
-    // about 0.8 near sticking (docs/stick-slip.md): at least 10^0.5 per decade here. A model error in the engine
-    // (mu 1 % off) makes it level off at that error instead.
+    // rest holds a contact again after its break-away (1 to 11 times in the 0.5 s). Both methods from the break-away for 0.5 s
+    // (trajectory_run, study.hpp: the engine at rtol 1e-10; GSL's bsimp with f = -mu N v / sqrt(|v|^2 + eps^2) at eps = 1e-4,
+    // 1e-5, 1e-6 v_ref, tol 1e-10), the configuration's difference at 0.5 s (relative to rho, rho, 1 rad). Where the engine is
+    // the eps -> 0 limit the difference shrinks like eps^p, p about 0.8 near sticking (docs/stick-slip.md): at least 10^0.5 per
+    // decade here. A model error in the engine (mu 1 % off) makes it level off at that error instead.
     int held = 0;
     for (std::uint64_t seed : {22, 92, 102, 138, 148}) {
         Vec3 q0;
@@ -643,9 +646,8 @@ TEST_CASE("full dynamics through stick-slip on random scenes: the regularised tr
         INFO("seed " << seed << " (" << sc.name << ")");
         const Trajectory tr = simulate(sc, Dynamics::Full, q0, Vec3::Zero(), 0.5, 0.5);
         REQUIRE(tr.stop.reason == StopReason::None);
-        held += std::any_of(tr.events.begin(), tr.events.end(), [&](const ModeEvent& e) {
-            return e.t > tr.events.front().t && e.to.kind != ModeKind::Slide;
-        });
+        held += std::any_of(tr.events.begin(), tr.events.end(),
+                            [&](const ModeEvent& e) { return e.t > tr.events.front().t && e.to.kind != ModeKind::Slide; });
         Solver engine;
         engine.engine = true;
         const RunResult e = trajectory_run(sc, q0, 0.5, 0.5, engine, 1e-10);
@@ -692,8 +694,7 @@ TEST_CASE("a pivot's break-away inside one step is not missed (random scene 132 
     CHECK(twist_distance(sc, l.twist, t.twist) <= 10 * 1e-5);
 }
 
-TEST_CASE("a slip reversing along a line is not overrun: fig1_point's period map and field at rtol 1e-8",
-          "[stick][reference]") {
+TEST_CASE("a slip reversing along a line is not overrun: fig1_point's period map and field at rtol 1e-8", "[stick][reference]") {
     // fig1_point at (0, -0.05): the plate drives the point part along x, so its slip passes through
     // zero along a line twice a period (a reversal: static friction cannot hold it). Steps that
     // overran the zero put reversed friction into their later stages; the error estimate jumped by

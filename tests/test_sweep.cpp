@@ -62,19 +62,19 @@ std::string slurp(const std::string& f) {
     return s.str();
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("a grid campaign's cases: the first parameter slowest, ranges with their end points exact", "[sweep]") {
     TempDir d;
-    const Campaign c = load_campaign(block_campaign(
-        d, R"([{"name": "mu", "pointer": "/part/friction", "from": 0.1, "to": 0.4, "count": 4},
+    const Campaign c =
+        load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "from": 0.1, "to": 0.4, "count": 4},
                {"name": "A", "pointer": "/plate/harmonics/0/amp", "values": [1, 2, 3]}])"));
     REQUIRE(c.cases() == 12);
     CHECK(case_values(c, 0) == std::vector<double>{0.1, 1});
     CHECK(case_values(c, 1) == std::vector<double>{0.1, 2});
     CHECK(case_values(c, 3) == std::vector<double>{0.2, 1});
     CHECK(case_values(c, 11) == std::vector<double>{0.4, 3});   // (0.4 itself, not 0.1 + 3 * 0.1)
-    const Scene sc = case_scene(c, 5);                            // mu 0.2, A 3
+    const Scene sc = case_scene(c, 5);                          // mu 0.2, A 3
     CHECK(sc.part.mu[0] == 0.2);
     CHECK(sc.plate.harmonics.at(0).amp == 3);
 }
@@ -124,31 +124,37 @@ TEST_CASE("bad campaign files are refused with the file and the field named", "[
     };
     const std::string ok_params = R"("parameters": [{"name": "mu", "pointer": "/part/friction", "values": [0.2]}])";
     const std::string ok_compute = R"("compute": {"twist_at": [[0, 0]]})";
-    refused(R"({"name": "x", "scene": "block.json", )" + ok_params + ", " + ok_compute + R"(, "color": 1})", "color: unknown field");
-    refused(R"({"name": "x", "scene": "none.json", )" + ok_params + ", " + ok_compute + "}", "scene: " + (d / "none.json") + ": cannot open the scene file");
+    refused(R"({"name": "x", "scene": "block.json", )" + ok_params + ", " + ok_compute + R"(, "color": 1})",
+            "color: unknown field");
+    refused(R"({"name": "x", "scene": "none.json", )" + ok_params + ", " + ok_compute + "}",
+            "scene: " + (d / "none.json") + ": cannot open the scene file");
     refused(R"({"name": "x", "scene": "block.json", "parameters": [{"name": "m", "pointer": "/part/mass2", "values": [1]}], )" +
                 ok_compute + "}",
             "parameters[0].pointer: '/part/mass2' addresses no number");
     refused(R"({"name": "x", "scene": "block.json", "parameters": [{"name": "m", "pointer": "part/mass", "values": [1]}], )" +
                 ok_compute + "}",
             "is no JSON pointer");
-    refused(R"({"name": "x", "scene": "block.json", "parameters": [{"name": "m", "pointer": "/part/mass", "from": 1, "to": 2, "count": 0}], )" +
-                ok_compute + "}",
-            "parameters[0].count: expected a whole number from 1");
+    refused(
+        R"({"name": "x", "scene": "block.json", "parameters": [{"name": "m", "pointer": "/part/mass", "from": 1, "to": 2, "count": 0}], )" +
+            ok_compute + "}",
+        "parameters[0].count: expected a whole number from 1");
     refused(R"({"name": "x", "scene": "block.json", )" + ok_params + R"(, "compute": {"fixed_points": true}})",
             "compute.fixed_points: needs compute.field");
     refused(R"({"name": "x", "scene": "block.json", )" + ok_params + R"(, "compute": {}})", "compute: nothing to compute");
     refused(R"({"name": "x", "scene": "block.json", )" + ok_params + R"(, "compute": {"twist_at": [[0, 0, 0]]}})",
             "compute.twist_at[0]: expected an array of 2 numbers");   // a point part: SX SY
     refused(R"({"name": "x", "scene": "block.json", "parameters": [{"name": "a", "pointer": "/part/mass", "values": [1]},
-                {"name": "a", "pointer": "/part/friction", "values": [1]}], )" + ok_compute + "}",
+                {"name": "a", "pointer": "/part/friction", "values": [1]}], )" +
+                ok_compute + "}",
             "parameters[1].name: 'a' named twice");
 }
 
-TEST_CASE("a case's row is the direct computation's, and the stick threshold mu = A/g is where the closed form puts it", "[sweep]") {
+TEST_CASE("a case's row is the direct computation's, and the stick threshold mu = A/g is where the closed form puts it",
+          "[sweep]") {
     TempDir d;
     // A / g = 0.20387: 0.19 and 0.2 slide part of each period, 0.21 and 0.3 stick for ever.
-    const Campaign c = load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.19, 0.2, 0.21, 0.3]}])"));
+    const Campaign c =
+        load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.19, 0.2, 0.21, 0.3]}])"));
     for (int i = 0; i < c.cases(); ++i) {
         const Row row = run_case(c, i);
         const double mu = case_values(c, i)[0];
@@ -173,7 +179,8 @@ TEST_CASE("a case's row is the direct computation's, and the stick threshold mu 
 
 TEST_CASE("a case whose values make the scene invalid gets a failed row with the reason, the others go on", "[sweep]") {
     TempDir d;
-    const Campaign c = load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.3, -0.1]}])"));
+    const Campaign c =
+        load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.3, -0.1]}])"));
     const Row good = run_case(c, 0), bad = run_case(c, 1);
     CHECK(good["status"] == "ok");
     CHECK(bad["status"] == "failed");
@@ -187,9 +194,11 @@ TEST_CASE("a case whose values make the scene invalid gets a failed row with the
     CHECK(keys == columns(c));
 }
 
-TEST_CASE("the journal: entries survive, a torn last line is cut, a damaged one or another campaign's journal is refused", "[sweep][journal]") {
+TEST_CASE("the journal: entries survive, a torn last line is cut, a damaged one or another campaign's journal is refused",
+          "[sweep][journal]") {
     TempDir d;
-    const Campaign c = load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.1, 0.2, 0.3]}])"));
+    const Campaign c =
+        load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.1, 0.2, 0.3]}])"));
     const std::string dir = d / "out";
     std::string line1;
     {
@@ -212,19 +221,21 @@ TEST_CASE("the journal: entries survive, a torn last line is cut, a damaged one 
         CHECK(j.entries()[0].row.dump() == Row::parse(line1)["row"].dump());
     }
     CHECK(slurp(path) == complete);   // cut back to the last complete line
-    {   // a damaged line before the end is not a torn write: refused, not silently dropped
+    {                                 // a damaged line before the end is not a torn write: refused, not silently dropped
         std::ofstream(path, std::ios::app) << "{not json\n" << line1 << "\n";
         CHECK_THROWS_WITH(Journal(dir, c), Catch::Contains("journal.jsonl:3: not a journal line"));
         std::ofstream(path) << complete;
     }
     {   // another campaign (a different parameter list) may not resume this journal
-        const Campaign other = load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.1, 0.2, 0.35]}])"));
+        const Campaign other =
+            load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.1, 0.2, 0.35]}])"));
         CHECK(fingerprint(other) != fingerprint(c));
         CHECK_THROWS_WITH(Journal(dir, other), Catch::Contains("the journal of another campaign"));
     }
 }
 
-TEST_CASE("the table: full precision, missing values empty, text quoted, written only when every case is done", "[sweep][journal]") {
+TEST_CASE("the table: full precision, missing values empty, text quoted, written only when every case is done",
+          "[sweep][journal]") {
     TempDir d;
     const Campaign c = load_campaign(block_campaign(d, R"([{"name": "mu", "pointer": "/part/friction", "values": [0.1, -1]}])"));
     const std::string dir = d / "out";
@@ -261,21 +272,23 @@ TEST_CASE("the thread farm runs every task once and reports them one at a time",
     std::vector<int> count(600, 0);
     std::atomic<int> inside{0};
     int overlaps = 0;
-    farm->run(todo, [](int i) { return std::to_string(i * i); },
-              [&](int i, const std::string& r) {
-                  if (++inside > 1) ++overlaps;
-                  CHECK(r == std::to_string(i * i));
-                  ++count[static_cast<std::size_t>(i)];
-                  std::this_thread::yield();
-                  --inside;
-              });
+    farm->run(
+        todo, [](int i) { return std::to_string(i * i); },
+        [&](int i, const std::string& r) {
+            if (++inside > 1) ++overlaps;
+            CHECK(r == std::to_string(i * i));
+            ++count[static_cast<std::size_t>(i)];
+            std::this_thread::yield();
+            --inside;
+        });
     CHECK(overlaps == 0);
     for (int i = 0; i < 600; ++i) CHECK(count[static_cast<std::size_t>(i)] == (i % 3 == 0 ? 1 : 0));
     // A done() that throws (a journal that cannot be written) stops the farm and reaches the caller.
-    CHECK_THROWS_WITH(farm->run(todo, [](int i) { return std::to_string(i); },
-                                [](int i, const std::string&) {
-                                    if (i == 30) throw std::runtime_error("disk full");
-                                }),
+    CHECK_THROWS_WITH(farm->run(
+                          todo, [](int i) { return std::to_string(i); },
+                          [](int i, const std::string&) {
+                              if (i == 30) throw std::runtime_error("disk full");
+                          }),
                       "disk full");
 }
 
@@ -296,11 +309,16 @@ TEST_CASE("farm_tasks: a rank other than 0 gets every task's text from the broad
     } farm;
     std::vector<std::string> got(3, "unset");
     std::vector<int> order;
-    sweep::farm_tasks(farm)(3, [](int) -> std::string { FAIL("rank 1 ran a task itself"); return ""; },
-                            [&](int i, const std::string& t) {
-                                got[static_cast<std::size_t>(i)] = t;
-                                order.push_back(i);
-                            });
+    sweep::farm_tasks(farm)(
+        3,
+        [](int) -> std::string {
+            FAIL("rank 1 ran a task itself");
+            return "";
+        },
+        [&](int i, const std::string& t) {
+            got[static_cast<std::size_t>(i)] = t;
+            order.push_back(i);
+        });
     CHECK(got == std::vector<std::string>{"a:b", "", "x\ny 1:2"});
     CHECK(order == std::vector<int>{0, 1, 2});
 }

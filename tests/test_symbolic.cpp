@@ -31,7 +31,7 @@ const Finding& finding(const std::string& eq) {
     throw;
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("thin part: rows 3 and 6 swapped, the lower-left block of A vanishes", "[symbolic][thin]") {
     const matrix& A = D().A_thin_swapped;
@@ -78,8 +78,8 @@ TEST_CASE("thick part: the coupling the thin part loses is there", "[symbolic][t
 
 TEST_CASE("derivation against the printed equations", "[symbolic][paper]") {
     // Agreements: the derivation reproduces these from first principles.
-    for (const char* eq : {"(8)", "text after (14)", "(19)", "(27)", "(30)", "(31)", "(33)", "(34)", "(37)",
-                           "Appendix B (normality)"}) {
+    for (const char* eq :
+         {"(8)", "text after (14)", "(19)", "(27)", "(30)", "(31)", "(33)", "(34)", "(37)", "Appendix B (normality)"}) {
         INFO(eq);
         CHECK(finding(eq).agrees);
     }

@@ -12,7 +12,7 @@ using namespace plate;
 
 namespace {
 Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
-}  // namespace
+}   // namespace
 
 TEST_CASE("full dynamics tend to U-dynamics as the plate amplitude shrinks, at rate k^-2", "[trajectory][full]") {
     // Keep u's accelerations and divide the period by k: displacements and tilts shrink as k^-2,
@@ -91,8 +91,7 @@ TEST_CASE("Fig. 4: from rest near the edge, the part goes to the centre along th
     const Vec3 offset = X - lc.twist * t_last;
     const double bound_xy = offset.head<2>().norm() + 10 * D, bound_th = std::abs(offset[2]) + 10 * D_th;
     double worst_u = 0, worst_full = 0, worst_u_th = 0, worst_full_th = 0;
-    INFO("bounds " << bound_xy << " m (offset " << offset.transpose() << ", D " << D << "), " << bound_th
-                   << " rad");
+    INFO("bounds " << bound_xy << " m (offset " << offset.transpose() << ", D " << D << "), " << bound_th << " rad");
     for (std::size_t i = 0; i < curve.samples.size(); ++i) {
         if (curve.samples[i].t < 1.0) continue;   // after the transient
         CHECK((u.samples[i].q - curve.samples[i].q).head<2>().norm() < bound_xy);
@@ -107,8 +106,8 @@ TEST_CASE("Fig. 4: from rest near the edge, the part goes to the centre along th
         worst_u_th = std::max(worst_u_th, std::abs(u.samples[i].q[2] - curve.samples[i].q[2]));
         worst_full_th = std::max(worst_full_th, std::abs(full.samples[i].q[2] - curve.samples[i].q[2]));
     }
-    WARN("Fig. 4 from rest: U vs field curve " << worst_u << " m, " << worst_u_th << " rad; full vs curve "
-                                               << worst_full << " m, " << worst_full_th << " rad");
+    WARN("Fig. 4 from rest: U vs field curve " << worst_u << " m, " << worst_u_th << " rad; full vs curve " << worst_full
+                                               << " m, " << worst_full_th << " rad");
 }
 
 TEST_CASE("a part that cannot break away rides the plate: stuck all along, not moved", "[trajectory][stick]") {
@@ -200,7 +199,7 @@ TEST_CASE("fig1 from rest: stuck at t = 0, breaks away at the root of the stick 
         return pt.part.friction().static_(0) * F.dot(n) - (F - F.dot(n) * n).norm();
     });
     CHECK(breakaway_time(pt, s, 0, Dynamics::Full) == Approx(tb_point_full).epsilon(1e-8));   // 7.2236e-4 s
-    CHECK(tb_point_full > tb_point * 1.03);   // the tilt delays it by 3.75 %
+    CHECK(tb_point_full > tb_point * 1.03);                                                   // the tilt delays it by 3.75 %
 
     // The rigid part of Fig. 1 at (-0.04, 0.03, 1.2): at rest it needs about an eighth of the friction
     // it can have, breaks away near 0.77 ms (U) and later in full dynamics; after it every contact
@@ -219,7 +218,8 @@ TEST_CASE("fig1 from rest: stuck at t = 0, breaks away at the root of the stick 
     // it by 3.4 %; doubling the tilt would give 6.8 %.)
     Orientation rigid_R(sc.plate);
     const auto held = [&](Dynamics level, double t) {
-        const PlateState ps = level == Dynamics::U ? plate_state(sc.plate, t, level) : plate_state(sc.plate, t, level, rigid_R.at(t));
+        const PlateState ps =
+            level == Dynamics::U ? plate_state(sc.plate, t, level) : plate_state(sc.plate, t, level, rigid_R.at(t));
         mode_accelerations(sc, level, q0, Vec3::Zero(), ps, Mode{ModeKind::Stuck}, ws);
         return 1 - friction_gauge(sc.part, q0[2], ws.n, ws.F_needed, ws.tau_needed).gamma;
     };
@@ -242,7 +242,11 @@ TEST_CASE("friction never does positive work, in every mode (slide, pivot, stuck
     // planar rows of (31)/(32) give sum_i f_i = m s'' + f_dagger,xy and sum_i r_i x f_i =
     // J_zz theta'' + tau_dagger,z, so P = (m s'' + f_dagger,xy) . s' + theta' (J_zz theta'' + tau_dagger,z)
     // (v_i = s' + theta' e_z x r_i). Coulomb friction dissipates: P <= 0 to rounding.
-    struct Case { const char* scene; Vec3 q0; double duration; };
+    struct Case {
+        const char* scene;
+        Vec3 q0;
+        double duration;
+    };
     for (const Case& c : {Case{"fig6", Vec3(-0.05, 0.016666666666666663, 4.487989505128276), 0.2},
                           Case{"fig1", Vec3(-0.04, 0.03, 1.2), 0.05}, Case{"fig1_point", Vec3(-0.04, 0.03, 0), 0.05}}) {
         const Scene sc = scene(c.scene);
@@ -264,8 +268,10 @@ TEST_CASE("friction never does positive work, in every mode (slide, pivot, stuck
                      << seen[0] << ", pivot " << seen[1] << ", stuck " << seen[2]);
         CHECK(worst <= 1e-9 * scale);
         CHECK(seen[0] > 0);
-        if (std::string(c.scene) == "fig6") CHECK(seen[1] > 0);
-        else CHECK(seen[2] > 0);
+        if (std::string(c.scene) == "fig6")
+            CHECK(seen[1] > 0);
+        else
+            CHECK(seen[2] > 0);
     }
 }
 
@@ -282,11 +288,16 @@ TEST_CASE("a held contact's friction stays in its disk: no stick outlives its br
     // their end (fig6's pivots, heave_yaw's sticks: thousands of samples) they reach the rim
     // (measured 0.99996 and 0.99999), so checked against 0.99 mu (a model with 1 % less friction than
     // the engine's) those cases fail (measured 1.0101); fig1's brief sticks are sampled 39 times.
-    struct Case { const char* scene; Vec3 q0; double duration; bool pivots, rim; };
-    for (const Case& c : {Case{"fig6", Vec3(-0.05, 0.016666666666666663, 4.487989505128276), 0.2, true, true},
-                          Case{"fig1", Vec3(-0.04, 0.03, 1.2), 0.05, false, false},
-                          Case{"fig1_point", Vec3(-0.04, 0.03, 0), 0.05, false, false},
-                          Case{"heave_yaw", Vec3(0.03, 0.02, 1.0), 0.2, false, true}}) {
+    struct Case {
+        const char* scene;
+        Vec3 q0;
+        double duration;
+        bool pivots, rim;
+    };
+    for (const Case& c :
+         {Case{"fig6", Vec3(-0.05, 0.016666666666666663, 4.487989505128276), 0.2, true, true},
+          Case{"fig1", Vec3(-0.04, 0.03, 1.2), 0.05, false, false}, Case{"fig1_point", Vec3(-0.04, 0.03, 0), 0.05, false, false},
+          Case{"heave_yaw", Vec3(0.03, 0.02, 1.0), 0.2, false, true}}) {
         const Scene sc = scene(c.scene);
         const Part& P = sc.part;
         const Trajectory tr = simulate(sc, Dynamics::U, c.q0, Vec3::Zero(), c.duration, 2e-5);
@@ -309,8 +320,10 @@ TEST_CASE("a held contact's friction stays in its disk: no stick outlives its br
         INFO(c.scene << ": samples stuck " << stuck << ", pivoting " << pivoting << "; largest gauge " << gamma
                      << ", largest |f_k| / mu_k N_k " << pivot);
         CHECK(stuck + pivoting > 20);
-        if (c.pivots) CHECK(pivoting > 0);
-        else CHECK(stuck > 0);
+        if (c.pivots)
+            CHECK(pivoting > 0);
+        else
+            CHECK(stuck > 0);
         CHECK(gamma <= 1 + 1e-9);
         CHECK(pivot <= 1 + 1e-9);
         if (c.rim) CHECK(std::max(gamma, pivot) > 0.9999);   // the holds reach the rim: the check is not slack
@@ -354,8 +367,10 @@ TEST_CASE("a loose tolerance still finds the sticks that matter: sticking cycles
         const char* scene;
         Vec3 q;
     };
-    const Case cases[] = {{"heave_yaw", Vec3(0, 0.02, 0)}, {"heave_yaw", Vec3(0.03, 0.02, 1.0)},
-                          {"fig6", Vec3(-0.05 + 1.0 / 60, 1.0 / 60, 2 * kPi * 5 / 7)}, {"fig6", Vec3(0.0167, 0, 2.693)}};
+    const Case cases[] = {{"heave_yaw", Vec3(0, 0.02, 0)},
+                          {"heave_yaw", Vec3(0.03, 0.02, 1.0)},
+                          {"fig6", Vec3(-0.05 + 1.0 / 60, 1.0 / 60, 2 * kPi * 5 / 7)},
+                          {"fig6", Vec3(0.0167, 0, 2.693)}};
     for (const Case& c : cases) {
         const Scene sc = scene(c.scene);
         const Vec3 S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho());

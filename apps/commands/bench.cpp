@@ -27,7 +27,8 @@ struct BenchArgs : Options {
                   "the same questions (the engines found at build time; quick unless --full).\n") {
         text("--out", out, "DIR", "the report's folder; required");
         flag("--full", full, "the long campaign");
-        flag("--peers", peers, "instead: Bullet, ODE and MuJoCo beside plate (bench/peers/study.py, the engines this build found)");
+        flag("--peers", peers,
+             "instead: Bullet, ODE and MuJoCo beside plate (bench/peers/study.py, the engines this build found)");
         text("--source", source, "ROOT", "the project folder (default: the one this program was built from)");
     }
 };
@@ -41,8 +42,9 @@ int cmd_bench(const BenchArgs& a, Io& cio) {
         const std::filesystem::path dir = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path();
         const std::string source = a.has("--source") ? a.source : std::string(PLATE_SOURCE_DIR);
         if (ec || !std::filesystem::exists(dir / "bench_peers"))
-            throw UsageError("--peers: no bench_peers beside this plate (no peer engine was found when it was built: "
-                             "install libbullet-dev, libode-dev or libmujoco-dev and rebuild)");
+            throw UsageError(
+                "--peers: no bench_peers beside this plate (no peer engine was found when it was built: "
+                "install libbullet-dev, libode-dev or libmujoco-dev and rebuild)");
         auto quote = [](const std::string& x) {   // for the shell, quotes and all
             std::string q = "'";
             for (char ch : x) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -64,8 +66,8 @@ int cmd_bench(const BenchArgs& a, Io& cio) {
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_bench(CLI::App& app) { return make_command<BenchArgs>(app, cmd_bench); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

@@ -40,4 +40,4 @@ Command add_bench(CLI::App& app);          // bench.cpp
 Command add_design(CLI::App& app);         // design.cpp
 Command add_sweep(CLI::App& app);          // sweep.cpp
 
-}  // namespace plate::cli
+}   // namespace plate::cli

@@ -157,18 +157,17 @@ int cmd_design(const DesignArgs& a, Io& cio) {
         return 4;
     }
     if (rigid && t.kind == DesignTargetKind::FixedPoint && !d.unique) {   // (verified, but say it plainly)
-        cio.err << "plate design: " << a.scene << ": not unique: the target holds " << d.basin_share
-                << " of the random starts";
+        cio.err << "plate design: " << a.scene << ": not unique: the target holds " << d.basin_share << " of the random starts";
         for (const auto& c : d.competitors)
-            cio.err << "; a stable fixed point at (" << c.point.q[0] << ", " << c.point.q[1] << ", " << c.point.q[2]
-                    << ") holds " << c.basin_share;
+            cio.err << "; a stable fixed point at (" << c.point.q[0] << ", " << c.point.q[1] << ", " << c.point.q[2] << ") holds "
+                    << c.basin_share;
         cio.err << std::endl;
     }
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_design(CLI::App& app) { return make_command<DesignArgs>(app, cmd_design); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

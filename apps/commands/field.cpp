@@ -38,20 +38,23 @@ int cmd_field(const FieldArgs& a, Io& cio) {
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");
     const Field f = bounded_field(sc, g, cycle_opts(a, a.cycle), a.grid.threads, a.max_work, cio);
     if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 writes)
-    write_file_atomic(a.out, [&](std::ostream& out) {
-        if (format == "csv") {
-            write_field_csv(out, f);
-        } else {
-            nlohmann::json j = to_json(sc, f);
-            if (cio.farm) j["mpi"] = cio.farm->describe();
-            out << j.dump(1) << "\n";
-        }
-    }, cio.out);
+    write_file_atomic(
+        a.out,
+        [&](std::ostream& out) {
+            if (format == "csv") {
+                write_field_csv(out, f);
+            } else {
+                nlohmann::json j = to_json(sc, f);
+                if (cio.farm) j["mpi"] = cio.farm->describe();
+                out << j.dump(1) << "\n";
+            }
+        },
+        cio.out);
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_field(CLI::App& app) { return make_command<FieldArgs>(app, cmd_field); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

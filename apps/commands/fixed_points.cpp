@@ -35,16 +35,17 @@ int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
     const GridSpec g = grid_opts(a, a.grid);
     const Field f = bounded_field(sc, g, cycle, a.grid.threads, a.max_work, cio);
     if (cio.farm && !cio.farm->root()) return 0;   // (rank 0 refines the zeros and writes)
-    FixedPointOptions fpo;   // (the refinement has its own budget)
+    FixedPointOptions fpo;                         // (the refinement has its own budget)
     fpo.cycle = cycle;
     if (a.has("--max-work")) fpo.max_rhs_evaluations = std::min(fpo.max_rhs_evaluations, a.max_work);
     const FixedPoints fp = find_fixed_points(sc, f, fpo);
-    write_file_atomic(a.out, [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
+    write_file_atomic(
+        a.out, [&](std::ostream& out) { out << to_json(sc, fp).dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_fixed_points(CLI::App& app) { return make_command<FixedPointsArgs>(app, cmd_fixed_points); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

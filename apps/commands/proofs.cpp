@@ -37,8 +37,12 @@ struct ProofsArgs : Options {
 
 // The checks that tie Theorem 1's to the dynamics (statics, limit-surface wrench).
 nlohmann::json tie_json(const proofs::DynamicsTie& t) {
-    return {{"samples", t.samples}, {"worst_statics_over_mg", t.worst_statics}, {"worst_wrench_over_mg", t.worst_wrench},
-            {"tolerance", proofs::kTieTolerance}, {"failure", t.failure}, {"passed", t.passed()}};
+    return {{"samples", t.samples},
+            {"worst_statics_over_mg", t.worst_statics},
+            {"worst_wrench_over_mg", t.worst_wrench},
+            {"tolerance", proofs::kTieTolerance},
+            {"failure", t.failure},
+            {"passed", t.passed()}};
 }
 
 nlohmann::json contraction_json(const proofs::ContractionSummary& s) {
@@ -78,11 +82,19 @@ double exact(const nlohmann::json& j) {
     return s == "nan" ? std::nan("") : s == "inf" ? HUGE_VAL : -HUGE_VAL;
 }
 std::string case_text(const proofs::ContractionCase& c) {
-    return nlohmann::json{{"seed", c.seed}, {"valid", c.valid}, {"why_invalid", c.why_invalid},
-                          {"monotone", c.monotone}, {"converged", c.converged}, {"unique", c.unique},
-                          {"spectral_radius", exact(c.spectral_radius)}, {"worst_increase", exact(c.worst_increase)},
-                          {"rate", exact(c.rate)}, {"tie_samples", c.tie.samples}, {"tie_statics", exact(c.tie.worst_statics)},
-                          {"tie_wrench", exact(c.tie.worst_wrench)}, {"tie_failure", c.tie.failure}}
+    return nlohmann::json{{"seed", c.seed},
+                          {"valid", c.valid},
+                          {"why_invalid", c.why_invalid},
+                          {"monotone", c.monotone},
+                          {"converged", c.converged},
+                          {"unique", c.unique},
+                          {"spectral_radius", exact(c.spectral_radius)},
+                          {"worst_increase", exact(c.worst_increase)},
+                          {"rate", exact(c.rate)},
+                          {"tie_samples", c.tie.samples},
+                          {"tie_statics", exact(c.tie.worst_statics)},
+                          {"tie_wrench", exact(c.tie.worst_wrench)},
+                          {"tie_failure", c.tie.failure}}
         .dump();
 }
 proofs::ContractionCase case_from_text(const std::string& text) {
@@ -129,11 +141,12 @@ int cmd_proofs(const ProofsArgs& a, Io& cio) {
         std::vector<int> todo;
         for (int k = 0; root && k < n; ++k) todo.push_back(k);
         int done = 0;
-        farm->run(todo, [&](int k) { return case_text(proofs::contraction_random_case(o, k)); },
-                  [&](int k, const std::string& text) {
-                      cases[static_cast<std::size_t>(k)] = case_from_text(text);
-                      prog(++done, n);
-                  });
+        farm->run(
+            todo, [&](int k) { return case_text(proofs::contraction_random_case(o, k)); },
+            [&](int k, const std::string& text) {
+                cases[static_cast<std::size_t>(k)] = case_from_text(text);
+                prog(++done, n);
+            });
         if (!root) return nlohmann::json();
         return contraction_json(proofs::summarize_contraction(
             o, std::move(cases), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
@@ -143,28 +156,34 @@ int cmd_proofs(const ProofsArgs& a, Io& cio) {
     if (!root) return 0;
     if (farm) j["mpi"] = farm->describe();
     // Limit surfaces of random thin parts at random plate times.
-    const proofs::LimitSurfaceCampaign ls =
-        proofs::check_limit_surfaces(a.surfaces, seed);
-    j["limit_surfaces"] = {{"parts", ls.parts}, {"directions", 300}, {"convex_and_normal", ls.convex},
-                           {"strictly_convex", ls.strict}, {"worst_max_work_violation", ls.worst_max_work},
+    const proofs::LimitSurfaceCampaign ls = proofs::check_limit_surfaces(a.surfaces, seed);
+    j["limit_surfaces"] = {{"parts", ls.parts},
+                           {"directions", 300},
+                           {"convex_and_normal", ls.convex},
+                           {"strictly_convex", ls.strict},
+                           {"worst_max_work_violation", ls.worst_max_work},
                            {"worst_monotonicity_violation", ls.worst_monotonicity},
-                           {"min_separation", ls.min_separation}, {"min_strict_margin", ls.min_strict_margin},
-                           {"on_friction_set", ls.on_set}, {"worst_support_violation", ls.worst_support},
+                           {"min_separation", ls.min_separation},
+                           {"min_strict_margin", ls.min_strict_margin},
+                           {"on_friction_set", ls.on_set},
+                           {"worst_support_violation", ls.worst_support},
                            {"worst_outside_violation", ls.worst_outside},
-                           {"dynamics_tie", tie_json(ls.tie)}, {"passed", ls.passed()}};
+                           {"dynamics_tie", tie_json(ls.tie)},
+                           {"passed", ls.passed()}};
     // A's conditioning toward collinear contacts (dimensionless A, 20 sampled states per part).
     j["conditioning_of_A"] = nlohmann::json::array();
     for (const auto& cs : proofs::collinear_scenes({1.0, 0.1, 0.01, 0.001, 0.0})) {
         const proofs::Conditioning c = proofs::condition_of_A(cs.scene, 20, seed);
-        j["conditioning_of_A"].push_back({{"e_over_L", cs.e_over_L}, {"max_condition", c.max_condition},
-                                          {"min_singular_over_max", c.min_singular}});
+        j["conditioning_of_A"].push_back(
+            {{"e_over_L", cs.e_over_L}, {"max_condition", c.max_condition}, {"min_singular_over_max", c.min_singular}});
     }
-    write_file_atomic(a.out, [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
+    write_file_atomic(
+        a.out, [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_proofs(CLI::App& app) { return make_command<ProofsArgs>(app, cmd_proofs); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

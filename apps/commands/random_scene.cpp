@@ -32,12 +32,13 @@ int cmd_random_scene(const RandomSceneArgs& a, Io& cio) {
     ro.point = a.point;
     if (ro.thin && ro.point) throw UsageError("--thin and --point exclude each other");
     const Scene sc = random_scene(a.seed, ro);
-    write_file_atomic(a.out, [&](std::ostream& out) { out << scene_to_json(sc).dump(2) << "\n"; }, cio.out);
+    write_file_atomic(
+        a.out, [&](std::ostream& out) { out << scene_to_json(sc).dump(2) << "\n"; }, cio.out);
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_random_scene(CLI::App& app) { return make_command<RandomSceneArgs>(app, cmd_random_scene); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

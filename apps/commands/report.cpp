@@ -54,8 +54,8 @@ int cmd_report(const ReportArgs& a, Io& cio) {
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_report(CLI::App& app) { return make_command<ReportArgs>(app, cmd_report); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

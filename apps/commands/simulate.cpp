@@ -66,8 +66,8 @@ struct SimulateArgs : Options {
 // Bounded work (issue 18): the steps of a run of `dyn` over T seconds, extrapolated from one period
 // (one RK4 step of a field curve, whose limit cycles are taken to `tol`) run first, against the
 // budget (UsageError above it). `rows`: the CSV's, each of which ends a step.
-void check_simulate_work(const Scene& sc_run, const std::string& dyn, const Vec3& q0, const Vec3& qd0, double T,
-                         double dt, double rows, double tol, const IntegrationOptions& io, long budget) {
+void check_simulate_work(const Scene& sc_run, const std::string& dyn, const Vec3& q0, const Vec3& qd0, double T, double dt,
+                         double rows, double tol, const IntegrationOptions& io, long budget) {
     const auto t0 = std::chrono::steady_clock::now();
     double steps = 0, pilot_steps = 0;
     std::string what;
@@ -86,15 +86,14 @@ void check_simulate_work(const Scene& sc_run, const std::string& dyn, const Vec3
         // (averaged: its bursts are full dynamics; the estimate is the direct run's, an upper bound)
         const Trajectory pilot = simulate(sc_run, dyn == "u" ? Dynamics::U : Dynamics::Full, q0, qd0, span, span, io);
         pilot_steps = std::max<double>(pilot.stats.steps, 1) * std::min(span, Tp) / span;   // per period
-        steps = std::max(pilot_steps * T / std::min(span, Tp), rows);   // (every row ends a step)
-        what = fmt(steps) + " integrator steps (" + fmt(T / Tp) + " plate periods at " + fmt(pilot_steps) +
-               " steps each)";
+        steps = std::max(pilot_steps * T / std::min(span, Tp), rows);                       // (every row ends a step)
+        what = fmt(steps) + " integrator steps (" + fmt(T / Tp) + " plate periods at " + fmt(pilot_steps) + " steps each)";
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (steps > budget)
-        throw UsageError("--time " + fmt(T) + " s would take about " + what + ", about " +
-                         fmt(secs / pilot_steps * steps) + " s here, above the budget of " +
-                         fmt(static_cast<double>(budget)) + " steps: raise it with --max-steps or shorten --time");
+        throw UsageError("--time " + fmt(T) + " s would take about " + what + ", about " + fmt(secs / pilot_steps * steps) +
+                         " s here, above the budget of " + fmt(static_cast<double>(budget)) +
+                         " steps: raise it with --max-steps or shorten --time");
 }
 
 int cmd_simulate(const SimulateArgs& a, Io& cio) {
@@ -126,10 +125,10 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
         Rung picked;
         picked.part = part;
         picked.dynamics = d;
-        cio.err << "auto model, decided up front (tolerance " << tol << "): picked " << picked.name()
-                  << " (predicted error " << predicted << ")\n  estimates: |xi| " << est.xi << "/s, point " << est.e_point
-                  << ", thin " << est.e_thin << ", eps_U " << est.eps_U << ", transient offset " << est.offset
-                  << ", growth " << est.growth() << (est.ok ? "" : " (" + est.note + ")") << "\n";
+        cio.err << "auto model, decided up front (tolerance " << tol << "): picked " << picked.name() << " (predicted error "
+                << predicted << ")\n  estimates: |xi| " << est.xi << "/s, point " << est.e_point << ", thin " << est.e_thin
+                << ", eps_U " << est.eps_U << ", transient offset " << est.offset << ", growth " << est.growth()
+                << (est.ok ? "" : " (" + est.note + ")") << "\n";
         used = simplified(sc, part);
         dyn = d == Dynamics::Full ? "full" : d == Dynamics::U ? "u" : "field";
         verify_auto = a.verify && picked.name() != Rung{}.name();
@@ -161,15 +160,17 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
         if (ref.stop.reason == StopReason::None && !ref.samples.empty()) {
             const Vec3 dq = tr.samples.back().q - ref.samples.back().q;
             cio.err << "  verified against the full model: measured error "
-                      << std::max({std::abs(dq[0]) / sc.part.rho(), std::abs(dq[1]) / sc.part.rho(), std::abs(wrap_angle(dq[2]))})
-                      << "\n";
+                    << std::max({std::abs(dq[0]) / sc.part.rho(), std::abs(dq[1]) / sc.part.rho(), std::abs(wrap_angle(dq[2]))})
+                    << "\n";
         } else {
             cio.err << "  verify: the full model stopped: " << ref.stop.describe() << "\n";
         }
     }
     if (tr.stop.reason == StopReason::StepLimit)   // the estimate was low: a cut-off run is not a result
-        throw std::runtime_error(a.scene + ": stopped: " + tr.stop.describe() + " (the up-front estimate was low: raise --max-steps); nothing written");
-    write_file_atomic(a.out, [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio.out);
+        throw std::runtime_error(a.scene + ": stopped: " + tr.stop.describe() +
+                                 " (the up-front estimate was low: raise --max-steps); nothing written");
+    write_file_atomic(
+        a.out, [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio.out);
     if (tr.stop.reason != StopReason::None) {
         cio.err << "plate simulate: " << a.scene << ": stopped: " << tr.stop.describe() << std::endl;
         return tr.stop.reason == StopReason::ContactLost ? 3 : 1;
@@ -177,8 +178,8 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_simulate(CLI::App& app) { return make_command<SimulateArgs>(app, cmd_simulate); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

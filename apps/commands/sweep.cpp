@@ -37,8 +37,9 @@ int cmd_sweep(const SweepArgs& a, Io& cio) {
     std::unique_ptr<sweep::Farm> farm;
     if (sweep::mpi_launched()) {
         if (!sweep::mpi_built())
-            throw UsageError("started by an MPI launcher with several ranks, but this plate was built without MPI: "
-                             "every process would run the whole campaign (rebuild with libopenmpi-dev, or run it alone)");
+            throw UsageError(
+                "started by an MPI launcher with several ranks, but this plate was built without MPI: "
+                "every process would run the whole campaign (rebuild with libopenmpi-dev, or run it alone)");
         farm = sweep::mpi_farm(a.threads);
     } else {
         farm = sweep::thread_farm(a.threads);
@@ -52,7 +53,7 @@ int cmd_sweep(const SweepArgs& a, Io& cio) {
     try {
         s = sweep::run_sweep(a.campaign, o, *farm);
     } catch (const sweep::Reported&) {   // bad input, which rank 0 reports; every rank returns 2, rank 0
-        farm->barrier();                  // first (the launcher ends the job at the first failed rank)
+        farm->barrier();                 // first (the launcher ends the job at the first failed rank)
         return 2;
     } catch (const InputError& e) {
         cio.err << "plate sweep: " << e.what() << std::endl;
@@ -81,8 +82,8 @@ int cmd_sweep(const SweepArgs& a, Io& cio) {
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_sweep(CLI::App& app) { return make_command<SweepArgs>(app, cmd_sweep); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

@@ -37,8 +37,8 @@ int cmd_twist(const TwistArgs& a, Io& cio) {
     return 0;
 }
 
-}  // namespace
+}   // namespace
 
 Command add_twist(CLI::App& app) { return make_command<TwistArgs>(app, cmd_twist); }
 
-}  // namespace plate::cli
+}   // namespace plate::cli

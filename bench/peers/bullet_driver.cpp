@@ -21,7 +21,7 @@ namespace plate::peers {
 namespace {
 btVector3 bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
 btQuaternion bt(const Eigen::Quaterniond& q) { return btQuaternion(q.x(), q.y(), q.z(), q.w()); }
-}  // namespace
+}   // namespace
 
 PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double sample_dt, const PeerOptions& opt) {
     PeerRun r;
@@ -48,7 +48,8 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     world.getSolverInfo().m_numIterations = 100;
     world.getSolverInfo().m_splitImpulse = 0;
     if (opt.pyramid)   // two friction directions, fixed in the contact's plane: a box
-        world.getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
+        world.getSolverInfo().m_solverMode |=
+            SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
     // The plate: a box whose top face is the plate plane.
     btBoxShape box(btVector3(1, 1, 0.05));
     box.setMargin(1e-4);
@@ -85,13 +86,16 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     part.setLinearVelocity(bt(b.v));
     part.setAngularVelocity(bt(b.w));
     world.addRigidBody(&part);
-    r.settings = std::string("double precision, fixed steps (no interpolation or sub-steps), 100 sequential-impulse iterations, "
-                             "no split impulse, ") +
-                 (opt.pyramid ? "TWO FIXED friction directions (a box), "
-                              : "one friction direction, along the slip (Bullet's default: a sliding contact feels mu N against its "
-                                "slip), ") +
-                 "collision margins 0.1 mm (the default 4 cm lifts a small part off the plate), no deactivation (a sleeping part "
-                 "stops); the plate a kinematic body; spheres r = " + std::to_string(std::lround(rad * 1e6)) + " um";
+    r.settings =
+        std::string(
+            "double precision, fixed steps (no interpolation or sub-steps), 100 sequential-impulse iterations, "
+            "no split impulse, ") +
+        (opt.pyramid ? "TWO FIXED friction directions (a box), "
+                     : "one friction direction, along the slip (Bullet's default: a sliding contact feels mu N against its "
+                       "slip), ") +
+        "collision margins 0.1 mm (the default 4 cm lifts a small part off the plate), no deactivation (a sleeping part "
+        "stops); the plate a kinematic body; spheres r = " +
+        std::to_string(std::lround(rad * 1e6)) + " um";
     auto record = [&](double t) {
         const btTransform& T = part.getCenterOfMassTransform();
         const btQuaternion q = T.getRotation();
@@ -115,4 +119,4 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
     return r;
 }
 
-}  // namespace plate::peers
+}   // namespace plate::peers

@@ -17,4 +17,4 @@ std::vector<Engine> engines() {
     return e;
 }
 
-}  // namespace plate::peers
+}   // namespace plate::peers

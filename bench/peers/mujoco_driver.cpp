@@ -42,17 +42,19 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
     if (!r.failure.empty()) return r;
     std::ostringstream x;
     x.precision(17);
-    x << "<mujoco><option timestep=\"" << dt << "\" gravity=\"0 0 " << -sc.g
-      << "\" cone=\"" << (opt.pyramid ? "pyramidal" : "elliptic") << "\" impratio=\"100\" solver=\"Newton\" iterations=\"100\" tolerance=\"1e-12\"/>"
-      << "<default><geom condim=\"3\" solref=\"" << (opt.contact_time > 0 ? opt.contact_time : 4 * dt) << " 1\" solimp=\"0.95 0.99 0.0001\"/></default>"
-      << "<worldbody><body name=\"plate\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << kPlateMass
-      << "\" diaginertia=\"" << kPlateInertia << " " << kPlateInertia << " " << kPlateInertia << "\"/>"
+    x << "<mujoco><option timestep=\"" << dt << "\" gravity=\"0 0 " << -sc.g << "\" cone=\""
+      << (opt.pyramid ? "pyramidal" : "elliptic")
+      << "\" impratio=\"100\" solver=\"Newton\" iterations=\"100\" tolerance=\"1e-12\"/>"
+      << "<default><geom condim=\"3\" solref=\"" << (opt.contact_time > 0 ? opt.contact_time : 4 * dt)
+      << " 1\" solimp=\"0.95 0.99 0.0001\"/></default>"
+      << "<worldbody><body name=\"plate\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << kPlateMass << "\" diaginertia=\""
+      << kPlateInertia << " " << kPlateInertia << " " << kPlateInertia << "\"/>"
       << "<geom type=\"box\" size=\"1 1 0.05\" pos=\"0 0 -0.05\" friction=\"0 0 0\"/></body>"
-      << "<body name=\"part\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << P.m << "\" fullinertia=\"" << P.J(0, 0)
-      << " " << P.J(1, 1) << " " << P.J(2, 2) << " " << P.J(0, 1) << " " << P.J(0, 2) << " " << P.J(1, 2) << "\"/>";
+      << "<body name=\"part\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << P.m << "\" fullinertia=\"" << P.J(0, 0) << " "
+      << P.J(1, 1) << " " << P.J(2, 2) << " " << P.J(0, 1) << " " << P.J(0, 2) << " " << P.J(1, 2) << "\"/>";
     for (int i = 0; i < 3; ++i)
-        x << "<geom type=\"sphere\" size=\"" << rad << "\" pos=\"" << P.c[i].x() << " " << P.c[i].y() << " "
-          << P.c[i].z() + rad << "\" friction=\"" << P.friction().kinetic(i) << " 0 0\"/>";
+        x << "<geom type=\"sphere\" size=\"" << rad << "\" pos=\"" << P.c[i].x() << " " << P.c[i].y() << " " << P.c[i].z() + rad
+          << "\" friction=\"" << P.friction().kinetic(i) << " 0 0\"/>";
     x << "</body></worldbody></mujoco>";
     const std::string xml = x.str();
     auto vfs = std::make_unique<mjVFS>();
@@ -67,12 +69,15 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
         return r;
     }
     mjData* d = mj_makeData(m);
-    r.settings = std::string(opt.pyramid ? "PYRAMIDAL cone (MuJoCo's default)" : "elliptic cone (the friction disk; the default pyramid turns the part the wrong way in yaw)") +
-                 ", impratio 100 (friction rows stiffer than the normal's: little creep while sticking), Newton solver with 100 "
-                 "iterations to 1e-12 (the contact problem solved, not approximated), solref (4 dt, 1) (a few steps, critically damped: "
-                 "at MuJoCo's floor of 2 dt a sliding part hops, from ~10 dt on the soft contact turns it the wrong way), solimp 0.95 0.99 1e-4 (stiff), Euler integrator; the plate a 10 t free body set "
-                 "to the plate's pose and velocity every step (a mocap body would have zero velocity in the contact rows); spheres r = " +
-                 std::to_string(std::lround(rad * 1e6)) + " um";
+    r.settings =
+        std::string(opt.pyramid ? "PYRAMIDAL cone (MuJoCo's default)"
+                                : "elliptic cone (the friction disk; the default pyramid turns the part the wrong way in yaw)") +
+        ", impratio 100 (friction rows stiffer than the normal's: little creep while sticking), Newton solver with 100 "
+        "iterations to 1e-12 (the contact problem solved, not approximated), solref (4 dt, 1) (a few steps, critically damped: "
+        "at MuJoCo's floor of 2 dt a sliding part hops, from ~10 dt on the soft contact turns it the wrong way), solimp 0.95 "
+        "0.99 1e-4 (stiff), Euler integrator; the plate a 10 t free body set "
+        "to the plate's pose and velocity every step (a mocap body would have zero velocity in the contact rows); spheres r = " +
+        std::to_string(std::lround(rad * 1e6)) + " um";
     PlateTrack plate(sc.plate, opt.drift);
     auto set_plate = [&] {
         d->qpos[0] = plate.p.x(), d->qpos[1] = plate.p.y(), d->qpos[2] = plate.p.z();
@@ -117,4 +122,4 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
     return r;
 }
 
-}  // namespace plate::peers
+}   // namespace plate::peers

@@ -70,7 +70,7 @@ void near(void* data, dGeomID o1, dGeomID o2) {
 
 std::once_flag ode_init;
 
-}  // namespace
+}   // namespace
 
 PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_dt, const PeerOptions& opt) {
     PeerRun r;
@@ -109,8 +109,9 @@ PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_
         dGeomSetOffsetPosition(w.spheres[i], P.c[i].x(), P.c[i].y(), P.c[i].z() + rad);
         w.mu[i] = P.friction().kinetic(i);
     }
-    r.settings = std::string("dWorldStep (the Dantzig LCP, exact for the step, not the iterative QuickStep), dContactApprox1 "
-                             "(friction bounded by mu N, not a force in newtons), ") +
+    r.settings = std::string(
+                     "dWorldStep (the Dantzig LCP, exact for the step, not the iterative QuickStep), dContactApprox1 "
+                     "(friction bounded by mu N, not a force in newtons), ") +
                  (opt.pyramid ? "FIXED friction directions (ODE's box)"
                               : "the first friction direction set along the slip every step and the second freed while it slides "
                                 "(ODE's friction is a box: so a sliding contact feels mu N against its slip)") +
@@ -155,4 +156,4 @@ PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_
     return r;
 }
 
-}  // namespace plate::peers
+}   // namespace plate::peers

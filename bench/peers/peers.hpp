@@ -25,11 +25,11 @@ namespace plate::peers {
 class PlateTrack {
 public:
     explicit PlateTrack(const PlateMotion& u, const Vec3& drift = Vec3::Zero());
-    void advance(double t);    // to time t >= the current one (RK4 on the orientation, steps <= T/4000)
+    void advance(double t);   // to time t >= the current one (RK4 on the orientation, steps <= T/4000)
     double t = 0;
-    Vec3 p = Vec3::Zero(), v = Vec3::Zero();          // origin of the plate frame, its velocity (W)
-    Vec3 w = Vec3::Zero();                            // omega1 (W)
-    Vec3 a = Vec3::Zero(), alpha = Vec3::Zero();      // p'', omega1' (W)
+    Vec3 p = Vec3::Zero(), v = Vec3::Zero();                 // origin of the plate frame, its velocity (W)
+    Vec3 w = Vec3::Zero();                                   // omega1 (W)
+    Vec3 a = Vec3::Zero(), alpha = Vec3::Zero();             // p'', omega1' (W)
     Eigen::Quaterniond R = Eigen::Quaterniond::Identity();   // R1: P -> W
 
 private:
@@ -57,24 +57,24 @@ struct PeerOptions {
     // The pitfall, for the study and the tests to show: the engine's friction pyramid/box (MuJoCo's
     // default pyramidal cone, ODE's box along fixed directions; Bullet: two fixed friction directions).
     bool pyramid = false;
-    double contact_time = 0;       // MuJoCo's contact time constant (solref) [s]; 0: the driver's choice
+    double contact_time = 0;   // MuJoCo's contact time constant (solref) [s]; 0: the driver's choice
 };
 
 struct PeerRun {
-    std::string engine;        // "MuJoCo 2.2.2", ...
-    std::string settings;      // what was set and why, in a line
-    std::string failure;       // empty if the run went through
-    std::vector<double> t;     // samples every sample_dt from 0
-    std::vector<Vec3> q;       // (s_x, s_y, theta) in the plate frame
-    double cpu_seconds = 0;    // the engine's stepping only (set-up excluded), this thread's CPU time
+    std::string engine;       // "MuJoCo 2.2.2", ...
+    std::string settings;     // what was set and why, in a line
+    std::string failure;      // empty if the run went through
+    std::vector<double> t;    // samples every sample_dt from 0
+    std::vector<Vec3> q;      // (s_x, s_y, theta) in the plate frame
+    double cpu_seconds = 0;   // the engine's stepping only (set-up excluded), this thread's CPU time
     long steps = 0;
-    double max_lift = 0;       // largest |centre of mass height above the plate - s_z| over the samples [m]
+    double max_lift = 0;   // largest |centre of mass height above the plate - s_z| over the samples [m]
 };
 
 // Records the part's body pose (x, R: its centre of mass and frame in W) at time t as a sample of r in
 // the plate frame, and its lift off the resting height; false (r.failure set) if it left the plate.
-bool record_sample(PeerRun& r, const Part& part, const PlateTrack& plate, double t, const Vec3& x,
-                   const Eigen::Quaterniond& R, double first_theta);
+bool record_sample(PeerRun& r, const Part& part, const PlateTrack& plate, double t, const Vec3& x, const Eigen::Quaterniond& R,
+                   double first_theta);
 
 // This thread's CPU time [s] (the study runs one thread each).
 double cpu_now();
@@ -93,4 +93,4 @@ PeerRun run_bullet(const Scene&, const Vec3&, double, double, const PeerOptions&
 PeerRun run_ode(const Scene&, const Vec3&, double, double, const PeerOptions&);
 PeerRun run_mujoco(const Scene&, const Vec3&, double, double, const PeerOptions&);
 
-}  // namespace plate::peers
+}   // namespace plate::peers

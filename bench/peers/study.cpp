@@ -82,8 +82,8 @@ double twist_err(const Scene& sc, const Vec3& a, const Vec3& b) {
 // cycle tolerance on an rtol of 1e-4 (a coarser rtol makes the period map too noisy for the
 // shooting's test: fig4's field at tol 1e-2, rtol 1e-3 took 0.34 s; at rtol 1e-4 its starts predicted
 // from their neighbours take 1.05 periods each, largest error 2.9e-4 m/s).
-const std::vector<std::pair<double, double>> kCycleSettings = {
-    {1e-2, 1e-4}, {1e-3, 1e-4}, {1e-4, 1e-5}, {1e-5, 1e-6}, {1e-6, 1e-7}, {1e-7, 1e-8}, {1e-8, 1e-9}, {1e-9, 1e-10}};
+const std::vector<std::pair<double, double>> kCycleSettings = {{1e-2, 1e-4}, {1e-3, 1e-4}, {1e-4, 1e-5}, {1e-5, 1e-6},
+                                                               {1e-6, 1e-7}, {1e-7, 1e-8}, {1e-8, 1e-9}, {1e-9, 1e-10}};
 std::string cycle_setting(double tol, double rtol) { return "tol " + sci(tol) + ", rtol " + sci(rtol); }
 
 // (a) the trajectory.
@@ -137,10 +137,13 @@ void question_a(json& j, const Scene& fig4, const std::vector<peers::Engine>& en
             if (r.failure.empty()) path_error(fig4, flat(r.q), R, f, m);
             pts.push_back(point(r.engine, "dt " + sci(dt), r.cpu_seconds, f, r.failure));
             pts.back()["max_lift"] = r.max_lift;
-            say("(a) " + r.engine + " dt " + std::to_string(dt) + ": error " + std::to_string(f) + ", cpu " + std::to_string(r.cpu_seconds));
+            say("(a) " + r.engine + " dt " + std::to_string(dt) + ": error " + std::to_string(f) + ", cpu " +
+                std::to_string(r.cpu_seconds));
         }
-    j["a"] = {{"question", "fig4: full dynamics from rest at (0.04, -0.04, 1.0) for " + std::to_string(static_cast<int>(dur)) + " s, final configuration"},
-              {"reference_error", fe}, {"points", pts}};
+    j["a"] = {{"question", "fig4: full dynamics from rest at (0.04, -0.04, 1.0) for " + std::to_string(static_cast<int>(dur)) +
+                               " s, final configuration"},
+              {"reference_error", fe},
+              {"points", pts}};
 }
 
 // (b) one asymptotic twist.
@@ -163,7 +166,8 @@ void question_b(json& j, const Scene& fig4, const std::vector<peers::Engine>& en
         const double t0 = peers::cpu_now();
         const LimitCycleSummary lc = limit_cycle(fig4, q0, o);
         const double cpu = since(t0);
-        pts.push_back(point("plate", cycle_setting(tol, rtol), cpu, twist_err(fig4, lc.twist, ref.twist), lc.converged ? "" : "not converged"));
+        pts.push_back(point("plate", cycle_setting(tol, rtol), cpu, twist_err(fig4, lc.twist, ref.twist),
+                            lc.converged ? "" : "not converged"));
     }
     // The method error of the protocol itself: plate's full dynamics, k periods, then one averaged.
     IntegrationOptions io;
@@ -176,8 +180,8 @@ void question_b(json& j, const Scene& fig4, const std::vector<peers::Engine>& en
     json protocol = json::array();
     for (int k : ks)
         if (static_cast<int>(fq.size()) > k + 1)
-            protocol.push_back(point("plate full dynamics, k periods", "k " + std::to_string(k), cpu_full * (k + 1) / (ks.back() + 1),
-                                     twist_err(fig4, twist_after(fq, k, T), ref.twist)));
+            protocol.push_back(point("plate full dynamics, k periods", "k " + std::to_string(k),
+                                     cpu_full * (k + 1) / (ks.back() + 1), twist_err(fig4, twist_after(fq, k, T), ref.twist)));
     for (const auto& e : engines)
         for (double dt : dts) {
             peers::PeerOptions o;
@@ -191,8 +195,11 @@ void question_b(json& j, const Scene& fig4, const std::vector<peers::Engine>& en
             }
             say("(b) " + r.engine + " dt " + std::to_string(dt));
         }
-    j["b"] = {{"question", "fig4: the asymptotic twist at (0.02, -0.01, 0.5)"}, {"reference_error", ref_err},
-              {"twist", {ref.twist[0], ref.twist[1], ref.twist[2]}}, {"protocol_error", protocol}, {"points", pts}};
+    j["b"] = {{"question", "fig4: the asymptotic twist at (0.02, -0.01, 0.5)"},
+              {"reference_error", ref_err},
+              {"twist", {ref.twist[0], ref.twist[1], ref.twist[2]}},
+              {"protocol_error", protocol},
+              {"points", pts}};
 }
 
 // (c), (d): fields (SC's 7 x 7 x 7 field, or only its sticking configurations), under key ID.
@@ -253,8 +260,9 @@ void field_question(json& j, const Scene& sc, const std::string& id, const std::
         }
         pts.push_back(point("plate", cycle_setting(tol, rtol), cpu, err, failure));
     }
-    const std::vector<std::pair<double, int>> settings = quick ? std::vector<std::pair<double, int>>{{2.5e-4, 5}}
-                                                               : std::vector<std::pair<double, int>>{{5e-4, 5}, {2.5e-4, 5}, {1e-4, 10}};
+    const std::vector<std::pair<double, int>> settings =
+        quick ? std::vector<std::pair<double, int>>{{2.5e-4, 5}}
+              : std::vector<std::pair<double, int>>{{5e-4, 5}, {2.5e-4, 5}, {1e-4, 10}};
     for (const auto& e : engines)
         for (const auto& [dt, k] : settings) {
             peers::PeerOptions o;
@@ -273,21 +281,25 @@ void field_question(json& j, const Scene& sc, const std::string& id, const std::
                 err = std::max(err, twist_err(sc, twist_after(r.q, k, sc.plate.T), ref.points[i].twist));
             }
             pts.push_back(point(name, "dt " + sci(dt) + ", k " + std::to_string(k), cpu, err, failure));
-            say("(" + id + ") " + name + " dt " + std::to_string(dt) + " k " + std::to_string(k) + ": error " + std::to_string(err) + ", cpu " + std::to_string(cpu));
+            say("(" + id + ") " + name + " dt " + std::to_string(dt) + " k " + std::to_string(k) + ": error " +
+                std::to_string(err) + ", cpu " + std::to_string(cpu));
         }
     j[id] = {{"question", question}, {"configurations", idx.size()}, {"reference_error", ref_err}, {"points", pts}};
 }
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     std::string out, source = PLATE_SOURCE_DIR;
     bool quick = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        if (a == "--out" && i + 1 < argc) out = argv[++i];
-        else if (a == "--source" && i + 1 < argc) source = argv[++i];
-        else if (a == "--quick") quick = true;
+        if (a == "--out" && i + 1 < argc)
+            out = argv[++i];
+        else if (a == "--source" && i + 1 < argc)
+            source = argv[++i];
+        else if (a == "--quick")
+            quick = true;
         else {
             std::cerr << "usage: bench_peers --out FILE [--quick] [--source DIR]\n";
             return 2;
@@ -308,13 +320,14 @@ int main(int argc, char** argv) {
         j["engines"].push_back({{"name", r.engine}, {"settings", r.settings}});
     }
     // (steps that divide the period: samples land on whole periods)
-    const std::vector<double> dts = quick ? std::vector<double>{1e-3, 2.5e-4, 1e-4}
-                                          : std::vector<double>{1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5};
+    const std::vector<double> dts =
+        quick ? std::vector<double>{1e-3, 2.5e-4, 1e-4} : std::vector<double>{1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5};
 
     question_a(j, fig4, engines, dts, quick);
     question_b(j, fig4, engines, dts);
     field_question(j, fig4, "c", "fig4: the 343-configuration field (7 x 7 x 7), largest twist error", false, engines, quick);
-    field_question(j, fig6, "d", "fig6: its sticking configurations (stick fraction > 0 in the 7 x 7 x 7 field), largest twist error", true,
+    field_question(j, fig6, "d",
+                   "fig6: its sticking configurations (stick fraction > 0 in the 7 x 7 x 7 field), largest twist error", true,
                    engines, quick);
 
     std::ofstream f(out + ".tmp");

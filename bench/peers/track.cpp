@@ -9,8 +9,10 @@ namespace plate::peers {
 
 PlateTrack::PlateTrack(const PlateMotion& u, const Vec3& drift) : u_(&u), drift_(drift) {
     Vec3 phi;
-    if (u.T > 0) u.displacement(0.0, p0_, phi);
-    else phi.setZero();
+    if (u.T > 0)
+        u.displacement(0.0, p0_, phi);
+    else
+        phi.setZero();
     const double angle = phi.norm();
     R = angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, phi / angle)) : Eigen::Quaterniond::Identity();
     read(0);
@@ -74,8 +76,8 @@ long whole_steps(double span, double dt, std::string& failure) {
     return n;
 }
 
-bool record_sample(PeerRun& r, const Part& part, const PlateTrack& plate, double t, const Vec3& x,
-                   const Eigen::Quaterniond& R, double first_theta) {
+bool record_sample(PeerRun& r, const Part& part, const PlateTrack& plate, double t, const Vec3& x, const Eigen::Quaterniond& R,
+                   double first_theta) {
     const Vec3 q = plate_frame_config(part, plate, x, R.normalized(), r.q.empty() ? first_theta : r.q.back()[2]);
     const double lift = std::abs((plate.R.conjugate() * (x - plate.p)).z() - part.s_z());
     r.max_lift = std::max(r.max_lift, lift);
@@ -99,8 +101,7 @@ BodyState at_rest_on_plate(const Part& part, const PlateTrack& plate, const Vec3
     return b;
 }
 
-Vec3 plate_frame_config(const Part&, const PlateTrack& plate, const Vec3& x, const Eigen::Quaterniond& R,
-                        double previous_theta) {
+Vec3 plate_frame_config(const Part&, const PlateTrack& plate, const Vec3& x, const Eigen::Quaterniond& R, double previous_theta) {
     const Vec3 rel = plate.R.conjugate() * (x - plate.p);
     const Mat3 Rrel = (plate.R.conjugate() * R).toRotationMatrix();
     double th = std::atan2(Rrel(1, 0), Rrel(0, 0));
@@ -108,4 +109,4 @@ Vec3 plate_frame_config(const Part&, const PlateTrack& plate, const Vec3& x, con
     return Vec3(rel.x(), rel.y(), th);
 }
 
-}  // namespace plate::peers
+}   // namespace plate::peers

@@ -143,10 +143,10 @@ struct Candidate {
     PlateMotion u;
     Vec3 q;
     double rate;
-    double passage;   // [s] the slowest start's way round the ring to the stable orientation
-    int index;        // in the grid (ties)
-    PlateMotion base;             // the motion before rz: the pair's, tilts aligned, scaled
-    std::array<double, 4> g;      // rz's setting
+    double passage;            // [s] the slowest start's way round the ring to the stable orientation
+    int index;                 // in the grid (ties)
+    PlateMotion base;          // the motion before rz: the pair's, tilts aligned, scaled
+    std::array<double, 4> g;   // rz's setting
     double scale;
 };
 
@@ -381,8 +381,8 @@ double PairBreaker::settle_offset(const Candidate& c, double settle, double T) c
     placed.plate = placed_motion(c.u, c.q, target.at, target.theta);
     IntegrationOptions io;
     io.rtol = 1e-7;
-    const Trajectory tr = simulate(placed, Dynamics::Full, Vec3(target.at.x(), target.at.y(), target.theta), Vec3::Zero(),
-                                   settle, T / 20, io);
+    const Trajectory tr =
+        simulate(placed, Dynamics::Full, Vec3(target.at.x(), target.at.y(), target.theta), Vec3::Zero(), settle, T / 20, io);
     double sum_off = 0;
     int count = 0;
     for (const Sample& smp : tr.samples)
@@ -391,7 +391,7 @@ double PairBreaker::settle_offset(const Candidate& c, double settle, double T) c
     return offset;
 }
 
-}  // namespace
+}   // namespace
 
 DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion, const DesignTarget& target,
                          const DesignOptions& opt, double T, std::atomic<long>& cycles, Clock::time_point t0) {
@@ -429,10 +429,11 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
         }
         if (sum.verified && sum.unique) return sum;
         if (sum.verified && (!kept.verified || sum.basin_share > kept.basin_share)) kept = sum;
-        failure = "the first " + std::to_string(i + 1) + " of " + std::to_string(found.size()) +
-                  " candidates with one stable orientation at the centre did not verify as unique (the last: " +
-                  (sum.failure.empty() ? "verified with another stable fixed point, or unsearched cells, on the grid"
-                                       : sum.failure) + ")";
+        failure =
+            "the first " + std::to_string(i + 1) + " of " + std::to_string(found.size()) +
+            " candidates with one stable orientation at the centre did not verify as unique (the last: " +
+            (sum.failure.empty() ? "verified with another stable fixed point, or unsearched cells, on the grid" : sum.failure) +
+            ")";
         if (kept.verified && kept.basin_share >= 0.9) break;
     }
     if (kept.verified) {
@@ -445,4 +446,4 @@ DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion
     return none;
 }
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

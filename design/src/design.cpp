@@ -60,15 +60,15 @@ DesignSummary design_registered(const Scene& part_scene, const DesignTarget& tar
 // register_design_target for kinds added from outside the library).
 using BuiltInDesigner = DesignSummary (*)(const Scene&, const DesignTarget&, const DesignOptions&, double);
 constexpr std::pair<DesignTargetKind, BuiltInDesigner> kDesigners[] = {
-    {DesignTargetKind::Sink, design_sink},                 // sink.cpp
-    {DesignTargetKind::FixedPoint, design_fixed_point},    // rigid_fixed_point.cpp, break_pair.cpp
-    {DesignTargetKind::Transport, design_transport},       // transport.cpp
-    {DesignTargetKind::Orient, design_orientation},        // orient.cpp
-    {DesignTargetKind::LineSink, design_line_sink},        // line_sink.cpp
+    {DesignTargetKind::Sink, design_sink},                // sink.cpp
+    {DesignTargetKind::FixedPoint, design_fixed_point},   // rigid_fixed_point.cpp, break_pair.cpp
+    {DesignTargetKind::Transport, design_transport},      // transport.cpp
+    {DesignTargetKind::Orient, design_orientation},       // orient.cpp
+    {DesignTargetKind::LineSink, design_line_sink},       // line_sink.cpp
     {DesignTargetKind::Registered, design_registered},
 };
 
-}  // namespace
+}   // namespace
 
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt) {
     validate_design_options(opt);
@@ -83,4 +83,4 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
     return sum;
 }
 
-}  // namespace plate
+}   // namespace plate

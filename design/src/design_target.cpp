@@ -37,11 +37,12 @@ std::string number_text(double x) {
     return s.str();
 }
 
-}  // namespace
+}   // namespace
 
 std::string design_target_usage() {
-    std::string s = "sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA, line-sink X Y PHI "
-                    "or transport VX VY [OMEGA]";
+    std::string s =
+        "sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA, line-sink X Y PHI "
+        "or transport VX VY [OMEGA]";
     std::lock_guard<std::mutex> lock(registry_mutex);
     for (const DesignTargetType& r : registry()) s += ", " + r.name + (r.numbers.empty() ? "" : " " + r.numbers);
     return s;
@@ -65,29 +66,32 @@ DesignTarget parse_design_target(const std::string& kind, const std::vector<doub
             }
     }
     if (!b) throw std::invalid_argument(kind + ": expected " + design_target_usage());
-    const std::size_t want = b->kind == DesignTargetKind::Orient                                          ? 1
-                             : (b->kind == DesignTargetKind::FixedPoint && !point_part) ||
-                                       b->kind == DesignTargetKind::LineSink                              ? 3
-                                                                                                          : 2;
+    const std::size_t want = b->kind == DesignTargetKind::Orient ? 1
+                             : (b->kind == DesignTargetKind::FixedPoint && !point_part) || b->kind == DesignTargetKind::LineSink
+                                 ? 3
+                                 : 2;
     if (v.size() != want && !(b->kind == DesignTargetKind::Transport && v.size() == 3))
         throw std::invalid_argument(kind + ": expected " + design_target_usage());
     t.kind = b->kind;
     switch (b->kind) {
-    case DesignTargetKind::Sink:
-    case DesignTargetKind::FixedPoint:
-        t.at = Vec2(v[0], v[1]);
-        if (v.size() == 3) t.theta = v[2];
-        break;
-    case DesignTargetKind::Orient: t.theta = v[0]; break;
-    case DesignTargetKind::LineSink:
-        t.at = Vec2(v[0], v[1]);
-        t.theta = v[2];
-        break;
-    case DesignTargetKind::Transport:
-        t.velocity = Vec2(v[0], v[1]);
-        if (v.size() == 3) t.omega = v[2];
-        break;
-    case DesignTargetKind::Registered: break;
+        case DesignTargetKind::Sink:
+        case DesignTargetKind::FixedPoint:
+            t.at = Vec2(v[0], v[1]);
+            if (v.size() == 3) t.theta = v[2];
+            break;
+        case DesignTargetKind::Orient:
+            t.theta = v[0];
+            break;
+        case DesignTargetKind::LineSink:
+            t.at = Vec2(v[0], v[1]);
+            t.theta = v[2];
+            break;
+        case DesignTargetKind::Transport:
+            t.velocity = Vec2(v[0], v[1]);
+            if (v.size() == 3) t.omega = v[2];
+            break;
+        case DesignTargetKind::Registered:
+            break;
     }
     return t;
 }
@@ -101,15 +105,19 @@ std::string design_target_kind(const DesignTarget& t) {
 
 std::vector<double> design_target_values(const DesignTarget& t, bool point_part) {
     switch (t.kind) {
-    case DesignTargetKind::Sink: return {t.at.x(), t.at.y()};
-    case DesignTargetKind::FixedPoint:
-        return point_part ? std::vector<double>{t.at.x(), t.at.y()} : std::vector<double>{t.at.x(), t.at.y(), t.theta};
-    case DesignTargetKind::Orient: return {t.theta};
-    case DesignTargetKind::LineSink: return {t.at.x(), t.at.y(), t.theta};
-    case DesignTargetKind::Transport:
-        return t.omega != 0 ? std::vector<double>{t.velocity.x(), t.velocity.y(), t.omega}
-                            : std::vector<double>{t.velocity.x(), t.velocity.y()};
-    case DesignTargetKind::Registered: return t.values;
+        case DesignTargetKind::Sink:
+            return {t.at.x(), t.at.y()};
+        case DesignTargetKind::FixedPoint:
+            return point_part ? std::vector<double>{t.at.x(), t.at.y()} : std::vector<double>{t.at.x(), t.at.y(), t.theta};
+        case DesignTargetKind::Orient:
+            return {t.theta};
+        case DesignTargetKind::LineSink:
+            return {t.at.x(), t.at.y(), t.theta};
+        case DesignTargetKind::Transport:
+            return t.omega != 0 ? std::vector<double>{t.velocity.x(), t.velocity.y(), t.omega}
+                                : std::vector<double>{t.velocity.x(), t.velocity.y()};
+        case DesignTargetKind::Registered:
+            return t.values;
     }
     return {};
 }
@@ -117,7 +125,8 @@ std::vector<double> design_target_values(const DesignTarget& t, bool point_part)
 void validate_design_options(const DesignOptions& o) {
     // Every design is verified in full dynamics before it is reported: no runs, no verification (the
     // sinks, lines, transports and orienters would otherwise pass on the field alone).
-    if (o.verify_starts < 1) throw std::invalid_argument("verify_starts must be at least 1 (designs are verified in full dynamics)");
+    if (o.verify_starts < 1)
+        throw std::invalid_argument("verify_starts must be at least 1 (designs are verified in full dynamics)");
     const auto require = [](bool ok, const std::string& what) {
         if (!ok) throw std::invalid_argument(what);
     };
@@ -151,17 +160,20 @@ void validate_design_target(const DesignTarget& target, const Scene& part_scene,
     if (target.kind == DesignTargetKind::Transport) {
         if (!(target.velocity.norm() > 0)) throw std::invalid_argument("a transport target needs a velocity");
         if (target.omega != 0)
-            throw std::invalid_argument("transport with a turn: a plate that only translates cannot turn a part with one "
-                                        "friction coefficient, and a turning plate's alpha x s makes the twist depend on "
-                                        "position (a whirl), so no uniform twist with OMEGA != 0 is designed (DesignTarget)");
+            throw std::invalid_argument(
+                "transport with a turn: a plate that only translates cannot turn a part with one "
+                "friction coefficient, and a turning plate's alpha x s makes the twist depend on "
+                "position (a whirl), so no uniform twist with OMEGA != 0 is designed (DesignTarget)");
         if (rigid && friction_differs(part_scene.part))
-            throw std::invalid_argument("transport of a part whose contacts' friction differs: a translating plate turns it "
-                                        "(the weathervane) and its velocity with it, so it has no uniform twist (try orient)");
+            throw std::invalid_argument(
+                "transport of a part whose contacts' friction differs: a translating plate turns it "
+                "(the weathervane) and its velocity with it, so it has no uniform twist (try orient)");
         return;
     }
     if (!(std::abs(target.at.x()) <= opt.region && std::abs(target.at.y()) <= opt.region))
         throw std::invalid_argument("the target lies outside the plate region");
-    if (rigid && target.kind == DesignTargetKind::LineSink) throw std::invalid_argument("a line sink is built for point parts only");
+    if (rigid && target.kind == DesignTargetKind::LineSink)
+        throw std::invalid_argument("a line sink is built for point parts only");
     if (!rigid && target.kind == DesignTargetKind::Orient) throw std::invalid_argument("a point part has no orientation to set");
 }
 
@@ -184,6 +196,6 @@ const DesignTargetType* registered(const std::string& name) {
     return nullptr;
 }
 
-}  // namespace design_detail
+}   // namespace design_detail
 
-}  // namespace plate
+}   // namespace plate

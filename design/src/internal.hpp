@@ -46,8 +46,7 @@ double cycle_noise(const LimitCycleOptions& o);
 TaskRunner runner(const DesignOptions& opt);
 // c_k <= 0 for each axis' harmonics n = 1..n_max of `fin` within `room` times the axis' limit (6 n_max
 // entries, axis-major), then c <= 0 for no flight over the region; returns the entries written.
-int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
-                          double* c);
+int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room, double* c);
 
 // A search problem's bookkeeping. Derived (CRTP) supplies kParams, kConstraints, limit(i) (the
 // bound of parameter i), constraints(p, c) (c_k <= 0 when feasible) and evaluate(p).
@@ -116,8 +115,9 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
             any = any || probe.is_free(i);
             if (probe.is_free(i) && probe.limit(i) > 0) free_idx.push_back(i);
         }
-        if (!any) throw std::invalid_argument("the axes and harmonics allowed leave this target's motion family nothing to move (" +
-                                              std::string(P::kFamily) + ")");
+        if (!any)
+            throw std::invalid_argument("the axes and harmonics allowed leave this target's motion family nothing to move (" +
+                                        std::string(P::kFamily) + ")");
     }
     const int m = static_cast<int>(free_idx.size());
     const int n_starts = std::max(1, opt.starts);
@@ -125,114 +125,117 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
     std::vector<double> best_f(n_starts, std::numeric_limits<double>::infinity());
     std::vector<long> evals(n_starts, 0);
     std::atomic<long>* const cycles = make().cycles;   // (each start counts its own and sends it)
-    runner(opt)(n_starts, [&](int k) -> std::string {
-        P prob = make();
-        std::atomic<long> own_cycles{0};
-        prob.cycles = &own_cycles;
-        Rng rng(opt.seed * 1000003 + static_cast<std::uint64_t>(k));
-        std::vector<double> p(n), lo(n), hi(n), step(n);
-        bool ok = false;
-        // Start 0 from the part scene's own plate motion when the problem can express it and it is
-        // feasible (the "starting guess").
-        if (k == 0 && !prob.guess.empty()) {
-            p = prob.guess;
-            for (int i = 0; i < n; ++i)
-                if (!prob.is_free(i)) p[i] = 0;
-            ok = prob.feasible(p);
-        }
-        // (every 100 infeasible draws the box shrinks by 0.7: with z and rx, ry motion most of the full
-        // box lets the part fly)
-        for (int tries = 0; tries < 1000 && !ok; ++tries) {
-            const double box = std::pow(0.7, tries / 100) / std::sqrt(2.0);
-            for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) * box * prob.is_free(i);
-            ok = prob.feasible(p);
-        }
-        if (!ok) return "inf 0 0";
-        // The start's result as text (it may have run in another process): f, evaluations, cycles, p.
-        const auto result = [&] {
-            std::string text = exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' +
-                               std::to_string(own_cycles.load());
-            for (double x : prob.best_p) text += ' ' + exact_text(x);
-            return text;
-        };
-        prob.objective(p);   // the feasible start itself
-        if (m == 0) return result();   // (nothing free: the start is the answer)
-        // The local search on the free parameters: x (m of them) placed into the full p.
-        struct Reduced {
-            P* prob;
-            const std::vector<int>* idx;
-            std::vector<double> full;
-            const std::vector<double>& place(const double* x) {
-                for (std::size_t j = 0; j < idx->size(); ++j) full[static_cast<std::size_t>((*idx)[j])] = x[j];
-                return full;
+    runner(opt)(
+        n_starts,
+        [&](int k) -> std::string {
+            P prob = make();
+            std::atomic<long> own_cycles{0};
+            prob.cycles = &own_cycles;
+            Rng rng(opt.seed * 1000003 + static_cast<std::uint64_t>(k));
+            std::vector<double> p(n), lo(n), hi(n), step(n);
+            bool ok = false;
+            // Start 0 from the part scene's own plate motion when the problem can express it and it is
+            // feasible (the "starting guess").
+            if (k == 0 && !prob.guess.empty()) {
+                p = prob.guess;
+                for (int i = 0; i < n; ++i)
+                    if (!prob.is_free(i)) p[i] = 0;
+                ok = prob.feasible(p);
             }
-        } red{&prob, &free_idx, p};
-        std::vector<double> x(m);
-        lo.resize(m);
-        hi.resize(m);
-        step.resize(m);
-        for (int j = 0; j < m; ++j) {
-            const int i = free_idx[j];
-            x[j] = p[i];
-            lo[j] = -prob.limit(i);
-            hi[j] = prob.limit(i);
-            step[j] = prob.limit(i) / 4;
-        }
-        const bool gradients = opt.local == DesignOptions::Local::SlsqpFiniteDifferences;
-        nlopt::opt local(gradients ? nlopt::LD_SLSQP : nlopt::LN_COBYLA, m);
-        local.set_lower_bounds(lo);
-        local.set_upper_bounds(hi);
-        local.set_initial_step(step);
-        // (SLSQP: forward differences of 1e-3 of each parameter's limit -- the objective's noise, the
-        // cycles' tolerance, is ~1e-6 relative; the evaluations' budget includes the differences)
-        local.set_maxeval(gradients ? std::max(1, opt.local_evaluations / (n + 1)) : opt.local_evaluations);
-        local.set_stopval(stopval);
-        local.set_min_objective(
-            [](const std::vector<double>& xr, std::vector<double>& g, void* d) {
-                Reduced& r = *static_cast<Reduced*>(d);
-                const double f = r.prob->objective(r.place(xr.data()));
-                for (std::size_t j = 0; j < g.size(); ++j) {
-                    std::vector<double> xp = xr;
-                    const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
-                    xp[j] += h;
-                    g[j] = (r.prob->objective(r.place(xp.data())) - f) / h;
+            // (every 100 infeasible draws the box shrinks by 0.7: with z and rx, ry motion most of the full
+            // box lets the part fly)
+            for (int tries = 0; tries < 1000 && !ok; ++tries) {
+                const double box = std::pow(0.7, tries / 100) / std::sqrt(2.0);
+                for (int i = 0; i < n; ++i) p[i] = rng.uniform(-prob.limit(i), prob.limit(i)) * box * prob.is_free(i);
+                ok = prob.feasible(p);
+            }
+            if (!ok) return "inf 0 0";
+            // The start's result as text (it may have run in another process): f, evaluations, cycles, p.
+            const auto result = [&] {
+                std::string text =
+                    exact_text(prob.best_f) + ' ' + std::to_string(prob.evaluations) + ' ' + std::to_string(own_cycles.load());
+                for (double x : prob.best_p) text += ' ' + exact_text(x);
+                return text;
+            };
+            prob.objective(p);             // the feasible start itself
+            if (m == 0) return result();   // (nothing free: the start is the answer)
+            // The local search on the free parameters: x (m of them) placed into the full p.
+            struct Reduced {
+                P* prob;
+                const std::vector<int>* idx;
+                std::vector<double> full;
+                const std::vector<double>& place(const double* x) {
+                    for (std::size_t j = 0; j < idx->size(); ++j) full[static_cast<std::size_t>((*idx)[j])] = x[j];
+                    return full;
                 }
-                return f;
-            },
-            &red);
-        local.add_inequality_mconstraint(
-            [](unsigned, double* c, unsigned mr, const double* xr, double* grad, void* d) {
-                Reduced& r = *static_cast<Reduced*>(d);
-                r.prob->constraints(r.place(xr), c);
-                if (!grad) return;
-                double cp[P::kConstraints];
-                std::vector<double> xp(xr, xr + mr);
-                for (unsigned j = 0; j < mr; ++j) {   // grad[k m + j] = d c_k / d x_j
-                    const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
-                    xp[j] += h;
-                    r.prob->constraints(r.place(xp.data()), cp);
-                    xp[j] = xr[j];
-                    for (int k = 0; k < P::kConstraints; ++k) grad[k * mr + j] = (cp[k] - c[k]) / h;
-                }
-            },
-            &red, std::vector<double>(P::kConstraints, 1e-9));
-        double f = 0;
-        try {
-            local.optimize(x, f);
-        } catch (const std::exception&) {
-            // (a roundoff-limited stop: the best feasible point found stands)
-        }
-        return result();
-    }, [&](int k, const std::string& text) {
-        std::istringstream in(text);
-        std::string f, x;
-        long c = 0;
-        in >> f >> evals[k] >> c;
-        *cycles += c;
-        best_f[k] = exact_value(f);
-        best_p[k].clear();
-        while (in >> x) best_p[k].push_back(exact_value(x));
-    });
+            } red{&prob, &free_idx, p};
+            std::vector<double> x(m);
+            lo.resize(m);
+            hi.resize(m);
+            step.resize(m);
+            for (int j = 0; j < m; ++j) {
+                const int i = free_idx[j];
+                x[j] = p[i];
+                lo[j] = -prob.limit(i);
+                hi[j] = prob.limit(i);
+                step[j] = prob.limit(i) / 4;
+            }
+            const bool gradients = opt.local == DesignOptions::Local::SlsqpFiniteDifferences;
+            nlopt::opt local(gradients ? nlopt::LD_SLSQP : nlopt::LN_COBYLA, m);
+            local.set_lower_bounds(lo);
+            local.set_upper_bounds(hi);
+            local.set_initial_step(step);
+            // (SLSQP: forward differences of 1e-3 of each parameter's limit -- the objective's noise, the
+            // cycles' tolerance, is ~1e-6 relative; the evaluations' budget includes the differences)
+            local.set_maxeval(gradients ? std::max(1, opt.local_evaluations / (n + 1)) : opt.local_evaluations);
+            local.set_stopval(stopval);
+            local.set_min_objective(
+                [](const std::vector<double>& xr, std::vector<double>& g, void* d) {
+                    Reduced& r = *static_cast<Reduced*>(d);
+                    const double f = r.prob->objective(r.place(xr.data()));
+                    for (std::size_t j = 0; j < g.size(); ++j) {
+                        std::vector<double> xp = xr;
+                        const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
+                        xp[j] += h;
+                        g[j] = (r.prob->objective(r.place(xp.data())) - f) / h;
+                    }
+                    return f;
+                },
+                &red);
+            local.add_inequality_mconstraint(
+                [](unsigned, double* c, unsigned mr, const double* xr, double* grad, void* d) {
+                    Reduced& r = *static_cast<Reduced*>(d);
+                    r.prob->constraints(r.place(xr), c);
+                    if (!grad) return;
+                    double cp[P::kConstraints];
+                    std::vector<double> xp(xr, xr + mr);
+                    for (unsigned j = 0; j < mr; ++j) {   // grad[k m + j] = d c_k / d x_j
+                        const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
+                        xp[j] += h;
+                        r.prob->constraints(r.place(xp.data()), cp);
+                        xp[j] = xr[j];
+                        for (int k = 0; k < P::kConstraints; ++k) grad[k * mr + j] = (cp[k] - c[k]) / h;
+                    }
+                },
+                &red, std::vector<double>(P::kConstraints, 1e-9));
+            double f = 0;
+            try {
+                local.optimize(x, f);
+            } catch (const std::exception&) {
+                // (a roundoff-limited stop: the best feasible point found stands)
+            }
+            return result();
+        },
+        [&](int k, const std::string& text) {
+            std::istringstream in(text);
+            std::string f, x;
+            long c = 0;
+            in >> f >> evals[k] >> c;
+            *cycles += c;
+            best_f[k] = exact_value(f);
+            best_p[k].clear();
+            while (in >> x) best_p[k].push_back(exact_value(x));
+        });
     for (long e : evals) evaluations += e;
     const auto best = std::min_element(best_f.begin(), best_f.end()) - best_f.begin();
     return std::isfinite(best_f[best]) ? best_p[best] : std::vector<double>{};
@@ -299,31 +302,34 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
         sum.held.seconds = opt.hold;
     }
     auto job = [&](int k) -> DesignStartRun& { return k < opt.verify_starts ? sum.runs[k] : sum.held; };
-    runner(opt)(opt.verify_starts + holding, [&](int k) {
-        DesignStartRun r = job(k);
-        IntegrationOptions io;
-        io.rtol = 1e-7;
-        const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds,
-                                       r.from > 0 ? r.from : r.seconds, io);
-        r.end = tr.samples.empty() ? Vec3::Constant(std::numeric_limits<double>::quiet_NaN()) : tr.samples.back().q;
-        if (r.from > 0)
-            for (const Sample& smp : tr.samples)
-                if (std::abs(smp.t - r.from) <= 1e-9 * r.seconds) r.at_from = smp.q;
-        const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity() : end_distance(r, r.end);
-        // (text: the distance, the end, then why the run stopped early, if it did)
-        return exact_text(d) + ' ' + exact_text(r.end[0]) + ' ' + exact_text(r.end[1]) + ' ' + exact_text(r.end[2]) + ' ' +
-               exact_text(r.at_from[0]) + ' ' + exact_text(r.at_from[1]) + ' ' + exact_text(r.at_from[2]) +
-               (tr.stop.reason != StopReason::None ? ' ' + tr.stop.describe() : std::string());
-    }, [&](int k, const std::string& text) {
-        std::istringstream in(text);
-        std::string x[7];
-        for (auto& w : x) in >> w;
-        DesignStartRun& r = job(k);
-        r.end_distance = exact_value(x[0]);
-        r.end = Vec3(exact_value(x[1]), exact_value(x[2]), exact_value(x[3]));
-        r.at_from = Vec3(exact_value(x[4]), exact_value(x[5]), exact_value(x[6]));
-        std::getline(in >> std::ws, r.stop);
-    });
+    runner(opt)(
+        opt.verify_starts + holding,
+        [&](int k) {
+            DesignStartRun r = job(k);
+            IntegrationOptions io;
+            io.rtol = 1e-7;
+            const Trajectory tr = simulate(sum.scene, Dynamics::Full, Vec3(r.x, r.y, r.theta), Vec3::Zero(), r.seconds,
+                                           r.from > 0 ? r.from : r.seconds, io);
+            r.end = tr.samples.empty() ? Vec3::Constant(std::numeric_limits<double>::quiet_NaN()) : tr.samples.back().q;
+            if (r.from > 0)
+                for (const Sample& smp : tr.samples)
+                    if (std::abs(smp.t - r.from) <= 1e-9 * r.seconds) r.at_from = smp.q;
+            const double d = tr.samples.empty() ? std::numeric_limits<double>::infinity() : end_distance(r, r.end);
+            // (text: the distance, the end, then why the run stopped early, if it did)
+            return exact_text(d) + ' ' + exact_text(r.end[0]) + ' ' + exact_text(r.end[1]) + ' ' + exact_text(r.end[2]) + ' ' +
+                   exact_text(r.at_from[0]) + ' ' + exact_text(r.at_from[1]) + ' ' + exact_text(r.at_from[2]) +
+                   (tr.stop.reason != StopReason::None ? ' ' + tr.stop.describe() : std::string());
+        },
+        [&](int k, const std::string& text) {
+            std::istringstream in(text);
+            std::string x[7];
+            for (auto& w : x) in >> w;
+            DesignStartRun& r = job(k);
+            r.end_distance = exact_value(x[0]);
+            r.end = Vec3(exact_value(x[1]), exact_value(x[2]), exact_value(x[3]));
+            r.at_from = Vec3(exact_value(x[4]), exact_value(x[5]), exact_value(x[6]));
+            std::getline(in >> std::ws, r.stop);
+        });
     int stopped = 0;
     sum.worst_end_distance = 0;
     for (const DesignStartRun& r : sum.runs) {
@@ -345,7 +351,8 @@ int verification_runs(DesignSummary& sum, const DesignOptions& opt, Seconds&& se
 // (2e-3 rad/s: the sink walks 5.5 mm about the centre in two minutes); held to sink_coning_limit, the
 // first harmonic can tilt in circles only a little, and the third, which cones 27 times less for the
 // same amplitudes (coning pairs only equal n), adds the rest.
-constexpr double kConingLimit = 1e-4;   // [rad/s] rigid fixed points' coning (coning_rate, design.hpp): 0.012 rad over a 120 s hold
+constexpr double kConingLimit =
+    1e-4;   // [rad/s] rigid fixed points' coning (coning_rate, design.hpp): 0.012 rad over a 120 s hold
 // [rad/s] their tilt drift (tilt_drift_rate): a tilt pulls the part downhill, g times the tilt, all
 // along, so it is held to 1e-3 rad (0.01 m/s^2, 0.3 % of mu g for mu 0.3) over the longest runs
 // (break_pair's: up to about 500 s). A motion without rz has none; break_pair's has none by construction.
@@ -361,7 +368,10 @@ struct SinkProblem : Problem<SinkProblem> {
     // kConingLimit (the plate's turn would turn the part's orientation with it).
     SinkProblem(const Scene& part_, const Vec2& D_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_,
                 const double* orient_ = nullptr)
-        : Problem(part_, opt_, T_, cycles_), D(D_), cone_limit(sink_coning_limit(D_, opt_)), orient(orient_ != nullptr),
+        : Problem(part_, opt_, T_, cycles_),
+          D(D_),
+          cone_limit(sink_coning_limit(D_, opt_)),
+          orient(orient_ != nullptr),
           theta(orient_ ? *orient_ : 0.0) {
         if (orient) cone_limit = std::min(cone_limit, kConingLimit);
     }
@@ -391,8 +401,8 @@ struct SinkProblem : Problem<SinkProblem> {
         if (orient) c[k - 1] += 0.02;
         const double psi = coning_rate(fin);
         const double cone = !std::isfinite(cone_limit) ? 0.0
-                            : cone_limit > 0       ? psi / cone_limit
-                                                   : (psi == 0 ? 0.0 : std::copysign(1e9, psi));   // (max_coning 0)
+                            : cone_limit > 0           ? psi / cone_limit
+                                                       : (psi == 0 ? 0.0 : std::copysign(1e9, psi));   // (max_coning 0)
         c[k] = cone - 1;
         c[k + 1] = -cone - 1;
     }
@@ -484,8 +494,7 @@ void translation_constraints(const std::vector<double>& p, const DesignOptions& 
 // Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
 // `room`, no flight, no coning beyond kConingLimit either way and no tilt drift beyond kTiltDriftLimit
 // (6 n_max + 4 entries).
-void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
-                        double* c);
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room, double* c);
 // The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
 // from the cycle at q. False if a cycle did not converge.
 bool twist_and_jacobian(const Scene& sc, const Vec3& q, const LimitCycleOptions& cyc, Vec3& xi, Mat3& J,
@@ -496,10 +505,10 @@ PlateMotion placed_motion(const PlateMotion& centred, const Vec3& q, const Vec2&
 // target, checked against the limits, and verified (rigid_fixed_point.cpp).
 DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
-                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair = false,
-                                      double run_seconds = 0, double theta_offset = 0);
+                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair = false, double run_seconds = 0,
+                                      double theta_offset = 0);
 // The half-turn pair broken by rz about its centre (break_pair.cpp).
 DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion, const DesignTarget& target,
                          const DesignOptions& opt, double T, std::atomic<long>& cycles, Clock::time_point t0);
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -29,9 +29,7 @@ struct LineSinkProblem : Problem<LineSinkProblem> {
     PlateMotion placed(const std::vector<double>& p) const {
         return shift_motion(rotate_motion(line_motion(p, T), target.theta), target.at);
     }
-    void constraints(const std::vector<double>& p, double* c) const {
-        amplitude_constraints(placed(p), opt, part, 1, 1.0, c);
-    }
+    void constraints(const std::vector<double>& p, double* c) const { amplitude_constraints(placed(p), opt, part, 1, 1.0, c); }
     // The convergence rate onto the line, -dv_y/dy at y = 0 (v_y is odd: v_y(h) / h), and how much of
     // the region the field does not pull towards the line (four distances out to its reach).
     double evaluate(const std::vector<double>& p, double* rate_out = nullptr) {
@@ -56,10 +54,12 @@ struct LineSinkProblem : Problem<LineSinkProblem> {
 DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
-    sum.notes.push_back("y and rx, first harmonic: mirror symmetric about the line's normal and odd, so the field has a "
-                        "line of fixed points by construction (no drift along it)");
-    sum.notes.push_back("the line turned onto the direction asked (the field turns with the motion) and moved through "
-                        "the point asked by adding -alpha x D to the linear acceleration (the field shifts by D)");
+    sum.notes.push_back(
+        "y and rx, first harmonic: mirror symmetric about the line's normal and odd, so the field has a "
+        "line of fixed points by construction (no drift along it)");
+    sum.notes.push_back(
+        "the line turned onto the direction asked (the field turns with the motion) and moved through "
+        "the point asked by adding -alpha x D to the linear acceleration (the field shifts by D)");
     std::atomic<long> cycles{0};
     const auto make = [&] { return LineSinkProblem(part_scene, target, opt, T, &cycles); };
     const std::vector<double> best = multistart<LineSinkProblem>(opt, -HUGE_VAL, make, sum.evaluations);
@@ -80,13 +80,16 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
     int undefined = 0, away = 0;
     double along = 0;
     for (const FieldPoint& p : f.points) {
-        if (!p.converged) { ++undefined; continue; }
+        if (!p.converged) {
+            ++undefined;
+            continue;
+        }
         const Vec2 v = p.twist.head<2>();
         const double d = (p.q.head<2>() - target.at).dot(nrm);
         along = std::max(along, std::abs(v.dot(dir)));
         away += std::abs(d) > opt.fixed_point_tolerance && !(v.dot(nrm) * d < 0);
     }
-    sum.transport_spread = along;   // (the largest speed along the line on the grid)
+    sum.transport_spread = along;                                            // (the largest speed along the line on the grid)
     sum.transport_tolerance = cycle_noise(opt.cycle) * part_scene.v_ref();   // (zero by the symmetry)
     sum.fixed_point = Vec3(target.at.x(), target.at.y(), 0);
     sum.fixed_point_eigenvalues = Eigen::Vector3cd(sum.eigenvalues[0], sum.eigenvalues[1], 0);
@@ -125,4 +128,4 @@ DesignSummary design_line_sink(const Scene& part_scene, const DesignTarget& targ
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -118,13 +118,15 @@ double turn_time(const std::vector<double>& w, double theta0, double theta_s, do
 DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
-    sum.notes.push_back("orient by transport, a weathervane: a plate that only translates (x, y, z; n = 1, 2) gives the "
-                        "part the same twist at every position and full dynamics equal to its U-dynamics (no tilt, no "
-                        "coning); with unequal friction coefficients on its contacts the part turns to where friction's "
-                        "torque vanishes (on a plate shaken along one line with a heave in phase: its high-friction contact "
-                        "leads)");
+    sum.notes.push_back(
+        "orient by transport, a weathervane: a plate that only translates (x, y, z; n = 1, 2) gives the "
+        "part the same twist at every position and full dynamics equal to its U-dynamics (no tilt, no "
+        "coning); with unequal friction coefficients on its contacts the part turns to where friction's "
+        "torque vanishes (on a plate shaken along one line with a heave in phase: its high-friction contact "
+        "leads)");
     sum.notes.push_back("position free: the part travels while it turns and after (velocity_at_orientation)");
-    sum.notes.push_back("designed on a ring of " + std::to_string(kRing) + " orientations and turned onto THETA "
+    sum.notes.push_back("designed on a ring of " + std::to_string(kRing) +
+                        " orientations and turned onto THETA "
                         "(the field turns with the motion); the limits hold at every turn");
     std::atomic<long> cycles{0};
     const auto make = [&] {
@@ -146,7 +148,8 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     if (z.stable != 1) {
         sum.failure = "no plate motion that only translates found turns the part to one orientation" +
                       std::string(z.stable == 0 ? " (it does not turn it at all: with one friction coefficient on "
-                                                  "every contact none can)" : "");
+                                                  "every contact none can)"
+                                                : "");
         return finished(sum, cycles, t0);
     }
     // The stable orientation by bisection on theta' (at the refinement's tolerances), its rate by
@@ -212,15 +215,18 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     int undefined = 0;
     double spread = 0;
     for (const FieldPoint& p : f.points) {
-        if (!p.converged) { ++undefined; continue; }
+        if (!p.converged) {
+            ++undefined;
+            continue;
+        }
         for (const FieldPoint& o : f.points)
-            if (o.converged && o.q[2] == p.q[2]) spread = std::max(spread, (p.twist - o.twist).cwiseQuotient(S).cwiseAbs().maxCoeff());
+            if (o.converged && o.q[2] == p.q[2])
+                spread = std::max(spread, (p.twist - o.twist).cwiseQuotient(S).cwiseAbs().maxCoeff());
     }
     sum.transport_spread = spread;   // (relative to v_ref and v_ref / rho)
     sum.transport_tolerance = 2 * cycle_noise(opt.cycle);
     const int stopped = verification_runs(
-        sum, opt,
-        [&](const DesignStartRun& r) { return 1.5 * turn_time(w, r.theta, zf.theta, 0.01, 200) + 2; },
+        sum, opt, [&](const DesignStartRun& r) { return 1.5 * turn_time(w, r.theta, zf.theta, 0.01, 200) + 2; },
         [&](const DesignStartRun&, const Vec3& end) {
             return std::abs(wrap_angle(end[2] - target.theta)) * opt.verify_distance / 0.05;
         });
@@ -246,4 +252,4 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -53,4 +53,4 @@ OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, co
 }
 
 
-}  // namespace plate
+}   // namespace plate

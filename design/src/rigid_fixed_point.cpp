@@ -15,8 +15,7 @@ PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion
 // Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
 // `room`, no flight under the part's contacts over the region, no coning beyond kConingLimit either
 // way and no tilt drift beyond kTiltDriftLimit (6 n_max + 4 entries).
-void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
-                        double* c) {
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room, double* c) {
     const int k = amplitude_constraints(fin, opt, part, n_max, room, c);
     const double cone = coning_rate(fin) / kConingLimit;
     c[k] = cone - 1;
@@ -47,8 +46,7 @@ bool twist_and_jacobian(const Scene& sc, const Vec3& q, const LimitCycleOptions&
 struct RigidProblem : Problem<RigidProblem> {
     RigidProblem(const Scene& part_, const DesignTarget& t_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
         : Problem(part_, opt_, T_, cycles_), target(t_) {
-        if (std::abs(part_.plate.T - T_) <= 1e-12 * T_)
-            guess = params_from(part_.plate, kRigidAxes, {1, 2});
+        if (std::abs(part_.plate.T - T_) <= 1e-12 * T_) guess = params_from(part_.plate, kRigidAxes, {1, 2});
     }
     DesignTarget target;
     static constexpr int kParams = 24;
@@ -60,8 +58,8 @@ struct RigidProblem : Problem<RigidProblem> {
     double limit(int i) const { return i < 12 ? opt.lin_limit : opt.ang_limit; }
     bool is_free(int i) const { return free(kRigidAxes, {1, 2}, i); }
     void constraints(const std::vector<double>& p, double* c) const {
-        placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt,
-                           part, 2, kRoom, c);
+        placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt, part, 2,
+                           kRoom, c);
     }
     // -rate at the centre, plus how far the centre is from being the fixed point (the Newton step
     // J^-1 xi there, over 1 cm / 0.1 rad), plus how much the region's edge (8 points, theta = 0) and
@@ -112,7 +110,8 @@ PlateMotion placed_motion(const PlateMotion& centred, const Vec3& q, const Vec2&
 // Where no unique fixed point is found (fig4's part: its first harmonic in theta stays below the rest
 // within the limits -- bench_orientation_drive -- and the one orientation reachable by tuning the mean
 // loses the position's pull, README), the sink's motion (odd harmonics on x, y, rx, ry; n = 1, 3) with
-// theta' at THETA made a stable zero as well, coning held to kConingLimit. Turning such a motion by pi is shifting it by half a period, so (s*, THETA) and
+// theta' at THETA made a stable zero as well, coning held to kConingLimit. Turning such a motion by pi is shifting it by half a
+// period, so (s*, THETA) and
 // (-s*, THETA + pi) are both stable fixed points, at the centre (s* ~ 0) the same position: the part
 // is brought to the target's position from everywhere and to its orientation up to a half turn.
 // Then broken (break_pair, where DesignOptions::break_pair): the pair's field checked first (no runs),
@@ -122,9 +121,10 @@ PlateMotion placed_motion(const PlateMotion& centred, const Vec3& q, const Vec2&
 DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
-    sum.notes.push_back("a half-turn pair: odd harmonics on x, y, rx, ry (n = 1, 3) pull the position to the target at "
-                        "every orientation, and THETA is made a stable zero of theta' there; such a motion turned by pi "
-                        "is the same motion half a period later, so THETA + pi is one as well (not unique)");
+    sum.notes.push_back(
+        "a half-turn pair: odd harmonics on x, y, rx, ry (n = 1, 3) pull the position to the target at "
+        "every orientation, and THETA is made a stable zero of theta' there; such a motion turned by pi "
+        "is the same motion half a period later, so THETA + pi is one as well (not unique)");
     sum.notes.push_back("coning held to 1e-4 rad/s (the plate's turn about z turns the part's orientation with it)");
     std::atomic<long> cycles{0};
     const double theta = wrap_angle(target.theta);
@@ -139,14 +139,16 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
         return finished(sum, cycles, t0);
     }
     // (the search's motion is centred: the placement shifts it by the target less the small offset of
-    // the fixed point found.) Broken first: where that verifies as unique the pair's own runs are not needed (its field is checked,
-    // a pair that does not hold the target is not broken); else the pair verified in full and the better kept.
+    // the fixed point found.) Broken first: where that verifies as unique the pair's own runs are not needed (its field is
+    // checked, a pair that does not hold the target is not broken); else the pair verified in full and the better kept.
     DesignSummary broken;
     broken.failure = "not tried";
     // (the broken pair returned, saying what the pair was)
     auto adopt = [&](const std::string& pair_was) -> DesignSummary {
-        broken.notes.insert(broken.notes.begin(), "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA "
-                                                  "a stable zero of theta'; " + pair_was + ")");
+        broken.notes.insert(broken.notes.begin(),
+                            "from a half-turn pair (odd harmonics n = 1, 3 on x, y, rx, ry with THETA "
+                            "a stable zero of theta'; " +
+                                pair_was + ")");
         broken.evaluations += sum.evaluations;
         broken.starts = sum.starts;
         return finished(broken, cycles, t0);
@@ -157,8 +159,10 @@ DesignSummary design_rigid_pair(const Scene& part_scene, const DesignTarget& tar
         quick.hold = 0;
         DesignSummary probe = sum;
         place_and_verify_rigid(probe, part_scene, sink_motion(best, T), Vec3(0, 0, theta), target, quick, cycles, t0, true);
-        if (probe.verified) broken = break_pair(part_scene, sink_motion(best, T), target, opt, T, cycles, t0);
-        else broken.failure = "not tried: the pair's field does not hold the target (" + probe.failure + ")";
+        if (probe.verified)
+            broken = break_pair(part_scene, sink_motion(best, T), target, opt, T, cycles, t0);
+        else
+            broken.failure = "not tried: the pair's field does not hold the target (" + probe.failure + ")";
         if (broken.verified && broken.unique)
             return adopt("its field checked, its own full-dynamics runs not needed once the broken pair verified as unique");
     }
@@ -180,14 +184,19 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     const auto t0 = Clock::now();
     DesignSummary sum;
     const bool orient = target.kind == DesignTargetKind::Orient;
-    sum.notes.push_back("harmonics n = 1, 2 on x, y, z, rx, ry, rz: z, rz and n = 2 break the pairing of fixed points "
-                        "(s, theta), (-s, theta + pi) that odd x, y, rx, ry motions force");
-    sum.notes.push_back("designed for a fixed point at the centre, theta = 0; the one found, q*, placed on the target by "
-                        "turning the motion by THETA - theta* (the field turns) and adding -alpha x D (the field shifts by D)");
-    sum.notes.push_back("no coning (|rx, ry out of phase| turns the plate about z, which the field does not see and the "
-                        "full dynamics does): the plate's yaw drift held within 1e-4 rad/s");
-    if (orient) sum.notes.push_back("orient: designed as a fixed point at the region's centre with orientation THETA "
-                                    "(a stronger target); verified on the orientation only");
+    sum.notes.push_back(
+        "harmonics n = 1, 2 on x, y, z, rx, ry, rz: z, rz and n = 2 break the pairing of fixed points "
+        "(s, theta), (-s, theta + pi) that odd x, y, rx, ry motions force");
+    sum.notes.push_back(
+        "designed for a fixed point at the centre, theta = 0; the one found, q*, placed on the target by "
+        "turning the motion by THETA - theta* (the field turns) and adding -alpha x D (the field shifts by D)");
+    sum.notes.push_back(
+        "no coning (|rx, ry out of phase| turns the plate about z, which the field does not see and the "
+        "full dynamics does): the plate's yaw drift held within 1e-4 rad/s");
+    if (orient)
+        sum.notes.push_back(
+            "orient: designed as a fixed point at the region's centre with orientation THETA "
+            "(a stronger target); verified on the orientation only");
     std::atomic<long> cycles{0};
     const auto make = [&] { return RigidProblem(part_scene, target, opt, T, &cycles); };
     const std::vector<double> best = multistart<RigidProblem>(opt, -HUGE_VAL, make, sum.evaluations);
@@ -200,6 +209,28 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
     return place_and_verify_rigid(sum, part_scene, rigid_motion(best, T), Vec3::Zero(), target, opt, cycles, t0);
 }
 
+// A note on what the orientation has to work with at the fixed point found (or the centre):
+// theta''s first harmonic against the rest (orientation_harmonics, design.hpp).
+static void note_orientation_drive(DesignSummary& sum, const Scene& centred, const Vec3& q, bool found, const DesignOptions& opt,
+                                   std::atomic<long>& cycles) {
+    const bool near = found && q.head<2>().norm() <= opt.region;
+    const int ring = 12;
+    const OrientationHarmonics oh = orientation_harmonics(centred, near ? Vec2(q.head<2>()) : Vec2::Zero(), opt.cycle, ring);
+    cycles += ring;
+    if (oh.defined) {
+        std::ostringstream note;
+        note.precision(2);
+        note << "theta' at the " << (near ? "fixed point's position" : "centre") << " (12 orientations): first harmonic "
+             << oh.first() << " rad/s against " << oh.rest() << " for the mean and the others ("
+             << (oh.one_stable()          ? "enough for exactly one stable orientation"
+                 : oh.first() > oh.rest() ? "the zeros lie in two arcs, but more than one may be stable"
+                                          : "below the rest: not enough by itself for one orientation, whose stable ones pair "
+                                            "about a half turn apart unless the mean is tuned near a saddle-node")
+             << "; orientation_harmonics, design.hpp)";
+        sum.notes.push_back(note.str());
+    }
+}
+
 // A rigid design's last stages, shared: the fixed point of `centred` near q0 (Newton with the
 // central-difference Jacobian, at the refinement's tolerances: field noise well below the step),
 // placed exactly on the target by the two symmetries (turned by THETA - theta*, shifted by the target
@@ -207,8 +238,8 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
 // dynamics from random starts (the target's basin share and each competing stable point's), the hold.
 DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scene, const PlateMotion& centred_motion,
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
-                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair,
-                                      double run_seconds, double theta_offset) {
+                                      std::atomic<long>& cycles, Clock::time_point t0, bool pair, double run_seconds,
+                                      double theta_offset) {
     // (run_seconds: the verification runs last at least this long; theta_offset: the field's fixed point
     // is placed this far short of THETA -- break_pair's, where the full dynamics settles past it)
     const bool orient = target.kind == DesignTargetKind::Orient;
@@ -233,24 +264,7 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
             break;
         }
     }
-    {   // What the orientation has to work with there (orientation_harmonics, design.hpp).
-        const bool near = found && q.head<2>().norm() <= opt.region;
-        const int ring = 12;
-        const OrientationHarmonics oh = orientation_harmonics(centred, near ? Vec2(q.head<2>()) : Vec2::Zero(), opt.cycle, ring);
-        cycles += ring;
-        if (oh.defined) {
-            std::ostringstream note;
-            note.precision(2);
-            note << "theta' at the " << (near ? "fixed point's position" : "centre") << " (12 orientations): first harmonic "
-                 << oh.first() << " rad/s against " << oh.rest() << " for the mean and the others ("
-                 << (oh.one_stable()            ? "enough for exactly one stable orientation"
-                     : oh.first() > oh.rest() ? "the zeros lie in two arcs, but more than one may be stable"
-                                              : "below the rest: not enough by itself for one orientation, whose stable ones pair "
-                                                "about a half turn apart unless the mean is tuned near a saddle-node")
-                 << "; orientation_harmonics, design.hpp)";
-            sum.notes.push_back(note.str());
-        }
-    }
+    note_orientation_drive(sum, centred, q, found, opt, cycles);
     if (!found || q.head<2>().norm() > opt.region || std::abs(wrap_angle(q[2] - q0[2])) > kPi / 2) {
         sum.failure = "the search's best motion has no fixed point near the design's centre";
         return finished(sum, cycles, t0);
@@ -286,8 +300,10 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
             sum.fixed_point = p.q;
             sum.fixed_point_eigenvalues = p.eigenvalues;
         }
-        if (reached(p.q, goal, opt.fixed_point_tolerance, 0.02)) ++stable_at_target;
-        else others.push_back(p);
+        if (reached(p.q, goal, opt.fixed_point_tolerance, 0.02))
+            ++stable_at_target;
+        else
+            others.push_back(p);
     }
     int stable_lines = 0;
     for (const FixedLine& l : sum.fixed_points.lines) stable_lines += l.stability == Stability::Stable;
@@ -299,7 +315,9 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     sum.coning = coning_rate(sum.scene.plate);
     const int stopped = verification_runs(
         sum, opt,
-        [&](const DesignStartRun&) { return std::max(settle_time(2 * opt.region, sum.rate, opt), run_seconds); },   // (from across the region)
+        [&](const DesignStartRun&) {
+            return std::max(settle_time(2 * opt.region, sum.rate, opt), run_seconds);
+        },   // (from across the region)
         [&](const DesignStartRun&, const Vec3& end) {
             return std::max(orient ? 0.0 : (end.head<2>() - at).norm(),
                             std::abs(wrap_angle(end[2] - goal[2])) * opt.verify_distance / 0.05);
@@ -330,14 +348,16 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
         note << "the pairing caps the target's basin share in the field's flow at " << sum.basin_share_bound
              << " of starts uniform over the region: the twin's basin is the image of the target's under the half turn about "
                 "the design's centre, so where the region is its own image at most half of it can go to the target (the "
-                "full-dynamics runs' share is a sample of " << sum.runs.size() << " from phase 0 and can exceed it by chance)";
+                "full-dynamics runs' share is a sample of "
+             << sum.runs.size() << " from phase 0 and can exceed it by chance)";
         sum.notes.push_back(note.str());
     }
     const bool twin_ok = others.size() == 1 && (others[0].q.head<2>() - twin_at).norm() <= opt.fixed_point_tolerance &&
                          std::abs(wrap_angle(others[0].q[2] - goal[2] - kPi)) <= 0.02;
     if (stable_at_target != 1)
-        sum.failure = "the designed field has " + std::to_string(stable_at_target) + " stable fixed point(s) at the target on the " +
-                      std::to_string(opt.verify_grid) + "^3 grid (" + std::to_string(stable) + " stable in all)";
+        sum.failure = "the designed field has " + std::to_string(stable_at_target) +
+                      " stable fixed point(s) at the target on the " + std::to_string(opt.verify_grid) + "^3 grid (" +
+                      std::to_string(stable) + " stable in all)";
     else if (stopped)
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
     else if (sum.unique && !(sum.worst_end_distance <= opt.verify_distance))
@@ -356,4 +376,4 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -39,7 +39,7 @@ PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& a
 }
 
 
-}  // namespace plate
+}   // namespace plate
 
 namespace plate::design_detail {
 
@@ -105,4 +105,4 @@ int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, cons
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

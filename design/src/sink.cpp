@@ -64,18 +64,21 @@ DesignSummary& verify_rigid_sink(DesignSummary& sum, const Field& field, const D
 DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
-    sum.notes.push_back("odd harmonics on x, y, rx, ry only: the field is odd about the design's centre, so the "
-                        "centre is a fixed point by construction and fixed points come in pairs s, -s");
-    sum.notes.push_back("the design's centre moved onto the target by adding -alpha x D to the linear acceleration "
-                        "(exact: the field shifts by D)");
+    sum.notes.push_back(
+        "odd harmonics on x, y, rx, ry only: the field is odd about the design's centre, so the "
+        "centre is a fixed point by construction and fixed points come in pairs s, -s");
+    sum.notes.push_back(
+        "the design's centre moved onto the target by adding -alpha x D to the linear acceleration "
+        "(exact: the field shifts by D)");
     if (std::isfinite(sink_coning_limit(target.at, opt)))
         sum.notes.push_back("coning held to " + std::to_string(sink_coning_limit(target.at, opt)) +
                             " rad/s: the plate's second-order turn about z, which the field does not see, turns the "
                             "sink about the plate's centre; at most half the verification distance over the hold");
     else if (target.at.norm() > 0)   // (without a hold nothing limits the coning: say so)
-        sum.notes.push_back("coning not limited (no hold, no --max-coning): the plate's second-order turn about z turns "
-                            "the sink about the plate's centre, so a part held at the target walks off it in time "
-                            "(not checked)");
+        sum.notes.push_back(
+            "coning not limited (no hold, no --max-coning): the plate's second-order turn about z turns "
+            "the sink about the plate's centre, so a part held at the target walks off it in time "
+            "(not checked)");
     std::atomic<long> cycles{0};
     const auto make = [&] { return SinkProblem(part_scene, target.at, opt, T, &cycles); };
     const std::vector<double> best = multistart<SinkProblem>(opt, -HUGE_VAL, make, sum.evaluations);
@@ -121,4 +124,4 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -9,15 +9,17 @@ namespace {
 
 nlohmann::json complex_json(const std::complex<double>& z) { return {z.real(), z.imag()}; }
 
-}  // namespace
+}   // namespace
 
 nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_scene, const DesignTarget& t,
                                    const DesignOptions& opt, const std::string& scene_path) {
     const bool transport = t.kind == DesignTargetKind::Transport, rigid = !part_scene.part.point;
     nlohmann::json j;
     j["target"] = {{"kind", design_target_kind(t)}};
-    if (transport) j["target"]["velocity"] = {t.velocity.x(), t.velocity.y()};
-    else if (t.kind != DesignTargetKind::Orient) j["target"]["at"] = {t.at.x(), t.at.y()};
+    if (transport)
+        j["target"]["velocity"] = {t.velocity.x(), t.velocity.y()};
+    else if (t.kind != DesignTargetKind::Orient)
+        j["target"]["at"] = {t.at.x(), t.at.y()};
     if (rigid) j["target"]["theta"] = t.theta;
     if (t.kind == DesignTargetKind::LineSink) j["target"]["direction"] = t.theta;
     if (t.kind == DesignTargetKind::Registered) j["target"]["values"] = t.values;
@@ -47,7 +49,8 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
             // (the orientation is free: where the position's field vanishes at each orientation)
             nlohmann::json pulls = nlohmann::json::array();
             for (const auto& p : d.pulls)
-                pulls.push_back({{"theta", p.theta}, {"position_zero", {p.zero.x(), p.zero.y()}},
+                pulls.push_back({{"theta", p.theta},
+                                 {"position_zero", {p.zero.x(), p.zero.y()}},
                                  {"eigenvalues", {complex_json(p.eigenvalues[0]), complex_json(p.eigenvalues[1])}}});
             j["position_pull_per_orientation"] = pulls;
         } else if (rigid) {
@@ -60,13 +63,15 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
             nlohmann::json comp = nlohmann::json::array();
             for (const auto& c : d.competitors)
                 comp.push_back({{"at", {c.point.q[0], c.point.q[1], c.point.q[2]}},
-                                {"eigenvalues", {complex_json(c.point.eigenvalues[0]), complex_json(c.point.eigenvalues[1]),
-                                                 complex_json(c.point.eigenvalues[2])}},
+                                {"eigenvalues",
+                                 {complex_json(c.point.eigenvalues[0]), complex_json(c.point.eigenvalues[1]),
+                                  complex_json(c.point.eigenvalues[2])}},
                                 {"basin_share", c.basin_share}});
             j["competing_fixed_points"] = comp;
         } else if (!line) {
             j["fixed_point"] = {d.fixed_point[0], d.fixed_point[1]};
-            j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]), complex_json(d.fixed_point_eigenvalues[1])};
+            j["fixed_point_eigenvalues"] = {complex_json(d.fixed_point_eigenvalues[0]),
+                                            complex_json(d.fixed_point_eigenvalues[1])};
         }
         if (!rigid_sink) j["fixed_points_on_grid"] = fixed_points_sentence(d.fixed_points);   // (no grid search for those)
     } else {
@@ -79,7 +84,8 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     for (const DesignStartRun& r : d.runs) {
         nlohmann::json x = {{"start", rigid ? nlohmann::json{r.x, r.y, r.theta} : nlohmann::json{r.x, r.y}},
                             {"end", rigid ? nlohmann::json{r.end[0], r.end[1], r.end[2]} : nlohmann::json{r.end[0], r.end[1]}},
-                            {"seconds", r.seconds}, {"end_distance", r.end_distance}};
+                            {"seconds", r.seconds},
+                            {"end_distance", r.end_distance}};
         if (r.from > 0) {   // (transport: judged over [from, seconds])
             x["from"] = r.from;
             x["at_from"] = nlohmann::json{r.at_from[0], r.at_from[1]};
@@ -91,7 +97,8 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     j["worst_end_distance"] = d.worst_end_distance;
     if (d.held.seconds > 0) {   // (sinks and fixed points)
         const DesignStartRun& h = d.held;
-        nlohmann::json x = {{"seconds", h.seconds}, {"end_distance", h.end_distance},
+        nlohmann::json x = {{"seconds", h.seconds},
+                            {"end_distance", h.end_distance},
                             {"end", rigid ? nlohmann::json{h.end[0], h.end[1], h.end[2]} : nlohmann::json{h.end[0], h.end[1]}}};
         if (!h.stop.empty()) x["stop"] = h.stop;
         j["hold"] = x;
@@ -107,4 +114,4 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     return j;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -18,11 +18,20 @@ PlateMotion rotate_motion(const PlateMotion& u, double a) {
             r.harmonics.push_back({ay, h.n, h.amp * (is_x ? s : c), h.phase});
         };
         switch (h.axis) {
-            case Axis::x: pair(Axis::x, Axis::y, true); break;
-            case Axis::y: pair(Axis::x, Axis::y, false); break;
-            case Axis::rx: pair(Axis::rx, Axis::ry, true); break;
-            case Axis::ry: pair(Axis::rx, Axis::ry, false); break;
-            default: r.harmonics.push_back(h);
+            case Axis::x:
+                pair(Axis::x, Axis::y, true);
+                break;
+            case Axis::y:
+                pair(Axis::x, Axis::y, false);
+                break;
+            case Axis::rx:
+                pair(Axis::rx, Axis::ry, true);
+                break;
+            case Axis::ry:
+                pair(Axis::rx, Axis::ry, false);
+                break;
+            default:
+                r.harmonics.push_back(h);
         }
     }
     return r;
@@ -49,7 +58,7 @@ double pair_basin_bound(const Vec2& D, double region) {
     return 1 - overlap / (2 * 4 * region * region);
 }
 
-}  // namespace plate
+}   // namespace plate
 
 namespace plate::design_detail {
 
@@ -68,7 +77,7 @@ double drift_sum(const PlateMotion& u, Axis a, Axis b) {
     return r;
 }
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail
 
 namespace plate {
 
@@ -78,4 +87,4 @@ double coning_rate(const PlateMotion& u) { return drift_sum(u, Axis::rx, Axis::r
 
 Vec2 tilt_drift_rate(const PlateMotion& u) { return Vec2(drift_sum(u, Axis::ry, Axis::rz), drift_sum(u, Axis::rz, Axis::rx)); }
 
-}  // namespace plate
+}   // namespace plate

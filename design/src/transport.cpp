@@ -5,9 +5,7 @@ namespace plate::design_detail {
 // --- the point-part transport --------------------------------------------------------------------
 // Parameters: cosine and sine coefficients of harmonics n = 1, 2 on x, y and z (a plate that only
 // translates). The field is uniform; its value at the centre is driven onto the target.
-PlateMotion transport_motion(const std::vector<double>& p, double T) {
-    return motion_from(p, kTranslationAxes, {1, 2}, T);
-}
+PlateMotion transport_motion(const std::vector<double>& p, double T) { return motion_from(p, kTranslationAxes, {1, 2}, T); }
 
 // c_k <= 0: each of transport_motion's six harmonics within the linear limit, and no flight.
 void translation_constraints(const std::vector<double>& p, const DesignOptions& opt, double g, double T, double* c) {
@@ -44,9 +42,10 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     // that coefficient (DesignTarget): the search runs on that point part, the verification on the part.
     Scene point = part_scene;
     if (!point.part.point) {
-        sum.notes.push_back("a rigid part with one friction coefficient on a plate that only translates: it moves as a point "
-                            "part with that coefficient (no turn; the same velocity at every orientation); designed as that "
-                            "point part, verified as the part itself");
+        sum.notes.push_back(
+            "a rigid part with one friction coefficient on a plate that only translates: it moves as a point "
+            "part with that coefficient (no turn; the same velocity at every orientation); designed as that "
+            "point part, verified as the part itself");
         point.part.point = true;
         point.part.mu.setConstant(part_scene.part.friction().kinetic(0));
     }
@@ -64,8 +63,10 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     const Field f = verification_field(sum.scene, opt);
     int undefined = 0;
     for (const FieldPoint& p : f.points) {
-        if (!p.converged) ++undefined;
-        else sum.transport_mean += p.twist.head<2>();
+        if (!p.converged)
+            ++undefined;
+        else
+            sum.transport_mean += p.twist.head<2>();
     }
     if (undefined < static_cast<int>(f.points.size())) sum.transport_mean /= static_cast<double>(f.points.size() - undefined);
     for (const FieldPoint& p : f.points)
@@ -78,8 +79,8 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     const double turn_tolerance = sum.transport_tolerance / sum.scene.part.rho();
     // Each run for a region's width of travel (1-20 s), judged over its second half: released at rest
     // the part lags the plate's drive while its cycle builds up (about 0.1 s on fig1_point, which a check
-    // from the start would count against the design), so the distance is from where the target velocity takes it from the run's midpoint, within the
-    // field's 2 % over that half (and 5 mm).
+    // from the start would count against the design), so the distance is from where the target velocity takes it from the run's
+    // midpoint, within the field's 2 % over that half (and 5 mm).
     const int stopped = verification_runs(
         sum, opt, [&](const DesignStartRun&) { return std::clamp(0.05 / target.velocity.norm(), 1.0, 20.0); },
         [&](const DesignStartRun& r, const Vec3& end) {   // (a rigid part's turn over the half: 0.05 rad counts as 5 mm)
@@ -90,10 +91,12 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
     double allowed = opt.verify_distance;
     for (const DesignStartRun& r : sum.runs) allowed = std::min(allowed, sum.transport_tolerance * (r.seconds - r.from));
     sum.unique = true;   // (no fixed point is sought)
-    if (undefined) sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
+    if (undefined)
+        sum.failure = std::to_string(undefined) + " configurations of the field are undefined";
     else if (!((sum.transport_mean - target.velocity).norm() <= sum.transport_tolerance))
         sum.failure = "the field's mean velocity (" + std::to_string(sum.transport_mean.x()) + ", " +
-                      std::to_string(sum.transport_mean.y()) + ") m/s misses the target by more than 2%: out of reach within the limits";
+                      std::to_string(sum.transport_mean.y()) +
+                      ") m/s misses the target by more than 2%: out of reach within the limits";
     else if (!(sum.transport_spread <= sum.transport_tolerance))
         sum.failure = "the field is not uniform over the region";
     else if (!(sum.transport_turn <= turn_tolerance))
@@ -109,4 +112,4 @@ DesignSummary design_transport(const Scene& part_scene, const DesignTarget& targ
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -68,7 +68,8 @@ double field_settle_time(const Field& f, const Vec2& start, const Vec2& target, 
     constexpr double h = 0.05, cap = 120;
     if (g.nx < 2 || g.ny < 2) return cap;   // (no cell to interpolate in)
     auto v = [&](const Vec2& s) {
-        const double u = std::clamp((s.x() - g.x0) / g.dx(), 0.0, g.nx - 1.0), w = std::clamp((s.y() - g.y0) / g.dy(), 0.0, g.ny - 1.0);
+        const double u = std::clamp((s.x() - g.x0) / g.dx(), 0.0, g.nx - 1.0),
+                     w = std::clamp((s.y() - g.y0) / g.dy(), 0.0, g.ny - 1.0);
         const int i = std::min(static_cast<int>(u), g.nx - 2), j = std::min(static_cast<int>(w), g.ny - 2);
         const double a = u - i, b = w - j;
         auto at = [&](int di, int dj) -> Vec2 { return f.points[g.index(i + di, j + dj, 0)].twist.head<2>(); };
@@ -132,7 +133,8 @@ DesignSummary& sink_verdict(DesignSummary& sum, const Field& settle, const Desig
         sum, opt, [&](const DesignStartRun& r) { return field_settle_time(settle, Vec2(r.x, r.y), target.at, opt); },
         [&](const DesignStartRun&, const Vec3& end) { return (end.head<2>() - target.at).norm(); }, &hold_at);
     const std::string unheld = hold_failure(sum, opt, " m");
-    if (!sum.unique) sum.failure = not_unique;
+    if (!sum.unique)
+        sum.failure = not_unique;
     else if (stopped)
         sum.failure = std::to_string(stopped) + " full-dynamics run(s) left the model";
     else if (!(sum.worst_end_distance <= opt.verify_distance))
@@ -141,4 +143,4 @@ DesignSummary& sink_verdict(DesignSummary& sum, const Field& settle, const Desig
 }
 
 
-}  // namespace plate::design_detail
+}   // namespace plate::design_detail

@@ -15,9 +15,12 @@ namespace plate {
 
 const char* part_model_name(PartModel p) {
     switch (p) {
-        case PartModel::Point: return "point";
-        case PartModel::Thin: return "thin";
-        case PartModel::Thick: return "thick";
+        case PartModel::Point:
+            return "point";
+        case PartModel::Thin:
+            return "thin";
+        case PartModel::Thick:
+            return "thick";
     }
     return "?";
 }
@@ -48,8 +51,10 @@ std::string ModelChoice::explain() const {
       << (any_simplification ? "" : " (no simplification is within the tolerance)") << "\n";
     for (const auto& r : rungs) {
         o << "  " << r.name() << ": ";
-        if (r.ok) o << "error " << r.error << ", " << r.seconds << " s";
-        else o << "did not run to the end (" << r.note << ")";
+        if (r.ok)
+            o << "error " << r.error << ", " << r.seconds << " s";
+        else
+            o << "did not run to the end (" << r.note << ")";
         o << "\n";
     }
     return o.str();
@@ -81,12 +86,14 @@ Rung run_rung(const Scene& sc, PartModel p, Dynamics d, const Vec3& q0, double d
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.work = tr.stats.rhs_evals;
     r.ok = tr.stop.reason == StopReason::None && !tr.samples.empty();
-    if (!r.ok) r.note = tr.stop.describe();
-    else q_end = tr.samples.back().q;
+    if (!r.ok)
+        r.note = tr.stop.describe();
+    else
+        q_end = tr.samples.back().q;
     return r;
 }
 
-}  // namespace
+}   // namespace
 
 ModelChoice choose_model(const Scene& sc, const Vec3& q0, double duration, double tol) {
     ModelChoice mc;
@@ -111,8 +118,9 @@ ModelChoice choose_model(const Scene& sc, const Vec3& q0, double duration, doubl
             if (p == own && d == Dynamics::Full) continue;
             Vec3 q;
             Rung r = run_rung(sc, p, d, q0, duration, q);
-            if (r.ok) r.error = std::max({std::abs(q[0] - q_ref[0]) / rho, std::abs(q[1] - q_ref[1]) / rho,
-                                          std::abs(wrap_angle(q[2] - q_ref[2]))});
+            if (r.ok)
+                r.error = std::max(
+                    {std::abs(q[0] - q_ref[0]) / rho, std::abs(q[1] - q_ref[1]) / rho, std::abs(wrap_angle(q[2] - q_ref[2]))});
             mc.rungs.push_back(r);
         }
     }
@@ -124,7 +132,7 @@ ModelChoice choose_model(const Scene& sc, const Vec3& q0, double duration, doubl
     return mc;
 }
 
-}  // namespace plate
+}   // namespace plate
 
 namespace plate {
 
@@ -164,7 +172,8 @@ ModelEstimate estimate_model_errors(const Scene& sc, const Vec3& q0, double dura
     // on the recorded steps) less xi_a times its duration.
     auto offset_of = [](const LimitCycleSummary& c) {
         Vec3 X = Vec3::Zero();
-        for (std::size_t i = 1; i < c.path.size(); ++i) X += 0.5 * (c.path[i].qd + c.path[i - 1].qd) * (c.path[i].t - c.path[i - 1].t);
+        for (std::size_t i = 1; i < c.path.size(); ++i)
+            X += 0.5 * (c.path[i].qd + c.path[i - 1].qd) * (c.path[i].t - c.path[i - 1].t);
         return Vec3(X - c.twist * c.path.back().t);
     };
     const double t_last = lc.path.back().t;
@@ -254,8 +263,8 @@ std::string APrioriChoice::explain() const {
     o.precision(3);
     o << "auto model, decided up front: picked " << picked.name() << " (predicted error " << predicted << ")";
     if (verified) o << "; verified against the full model: measured error " << measured;
-    o << "\n  estimates: |xi| " << estimate.xi << "/s, point " << estimate.e_point << ", thin " << estimate.e_thin
-      << ", eps_U " << estimate.eps_U << ", transient offset " << estimate.offset << ", excursion " << estimate.excursion
+    o << "\n  estimates: |xi| " << estimate.xi << "/s, point " << estimate.e_point << ", thin " << estimate.e_thin << ", eps_U "
+      << estimate.eps_U << ", transient offset " << estimate.offset << ", excursion " << estimate.excursion
       << (estimate.ok ? "" : " (" + estimate.note + ")") << "\n";
     return o.str();
 }
@@ -299,12 +308,12 @@ APrioriChoice choose_model_a_priori(const Scene& sc, const Vec3& q0, double dura
         if (ref.ok && c.picked.ok) {
             const double rho = sc.part.rho();
             c.verified = true;
-            c.measured = std::max({std::abs(q[0] - q_ref[0]) / rho, std::abs(q[1] - q_ref[1]) / rho,
-                                   std::abs(wrap_angle(q[2] - q_ref[2]))});
+            c.measured = std::max(
+                {std::abs(q[0] - q_ref[0]) / rho, std::abs(q[1] - q_ref[1]) / rho, std::abs(wrap_angle(q[2] - q_ref[2]))});
             c.picked.error = c.measured;
         }
     }
     return c;
 }
 
-}  // namespace plate
+}   // namespace plate

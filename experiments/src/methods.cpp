@@ -88,8 +88,7 @@ bool fail(MethodRun& run, const std::string& why) {
 
 // The adaptive loop for odeint's controlled steppers: try_step until t1, clamping the last step.
 template <class TryStep>
-bool adaptive_loop(TryStep&& try_step, const Counted& c, double t0, double t1, Vec& y, const MethodOptions& opt,
-                   MethodRun& run) {
+bool adaptive_loop(TryStep&& try_step, const Counted& c, double t0, double t1, Vec& y, const MethodOptions& opt, MethodRun& run) {
     double t = t0;
     double dt = opt.h > 0 ? opt.h : (t1 - t0) / 1000;
     const double h_min = opt.h_min > 0 ? opt.h_min : 1e-14 * (t1 - t0);
@@ -129,8 +128,7 @@ bool fixed_loop(Step&& step, double t0, double t1, Vec& y, const MethodOptions& 
     return true;
 }
 
-bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const MethodOptions& opt,
-                MethodRun& run) {
+bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const MethodOptions& opt, MethodRun& run) {
     const Counted c{sys, run, opt.max_evals};
     auto rhs = [&c](const Vec& x, Vec& dx, double t) {
         dx.resize(x.size());
@@ -152,7 +150,8 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
                 odeint::runge_kutta_fehlberg78<Vec> st;
                 return fixed_loop([&](Vec& x, double t, double h) { st.do_step(rhs, x, t, h); }, t0, t1, y, opt, run, c);
             }
-            default: break;   // Rosenbrock below; variable-order methods have no fixed step
+            default:
+                break;   // Rosenbrock below; variable-order methods have no fixed step
         }
         if (m != Method::Rosenbrock4) throw std::invalid_argument(std::string(method_info(m).name) + " has no fixed-step form");
     }
@@ -172,23 +171,23 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
         }
         case Method::Dopri5: {
             auto st = odeint::make_controlled(tol, tol, odeint::runge_kutta_dopri5<Vec>());
-            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; },
-                                 c, t0, t1, y, opt, run);
+            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; }, c,
+                                 t0, t1, y, opt, run);
         }
         case Method::CashKarp54: {
             auto st = odeint::make_controlled(tol, tol, odeint::runge_kutta_cash_karp54<Vec>());
-            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; },
-                                 c, t0, t1, y, opt, run);
+            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; }, c,
+                                 t0, t1, y, opt, run);
         }
         case Method::Fehlberg78: {
             auto st = odeint::make_controlled(tol, tol, odeint::runge_kutta_fehlberg78<Vec>());
-            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; },
-                                 c, t0, t1, y, opt, run);
+            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; }, c,
+                                 t0, t1, y, opt, run);
         }
         case Method::BulirschStoer: {
             odeint::bulirsch_stoer<Vec> st(tol, tol);
-            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; },
-                                 c, t0, t1, y, opt, run);
+            return adaptive_loop([&](Vec& x, double& t, double& h) { return st.try_step(rhs, x, t, h) == odeint::success; }, c,
+                                 t0, t1, y, opt, run);
         }
         case Method::Dopri5Dense: {
             auto st = odeint::make_dense_output(tol, tol, odeint::runge_kutta_dopri5<Vec>());
@@ -199,8 +198,7 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
                 if (c.over_budget()) return fail(run, at("evaluation budget exhausted", st.current_time()));
                 const auto span = st.do_step(rhs);
                 ++run.steps;
-                if (span.second - span.first < h_min && span.second < t1)
-                    return fail(run, at("step-size collapse", span.first));
+                if (span.second - span.first < h_min && span.second < t1) return fail(run, at("step-size collapse", span.first));
                 if (!finite(st.current_state().data(), static_cast<int>(y.size())))
                     return fail(run, at("non-finite state", span.second));
             }
@@ -212,7 +210,10 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
             using UVec = ublas::vector<double>;
             using UMat = ublas::matrix<double>;
             const int n = sys.n;
-            auto f = [&c, n](const UVec& x, UVec& dx, double t) { c.f(t, &x[0], &dx[0]); (void)n; };
+            auto f = [&c, n](const UVec& x, UVec& dx, double t) {
+                c.f(t, &x[0], &dx[0]);
+                (void)n;
+            };
             Vec Jbuf(static_cast<std::size_t>(n) * n), dfdt(n);
             auto jac = [&](const UVec& x, UMat& J, const double& t, UVec& dt) {
                 ++run.jac_evals;
@@ -244,7 +245,8 @@ bool run_odeint(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, co
                 c, t0, t1, y, opt, run);
             return ok;
         }
-        default: break;
+        default:
+            break;
     }
     throw std::logic_error("run_odeint: not an odeint method");
 }
@@ -271,12 +273,23 @@ int gsl_jac(double t, const double y[], double* dfdy, double dfdt[], void* p) {
 bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const MethodOptions& opt, MethodRun& run) {
     const gsl_odeiv2_step_type* type = nullptr;
     switch (m) {
-        case Method::GslRkf45: type = gsl_odeiv2_step_rkf45; break;
-        case Method::GslRk8pd: type = gsl_odeiv2_step_rk8pd; break;
-        case Method::GslMsadams: type = gsl_odeiv2_step_msadams; break;
-        case Method::GslMsbdf: type = gsl_odeiv2_step_msbdf; break;
-        case Method::GslBsimp: type = gsl_odeiv2_step_bsimp; break;
-        default: throw std::logic_error("run_gsl: not a GSL method");
+        case Method::GslRkf45:
+            type = gsl_odeiv2_step_rkf45;
+            break;
+        case Method::GslRk8pd:
+            type = gsl_odeiv2_step_rk8pd;
+            break;
+        case Method::GslMsadams:
+            type = gsl_odeiv2_step_msadams;
+            break;
+        case Method::GslMsbdf:
+            type = gsl_odeiv2_step_msbdf;
+            break;
+        case Method::GslBsimp:
+            type = gsl_odeiv2_step_bsimp;
+            break;
+        default:
+            throw std::logic_error("run_gsl: not a GSL method");
     }
     // GSL's implicit steppers call the Jacobian unconditionally (a null pointer crashes): guard it.
     if (method_info(m).needs_jacobian && !sys.jac) return fail(run, "needs the Jacobian, none given");
@@ -304,8 +317,14 @@ bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const
     const double h_min = opt.h_min > 0 ? opt.h_min : 1e-14 * (t1 - t0);
     bool ok = true;
     while (t < t1) {
-        if (run.steps >= opt.max_steps) { ok = fail(run, at("step limit", t)); break; }
-        if (c.over_budget()) { ok = fail(run, at("evaluation budget exhausted", t)); break; }
+        if (run.steps >= opt.max_steps) {
+            ok = fail(run, at("step limit", t));
+            break;
+        }
+        if (c.over_budget()) {
+            ok = fail(run, at("evaluation budget exhausted", t));
+            break;
+        }
         const long fails_before = static_cast<long>(d->e->failed_steps);
         const int status = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &s, &t, t1, &h, y.data());
         run.rejected += static_cast<long>(d->e->failed_steps) - fails_before;
@@ -314,14 +333,20 @@ bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const
             break;
         }
         ++run.steps;
-        if (!finite(y.data(), sys.n)) { ok = fail(run, at("non-finite state", t)); break; }
-        if (h < h_min && t < t1) { ok = fail(run, at("step-size collapse", t)); break; }
+        if (!finite(y.data(), sys.n)) {
+            ok = fail(run, at("non-finite state", t));
+            break;
+        }
+        if (h < h_min && t < t1) {
+            ok = fail(run, at("step-size collapse", t));
+            break;
+        }
     }
     gsl_odeiv2_driver_free(d);
     return ok;
 }
 
-}  // namespace
+}   // namespace
 
 bool integrate(Method m, const OdeSystem& sys, double t0, double t1, std::vector<double>& y, const MethodOptions& opt,
                MethodRun& run) {
@@ -334,8 +359,10 @@ bool integrate(Method m, const OdeSystem& sys, double t0, double t1, std::vector
             case Method::GslRk8pd:
             case Method::GslMsadams:
             case Method::GslMsbdf:
-            case Method::GslBsimp: return run_gsl(m, sys, t0, t1, y, opt, run);
-            default: return run_odeint(m, sys, t0, t1, y, opt, run);
+            case Method::GslBsimp:
+                return run_gsl(m, sys, t0, t1, y, opt, run);
+            default:
+                return run_odeint(m, sys, t0, t1, y, opt, run);
         }
     } catch (const std::invalid_argument&) {
         throw;
@@ -344,4 +371,4 @@ bool integrate(Method m, const OdeSystem& sys, double t0, double t1, std::vector
     }
 }
 
-}  // namespace plate
+}   // namespace plate

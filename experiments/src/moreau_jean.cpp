@@ -50,7 +50,7 @@ struct Fc3d {
     Fc3d& operator=(const Fc3d&) = delete;
 };
 
-}  // namespace
+}   // namespace
 
 MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration, const MoreauJeanOptions& opt) {
     if (!(duration > 0) || opt.steps_per_period < 1)
@@ -110,8 +110,7 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
         x += h * v;
         R = detail::exp_so3(h * w) * R;
         theta += std::remainder(std::atan2(R(1, 0), R(0, 0)) - theta, 2 * kPi);
-        for (int i = 0; i < nc; ++i)
-            out.max_gap = std::max(out.max_gap, (x + R * (P.point ? Vec3::Zero() : P.c[i])).z());
+        for (int i = 0; i < nc; ++i) out.max_gap = std::max(out.max_gap, (x + R * (P.point ? Vec3::Zero() : P.c[i])).z());
     }
     out.q = Vec3(x.x(), x.y(), P.point ? 0.0 : theta);
     out.qd = Vec3(v.x(), v.y(), P.point ? 0.0 : w.z());
@@ -120,4 +119,4 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
     return out;
 }
 
-}  // namespace plate
+}   // namespace plate

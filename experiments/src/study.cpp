@@ -105,7 +105,8 @@ MethodOptions method_options(const Solver& s, double knob, double T, long max_ev
     MethodOptions mo;
     mo.max_evals = max_evals;
     mo.h_min = 1e-13 * T;
-    if (s.method == Method::RK4) mo.h = T / knob;
+    if (s.method == Method::RK4)
+        mo.h = T / knob;
     else {
         mo.tol = knob;
         mo.h = 1e-3 * T;
@@ -113,7 +114,7 @@ MethodOptions method_options(const Solver& s, double knob, double T, long max_ev
     return mo;
 }
 
-}  // namespace
+}   // namespace
 
 namespace {
 
@@ -128,8 +129,7 @@ OdeSystem reduced_from(const std::shared_ptr<ReducedW>& w, const Scene& sc) {
         const auto& s = w->scale;
         const Vec3 qd(ys[0] * s[0], ys[1] * s[1], ys[2] * s[2]);
         Mat3 Jq;
-        twist_jacobian(sc, Dynamics::ReducedU, w->model.q0, qd, plate_state(sc.plate, t, Dynamics::ReducedU), w->model.ws,
-                       Jq);
+        twist_jacobian(sc, Dynamics::ReducedU, w->model.q0, qd, plate_state(sc.plate, t, Dynamics::ReducedU), w->model.ws, Jq);
         for (int i = 0; i < 36; ++i) J[i] = 0;
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) J[i * 6 + j] = Jq(i, j) * s[j] / s[i];
@@ -149,8 +149,8 @@ OdeSystem reduced_from(const std::shared_ptr<ReducedW>& w, const Scene& sc) {
 // the contraction estimate r c / (1 - c) is at most cycle_tol (r: the change of q' over a period, in
 // v_ref). Returns the periods integrated when converged -- y then holds the last period's end and
 // *start its start -- or 0 (run.ok says whether the method failed).
-int periods_to_cycle(Method m, const OdeSystem& sys, double T, const MethodOptions& mo, MethodRun& run,
-                     double cycle_tol, int max_periods, std::vector<double>& y, Vec3* start = nullptr) {
+int periods_to_cycle(Method m, const OdeSystem& sys, double T, const MethodOptions& mo, MethodRun& run, double cycle_tol,
+                     int max_periods, std::vector<double>& y, Vec3* start = nullptr) {
     Vec3 prev(y[0], y[1], y[2]);
     double r_prev = 0;
     for (int k = 1; k <= max_periods; ++k) {
@@ -176,7 +176,7 @@ std::shared_ptr<ReducedW> reduced_wrapped(const Scene& sc, const Vec3& q0, Frict
     return w;
 }
 
-}  // namespace
+}   // namespace
 
 OdeSystem reduced_system(const Scene& sc, const Vec3& q0, FrictionLaw law, double eps, std::vector<double>& scale) {
     auto w = reduced_wrapped(sc, q0, law, eps);
@@ -198,8 +198,10 @@ RunResult twist_run(const Scene& sc, const Vec3& q0, const Solver& s, double kno
         r.seconds = seconds_since(t0);
         r.rhs_evals = lc.stats.rhs_evals;
         r.ok = lc.converged;
-        if (!r.ok) r.failure = lc.stop.reason != StopReason::None ? lc.stop.describe() : "not converged";
-        else r.value = {lc.twist[0], lc.twist[1], lc.twist[2]};
+        if (!r.ok)
+            r.failure = lc.stop.reason != StopReason::None ? lc.stop.describe() : "not converged";
+        else
+            r.value = {lc.twist[0], lc.twist[1], lc.twist[2]};
         return r;
     }
     // The same start and restart rule as the engine's (limit_cycle): from rest, and where the run
@@ -207,8 +209,7 @@ RunResult twist_run(const Scene& sc, const Vec3& q0, const Solver& s, double kno
     // twists -- slip speed v_ref along x, then y, then a spin (a point part: the diagonal) -- up to
     // LimitCycleOptions::restarts times; contact lost from every start is what is reported.
     const double v = sc.v_ref(), wz = v / sc.part.rho();
-    const Vec3 starts[] = {Vec3::Zero(), Vec3(v, 0, 0), Vec3(0, v, 0),
-                           sc.part.point ? Vec3(-v, -v, 0) : Vec3(0, 0, wz)};
+    const Vec3 starts[] = {Vec3::Zero(), Vec3(v, 0, 0), Vec3(0, v, 0), sc.part.point ? Vec3(-v, -v, 0) : Vec3(0, 0, wz)};
     const int n_starts = 1 + std::min(LimitCycleOptions{}.restarts, 3);
     const MethodOptions mo = method_options(s, knob, T, max_evals);
     for (int k = 0; k < n_starts; ++k) {
@@ -243,8 +244,8 @@ RunResult twist_run(const Scene& sc, const Vec3& q0, const Solver& s, double kno
     return r;
 }
 
-RunResult trajectory_run(const Scene& sc, const Vec3& q0, double duration, double sample_dt, const Solver& s,
-                         double knob, long max_evals) {
+RunResult trajectory_run(const Scene& sc, const Vec3& q0, double duration, double sample_dt, const Solver& s, double knob,
+                         long max_evals) {
     RunResult r;
     r.knob = knob;
     const auto t0 = Clock::now();
@@ -324,7 +325,10 @@ double field_max_error(const Scene& sc, const Field& f, const Field& ref, int* m
     int miss = 0;
     for (std::size_t i = 0; i < f.points.size(); ++i) {
         if (!ref.points[i].converged) continue;
-        if (!f.points[i].converged) { ++miss; continue; }
+        if (!f.points[i].converged) {
+            ++miss;
+            continue;
+        }
         const Vec3 d = f.points[i].twist, r = ref.points[i].twist;
         e = std::max(e, twist_error(sc, {d[0], d[1], d[2]}, {r[0], r[1], r[2]}));
     }
@@ -339,8 +343,8 @@ void path_error(const Scene& sc, const std::vector<double>& a, const std::vector
     const double rho = sc.part.rho();
     max_error = 0;
     for (std::size_t i = 0; i < a.size(); i += 3) {
-        const double e = std::max({std::abs(a[i] - b[i]) / rho, std::abs(a[i + 1] - b[i + 1]) / rho,
-                                   std::abs(a[i + 2] - b[i + 2])});
+        const double e =
+            std::max({std::abs(a[i] - b[i]) / rho, std::abs(a[i + 1] - b[i + 1]) / rho, std::abs(a[i + 2] - b[i + 2])});
         max_error = std::max(max_error, e);
         final_error = e;
     }
@@ -378,7 +382,9 @@ RegularisedReference regularised_reference(const Scene& sc, const Vec3& q0, cons
         if (!run.ok || !done || w->min_n < 0) {
             std::ostringstream m;
             m << "regularised cycle at eps = " << eps << " v_ref: "
-              << (!run.ok ? run.failure : w->min_n < 0 ? std::string("contact lost") : std::string("not converged"));
+              << (!run.ok        ? run.failure
+                  : w->min_n < 0 ? std::string("contact lost")
+                                 : std::string("not converged"));
             out.failure = m.str();
             out.seconds = seconds_since(t0);
             return out;
@@ -457,4 +463,4 @@ RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& o
     return c;
 }
 
-}  // namespace plate
+}   // namespace plate

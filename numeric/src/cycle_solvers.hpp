@@ -60,4 +60,4 @@ struct CycleRun {
 // Newton shooting from the warm start qd0 (shooting_cycle.cpp).
 LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0);
 
-}  // namespace plate::detail
+}   // namespace plate::detail

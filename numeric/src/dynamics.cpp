@@ -13,9 +13,12 @@ namespace plate {
 
 const char* dynamics_name(Dynamics d) {
     switch (d) {
-        case Dynamics::Full: return "full";
-        case Dynamics::U: return "u";
-        case Dynamics::ReducedU: return "reduced-u";
+        case Dynamics::Full:
+            return "full";
+        case Dynamics::U:
+            return "u";
+        case Dynamics::ReducedU:
+            return "reduced-u";
     }
     return "?";
 }
@@ -68,8 +71,8 @@ Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const
     const Mat3& R1 = ps.R1;
     const Vec3 sd(qd[0], qd[1], 0);
     const Vec3 Rs = R1 * s, Rsd = R1 * sd;
-    b.head<3>() = P.m * (R1.transpose() * (ps.pdd + ps.w1.cross(ps.w1.cross(Rs)) + ps.wd.cross(Rs) +
-                                           2 * ps.w1.cross(Rsd) + sc.g * ez));
+    b.head<3>() =
+        P.m * (R1.transpose() * (ps.pdd + ps.w1.cross(ps.w1.cross(Rs)) + ps.wd.cross(Rs) + 2 * ps.w1.cross(Rsd) + sc.g * ez));
     if (P.point) {
         b.tail<3>().setZero();
         return b;
@@ -102,13 +105,18 @@ void Workspace::prepare(const Scene& sc) {
     ks.in.Jyy = P.J(1, 1);
     ks.in.Jyz = P.J(1, 2);
     ks.in.Jzz = P.J(2, 2);
-    ks.in.c1x = P.c[0].x(); ks.in.c1y = P.c[0].y();
-    ks.in.c2x = P.c[1].x(); ks.in.c2y = P.c[1].y();
-    ks.in.c3x = P.c[2].x(); ks.in.c3y = P.c[2].y();
+    ks.in.c1x = P.c[0].x();
+    ks.in.c1y = P.c[0].y();
+    ks.in.c2x = P.c[1].x();
+    ks.in.c2y = P.c[1].y();
+    ks.in.c3x = P.c[2].x();
+    ks.in.c3y = P.c[2].y();
     ks.in.cz = P.point ? 0.0 : P.c[0].z();
     ks.in.sz = P.s_z();
     const ContactFriction fr = P.friction();   // (the kernels' slides take the kinetic coefficients)
-    ks.in.mu1 = fr.kinetic(0); ks.in.mu2 = fr.kinetic(1); ks.in.mu3 = fr.kinetic(2);
+    ks.in.mu1 = fr.kinetic(0);
+    ks.in.mu2 = fr.kinetic(1);
+    ks.in.mu3 = fr.kinetic(2);
     ks.in.R11 = ks.in.R22 = ks.in.R33 = 1;
     ks.theta = std::numeric_limits<double>::quiet_NaN();
     ks.C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -183,7 +191,10 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
             const double s2 = sp[i];
             const double along = vx[i] * ss.hint[i].x() + vy[i] * ss.hint[i].y();
             const bool past_zero = s2 < 0.01 * ss.hint_from[i] * ss.hint_from[i] && (along <= 0 || along * along <= 0.25 * s2);
-            if (s2 <= hs2 || past_zero || (ss.creep >> i & 1u)) { ux[i] = ss.hint[i].x(); uy[i] = ss.hint[i].y(); }
+            if (s2 <= hs2 || past_zero || (ss.creep >> i & 1u)) {
+                ux[i] = ss.hint[i].x();
+                uy[i] = ss.hint[i].y();
+            }
         }
     }
     for (int i = nc; i < 3; ++i) ws.slip[i].setZero();
@@ -201,22 +212,32 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
     if (q[0] != ks.C_q[0] || q[1] != ks.C_q[1] || q[2] != ks.C_q[2]) {
         set_configuration(P, q, ws);
         ks.C_q = q;
-        if (P.point) gen::reduced_U_point_config(ks.in, ks.C.data());
-        else if (ks.thin) gen::reduced_U_thin_config(ks.in, ks.M38_inv_rowmajor.data(), ks.C.data());
-        else gen::reduced_U_thick_config(ks.in, ks.C.data());
+        if (P.point)
+            gen::reduced_U_point_config(ks.in, ks.C.data());
+        else if (ks.thin)
+            gen::reduced_U_thin_config(ks.in, ks.M38_inv_rowmajor.data(), ks.C.data());
+        else
+            gen::reduced_U_thick_config(ks.in, ks.C.data());
     }
     // The staged kernels read only the slip directions and u(t): those fields are written here.
     gen::KernelInput& k = ks.staged;
-    k.pddx = ps.pdd.x(); k.pddy = ps.pdd.y(); k.pddz = ps.pdd.z();
-    k.wdx = ps.wd.x(); k.wdy = ps.wd.y(); k.wdz = ps.wd.z();
+    k.pddx = ps.pdd.x();
+    k.pddy = ps.pdd.y();
+    k.pddz = ps.pdd.z();
+    k.wdx = ps.wd.x();
+    k.wdy = ps.wd.y();
+    k.wdz = ps.wd.z();
     double ux[3], uy[3];
     double dq[18];   // d q''_r / d u_j, row-major (3 x 6; point part 2 x 2)
     if (P.point) {
         slip_directions(1, qd, ws, ux, uy);
-        k.u1x = ux[0]; k.u1y = uy[0];
+        k.u1x = ux[0];
+        k.u1y = uy[0];
         double z[3];
-        if (Jq) gen::reduced_U_point_du(k, ks.C.data(), z, dq);
-        else gen::reduced_U_point(k, ks.C.data(), z);
+        if (Jq)
+            gen::reduced_U_point_du(k, ks.C.data(), z, dq);
+        else
+            gen::reduced_U_point(k, ks.C.data(), z);
         ws.qdd = Vec3(z[0], z[1], 0);
         ws.n = Vec3(z[2], 0, 0);
         if (Jq) {
@@ -227,17 +248,24 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
         return true;
     }
     slip_directions(3, qd, ws, ux, uy);
-    k.u1x = ux[0]; k.u1y = uy[0];
-    k.u2x = ux[1]; k.u2y = uy[1];
-    k.u3x = ux[2]; k.u3y = uy[2];
+    k.u1x = ux[0];
+    k.u1y = uy[0];
+    k.u2x = ux[1];
+    k.u2y = uy[1];
+    k.u3x = ux[2];
+    k.u3y = uy[2];
     bool regular = true;
     if (ks.thin) {
-        if (Jq) gen::reduced_U_thin_du(k, ks.C.data(), ws.n.data(), ws.qdd.data(), dq);
-        else gen::reduced_U_thin(k, ks.C.data(), ws.n.data(), ws.qdd.data());
+        if (Jq)
+            gen::reduced_U_thin_du(k, ks.C.data(), ws.n.data(), ws.qdd.data(), dq);
+        else
+            gen::reduced_U_thin(k, ks.C.data(), ws.n.data(), ws.qdd.data());
     } else {
         double det;
-        if (Jq) gen::reduced_U_thick_du(k, ks.C.data(), ws.n.data(), ws.qdd.data(), &det, dq);
-        else gen::reduced_U_thick(k, ks.C.data(), ws.n.data(), ws.qdd.data(), &det);
+        if (Jq)
+            gen::reduced_U_thick_du(k, ks.C.data(), ws.n.data(), ws.qdd.data(), &det, dq);
+        else
+            gen::reduced_U_thick(k, ks.C.data(), ws.n.data(), ws.qdd.data(), &det);
         regular = std::abs(det) > ks.det_floor;
     }
     if (Jq && regular) {
@@ -262,7 +290,7 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
     return regular;
 }
 
-}  // namespace
+}   // namespace
 
 namespace detail {
 // The engine's most frequent evaluation (models.hpp): a slide without creep in the reduced
@@ -276,10 +304,9 @@ bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const Plate
     ++ws.evals;
     return true;
 }
-}  // namespace detail
+}   // namespace detail
 
-void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                   Workspace& ws) {
+void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
     const Part& P = sc.part;
     ++ws.evals;
@@ -293,14 +320,21 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     {
         double ux[3], uy[3];
         slip_directions(P.point ? 1 : 3, qd, ws, ux, uy);
-        in.u1x = ux[0]; in.u1y = uy[0];
+        in.u1x = ux[0];
+        in.u1y = uy[0];
         if (!P.point) {
-            in.u2x = ux[1]; in.u2y = uy[1];
-            in.u3x = ux[2]; in.u3y = uy[2];
+            in.u2x = ux[1];
+            in.u2y = uy[1];
+            in.u3x = ux[2];
+            in.u3y = uy[2];
         }
     }
-    in.pddx = ps.pdd.x(); in.pddy = ps.pdd.y(); in.pddz = ps.pdd.z();
-    in.wdx = ps.wd.x(); in.wdy = ps.wd.y(); in.wdz = ps.wd.z();
+    in.pddx = ps.pdd.x();
+    in.pddy = ps.pdd.y();
+    in.pddz = ps.pdd.z();
+    in.wdx = ps.wd.x();
+    in.wdy = ps.wd.y();
+    in.wdz = ps.wd.z();
     double b[6];
     if (ks.thin && level != Dynamics::Full) {   // the thin part's specialised kernel does it all
         double n[3], qdd[3];
@@ -311,10 +345,18 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         return;
     }
     if (level == Dynamics::Full) {
-        in.wx = ps.w1.x(); in.wy = ps.w1.y(); in.wz = ps.w1.z();
-        in.R11 = ps.R1(0, 0); in.R12 = ps.R1(0, 1); in.R13 = ps.R1(0, 2);
-        in.R21 = ps.R1(1, 0); in.R22 = ps.R1(1, 1); in.R23 = ps.R1(1, 2);
-        in.R31 = ps.R1(2, 0); in.R32 = ps.R1(2, 1); in.R33 = ps.R1(2, 2);
+        in.wx = ps.w1.x();
+        in.wy = ps.w1.y();
+        in.wz = ps.w1.z();
+        in.R11 = ps.R1(0, 0);
+        in.R12 = ps.R1(0, 1);
+        in.R13 = ps.R1(0, 2);
+        in.R21 = ps.R1(1, 0);
+        in.R22 = ps.R1(1, 1);
+        in.R23 = ps.R1(1, 2);
+        in.R31 = ps.R1(2, 0);
+        in.R32 = ps.R1(2, 1);
+        in.R33 = ps.R1(2, 2);
         gen::b_full(in, b);
     } else {
         gen::b_U(in, b);
@@ -337,8 +379,8 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
             // Near-collinear contacts: the cofactor solution loses accuracy; use a pivoted LU instead.
             double M[9], r[3];
             gen::thick_reduced(in, b, M, r);
-            const Vec3 nn = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(
-                Eigen::Map<const Vec3>(r));
+            const Vec3 nn =
+                Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(M).partialPivLu().solve(Eigen::Map<const Vec3>(r));
             for (int i = 0; i < 3; ++i) n[i] = nn[i];
             gen::back_substitution(in, b, n, qdd);
         }
@@ -347,8 +389,8 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     ws.qdd = Vec3(qdd[0], qdd[1], qdd[2]);
 }
 
-void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                    Workspace& ws, Mat3& Jq) {
+void twist_jacobian(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws,
+                    Mat3& Jq) {
     detail::KernelScratch& ks = detail::kernels(ws);
     if (level == Dynamics::Full) throw std::invalid_argument("twist_jacobian: U- and reduced U-dynamics only");
     if (level == Dynamics::ReducedU) {
@@ -411,10 +453,10 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
     for (int i = 0; i < 3; ++i) {
         const double v = ws.slip[i].norm();
         const Vec2 u = v > 0 ? Vec2(ws.slip[i] / v) : Vec2::Zero();
-        const Vec3 d(-fr.kinetic(i) * u.x(), -fr.kinetic(i) * u.y(), 1.0);              // (17)
-        const Vec3 dS(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());  // R2^T d_i
+        const Vec3 d(-fr.kinetic(i) * u.x(), -fr.kinetic(i) * u.y(), 1.0);     // (17)
+        const Vec3 dS(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());   // R2^T d_i
         A.block<3, 1>(0, 3 + i) = d;
-        A.block<3, 1>(3, 3 + i) = P.c[i].cross(dS);                          // h_i (23)
+        A.block<3, 1>(3, 3 + i) = P.c[i].cross(dS);   // h_i (23)
     }
     ks.lu.compute(A);
     ks.z = ks.lu.solve(ws.b);
@@ -422,4 +464,4 @@ void accelerations_reference(const Scene& sc, Dynamics level, const Vec3& q, con
     ws.n = ks.z.tail<3>();
 }
 
-}  // namespace plate
+}   // namespace plate

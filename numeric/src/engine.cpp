@@ -14,4 +14,4 @@ template class Engine<ReducedModel>;
 template class Engine<UModel>;
 template class Engine<FullModel>;
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -52,7 +52,8 @@ inline double zero_band(double rtol) { return std::clamp(3e2 * rtol, 1e-9, 3e-3)
 // A non-owning reference to a callable with signature R(A...): Engine::advance's step observer,
 // so that the loop is compiled once per model and not once per observer. It must not outlive the
 // callable (a lambda passed to advance lives until advance returns).
-template <class Sig> class FunctionRef;
+template <class Sig>
+class FunctionRef;
 template <class R, class... A>
 class FunctionRef<R(A...)> {
 public:
@@ -97,7 +98,8 @@ public:
     const Vec3& n() const { return n_; }
     // Overwrites components of the state (e.g. to reset an integral, or a new start twist), keeping
     // the time; a changed twist chooses its mode again.
-    template <class F> void modify(F&& f) {
+    template <class F>
+    void modify(F&& f) {
         State y = this->y();
         const Vec3 qd_old = model_.qd(y);
         f(y);
@@ -138,35 +140,35 @@ private:
     // friction. False if a stop occurred.
     bool accept_step(double t1, const Guards& g1, const Vec3& n1, const std::array<Vec2, 3>& slip1);
     double zero_cap();   // the step that ends just past the first zero of a slip heading for it
-    void reference_directions(const std::array<Vec2, 3>& slip);   // of the slide guards, at a step's start
-    void rebase(const Guards& g, const std::array<Vec2, 3>& slip);  // the guards' baseline at a new start
-    void dense(double t, double t1, State& out);   // the scaled state at t in the last step
-    void account(double t1);   // held time up to t1
+    void reference_directions(const std::array<Vec2, 3>& slip);      // of the slide guards, at a step's start
+    void rebase(const Guards& g, const std::array<Vec2, 3>& slip);   // the guards' baseline at a new start
+    void dense(double t, double t1, State& out);                     // the scaled state at t in the last step
+    void account(double t1);                                         // held time up to t1
     double min_n() const { return model_.ws.n.head(scene_.part.contacts()).minCoeff(); }
 
     // --- guards and events (engine_events.hxx) ---
-    void guards(const State& ys, Guards& g);   // at scaled state ys, evaluated there
+    void guards(const State& ys, Guards& g);           // at scaled state ys, evaluated there
     bool crossed(int i, double g0, double g1) const;   // has guard i changed sign over the step?
     double locate(int i, double t1, double tb, double gb, const State& yb, State& yr);   // its first root
-    void note_stage(double t, const State& y);   // the hold guards at a step's stages
+    void note_stage(double t, const State& y);                                           // the hold guards at a step's stages
     void note_stage_guard(int i, double t, double g);
     bool stage_dip(int i, double t1, double g1, double& tb, double& gb, State& yb);   // a hold lost inside a step
-    double guard_at(int i, double t, double t1, State& ym);   // guard i on the step's dense output
-    bool turn_dip(double t1, double g1, double& tb, double& gb, State& yb);   // a pivot's turn through zero and back
+    double guard_at(int i, double t, double t1, State& ym);                           // guard i on the step's dense output
+    bool turn_dip(double t1, double g1, double& tb, double& gb, State& yb);           // a pivot's turn through zero and back
     bool slip_zero(int k, double t, const State& yr);   // did contact k's slip reach zero at its root?
     double slip_bound(int k) const { return std::max(1e-3 * slip0_norm(k), zero_abs_); }
     double slip0_norm(int k) const { return std::abs(g0_[3 + k]); }
 
     // --- modes: starts, events, holds (engine_modes.hxx) ---
-    void set(const State& y);   // sets the state (physical units) and evaluates there
+    void set(const State& y);                     // sets the state (physical units) and evaluates there
     void restart(State& y, const Vec3& qd_old);   // after modify(): the mode again if the twist changed
-    bool classify(State& y);   // chooses the mode of state y at t_ and sets it
+    bool classify(State& y);                      // chooses the mode of state y at t_ and sets it
     void log_event(const Mode& from);
-    bool event(int ev);   // handles event ev at (t_, ys_)
-    bool try_hold(unsigned zero);   // a lingering slip: held if static friction can hold it
-    bool switch_mode(unsigned zero, bool hold);   // the mode with the contacts `zero` at zero slip
+    bool event(int ev);                                   // handles event ev at (t_, ys_)
+    bool try_hold(unsigned zero);                         // a lingering slip: held if static friction can hold it
+    bool switch_mode(unsigned zero, bool hold);           // the mode with the contacts `zero` at zero slip
     bool enter(const Mode& m, State y, const Vec3& qd);   // goes on from y with twist qd in mode m
-    bool lose(int k);   // contact k is lost at (t_, ys_)
+    bool lose(int k);                                     // contact k is lost at (t_, ys_)
     bool check_burst();
 
     // --- creep (engine_creep.hxx) ---
@@ -186,16 +188,16 @@ private:
     State scale_{}, inv_scale_{}, ys_{}, fs_{}, ys1_{}, fs1_{}, last_y_{};
     double t_ = 0, dt_ = 0, last_t_ = std::numeric_limits<double>::quiet_NaN();
     double v_ref_ = 0, h_min_ = 0, zero_abs_ = 0;
-    bool frozen_ = false;   // stuck with nothing moving: the step is on the guards alone
+    bool frozen_ = false;     // stuck with nothing moving: the step is on the guards alone
     Vec3 n_ = Vec3::Zero();   // the normal forces at t_
 
     // --- guards and events ---
-    Guards g0_{};   // the guards at the step's start
-    unsigned fresh_ = 0;   // contacts sliding on from a reversal, still inside the zero band
-    std::array<Vec2, 3> ref_ = zeros<Vec2>();   // the slide guards' directions (reference_directions)
-    bool collect_ = false;                  // in a step: note the hold guards at its stages
+    Guards g0_{};                                     // the guards at the step's start
+    unsigned fresh_ = 0;                              // contacts sliding on from a reversal, still inside the zero band
+    std::array<Vec2, 3> ref_ = zeros<Vec2>();         // the slide guards' directions (reference_directions)
+    bool collect_ = false;                            // in a step: note the hold guards at its stages
     std::array<double, 5> stage_min_{}, stage_t_{};   // each hold guard's least value at a stage, and when
-    int burst_ = 0;   // mode changes in a row within 1e-9 T of each other (check_burst)
+    int burst_ = 0;                                   // mode changes in a row within 1e-9 T of each other (check_burst)
     double last_event_t_ = -std::numeric_limits<double>::infinity();
     static constexpr int kBurst = 1000;
 
@@ -243,4 +245,4 @@ private:
     std::array<double, 3> slow_from_{};   // the slip when slow_ began counting
 };
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -90,7 +90,9 @@ bool Engine<Model>::creep_step(const std::array<Vec2, 3>& slip) {
         // The direction's signed turn over the step: its rate is followed in the next steps
         // (StickSlipState::creep_rate), so what the creep leaves out is the rate's change over a step
         // (the turn less the last rate's), times the slip.
-        const double turn = creep_dir_[i].isZero() ? 0.0 : std::atan2(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x(), creep_dir_[i].dot(u));
+        const double turn = creep_dir_[i].isZero()
+                                ? 0.0
+                                : std::atan2(creep_dir_[i].x() * u.y() - creep_dir_[i].y() * u.x(), creep_dir_[i].dot(u));
         const double sn = slip[i].norm(), inc = std::abs(turn - ss.creep_rate[i] * h) * sn;
         // Rigid parts carry the turn too (with the twist creep's turn, modes.cpp; docs/decisions.md,
         // Creeps carry the slip's turn).
@@ -183,4 +185,4 @@ void Engine<Model>::start_creep(const State& y) {
         }
 }
 
-}  // namespace plate::detail
+}   // namespace plate::detail

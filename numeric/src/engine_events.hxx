@@ -134,8 +134,19 @@ bool Engine<Model>::turn_dip(double t1, double g1, double& tb, double& gb, State
     constexpr double r = 0.6180339887498949;
     double a = t_, b = t1, c = b - r * (b - a), d = a + r * (b - a), gc = turn(c), gd = turn(d);
     for (int it = 0; it < 40 && b - a > 1e-13 * scene_.plate.T; ++it) {
-        if (gc < gd) { b = d; d = c; gd = gc; c = b - r * (b - a); gc = turn(c); }
-        else { a = c; c = d; gc = gd; d = a + r * (b - a); gd = turn(d); }
+        if (gc < gd) {
+            b = d;
+            d = c;
+            gd = gc;
+            c = b - r * (b - a);
+            gc = turn(c);
+        } else {
+            a = c;
+            c = d;
+            gc = gd;
+            d = a + r * (b - a);
+            gd = turn(d);
+        }
     }
     const double tm = gc < gd ? c : d;
     const double gm = turn(tm);
@@ -155,4 +166,4 @@ bool Engine<Model>::slip_zero(int k, double t, const State& yr) {
     return model_.ws.slip[k].norm() <= slip_bound(k);
 }
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -23,8 +23,10 @@ bool Engine<Model>::start(double t0, const State& y0) {
 // After modify() changed the state to y (its twist was qd_old): a changed twist chooses its mode again.
 template <class Model>
 void Engine<Model>::restart(State& y, const Vec3& qd_old) {
-    if (model_.qd(y) != qd_old) classify(y);   // (a contact lost there sets stop)
-    else set(y);
+    if (model_.qd(y) != qd_old)
+        classify(y);   // (a contact lost there sets stop)
+    else
+        set(y);
 }
 
 // Sets the state (physical units) and evaluates there; the guards' baseline follows.
@@ -191,4 +193,4 @@ bool Engine<Model>::check_burst() {
     return true;
 }
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -10,8 +10,7 @@
 namespace plate::detail {
 
 template <class Model>
-Engine<Model>::Engine(Model& model, const Scene& scene, const IntegrationOptions& opt)
-    : model_(model), scene_(scene), opt_(opt) {
+Engine<Model>::Engine(Model& model, const Scene& scene, const IntegrationOptions& opt) : model_(model), scene_(scene), opt_(opt) {
     scale_ = model_.scale();
     for (std::size_t i = 0; i < scale_.size(); ++i) inv_scale_[i] = 1 / scale_[i];
     v_ref_ = scene_.v_ref();
@@ -73,8 +72,7 @@ bool Engine<Model>::advance(double t_end, OnStep on_step) {
         if (clamp) t1 = t_end;   // land on t_end exactly despite rounding
         ++stats.steps;
         // Diagnostics at the new point: the FSAL stage evaluated it last.
-        if (frozen_ || !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0))
-            sys(ys1_, fs1_, t1);
+        if (frozen_ || !(last_t_ == t1 && std::memcmp(last_y_.data(), ys1_.data(), sizeof(ys1_)) == 0)) sys(ys1_, fs1_, t1);
         Guards g1;
         guards(ys1_, g1);
         const Vec3 n1 = model_.ws.n;
@@ -139,7 +137,11 @@ int Engine<Model>::first_event(double t1, const Guards& g1, double& t_ev, State&
             swing = true;   // the slip swung past zero without reaching it
             continue;
         }
-        if (tr < t_ev || (tr == t_ev && i < 3)) { t_ev = tr; ev = i; y_ev = yr; }
+        if (tr < t_ev || (tr == t_ev && i < 3)) {
+            t_ev = tr;
+            ev = i;
+            y_ev = yr;
+        }
     }
     return ev;
 }
@@ -294,7 +296,10 @@ void Engine<Model>::rebase(const Guards& g, const std::array<Vec2, 3>& slip) {
 // The state at time t in the last step, scaled (dense output; constant while frozen).
 template <class Model>
 void Engine<Model>::dense(double t, double t1, State& out) {
-    if (frozen_) { out = ys_; return; }
+    if (frozen_) {
+        out = ys_;
+        return;
+    }
     stepper_.dense(t, ys_, fs_, t_, ys1_, fs1_, t1, out);
 }
 
@@ -304,4 +309,4 @@ void Engine<Model>::account(double t1) {
         if (model_.mode.holds(i)) held_time[i] += t1 - t_;
 }
 
-}  // namespace plate::detail
+}   // namespace plate::detail

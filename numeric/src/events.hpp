@@ -35,4 +35,4 @@ double illinois_first_root(double a, double b, double ga, double gb, double tol,
     return b;
 }
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -29,9 +29,8 @@ Vec3 field_at(const Scene& sc, const Vec3& q, const LimitCycleOptions& opt, Vec3
     }
     if (!lc.converged) {
         const bool stopped = lc.stop.reason != StopReason::None;
-        throw FieldUndefined("asymptotic twist undefined at (" + std::to_string(q[0]) + ", " +
-                                 std::to_string(q[1]) + ", " + std::to_string(q[2]) +
-                                 "): " + (stopped ? lc.stop.describe() : "limit cycle not converged"),
+        throw FieldUndefined("asymptotic twist undefined at (" + std::to_string(q[0]) + ", " + std::to_string(q[1]) + ", " +
+                                 std::to_string(q[2]) + "): " + (stopped ? lc.stop.describe() : "limit cycle not converged"),
                              stopped ? lc.stop.reason : StopReason::NotConverged);
     }
     if (warm) *warm = lc.qd_start;
@@ -52,13 +51,16 @@ bool is_rotation_invariant(const Scene& sc) {
 }
 
 // One of the shooting field's lines (FieldRun): 'A': k; 'B': i; 'C': i, k.
-struct Line { char kind; int i, k; };
+struct Line {
+    char kind;
+    int i, k;
+};
 
 // A solved start near the one predicted (FieldRun::turned_warm).
 struct Near {
     double d;   // squared distance in p
     Vec2 p;
-    Vec3 x;     // the solved start in the part's frame (scaled)
+    Vec3 x;   // the solved start in the part's frame (scaled)
 };
 
 // One compute_field: the grid's points, what their predictions and schedules share, and the stages
@@ -79,19 +81,25 @@ struct FieldRun {
     bool report_progress = true;   // (with a task runner, the runner's done reports)
     std::atomic<bool> over{false};
     const bool rotation_invariant;
-    std::vector<double> hint;         // each point's step hint (run_line)
-    std::vector<char> switching;      // the point's cycle changes mode (or failed)
-    std::vector<Line> lines;          // in an order that respects the predecessors
-    int phase1_lines = 0;             // the A and B lines, first in `lines`
+    std::vector<double> hint;      // each point's step hint (run_line)
+    std::vector<char> switching;   // the point's cycle changes mode (or failed)
+    std::vector<Line> lines;       // in an order that respects the predecessors
+    int phase1_lines = 0;          // the A and B lines, first in `lines`
     // A runner's task t: with shooting the plane x_t (its lines C_tk), else the line
     // (x_i, y_j, theta) with t = i ny + j.
     const int tasks;
 
     FieldRun(const Scene& sc, const GridSpec& grid, const FieldOptions& opt, Field& f)
-        : sc(sc), grid(grid), opt(opt), f(f), shooting(opt.warm_start && opt.cycle.solver == CycleSolver::Shooting),
+        : sc(sc),
+          grid(grid),
+          opt(opt),
+          f(f),
+          shooting(opt.warm_start && opt.cycle.solver == CycleSolver::Shooting),
           S(sc.v_ref(), sc.v_ref(), sc.v_ref() / sc.part.rho()),
           start(grid.size(), Vec3::Constant(std::numeric_limits<double>::quiet_NaN())),
-          rotation_invariant(is_rotation_invariant(sc)), hint(grid.size(), 0.0), switching(grid.size(), 0),
+          rotation_invariant(is_rotation_invariant(sc)),
+          hint(grid.size(), 0.0),
+          switching(grid.size(), 0),
           tasks(shooting ? grid.nx : grid.nx * grid.ny) {
         make_lines();
     }
@@ -284,15 +292,20 @@ void FieldRun::make_lines() {
 
 std::vector<int> FieldRun::line_points(const Line& l) const {
     std::vector<int> idx;
-    if (l.kind == 'A') for (int i = 0; i < grid.nx; ++i) idx.push_back(grid.index(i, 0, l.k));
-    else for (int j = 1; j < grid.ny; ++j) idx.push_back(grid.index(l.i, j, l.kind == 'B' ? 0 : l.k));
+    if (l.kind == 'A')
+        for (int i = 0; i < grid.nx; ++i) idx.push_back(grid.index(i, 0, l.k));
+    else
+        for (int j = 1; j < grid.ny; ++j) idx.push_back(grid.index(l.i, j, l.kind == 'B' ? 0 : l.k));
     return idx;
 }
 
 std::vector<int> FieldRun::predecessors(const Line& l) const {
     std::vector<int> d;   // indices into lines
     if (l.kind == 'A' && l.k > 0) d.push_back(l.k - 1);
-    if (l.kind == 'B') { d.push_back(0); if (l.i > 0) d.push_back(grid.nth + l.i - 1); }
+    if (l.kind == 'B') {
+        d.push_back(0);
+        if (l.i > 0) d.push_back(grid.nth + l.i - 1);
+    }
     if (l.kind == 'C') {
         d.push_back(l.k);
         d.push_back(l.k == 1 ? grid.nth + l.i : phase1_lines + l.i * (grid.nth - 1) + l.k - 2);
@@ -303,8 +316,7 @@ std::vector<int> FieldRun::predecessors(const Line& l) const {
 void FieldRun::run_line(const Line& l) {
     const std::vector<int> idx = line_points(l);
     if (idx.empty()) return;
-    const int before = l.kind == 'A' ? (l.k > 0 ? grid.index(0, 0, l.k - 1) : -1)
-                                     : grid.index(l.i, 0, l.kind == 'B' ? 0 : l.k);
+    const int before = l.kind == 'A' ? (l.k > 0 ? grid.index(0, 0, l.k - 1) : -1) : grid.index(l.i, 0, l.kind == 'B' ? 0 : l.k);
     double h0 = before >= 0 ? hint[before] : 0.0;
     bool tight = before >= 0 && switching[before];
     for (int id : idx) {
@@ -347,11 +359,11 @@ std::string FieldRun::task_text(int t) const {
     std::string text;
     for (int idx : task_points(t)) {
         const FieldPoint& p = f.points[idx];
-        for (double x : {p.twist[0], p.twist[1], p.twist[2], p.residual, p.min_normal_force,
-                         p.stick_fraction[0], p.stick_fraction[1], p.stick_fraction[2]})
+        for (double x : {p.twist[0], p.twist[1], p.twist[2], p.residual, p.min_normal_force, p.stick_fraction[0],
+                         p.stick_fraction[1], p.stick_fraction[2]})
             text += exact_text(x) + ' ';
-        text += std::to_string(p.converged) + ' ' + std::to_string(p.periods) + ' ' +
-                std::to_string(static_cast<int>(p.stop)) + ' ' + std::to_string(p.rhs_evals) + '\n';
+        text += std::to_string(p.converged) + ' ' + std::to_string(p.periods) + ' ' + std::to_string(static_cast<int>(p.stop)) +
+                ' ' + std::to_string(p.rhs_evals) + '\n';
     }
     return text;
 }
@@ -384,15 +396,16 @@ int FieldRun::read_task_text(int t, const std::string& text) {
 void FieldRun::run_tasks(int first_done) {
     report_progress = false;
     int reported = 0;
-    opt.tasks(tasks,
-              [&](int t) {
-                  run_task(t);
-                  return task_text(t);
-              },
-              [&](int t, const std::string& text) {
-                  reported += read_task_text(t, text);
-                  if (opt.progress) opt.progress(first_done + reported, grid.size());
-              });
+    opt.tasks(
+        tasks,
+        [&](int t) {
+            run_task(t);
+            return task_text(t);
+        },
+        [&](int t, const std::string& text) {
+            reported += read_task_text(t, text);
+            if (opt.progress) opt.progress(first_done + reported, grid.size());
+        });
     f.threads = 0;
 }
 
@@ -412,7 +425,10 @@ void FieldRun::run_lines_on_threads(int threads) {
     std::vector<int> waiting(n, 0);
     std::vector<std::vector<int>> after(n);
     for (int l = 0; l < n; ++l)
-        for (int d : predecessors(lines[l])) { ++waiting[l]; after[d].push_back(l); }
+        for (int d : predecessors(lines[l])) {
+            ++waiting[l];
+            after[d].push_back(l);
+        }
     // Of the ready lines, the one with the most points still behind it (itself and its
     // longest chain of successors) goes first: fig6's 7^3 field (its costs per point
     // replayed on 2 workers) 1.85x -> 1.95x the one-thread time, against "first in order".
@@ -456,10 +472,13 @@ void FieldRun::settle_budget() {
     f.budget_spent = over || (opt.max_rhs_evaluations > 0 && f.rhs_evals > opt.max_rhs_evaluations);
 }
 
-}  // namespace
+}   // namespace
 
 Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
-    if (sc.part.point) { grid.nth = 1; grid.th0 = 0; }
+    if (sc.part.point) {
+        grid.nth = 1;
+        grid.th0 = 0;
+    }
     if (grid.nx < 1 || grid.ny < 1 || grid.nth < 1) throw std::invalid_argument("grid sizes must be >= 1");
     Field f;
     f.grid = grid;
@@ -488,8 +507,8 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     return f;
 }
 
-Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double sample_dt,
-                       const LimitCycleOptions& opt, double h) {
+Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double sample_dt, const LimitCycleOptions& opt,
+                       double h) {
     if (!(duration > 0 && sample_dt > 0 && h > 0)) throw std::invalid_argument("field_curve: times must be > 0");
     Trajectory tr;
     Vec3 q = q0, warm = Vec3::Zero();
@@ -523,11 +542,14 @@ Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double 
 
 const char* stability_name(Stability s) {
     switch (s) {
-        case Stability::Stable: return "stable";
-        case Stability::Unstable: return "unstable";
-        case Stability::Saddle: return "saddle";
+        case Stability::Stable:
+            return "stable";
+        case Stability::Unstable:
+            return "unstable";
+        case Stability::Saddle:
+            return "saddle";
     }
     return "?";
 }
 
-}  // namespace plate
+}   // namespace plate

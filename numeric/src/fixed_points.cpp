@@ -103,7 +103,7 @@ bool newton(ScaledField& f, VecX& z, double ftol, int max_it, double max_step, d
 // order 1e-4 relative.
 constexpr double kCut = 1e-3;
 
-}  // namespace
+}   // namespace
 
 // Stuck all period: every contact held the whole cycle, so the twist is exactly zero.
 static bool stuck_all_period(const FieldPoint& p, int dim) {
@@ -131,8 +131,7 @@ struct FixedPointSearch {
     FixedPoints out;
 
     FixedPointSearch(const Scene& sc, const Field& field, const FixedPointOptions& opt)
-        : field(field), opt(opt), g(field.grid), dim(sc.part.point ? 2 : 3), cycle(opt.cycle),
-          f{sc, cycle, dim, sc.part.rho()} {
+        : field(field), opt(opt), g(field.grid), dim(sc.part.point ? 2 : 3), cycle(opt.cycle), f{sc, cycle, dim, sc.part.rho()} {
         // field noise well below ftol (FixedPointOptions)
         cycle.integration.rtol = std::min(cycle.integration.rtol, 1e-3 * opt.ftol);
         cycle.tol = std::min(cycle.tol, 1e-2 * opt.ftol);
@@ -156,8 +155,8 @@ struct FixedPointSearch {
     bool in_cell(const Vec3& qc) const;
     bool candidate(int i, int j, int k);
     void search_cell(int i, int j, int k);
-    bool follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3,
-                     const VecX& v, const Vec3& q);
+    bool follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3, const VecX& v,
+                     const Vec3& q);
 };
 
 bool FixedPointSearch::known(const VecX& z, double radius) const {
@@ -192,7 +191,10 @@ bool FixedPointSearch::candidate(int i, int j, int k) {
     for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
         const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
         const FieldPoint& p = field.points[g.index(ii, jj, kk)];
-        if (!p.converged) { ok = false; break; }
+        if (!p.converged) {
+            ok = false;
+            break;
+        }
         const Vec3 v(p.twist[0], p.twist[1], f.rho * p.twist[2]);
         lo = lo.cwiseMin(v);
         hi = hi.cwiseMax(v);
@@ -234,7 +236,11 @@ void FixedPointSearch::search_cell(int i, int j, int k) {
 
     // Classify.
     MatX Jm;
-    try { Jm = f.J(z, h); } catch (const FieldUndefined&) { return; }
+    try {
+        Jm = f.J(z, h);
+    } catch (const FieldUndefined&) {
+        return;
+    }
     Eigen::EigenSolver<MatX> es(Jm);
     const Eigen::VectorXcd ev = es.eigenvalues();
     Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
@@ -258,8 +264,8 @@ void FixedPointSearch::search_cell(int i, int j, int k) {
 
 // Follows the null direction v of the zero z (at q; Jm its Jacobian, ev its eigenvalues) both ways;
 // kept as a line if it goes on for at least two points.
-bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev,
-                                   const Eigen::Vector3cd& ev3, const VecX& v, const Vec3& q) {
+bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3,
+                                   const VecX& v, const Vec3& q) {
     FixedLine line;
     std::vector<Vec3> fwd, bwd;
     for (int sgn : {1, -1}) {
@@ -291,13 +297,12 @@ bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::V
     int skip = 0;
     ev.cwiseAbs().minCoeff(&skip);
     line.stability = classify(ev, skip);
-    for (std::size_t m = 1; m < line.points.size(); ++m)
-        line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
+    for (std::size_t m = 1; m < line.points.size(); ++m) line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
     out.lines.push_back(line);
     return true;
 }
 
-}  // namespace
+}   // namespace
 
 FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPointOptions& opt) {
     FixedPointSearch run(sc, field, opt);
@@ -324,15 +329,17 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
 }
 
 std::string fixed_points_sentence(const FixedPoints& fp) {
-    auto count = [](std::size_t n, const char* one, const char* many) {
-        return std::to_string(n) + " " + (n == 1 ? one : many);
-    };
+    auto count = [](std::size_t n, const char* one, const char* many) { return std::to_string(n) + " " + (n == 1 ? one : many); };
     std::string s;
-    if (fp.points.empty() && fp.lines.empty()) s = "no fixed point found";
-    else if (fp.lines.empty()) s = count(fp.points.size(), "fixed point", "fixed points") + " found";
-    else if (fp.points.empty()) s = count(fp.lines.size(), "line of fixed points", "lines of fixed points") + " found";
-    else s = count(fp.points.size(), "fixed point", "fixed points") + " and " +
-             count(fp.lines.size(), "line of fixed points", "lines of fixed points") + " found";
+    if (fp.points.empty() && fp.lines.empty())
+        s = "no fixed point found";
+    else if (fp.lines.empty())
+        s = count(fp.points.size(), "fixed point", "fixed points") + " found";
+    else if (fp.points.empty())
+        s = count(fp.lines.size(), "line of fixed points", "lines of fixed points") + " found";
+    else
+        s = count(fp.points.size(), "fixed point", "fixed points") + " and " +
+            count(fp.lines.size(), "line of fixed points", "lines of fixed points") + " found";
     if (fp.undefined_cells > 0)
         s += " in the defined part (" + std::to_string(fp.undefined_cells) + " of " + std::to_string(fp.cells) +
              " cells undefined: a corner has no cycle)";
@@ -346,4 +353,4 @@ std::string fixed_points_sentence(const FixedPoints& fp) {
     return s;
 }
 
-}  // namespace plate
+}   // namespace plate

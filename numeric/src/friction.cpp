@@ -9,10 +9,14 @@ namespace plate {
 
 const char* friction_law_name(FrictionLaw f) {
     switch (f) {
-        case FrictionLaw::Coulomb: return "coulomb";
-        case FrictionLaw::Tanh: return "tanh";
-        case FrictionLaw::Linear: return "linear";
-        case FrictionLaw::Sqrt: return "sqrt";
+        case FrictionLaw::Coulomb:
+            return "coulomb";
+        case FrictionLaw::Tanh:
+            return "tanh";
+        case FrictionLaw::Linear:
+            return "linear";
+        case FrictionLaw::Sqrt:
+            return "sqrt";
     }
     return "?";
 }
@@ -38,11 +42,18 @@ Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v)
 
 gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho) {
     gen::WrenchInput in;
-    in.N1 = n[0]; in.N2 = n[1]; in.N3 = n[2];
-    in.r1x = r[0].x(); in.r1y = r[0].y();
-    in.r2x = r[1].x(); in.r2y = r[1].y();
-    in.r3x = r[2].x(); in.r3y = r[2].y();
-    in.mu1 = mu[0]; in.mu2 = mu[1]; in.mu3 = mu[2];
+    in.N1 = n[0];
+    in.N2 = n[1];
+    in.N3 = n[2];
+    in.r1x = r[0].x();
+    in.r1y = r[0].y();
+    in.r2x = r[1].x();
+    in.r2y = r[1].y();
+    in.r3x = r[2].x();
+    in.r3y = r[2].y();
+    in.mu1 = mu[0];
+    in.mu2 = mu[1];
+    in.mu3 = mu[2];
     in.rho = rho;
     return in;
 }
@@ -131,7 +142,10 @@ bool kink_optimum(const GaugeProblem& p, FrictionGauge& g) {
             if (j == k) continue;
             const Vec2 v = p.Gt(j, d);
             const double nv = v.norm();
-            if (!(nv > 0)) { ok = false; break; }
+            if (!(nv > 0)) {
+                ok = false;
+                break;
+            }
             u[j] = v / nv;
             rhs -= cap[j] * p.Gf(j, u[j]);
             h += cap[j] * nv;
@@ -188,7 +202,11 @@ double newton(GaugeProblem& p, Vec2& y, Vec3& d, double& h, FrictionGauge& g) {
             if (h1 <= h + 1e-4 * alpha * slope) break;
         }
         const double moved = (alpha * step).norm();
-        if (h1 <= h) { y = y1; d = d0 + B * y; h = h1; }
+        if (h1 <= h) {
+            y = y1;
+            d = d0 + B * y;
+            h = h1;
+        }
         if (moved <= 1e-14 * (1 + y.norm()) || h1 > h) break;
     }
     return last_gy;
@@ -313,7 +331,7 @@ bool smoothed_repair(GaugeProblem& p, Vec2& y, double h, FrictionGauge& g) {
     return true;
 }
 
-}  // namespace
+}   // namespace
 
 FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const Vec2& F, double tau) {
     FrictionGauge g;
@@ -363,4 +381,4 @@ FrictionGauge friction_gauge(const Part& P, double theta, const Vec3& n, const V
     return g;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -18,9 +18,8 @@ namespace plate {
 std::string LimitCycleSummary::report() const {
     std::ostringstream s;
     s.precision(6);
-    s << (converged ? "converged" : "NOT converged") << " after " << periods << " periods; residual "
-      << residual << ", error estimate " << error_estimate << " (x v_ref), contraction " << contraction
-      << " per period\n";
+    s << (converged ? "converged" : "NOT converged") << " after " << periods << " periods; residual " << residual
+      << ", error estimate " << error_estimate << " (x v_ref), contraction " << contraction << " per period\n";
     s << "twist [" << twist.transpose() << "], min normal force " << min_normal_force << " N\n";
     s << "rhs evaluations " << stats.rhs_evals << ", steps " << stats.steps << " (+" << stats.rejected
       << " rejected), slip reversals " << stats.slip_reversals << "\n";
@@ -31,10 +30,14 @@ std::string LimitCycleSummary::report() const {
 
 const char* cycle_solver_name(CycleSolver s) {
     switch (s) {
-        case CycleSolver::PeriodByPeriod: return "period-by-period";
-        case CycleSolver::Anderson: return "anderson";
-        case CycleSolver::Newton: return "newton";
-        case CycleSolver::Shooting: return "shooting";
+        case CycleSolver::PeriodByPeriod:
+            return "period-by-period";
+        case CycleSolver::Anderson:
+            return "anderson";
+        case CycleSolver::Newton:
+            return "newton";
+        case CycleSolver::Shooting:
+            return "shooting";
     }
     return "?";
 }
@@ -42,8 +45,7 @@ const char* cycle_solver_name(CycleSolver s) {
 CycleSolver parse_cycle_solver(const std::string& name) {
     for (CycleSolver s : {CycleSolver::PeriodByPeriod, CycleSolver::Anderson, CycleSolver::Newton, CycleSolver::Shooting})
         if (name == cycle_solver_name(s)) return s;
-    throw std::invalid_argument("unknown cycle solver '" + name +
-                                "' (expected period-by-period, anderson, newton or shooting)");
+    throw std::invalid_argument("unknown cycle solver '" + name + "' (expected period-by-period, anderson, newton or shooting)");
 }
 
 // What the limit-cycle solvers share (described in cycle_solvers.hpp).
@@ -68,10 +70,9 @@ PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const In
     PeriodResult r;
     const Vec3 qd = sc.part.point ? Vec3(x[0], x[1], 0) : x;
     double min_n = std::numeric_limits<double>::infinity();
-    r.ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) &&
-           e.advance(sc.plate.T, [&](double, const auto&, const Vec3& n) {
-               min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
-           });
+    r.ok = e.start(0, {qd[0], qd[1], qd[2], 0, 0, 0}) && e.advance(sc.plate.T, [&](double, const auto&, const Vec3& n) {
+        min_n = std::min(min_n, n.head(sc.part.contacts()).minCoeff());
+    });
     r.stop = e.stop;
     total += e.stats;
     if (r.ok) {
@@ -83,7 +84,7 @@ PeriodResult one_period(const Scene& sc, const Vec3& q0, const Vec3& x, const In
     return r;
 }
 
-}  // namespace detail
+}   // namespace detail
 
 namespace {
 
@@ -154,8 +155,11 @@ struct PeriodIteration : detail::CycleRun {
     double r_floor = std::numeric_limits<double>::infinity();   // the last such return
 
     PeriodIteration(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd_init)
-        : CycleRun(sc, q0, opt), scale(twist_scale(sc)),
-          y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0}, prev(qd_init), anderson(opt.solver == CycleSolver::Anderson) {}
+        : CycleRun(sc, q0, opt),
+          scale(twist_scale(sc)),
+          y{qd_init[0], qd_init[1], qd_init[2], 0, 0, 0},
+          prev(qd_init),
+          anderson(opt.solver == CycleSolver::Anderson) {}
 
     void record(double t, const State& z, const Vec3& n) {
         if (opt.record) out.path.push_back(Sample{t, q0, model.qd(z), n, e.mode()});
@@ -295,14 +299,24 @@ void PeriodIteration::next_start(int k, double r, const Vec3& qd, bool began_fre
         // Plain periods until the map's own contraction is measured, then extrapolate.
         X.push_back(start.cwiseQuotient(scale));
         Fx.push_back(qd.cwiseQuotient(scale));
-        if (static_cast<int>(X.size()) > opt.anderson_memory + 1) { X.pop_front(); Fx.pop_front(); }
+        if (static_cast<int>(X.size()) > opt.anderson_memory + 1) {
+            X.pop_front();
+            Fx.pop_front();
+        }
         // Extrapolate only where the iteration contracts; forget the transient before.
-        if (r >= r_prev_plain) { X.erase(X.begin(), X.end() - 1); Fx.erase(Fx.begin(), Fx.end() - 1); }
+        if (r >= r_prev_plain) {
+            X.erase(X.begin(), X.end() - 1);
+            Fx.erase(Fx.begin(), Fx.end() - 1);
+        }
         r_prev_plain = r;
         if (k >= 2 && X.size() >= 2) {
             const Vec3 next = anderson_next(X, Fx).cwiseProduct(scale);
             extrapolated = next != prev;
-            e.modify([&](auto& z) { z[0] = next[0]; z[1] = next[1]; z[2] = sc.part.point ? 0.0 : next[2]; });
+            e.modify([&](auto& z) {
+                z[0] = next[0];
+                z[1] = next[1];
+                z[2] = sc.part.point ? 0.0 : next[2];
+            });
             prev = model.qd(e.y());
         }
     }
@@ -436,7 +450,7 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
     return out;
 }
 
-}  // namespace
+}   // namespace
 
 LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt_in, const Vec3& qd0) {
     // Within one period the engine's own budget applies: no more than the cycle's.
@@ -466,7 +480,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
             a.solver = CycleSolver::Anderson;
             return limit_cycle(sc, q0, a, qd0);
         }
-        LimitCycleSummary fast = shoot ? shooting_cycle(sc, q0, shooting_opt, qd0)
+        LimitCycleSummary fast = shoot                               ? shooting_cycle(sc, q0, shooting_opt, qd0)
                                  : opt.solver == CycleSolver::Newton ? newton_cycle(sc, q0, opt, qd0)
                                                                      : one_start(sc, q0, opt, qd0);
         if (fast.converged || fast.periods >= opt.max_periods || fast.stats.rhs_evals >= opt.max_rhs_evaluations ||
@@ -499,8 +513,7 @@ LimitCycleSummary limit_cycle(const Scene& sc, const Vec3& q0, const LimitCycleO
     return out;
 }
 
-bool period_map(const Scene& sc, const Vec3& q0, const Vec3& qd0, Vec3& out, const IntegrationOptions& opt,
-                StopEvent* stop) {
+bool period_map(const Scene& sc, const Vec3& q0, const Vec3& qd0, Vec3& out, const IntegrationOptions& opt, StopEvent* stop) {
     Stats ignored;
     const PeriodResult r = one_period(sc, q0, qd0, opt, ignored);
     if (stop) *stop = r.stop;
@@ -508,4 +521,4 @@ bool period_map(const Scene& sc, const Vec3& q0, const Vec3& qd0, Vec3& out, con
     return r.ok;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -14,8 +14,7 @@ bool Part::thin(double rel_tol) const {
     double size = 0;
     for (const auto& ci : c) size = std::max(size, ci.head<2>().norm());
     const double jscale = J.diagonal().maxCoeff();
-    return std::abs(c[0].z()) <= rel_tol * size && std::abs(J(0, 2)) <= rel_tol * jscale &&
-           std::abs(J(1, 2)) <= rel_tol * jscale;
+    return std::abs(c[0].z()) <= rel_tol * size && std::abs(J(0, 2)) <= rel_tol * jscale && std::abs(J(1, 2)) <= rel_tol * jscale;
 }
 
 const char* axis_name(Axis a) {
@@ -32,7 +31,10 @@ void PlateMotion::acceleration(double t, Vec3& pdd, Vec3& wd) const {
     for (const auto& h : harmonics) {
         const double v = h.amp * std::sin(h.n * w * t + h.phase);
         const int a = static_cast<int>(h.axis);
-        if (a < 3) pdd[a] += v; else wd[a - 3] += v;
+        if (a < 3)
+            pdd[a] += v;
+        else
+            wd[a - 3] += v;
     }
 }
 
@@ -44,7 +46,10 @@ void PlateMotion::velocity(double t, Vec3& pd, Vec3& w1) const {
         const double k = h.n * w;
         const double v = -h.amp / k * std::cos(k * t + h.phase);
         const int a = static_cast<int>(h.axis);
-        if (a < 3) pd[a] += v; else w1[a - 3] += v;
+        if (a < 3)
+            pd[a] += v;
+        else
+            w1[a - 3] += v;
     }
 }
 
@@ -56,7 +61,10 @@ void PlateMotion::displacement(double t, Vec3& p, Vec3& phi) const {
         const double k = h.n * w;
         const double v = -h.amp / (k * k) * std::sin(k * t + h.phase);
         const int a = static_cast<int>(h.axis);
-        if (a < 3) p[a] += v; else phi[a - 3] += v;
+        if (a < 3)
+            p[a] += v;
+        else
+            phi[a - 3] += v;
     }
 }
 
@@ -83,4 +91,4 @@ double Scene::v_ref() const {
     return a / plate.omega();
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -91,10 +91,9 @@ public:
         const double x2 = x * x;
         // (Estrin's scheme in x^2: a shorter chain of dependent operations than Horner's)
         const double x4 = x2 * x2, x8 = x4 * x4;
-        const double sx = x + x * x2 * ((-1.0 / 6 + x2 * (1.0 / 120)) + x4 * (-1.0 / 5040 + x2 * (1.0 / 362880)) +
-                                        x8 * (-1.0 / 39916800));
-        const double cx = 1 + x2 * ((-0.5 + x2 * (1.0 / 24)) + x4 * (-1.0 / 720 + x2 * (1.0 / 40320)) +
-                                    x8 * (-1.0 / 3628800));
+        const double sx =
+            x + x * x2 * ((-1.0 / 6 + x2 * (1.0 / 120)) + x4 * (-1.0 / 5040 + x2 * (1.0 / 362880)) + x8 * (-1.0 / 39916800));
+        const double cx = 1 + x2 * ((-0.5 + x2 * (1.0 / 24)) + x4 * (-1.0 / 720 + x2 * (1.0 / 40320)) + x8 * (-1.0 / 3628800));
         const int m = static_cast<int>(static_cast<long long>(jd) & 15);
         s = sin_[m] * cx + cos_[m] * sx;
         c = cos_[m] * cx - sin_[m] * sx;
@@ -138,11 +137,18 @@ struct ReducedModel {
         t_last = t;
         if (!(mode.kind == ModeKind::Slide && !stick_slip(ws).creep && reduced_U_slide(sc, q0, qd, ps_last, ws)))
             mode_accelerations(sc, level, q0, qd, ps_last, mode, ws);
-        for (int i = 0; i < 3; ++i) { dy[i] = ws.qdd[i]; dy[3 + i] = qd[i]; }
+        for (int i = 0; i < 3; ++i) {
+            dy[i] = ws.qdd[i];
+            dy[3 + i] = qd[i];
+        }
     }
     Vec3 q(const State&) const { return q0; }
     Vec3 qd(const State& y) const { return Vec3(y[0], y[1], y[2]); }
-    void set_qd(State& y, const Vec3& v) const { y[0] = v[0]; y[1] = v[1]; y[2] = v[2]; }
+    void set_qd(State& y, const Vec3& v) const {
+        y[0] = v[0];
+        y[1] = v[1];
+        y[2] = v[2];
+    }
     PlateState plate(double t, const State&) const { return u.state(t, level); }
     PlateState plate_at(double t) const { return t == t_last ? ps_last : u.state(t, level); }
     State scale() const {
@@ -165,12 +171,19 @@ struct UModel {
     void rhs(double t, const State& y, State& dy) {
         u.acceleration(t, ps_);   // (R1 and w1 stay identity and zero: unused at this level)
         mode_accelerations(sc, level, q(y), qd(y), ps_, mode, ws);
-        for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; }
+        for (int i = 0; i < 3; ++i) {
+            dy[i] = y[3 + i];
+            dy[3 + i] = ws.qdd[i];
+        }
     }
     PlateState ps_;
     Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
-    void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }
+    void set_qd(State& y, const Vec3& v) const {
+        y[3] = v[0];
+        y[4] = v[1];
+        y[5] = v[2];
+    }
     PlateState plate(double t, const State&) const { return u.state(t, level); }
     State scale() const {
         const Scales s(sc);
@@ -192,14 +205,20 @@ struct FullModel {
         const PlateState ps = plate(t, y);
         mode_accelerations(sc, level, q(y), qd(y), ps, mode, ws);
         const Vec3 phid = dexp_inv(Vec3(y[6], y[7], y[8]), ps.w1);
-        for (int i = 0; i < 3; ++i) { dy[i] = y[3 + i]; dy[3 + i] = ws.qdd[i]; dy[6 + i] = phid[i]; }
+        for (int i = 0; i < 3; ++i) {
+            dy[i] = y[3 + i];
+            dy[3 + i] = ws.qdd[i];
+            dy[6 + i] = phid[i];
+        }
     }
     Vec3 q(const State& y) const { return Vec3(y[0], y[1], y[2]); }
     Vec3 qd(const State& y) const { return Vec3(y[3], y[4], y[5]); }
-    void set_qd(State& y, const Vec3& v) const { y[3] = v[0]; y[4] = v[1]; y[5] = v[2]; }
-    PlateState plate(double t, const State& y) const {
-        return u.state(t, level, exp_so3(Vec3(y[6], y[7], y[8])));
+    void set_qd(State& y, const Vec3& v) const {
+        y[3] = v[0];
+        y[4] = v[1];
+        y[5] = v[2];
     }
+    PlateState plate(double t, const State& y) const { return u.state(t, level, exp_so3(Vec3(y[6], y[7], y[8]))); }
     State scale() const {
         const Scales s(sc);
         const double w = sc.plate.omega();
@@ -208,4 +227,4 @@ struct FullModel {
     }
 };
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -39,9 +39,12 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
     const Part& P = sc.part;
     const Vec6 b = rhs_b(sc, level, q, qd, ps);
     gen::KernelInput in = mode_input(q, qd, ws);
-    in.u1x = u[0].x(); in.u1y = u[0].y();
-    in.u2x = u[1].x(); in.u2y = u[1].y();
-    in.u3x = u[2].x(); in.u3y = u[2].y();
+    in.u1x = u[0].x();
+    in.u1y = u[0].y();
+    in.u2x = u[1].x();
+    in.u2y = u[1].y();
+    in.u3x = u[2].x();
+    in.u3y = u[2].y();
     Eigen::Matrix<double, 8, 8, Eigen::RowMajor> M;
     double c[2] = {0, 0};
     using System = void (*)(const gen::KernelInput&, double*, double*);
@@ -90,13 +93,16 @@ void stuck_solve(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd,
     ws.tau_needed = w[2];
 }
 
-}  // namespace
+}   // namespace
 
 std::string mode_name(const Mode& m) {
     switch (m.kind) {
-        case ModeKind::Slide: return "slide";
-        case ModeKind::Pivot: return "pivot" + std::to_string(m.k + 1);
-        case ModeKind::Stuck: return "stuck";
+        case ModeKind::Slide:
+            return "slide";
+        case ModeKind::Pivot:
+            return "pivot" + std::to_string(m.k + 1);
+        case ModeKind::Stuck:
+            return "stuck";
     }
     return "?";
 }
@@ -106,7 +112,7 @@ namespace {
 Vec2 contact_acceleration_at(const Vec2& r, Dynamics level, const Vec3& qd, const Vec3& qdd) {
     return qdd.head<2>() + qdd[2] * perp(r) - kappa(level) * qd[2] * qd[2] * r;
 }
-}  // namespace
+}   // namespace
 
 Vec2 contact_acceleration(const Part& P, Dynamics level, int i, const Vec3& q, const Vec3& qd, const Vec3& qdd) {
     if (P.point) return qdd.head<2>();
@@ -181,8 +187,7 @@ void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, c
 // slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
 // first order at the rim's direction). Newton's method on the angles, from the last solution
 // (StickSlipState::hint), with a forward-difference Jacobian; leaves ws evaluated at the solution.
-void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                         Workspace& ws) {
+void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
     detail::StickSlipState& ss = detail::stick_slip(ws);
     const Part& P = sc.part;
@@ -229,10 +234,12 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
             for (int j = 0; j < m; ++j) J(j, l) = (cj[j] - c[j]) / dphi;
         }
         Eigen::Vector3d step = Eigen::Vector3d::Zero();
-        if (m == 1) step[0] = -c[0] / J(0, 0);   // (one creeping contact, the usual case: no LU)
-        else step.head(m) = -J.topLeftCorner(m, m).partialPivLu().solve(c.head(m));
-        if (!step.allFinite()) step.setZero();       // a singular Jacobian: keep the last directions
-        step = step.cwiseMax(-0.5).cwiseMin(0.5);    // (a Newton step of at most ~30 degrees)
+        if (m == 1)
+            step[0] = -c[0] / J(0, 0);   // (one creeping contact, the usual case: no LU)
+        else
+            step.head(m) = -J.topLeftCorner(m, m).partialPivLu().solve(c.head(m));
+        if (!step.allFinite()) step.setZero();      // a singular Jacobian: keep the last directions
+        step = step.cwiseMax(-0.5).cwiseMin(0.5);   // (a Newton step of at most ~30 degrees)
         phi += step;
         set_angles(phi);
         accelerations(sc, level, q, qd, ps, ws);
@@ -267,7 +274,9 @@ void release_twist(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
         Vec3 Qn;
         const double rn = misfit(next, Qn);
         if (rn <= r) {
-            xi = next; Q = Qn; r = rn;
+            xi = next;
+            Q = Qn;
+            r = rn;
             tau = std::min(0.5, 1.5 * tau);
         } else {
             tau *= 0.3;
@@ -277,18 +286,20 @@ void release_twist(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
     ss.creep_twist = xi;
 }
 
-}  // namespace
+}   // namespace
 
-void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
-                        const Mode& mode, Workspace& ws) {
+void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, const Mode& mode,
+                        Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
     detail::StickSlipState& ss = detail::stick_slip(ws);
     const Part& P = sc.part;
     if (ks.prepared != &sc) ws.prepare(sc);
     switch (mode.kind) {
         case ModeKind::Slide:
-            if (ss.creep) creep_accelerations(sc, level, q, qd, ps, ws);
-            else accelerations(sc, level, q, qd, ps, ws);
+            if (ss.creep)
+                creep_accelerations(sc, level, q, qd, ps, ws);
+            else
+                accelerations(sc, level, q, qd, ps, ws);
             return;
         case ModeKind::Stuck:
             ++ws.evals;
@@ -322,7 +333,10 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
     ModeChoice out;
     int count = 0, k = -1;
     for (int i = 0; i < nc; ++i)
-        if (zero & (1u << i)) { ++count; k = i; }
+        if (zero & (1u << i)) {
+            ++count;
+            k = i;
+        }
     auto normal_ok = [&]() {
         int arg = 0;
         if (ws.n.head(nc).minCoeff(&arg) < 0) {
@@ -358,7 +372,8 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
         std::array<Vec2, 3> v;
         slip_velocities(P, q, qd, v);
         qd.head<2>() -= v[k];
-        if (qd[2] == 0) count = 3;   // the others are then at rest too
+        if (qd[2] == 0)
+            count = 3;   // the others are then at rest too
         else {
             Mode pivot{ModeKind::Pivot, k, qd[2] > 0 ? 1.0 : -1.0};
             mode_accelerations(sc, level, q, qd, ps, pivot, ws);
@@ -424,15 +439,16 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
         ss.creep_twist = d.norm() > 0 ? Vec3(-d.normalized()) : Vec3::Zero();
     }
     if (g.gamma > 1 + 1e-6) {
-        if (P.point) refine_hints(all);
-        else release_twist(sc, level, q, qd, ps, ws);
+        if (P.point)
+            refine_hints(all);
+        else
+            release_twist(sc, level, q, qd, ps, ws);
     }
     out.mode = Mode{};
     return out;
 }
 
-StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd,
-                     const PlateState& ps) {
+StickTest stick_test(const Scene& sc, Dynamics level, int k, const Vec3& q, const Vec3& qd, const PlateState& ps) {
     const Part& P = sc.part;
     Workspace ws;
     StickTest r;
@@ -461,9 +477,8 @@ StickTest stick_test_all(const Scene& sc, Dynamics level, const Vec3& q, const V
     r.friction_needed = ws.F_needed.norm();
     const ContactFriction fr = sc.part.friction();
     for (int i = 0; i < nc; ++i) r.friction_available += fr.disk(i, ws.n[i]);
-    r.sticks = ws.n.head(nc).minCoeff() >= 0 &&
-               friction_gauge(sc.part, q[2], ws.n, ws.F_needed, ws.tau_needed).gamma <= 1;
+    r.sticks = ws.n.head(nc).minCoeff() >= 0 && friction_gauge(sc.part, q[2], ws.n, ws.F_needed, ws.tau_needed).gamma <= 1;
     return r;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -39,7 +39,7 @@ json eig(const Eigen::Vector3cd& e, int n) {
     return a;
 }
 
-}  // namespace
+}   // namespace
 
 json to_json(const Scene& sc, const Vec3& q, const LimitCycleSummary& lc) {
     const int d = sc.part.point ? 2 : 3;
@@ -64,7 +64,8 @@ json to_json(const Scene& sc, const Vec3& q, const LimitCycleSummary& lc) {
     j["mode_sequence"] = modes;
     j["stuck_all_period"] = lc.stuck_all_period();
     if (lc.stuck_all_period())
-        j["stuck_note"] = "the part rides the plate all period long (static friction holds it): the asymptotic twist is exactly zero";
+        j["stuck_note"] =
+            "the part rides the plate all period long (static friction holds it): the asymptotic twist is exactly zero";
     j["stop"] = stop_name(lc.stop.reason);
     if (lc.stop.reason != StopReason::None) {
         j["stop_message"] = lc.stop.describe();
@@ -88,17 +89,24 @@ json to_json(const Scene& sc, const Field& f) {
     json j;
     j["scene"] = sc.name;
     j["kind"] = f.point_part ? "asymptotic velocity field" : "asymptotic twist field";
-    j["grid"] = {{"nx", f.grid.nx}, {"ny", f.grid.ny}, {"ntheta", f.point_part ? 1 : f.grid.nth},
-                 {"x", {f.grid.x0, f.grid.x1}}, {"y", {f.grid.y0, f.grid.y1}},
+    j["grid"] = {{"nx", f.grid.nx},
+                 {"ny", f.grid.ny},
+                 {"ntheta", f.point_part ? 1 : f.grid.nth},
+                 {"x", {f.grid.x0, f.grid.x1}},
+                 {"y", {f.grid.y0, f.grid.y1}},
                  {"theta0", f.grid.th0}};
     j["seconds"] = f.seconds;
     j["threads"] = f.threads;
     j["rhs_evaluations"] = f.rhs_evals;
     json pts = json::array();
     for (const auto& p : f.points) {
-        pts.push_back({{"at", vec(p.q, d)}, {"twist", vec(p.twist, d)}, {"converged", p.converged},
-                       {"periods", p.periods}, {"residual", num(p.residual)},
-                       {"min_normal_force", num(p.min_normal_force)}, {"stop", stop_name(p.stop)},
+        pts.push_back({{"at", vec(p.q, d)},
+                       {"twist", vec(p.twist, d)},
+                       {"converged", p.converged},
+                       {"periods", p.periods},
+                       {"residual", num(p.residual)},
+                       {"min_normal_force", num(p.min_normal_force)},
+                       {"stop", stop_name(p.stop)},
                        {"stick_fraction", stick_fractions(p.stick_fraction, d == 2 ? 1 : 3)}});
     }
     j["points"] = pts;
@@ -111,23 +119,29 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
     j["scene"] = sc.name;
     json pts = json::array();
     for (const auto& p : fp.points)
-        pts.push_back({{"at", vec(p.q, d)}, {"stability", stability_name(p.stability)},
-                       {"eigenvalues", eig(p.eigenvalues, d)}, {"residual", num(p.residual)}});
+        pts.push_back({{"at", vec(p.q, d)},
+                       {"stability", stability_name(p.stability)},
+                       {"eigenvalues", eig(p.eigenvalues, d)},
+                       {"residual", num(p.residual)}});
     json lines = json::array();
     for (const auto& l : fp.lines) {
         json ps = json::array();
         for (const auto& q : l.points) ps.push_back(vec(q, d));
-        lines.push_back({{"stability", stability_name(l.stability)}, {"direction", vec(l.direction, d)},
-                         {"from", vec(l.points.front(), d)}, {"to", vec(l.points.back(), d)},
-                         {"length", num(l.length)}, {"eigenvalues", eig(l.eigenvalues, d)}, {"points", ps}});
+        lines.push_back({{"stability", stability_name(l.stability)},
+                         {"direction", vec(l.direction, d)},
+                         {"from", vec(l.points.front(), d)},
+                         {"to", vec(l.points.back(), d)},
+                         {"length", num(l.length)},
+                         {"eigenvalues", eig(l.eigenvalues, d)},
+                         {"points", ps}});
     }
     j["points"] = pts;
     j["lines"] = lines;
     j["candidate_cells"] = fp.candidates;
     j["cells"] = fp.cells;
-    j["undefined_cells"] = fp.undefined_cells;   // skipped: a corner has no cycle
+    j["undefined_cells"] = fp.undefined_cells;     // skipped: a corner has no cycle
     j["unsearched_cells"] = fp.unsearched_cells;   // left when the evaluation budget was spent
-    j["stuck_cells"] = fp.stuck_cells;           // skipped: a corner is stuck all period (fixed region)
+    j["stuck_cells"] = fp.stuck_cells;             // skipped: a corner is stuck all period (fixed region)
     j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
     j["rhs_evaluations"] = fp.rhs_evaluations;
@@ -138,8 +152,10 @@ void write_field_csv(std::ostream& out, const Field& f) {
     // 17 significant digits (the numbers read back to the same doubles); an undefined twist (no
     // cycle there: converged = 0, stop says why) is left empty, not "nan".
     out << std::setprecision(17);
-    if (f.point_part) out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop,stick_1\n";
-    else out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop,stick_1,stick_2,stick_3\n";
+    if (f.point_part)
+        out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop,stick_1\n";
+    else
+        out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop,stick_1,stick_2,stick_3\n";
     auto v = [](double x) {
         if (!std::isfinite(x)) return std::string();
         std::ostringstream s;
@@ -167,8 +183,10 @@ void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_pa
         if (std::isfinite(x)) out << x;
         return out;
     };
-    if (point_part) out << "t,s_x,s_y,s_x_dot,s_y_dot,N1,mode\n";
-    else out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n";
+    if (point_part)
+        out << "t,s_x,s_y,s_x_dot,s_y_dot,N1,mode\n";
+    else
+        out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n";
     for (const auto& s : tr.samples) {
         num(s.t) << ',';
         num(s.q[0]) << ',';
@@ -239,14 +257,13 @@ extern "C" void remove_tmp_and_die(int sig) {
     std::signal(sig, SIG_DFL);
     std::raise(sig);
 }
-}  // namespace
+}   // namespace
 
 void install_interrupt_cleanup() {
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, remove_tmp_and_die);
 }
 
-void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write,
-                       std::ostream& standard_output) {
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write, std::ostream& standard_output) {
     if (path == "-") {
         write(standard_output);
         standard_output.flush();
@@ -260,7 +277,9 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     }
     struct Untrack {
         bool on;
-        ~Untrack() { if (on) g_has_tmp = 0; }
+        ~Untrack() {
+            if (on) g_has_tmp = 0;
+        }
     } untrack{tracked};
     try {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -282,4 +301,4 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     }
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -9,8 +9,7 @@ namespace plate {
 Scene random_scene(std::uint64_t seed, const RandomSceneOptions& opt) {
     Rng r(seed);
     Scene sc;
-    sc.name = std::string(opt.point ? "random-point-" : opt.thin ? "random-thin-" : "random-thick-") +
-              std::to_string(seed);
+    sc.name = std::string(opt.point ? "random-point-" : opt.thin ? "random-thin-" : "random-thick-") + std::to_string(seed);
     sc.g = 9.81;
     Part& P = sc.part;
     P.point = opt.point;
@@ -77,4 +76,4 @@ Scene random_scene(std::uint64_t seed, const RandomSceneOptions& opt) {
     return sc;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -25,8 +25,10 @@ struct Reader {
     static std::string printable(const std::string& s) {
         std::string o;
         for (unsigned char c : s) {
-            if (c == '\n') o += "\\n";
-            else if (c == '\t') o += "\\t";
+            if (c == '\n')
+                o += "\\n";
+            else if (c == '\t')
+                o += "\\t";
             else if (c < 0x20 || c == 0x7f) {
                 static const char* hex = "0123456789abcdef";
                 o += "\\x";
@@ -43,15 +45,12 @@ struct Reader {
                    const std::set<std::string>& required) const {
         if (!obj.is_object()) fail(field.empty() ? "(top level)" : field, "expected an object");
         for (auto it = obj.begin(); it != obj.end(); ++it)
-            if (!allowed.count(it.key()))
-                fail(join(field, it.key()), "unknown field (allowed: " + list(allowed) + ")");
+            if (!allowed.count(it.key())) fail(join(field, it.key()), "unknown field (allowed: " + list(allowed) + ")");
         for (const auto& k : required)
             if (!obj.contains(k)) fail(join(field, k), "missing required field");
     }
 
-    static std::string join(const std::string& a, const std::string& b) {
-        return a.empty() ? b : a + "." + b;
-    }
+    static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
     static std::string list(const std::set<std::string>& s) {
         std::string out;
         for (const auto& k : s) out += (out.empty() ? "" : ", ") + k;
@@ -74,8 +73,7 @@ struct Reader {
     Vec3 vec3(const json& v, const std::string& field) const {
         if (!v.is_array() || v.size() != 3)
             fail(field, "expected an array of 3 numbers" +
-                            (v.is_array() ? ", got " + std::to_string(v.size()) + " entries"
-                                          : std::string()));
+                            (v.is_array() ? ", got " + std::to_string(v.size()) + " entries" : std::string()));
         Vec3 out;
         for (int i = 0; i < 3; ++i) out[i] = number(v[i], field + "[" + std::to_string(i) + "]");
         return out;
@@ -113,7 +111,7 @@ struct Support {
     }
 };
 
-}  // namespace
+}   // namespace
 
 Scene parse_scene(const std::string& text, const std::string& source) {
     Reader r{source};
@@ -126,17 +124,20 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         // Report a line and column rather than a byte offset.
         std::size_t line = 1, col = 1;
         for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-            if (text[i] == '\n') { ++line; col = 1; } else { ++col; }
+            if (text[i] == '\n') {
+                ++line;
+                col = 1;
+            } else {
+                ++col;
+            }
         }
-        throw InputError(source + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                         ": malformed JSON: " + e.what());
+        throw InputError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": malformed JSON: " + e.what());
     }
 
     Scene s;
     s.source = source;
     r.only_keys(doc, "", {"name", "gravity", "part", "plate"}, {"name", "gravity", "part", "plate"});
-    if (!doc["name"].is_string() || doc["name"].get<std::string>().empty())
-        r.fail("name", "expected a non-empty string");
+    if (!doc["name"].is_string() || doc["name"].get<std::string>().empty()) r.fail("name", "expected a non-empty string");
     s.name = doc["name"].get<std::string>();
     s.g = r.positive(doc["gravity"], "gravity");
 
@@ -147,8 +148,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     if (point) {
         r.only_keys(p, "part", {"mass", "friction"}, {"mass", "friction"});
     } else {
-        r.only_keys(p, "part", {"mass", "inertia", "contacts", "friction"},
-                    {"mass", "inertia", "contacts", "friction"});
+        r.only_keys(p, "part", {"mass", "inertia", "contacts", "friction"}, {"mass", "inertia", "contacts", "friction"});
     }
     Part& part = s.part;
     part.point = point;
@@ -161,20 +161,16 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     } else if (f.is_array() && f.size() == 1 && point) {
         part.mu.setConstant(r.number(f[0], "part.friction[0]"));
     } else {
-        r.fail("part.friction", point ? "expected one number for a point part"
-                                      : "expected one number or an array of 3 numbers");
+        r.fail("part.friction", point ? "expected one number for a point part" : "expected one number or an array of 3 numbers");
     }
     for (int i = 0; i < part.contacts(); ++i)
-        if (part.mu[i] < 0)
-            r.fail("part.friction", "expected friction coefficients >= 0, got " + Reader::fmt(part.mu[i]));
+        if (part.mu[i] < 0) r.fail("part.friction", "expected friction coefficients >= 0, got " + Reader::fmt(part.mu[i]));
     if (!point) {
         const json& I = p["inertia"];
         if (!I.is_array() || I.size() != 3) r.fail("part.inertia", "expected a 3x3 array of numbers");
-        for (int i = 0; i < 3; ++i)
-            part.J.row(i) = r.vec3(I[i], "part.inertia[" + std::to_string(i) + "]").transpose();
+        for (int i = 0; i < 3; ++i) part.J.row(i) = r.vec3(I[i], "part.inertia[" + std::to_string(i) + "]").transpose();
         const json& C = p["contacts"];
-        if (!C.is_array() || C.size() != 3)
-            r.fail("part.contacts", "expected exactly 3 contact points, each [x, y, z]");
+        if (!C.is_array() || C.size() != 3) r.fail("part.contacts", "expected exactly 3 contact points, each [x, y, z]");
         for (int i = 0; i < 3; ++i) part.c[i] = r.vec3(C[i], "part.contacts[" + std::to_string(i) + "]");
     }
 
@@ -194,7 +190,10 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         bool found = false;
         if (a.is_string())
             for (const auto& [name, axis] : axes)
-                if (a.get<std::string>() == name) { h.axis = axis; found = true; }
+                if (a.get<std::string>() == name) {
+                    h.axis = axis;
+                    found = true;
+                }
         if (!found) r.fail(fk + ".axis", "expected one of \"x\", \"y\", \"z\", \"rx\", \"ry\", \"rz\"");
         const json& n = H[k]["n"];
         if (!n.is_number_integer() || n.get<long>() < 1 || n.get<long>() > 1000)
@@ -216,7 +215,8 @@ void validate_scene(const Scene& s) {
     // Ranges of the model's world (a rigid part on a rigid plate under Coulomb friction): outside
     // them the numbers are unit errors or outside the physics, and products such as m g or mu N
     // would lose the range of a double in the solves.
-    if (s.g > kMaxGravity) r.fail("gravity", Reader::fmt(s.g) + " m/s^2 is above " + Reader::fmt(kMaxGravity) + " m/s^2 (about 100 g)");
+    if (s.g > kMaxGravity)
+        r.fail("gravity", Reader::fmt(s.g) + " m/s^2 is above " + Reader::fmt(kMaxGravity) + " m/s^2 (about 100 g)");
     if (p.m < kMassRange[0] || p.m > kMassRange[1])
         r.fail("part.mass", Reader::fmt(p.m) + " kg is outside " + Reader::fmt(kMassRange[0]) + " to " +
                                 Reader::fmt(kMassRange[1]) + " kg (a microgram to a thousand tonnes)");
@@ -226,13 +226,11 @@ void validate_scene(const Scene& s) {
                                    Reader::fmt(kPeriodRange[1]) + " s (100 kHz to a thousandth of a hertz): a rigid plate " +
                                    "under Coulomb friction is not a model of it");
     for (int i = 0; i < p.contacts(); ++i)
-        if (!(std::isfinite(p.mu[i]) && p.mu[i] >= 0))
-            r.fail("part.friction", "expected finite friction coefficients >= 0");
+        if (!(std::isfinite(p.mu[i]) && p.mu[i] >= 0)) r.fail("part.friction", "expected finite friction coefficients >= 0");
     if (!p.point) {
         if (!p.J.allFinite()) r.fail("part.inertia", "expected finite numbers");
         const double scale = p.J.cwiseAbs().maxCoeff();
-        if ((p.J - p.J.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
-            r.fail("part.inertia", "expected a symmetric matrix");
+        if ((p.J - p.J.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) r.fail("part.inertia", "expected a symmetric matrix");
         Eigen::LLT<Mat3> llt(p.J);
         if (scale <= 0 || llt.info() != Eigen::Success ||
             Eigen::SelfAdjointEigenSolver<Mat3>(p.J).eigenvalues().minCoeff() <= 1e-12 * scale)
@@ -265,14 +263,16 @@ void validate_scene(const Scene& s) {
         int k = 0;
         share.minCoeff(&k);
         if (share[k] < 0)
-            r.fail("part.contacts", "the part tips over: the centre of mass's projection (0, 0) lies outside the support "
-                                    "triangle (at rest contact " + std::to_string(k + 1) + " would need a normal force of " +
-                                    Reader::fmt(share[k]) + " m g)");
+            r.fail("part.contacts",
+                   "the part tips over: the centre of mass's projection (0, 0) lies outside the support "
+                   "triangle (at rest contact " +
+                       std::to_string(k + 1) + " would need a normal force of " + Reader::fmt(share[k]) + " m g)");
         // Inertia of a rigid body: principal moments satisfy the triangle inequality.
         const Vec3 lam = Eigen::SelfAdjointEigenSolver<Mat3>(p.J).eigenvalues();   // ascending
         if (lam[0] + lam[1] < lam[2] * (1 - 1e-9))
             r.fail("part.inertia", "principal moments " + Reader::fmt(lam[0]) + ", " + Reader::fmt(lam[1]) + ", " +
-                                       Reader::fmt(lam[2]) + " violate the triangle inequality A + B >= C: no rigid body "
+                                       Reader::fmt(lam[2]) +
+                                       " violate the triangle inequality A + B >= C: no rigid body "
                                        "has this inertia");
         // Inertia against mass and size: the radius of gyration about z against the contacts'
         // distance from the centre of mass. Real parts lie within two orders of magnitude of each
@@ -294,8 +294,8 @@ void validate_scene(const Scene& s) {
         if (!std::isfinite(h.amp) || !std::isfinite(h.phase) || h.n < 1)
             r.fail("plate.harmonics[" + std::to_string(k) + "]", "expected finite amp and phase, n >= 1");
         if (std::abs(h.amp) > kMaxAmplitude)
-            r.fail("plate.harmonics[" + std::to_string(k) + "].amp", Reader::fmt(h.amp) + " is above " +
-                                                                         Reader::fmt(kMaxAmplitude) + " (m/s^2 or rad/s^2) in size");
+            r.fail("plate.harmonics[" + std::to_string(k) + "].amp",
+                   Reader::fmt(h.amp) + " is above " + Reader::fmt(kMaxAmplitude) + " (m/s^2 or rad/s^2) in size");
     }
 }
 
@@ -390,4 +390,4 @@ Scene load_scene(const std::string& path) {
     return parse_scene(buf.str(), path);
 }
 
-}  // namespace plate
+}   // namespace plate

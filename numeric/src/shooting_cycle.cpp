@@ -53,8 +53,8 @@ using detail::twist_scale;
 // 1 410, 0.177 -> 0.157 s on two threads; its largest errors against the rtol-1e-11 reference
 // unchanged (1.66e-7 v_ref sliding, 6.63e-7 sticking; median of the sticking ones 4.2e-8 -> 3.5e-8).
 constexpr double kDifferenceMonodromyNear = 3e-2;   // |P(x) - x| / scale below which (see the loop)
-constexpr int kPlainPeriodsMax = 20;                 // plain periods toward a switching cycle, then Anderson
-constexpr double kPaError = 0.02;                    // relative error allowed for Pa (and M) in the estimates
+constexpr int kPlainPeriodsMax = 20;                // plain periods toward a switching cycle, then Anderson
+constexpr double kPaError = 0.02;                   // relative error allowed for Pa (and M) in the estimates
 
 // One shooting_cycle: the engine, the iterate x and its monodromy, and what the stages of a period
 // share -- its integration with the variational equations, the full stick's acceptance, the
@@ -67,14 +67,14 @@ struct Shooting : detail::CycleRun {
     LimitCycleSummary out;
     Vec3 x;
     bool refresh = true;
-    bool reset_prev = false;   // the last period stuck fully (its end is the cycle's start)
+    bool reset_prev = false;                                      // the last period stuck fully (its end is the cycle's start)
     double res_floor = std::numeric_limits<double>::infinity();   // its return, if it began fresh too
-    Stats fd_stats;   // the difference monodromies' periods
+    Stats fd_stats;                                               // the difference monodromies' periods
     int fd_periods = 0;
     int plain_periods = 0;
     Mat3 M = Mat3::Zero(), Pa = Mat3::Zero();
     bool loose;
-    bool on_curve = false;   // x is the previous period's end (on the period map's image)
+    bool on_curve = false;      // x is the previous period's end (on the period map's image)
     Vec3 line = Vec3::Zero();   // with a rank-one M: its range, along which the iterates stay
     double d_prev = std::numeric_limits<double>::infinity();
     // The period just integrated (integrate): its integration options (the difference periods run
@@ -87,8 +87,12 @@ struct Shooting : detail::CycleRun {
     Mat3 Phi, Psi;
 
     Shooting(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0)
-        : CycleRun(sc, q0, opt), S(twist_scale(sc)), nc(sc.part.contacts()), point(sc.part.point),
-          x(point ? Vec3(qd0[0], qd0[1], 0) : qd0), loose(opt.integration.large_slip_factor != 1) {}
+        : CycleRun(sc, q0, opt),
+          S(twist_scale(sc)),
+          nc(sc.part.contacts()),
+          point(sc.part.point),
+          x(point ? Vec3(qd0[0], qd0[1], 0) : qd0),
+          loose(opt.integration.large_slip_factor != 1) {}
 
     bool integrate(int k);
     bool after_full_stick(int k, const State& z, const Vec3& r_now, bool accept);
@@ -109,8 +113,10 @@ bool Shooting::integrate(int k) {
     // After a full stick the next period starts on a fresh engine (its first step small again):
     // one carried over from a far start can step over a brief pivot (an outside audit found a
     // cycle 4.7e-6 v_ref off that way), and that period is the one accepted below.
-    if (k == 0 || reset_prev) ok = e.start(k * T, y);
-    else e.modify([&](auto& z) { z = y; });
+    if (k == 0 || reset_prev)
+        ok = e.start(k * T, y);
+    else
+        e.modify([&](auto& z) { z = y; });
     // The variational equations Phi' = J(t) Phi, Psi' = Phi (J = d q''/d q', generated) on the
     // engine's accepted steps by the trapezoidal rule, J at each step's end: second order,
     // within 1% of central differences of the period map on fig4, fig5 and fig3 (tests), one
@@ -152,8 +158,7 @@ bool Shooting::integrate(int k) {
 // after it, from P(x), is then the cycle: when it sticks fully too, it is converged (true).
 bool Shooting::after_full_stick(int k, const State& z, const Vec3& r_now, bool accept) {
     const double res = r_now.cwiseAbs().maxCoeff();
-    if (k >= 1 && reset_prev && accept &&
-        (res <= opt.tol || at_stuck_floor(res, res_floor, opt))) {
+    if (k >= 1 && reset_prev && accept && (res <= opt.tol || at_stuck_floor(res, res_floor, opt))) {
         // This period ran on a fresh engine from the previous one's end, and returns to its
         // start within tol, or within tol plus the zero band where the return has stopped
         // halving (the integration's error, which more periods do not shrink: one_start,
@@ -163,7 +168,7 @@ bool Shooting::after_full_stick(int k, const State& z, const Vec3& r_now, bool a
         out.residual = res;
         out.error_estimate = res;
         out.min_normal_force = min_n;
-        out.has_monodromy = true;            // dP/dx = 0: every Floquet multiplier is 0
+        out.has_monodromy = true;   // dP/dx = 0: every Floquet multiplier is 0
         out.monodromy.setZero();
         out.converged = true;
         return true;
@@ -273,7 +278,8 @@ bool Shooting::newton_step(int k, const State& z, const Vec3& r_now, bool accept
     // nothing is accepted before r_perp is below a tenth of tol. It falls quadratically (the map
     // puts every start on its image curve; r_perp is that curve's bend over the last step).
     const bool on_line = line.isZero() || (r - line * line.dot(r)).norm() <= 0.1 * opt.tol;
-    if (accept && was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol && kPaError * dn <= opt.tol) {
+    if (accept && was_fresh && on_line && 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn <= opt.tol &&
+        kPaError * dn <= opt.tol) {
         out.error_estimate = 2 * Pa.cwiseAbs().rowwise().sum().maxCoeff() * dn;
         out.converged = true;
         return false;
@@ -291,7 +297,10 @@ bool Shooting::newton_step(int k, const State& z, const Vec3& r_now, bool accept
             // chord-accepted twist 1e-6 v_ref off with an estimate of 7e-8.
             const double dist = 2 * theta / (1 - 2 * theta) * dn;
             out.error_estimate = Pa.cwiseAbs().rowwise().sum().maxCoeff() * (dist + kPaError * dn);
-            if (accept && on_line && out.error_estimate <= opt.tol) { out.converged = true; return false; }
+            if (accept && on_line && out.error_estimate <= opt.tol) {
+                out.converged = true;
+                return false;
+            }
         }
         if (theta > 0.5) {
             if (was_fresh) return false;   // even a fresh monodromy does not contract: give up
@@ -306,14 +315,14 @@ bool Shooting::newton_step(int k, const State& z, const Vec3& r_now, bool accept
 void Shooting::finish() {
     out.stop = e.stop;
     out.stats = e.stats;
-    out.stats += fd_stats;   // the difference monodromies' periods
+    out.stats += fd_stats;              // the difference monodromies' periods
     out.stats.rhs_evals += jws.evals;   // the Jacobians' evaluations
     out.step_hint = e.next_step() / T;
     if (!out.converged && out.stop.reason == StopReason::None) out.stop = StopEvent{StopReason::NotConverged, -1, e.t()};
     if (!out.converged) out.twist.setConstant(std::numeric_limits<double>::quiet_NaN());
 }
 
-}  // namespace
+}   // namespace
 
 LimitCycleSummary detail::shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
     Shooting s(sc, q0, opt, qd0);
@@ -352,4 +361,4 @@ LimitCycleSummary detail::shooting_cycle(const Scene& sc, const Vec3& q0, const 
     return s.out;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -12,13 +12,20 @@ namespace plate {
 
 const char* stop_name(StopReason r) {
     switch (r) {
-        case StopReason::None: return "none";
-        case StopReason::ContactLost: return "contact_lost";
-        case StopReason::Sticking: return "sticking";
-        case StopReason::StepCollapse: return "step_collapse";
-        case StopReason::StepLimit: return "step_limit";
-        case StopReason::NotConverged: return "not_converged";
-        case StopReason::EventAccumulation: return "event_accumulation";
+        case StopReason::None:
+            return "none";
+        case StopReason::ContactLost:
+            return "contact_lost";
+        case StopReason::Sticking:
+            return "sticking";
+        case StopReason::StepCollapse:
+            return "step_collapse";
+        case StopReason::StepLimit:
+            return "step_limit";
+        case StopReason::NotConverged:
+            return "not_converged";
+        case StopReason::EventAccumulation:
+            return "event_accumulation";
     }
     return "?";
 }
@@ -27,7 +34,8 @@ std::string StopEvent::describe() const {
     std::ostringstream s;
     s.precision(9);
     switch (reason) {
-        case StopReason::None: return "no stop";
+        case StopReason::None:
+            return "no stop";
         case StopReason::ContactLost:
             s << "contact " << contact + 1 << " lost (normal force reaches zero: the part would fly) at t = " << t << " s";
             break;
@@ -37,8 +45,12 @@ std::string StopEvent::describe() const {
         case StopReason::StepCollapse:
             s << "step size collapsed at t = " << t << " s (the method cannot resolve the motion)";
             break;
-        case StopReason::StepLimit: s << "work budget (steps or right-hand sides) spent at t = " << t << " s"; break;
-        case StopReason::NotConverged: s << "limit cycle not converged within the period cap"; break;
+        case StopReason::StepLimit:
+            s << "work budget (steps or right-hand sides) spent at t = " << t << " s";
+            break;
+        case StopReason::NotConverged:
+            s << "limit cycle not converged within the period cap";
+            break;
         case StopReason::EventAccumulation:
             s << "contact modes change without end at t = " << t << " s (an accumulation point of events)";
             break;
@@ -64,7 +76,7 @@ double first_release(Model& model, const Scene& sc, const typename Model::State&
     return tb;
 }
 
-}  // namespace
+}   // namespace
 
 double breakaway_time(const Scene& sc, const Vec3& q0, double t0, Dynamics level) {
     if (level == Dynamics::Full) {
@@ -99,8 +111,7 @@ Trajectory run(Model& model, const Scene& sc, const typename Model::State& y0, d
             push(e.t(), e.y(), e.n());
         }
     }
-    if (e.stop.reason != StopReason::None && (tr.samples.empty() || tr.samples.back().t < e.t()))
-        push(e.t(), e.y(), e.n());
+    if (e.stop.reason != StopReason::None && (tr.samples.empty() || tr.samples.back().t < e.t())) push(e.t(), e.y(), e.n());
     tr.stop = e.stop;
     tr.stats = e.stats;
     tr.events = e.events;
@@ -108,10 +119,10 @@ Trajectory run(Model& model, const Scene& sc, const typename Model::State& y0, d
     return tr;
 }
 
-}  // namespace
+}   // namespace
 
-Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration,
-                    double sample_dt, const IntegrationOptions& opt) {
+Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
+                    const IntegrationOptions& opt) {
     if (level == Dynamics::ReducedU)
         throw std::invalid_argument("simulate: reduced U-dynamics have no trajectory; use limit_cycle");
     if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate: duration and sample_dt must be > 0");
@@ -119,8 +130,7 @@ Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3&
         detail::FullModel m(sc);
         Vec3 p, phi;
         sc.plate.displacement(0.0, p, phi);   // R1 at the start
-        return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]}, duration, sample_dt,
-                   opt);
+        return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]}, duration, sample_dt, opt);
     }
     detail::UModel m(sc);
     return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, duration, sample_dt, opt);
@@ -148,9 +158,9 @@ struct Averaging {
     Trajectory tr;
     FullState y{};
     std::vector<Knot> knots;
-    long N = 0;     // whole periods in the duration
-    long n = 0;     // periods done
-    double t = 0;   // their end, n T (after the start)
+    long N = 0;         // whole periods in the duration
+    long n = 0;         // periods done
+    double t = 0;       // their end, n T (after the start)
     FullState last{};   // the last slope of (q, phi)
     bool ok = true;
 
@@ -244,9 +254,9 @@ void Averaging::run_macro_steps() {
         for (int i : kSlow) ye[i] += H * k1[i];
         const bool k2_ok = slope(t + H, ye, k1, k2);
         if (!k2_ok && K == 1) break;
-        const double err = k2_ok ? 0.5 * H * std::max({std::abs(k2[0] - k1[0]) / rho, std::abs(k2[1] - k1[1]) / rho,
-                                                        std::abs(k2[2] - k1[2])})
-                                 : std::numeric_limits<double>::infinity();
+        const double err =
+            k2_ok ? 0.5 * H * std::max({std::abs(k2[0] - k1[0]) / rho, std::abs(k2[1] - k1[1]) / rho, std::abs(k2[2] - k1[2])})
+                  : std::numeric_limits<double>::infinity();
         const double grow = err > 0 ? 0.9 * std::sqrt(avg.macro_tol / err) : 2.0;
         if (!(err <= avg.macro_tol) && K > 1) {   // (also a NaN or a stopped predictor)
             ++tr.stats.rejected;
@@ -307,13 +317,14 @@ void Averaging::finish(double duration, double sample_dt) {
         tr.samples.back().qd = Vec3(y[3], y[4], y[5]);
 }
 
-}  // namespace
+}   // namespace
 
 Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
                              const IntegrationOptions& opt, const AveragingOptions& avg) {
     if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate_averaged: duration and sample_dt must be > 0");
     if (avg.max_macro_periods < 1 || !(avg.macro_tol > 0) || avg.relax_periods < 0 || avg.start_periods < 0)
-        throw std::invalid_argument("simulate_averaged: macro_tol > 0, max_macro_periods >= 1, relax_periods and start_periods >= 0");
+        throw std::invalid_argument(
+            "simulate_averaged: macro_tol > 0, max_macro_periods >= 1, relax_periods and start_periods >= 0");
     Averaging run(sc, opt, avg);
     Vec3 p, phi;
     sc.plate.displacement(0.0, p, phi);
@@ -329,4 +340,4 @@ Trajectory simulate_averaged(const Scene& sc, const Vec3& q0, const Vec3& qd0, d
     return run.tr;
 }
 
-}  // namespace plate
+}   // namespace plate

@@ -46,8 +46,7 @@ public:
 
     // The state at t in the step from (t0, y0, f0) to (t1, y1, f1): Dormand-Prince's fourth-order
     // interpolant (no re-stepping).
-    void dense(double t, const State& y0, const State& f0, double t0, const State& y1, const State& f1, double t1,
-               State& out) {
+    void dense(double t, const State& y0, const State& f0, double t0, const State& y1, const State& f1, double t1, State& out) {
         stepper_.calc_state(t, out, y0, f0, t0, y1, f1, t1);
     }
 
@@ -57,4 +56,4 @@ private:
     double log_err_old_ = std::log(1e-4);
 };
 
-}  // namespace plate::detail
+}   // namespace plate::detail

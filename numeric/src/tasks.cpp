@@ -13,24 +13,24 @@
 namespace plate {
 
 TaskRunner thread_tasks(int threads) {
-    return [threads](int n, const std::function<std::string(int)>& work,
-                     const std::function<void(int, const std::string&)>& done) {
-        std::atomic<int> next{0};
-        std::mutex done_mutex;
-        auto worker = [&] {
-            for (int i; (i = next.fetch_add(1)) < n;) {
-                const std::string r = work(i);
-                std::lock_guard<std::mutex> lock(done_mutex);
-                done(i, r);
-            }
+    return
+        [threads](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
+            std::atomic<int> next{0};
+            std::mutex done_mutex;
+            auto worker = [&] {
+                for (int i; (i = next.fetch_add(1)) < n;) {
+                    const std::string r = work(i);
+                    std::lock_guard<std::mutex> lock(done_mutex);
+                    done(i, r);
+                }
+            };
+            const int hw = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+            const int nt = std::max(1, std::min(n, threads > 0 ? threads : hw));
+            std::vector<std::thread> pool;
+            for (int t = 1; t < nt; ++t) pool.emplace_back(worker);
+            worker();
+            for (auto& t : pool) t.join();
         };
-        const int hw = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-        const int nt = std::max(1, std::min(n, threads > 0 ? threads : hw));
-        std::vector<std::thread> pool;
-        for (int t = 1; t < nt; ++t) pool.emplace_back(worker);
-        worker();
-        for (auto& t : pool) t.join();
-    };
 }
 
 std::string exact_text(double x) {
@@ -47,9 +47,8 @@ double exact_value(const std::string& text) {
     if (text == "-inf") return -HUGE_VAL;
     char* end = nullptr;
     const double x = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size())
-        throw std::invalid_argument("not an exact number: '" + text + "'");
+    if (text.empty() || end != text.c_str() + text.size()) throw std::invalid_argument("not an exact number: '" + text + "'");
     return x;
 }
 
-}  // namespace plate
+}   // namespace plate

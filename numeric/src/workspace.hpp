@@ -18,20 +18,20 @@ namespace plate::detail {
 // (Workspace::prepare) and what depends on the configuration alone, cached while it stays.
 struct KernelScratch {
     const Scene* prepared = nullptr;
-    gen::KernelInput in;                   // inputs of the generated kernels
-    gen::KernelInput staged;               // the staged reduced-U kernels' inputs (slip directions, u(t));
-                                           // reused, not rebuilt: only those are written per evaluation
+    gen::KernelInput in;       // inputs of the generated kernels
+    gen::KernelInput staged;   // the staged reduced-U kernels' inputs (slip directions, u(t));
+                               // reused, not rebuilt: only those are written per evaluation
     bool thin = false;
-    Mat3 M38_inv = Mat3::Zero();           // thin part: inverse of (38)'s matrix, constant
+    Mat3 M38_inv = Mat3::Zero();   // thin part: inverse of (38)'s matrix, constant
     std::array<double, 9> M38_inv_rowmajor{};
-    double det_floor = 0;                  // thick part: below it, the cofactor solution gives way to LU
+    double det_floor = 0;                                      // thick part: below it, the cofactor solution gives way to LU
     double theta = std::numeric_limits<double>::quiet_NaN();   // of the cached cos/sin in `in` (and Workspace::r)
     // Reduced U-dynamics (35): the slots of the generated reduced_U_*_config kernel for the frozen
     // configuration C_q (computed when q changes; NaN = none yet).
     Vec3 C_q = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     std::array<double, std::max({gen::reduced_U_thick_slots, gen::reduced_U_thin_slots, gen::reduced_U_point_slots})> C{};
-    Vec6 z = Vec6::Zero();                 // the reference's solution [q''; n]
-    Eigen::PartialPivLU<Mat6> lu{6};       // ... and its factorisation
+    Vec6 z = Vec6::Zero();             // the reference's solution [q''; n]
+    Eigen::PartialPivLU<Mat6> lu{6};   // ... and its factorisation
     // Pivot about contact pivot_k: the factorised matrix of its system (modes.cpp), which depends on
     // theta (cos, sin), the held contact and the sliding contacts' directions only -- constant along a
     // pivot of the reduced U-dynamics, whose configuration is frozen (-1: none yet).
@@ -86,4 +86,4 @@ inline const KernelScratch& kernels(const Workspace& ws) { return ws.internals()
 inline StickSlipState& stick_slip(Workspace& ws) { return ws.internals().stick_slip; }
 inline const StickSlipState& stick_slip(const Workspace& ws) { return ws.internals().stick_slip; }
 
-}  // namespace plate::detail
+}   // namespace plate::detail

@@ -51,10 +51,10 @@ LimitCycleOptions cycle_options(double tol, double rtol, int max_periods, const 
 // --- results more than one topic holds ------------------------------------------------------------
 
 struct PyStop {
-    std::string reason;     // "none", "contact_lost", ... (stop_name)
-    int contact = 0;        // 1-based, 0 if none
+    std::string reason;   // "none", "contact_lost", ... (stop_name)
+    int contact = 0;      // 1-based, 0 if none
     double t = 0;
-    std::string message;    // StopEvent::describe()
+    std::string message;   // StopEvent::describe()
 };
 PyStop to_py(const StopEvent& e);
 
@@ -77,4 +77,4 @@ DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, dou
                                        const std::optional<std::tuple<double, double, double>>& line_sink,
                                        const std::optional<std::string>& target, bool point_part);
 
-}  // namespace plate::python
+}   // namespace plate::python

@@ -5,16 +5,13 @@
 
 namespace plate::python {
 
-py::object json_to_python(const nlohmann::json& j) {
-    return py::module_::import("json").attr("loads")(j.dump());
-}
+py::object json_to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name) {
     const std::size_t need = sc.part.point ? 2 : 3;
     if (v.size() != need)
         throw py::value_error(std::string(name) + ": expected " + std::to_string(need) + " numbers (" +
-                              (sc.part.point ? "point part: SX SY" : "SX SY THETA") + "), got " +
-                              std::to_string(v.size()));
+                              (sc.part.point ? "point part: SX SY" : "SX SY THETA") + "), got " + std::to_string(v.size()));
     Vec3 q = Vec3::Zero();
     for (std::size_t i = 0; i < need; ++i) {
         if (!std::isfinite(v[i])) throw py::value_error(std::string(name) + ": expected finite numbers");
@@ -55,4 +52,4 @@ PyStop to_py(const StopEvent& e) {
     return {stop_name(e.reason), e.contact + 1, e.t, e.reason == StopReason::None ? "" : e.describe()};
 }
 
-}  // namespace plate::python
+}   // namespace plate::python

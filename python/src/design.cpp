@@ -31,7 +31,7 @@ DesignTarget target_from_words(const std::string& words, bool point_part) {
     return parse_design_target(kind, values, point_part);
 }
 
-}  // namespace
+}   // namespace
 
 DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, double>>& sink,
                                        const std::optional<std::pair<double, double>>& transport,
@@ -39,8 +39,9 @@ DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, dou
                                        const std::optional<double>& orient,
                                        const std::optional<std::tuple<double, double, double>>& line_sink,
                                        const std::optional<std::string>& target, bool point_part) {
-    require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() +
-                    line_sink.has_value() + target.has_value() == 1,
+    require(sink.has_value() + transport.has_value() + fixed_point.has_value() + orient.has_value() + line_sink.has_value() +
+                    target.has_value() ==
+                1,
             "design: give one target, sink=(x, y), transport=(vx, vy), fixed_point=(x, y, theta), orient=theta, "
             "line_sink=(x, y, phi) or target='KIND NUMBERS' as the command line's --target");
     // Every form goes through the library's parser (the command line's and campaigns' too).
@@ -80,89 +81,102 @@ void bind_design(py::module_& m) {
         .def_readonly("notes", &DesignSummary::notes)
         .def_readonly("transport_mean", &DesignSummary::transport_mean)
         .def_readonly("transport_spread", &DesignSummary::transport_spread)
-        .def_property_readonly("ring", [](const DesignSummary& s) {
-            std::vector<std::tuple<double, Vec3>> r;
-            for (std::size_t k = 0; k < s.ring_theta.size(); ++k) r.emplace_back(s.ring_theta[k], s.ring_twist[k]);
-            return r;
-        }, "orient by transport: (theta, twist) at the centre on the verification's ring of orientations")
+        .def_property_readonly(
+            "ring",
+            [](const DesignSummary& s) {
+                std::vector<std::tuple<double, Vec3>> r;
+                for (std::size_t k = 0; k < s.ring_theta.size(); ++k) r.emplace_back(s.ring_theta[k], s.ring_twist[k]);
+                return r;
+            },
+            "orient by transport: (theta, twist) at the centre on the verification's ring of orientations")
         .def_readonly("basin_share", &DesignSummary::basin_share,
                       "rigid parts: the share of the verification runs that end at the target")
         .def_readonly("basin_share_bound", &DesignSummary::basin_share_bound,
                       "the largest share the design's symmetry allows (a half-turn pair: below 1)")
-        .def_property_readonly("competitors", [](const DesignSummary& s) {
-            std::vector<std::tuple<Vec3, double>> r;
-            for (const auto& c : s.competitors) r.emplace_back(c.point.q, c.basin_share);
-            return r;
-        }, "rigid parts: the other stable fixed points on the grid, (q, share of the runs ending there)")
-        .def_property_readonly("runs", [](const DesignSummary& s) {
-            std::vector<std::tuple<double, double, double, double>> r;
-            for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
-            return r;
-        }, "(x, y, seconds, end distance) of each verification run")
-        .def_property_readonly("held", [](const DesignSummary& s) {
-            return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance);
-        }, "sinks and fixed points: (seconds, end, distance) of the part released at rest at the target")
+        .def_property_readonly(
+            "competitors",
+            [](const DesignSummary& s) {
+                std::vector<std::tuple<Vec3, double>> r;
+                for (const auto& c : s.competitors) r.emplace_back(c.point.q, c.basin_share);
+                return r;
+            },
+            "rigid parts: the other stable fixed points on the grid, (q, share of the runs ending there)")
+        .def_property_readonly(
+            "runs",
+            [](const DesignSummary& s) {
+                std::vector<std::tuple<double, double, double, double>> r;
+                for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
+                return r;
+            },
+            "(x, y, seconds, end distance) of each verification run")
+        .def_property_readonly(
+            "held", [](const DesignSummary& s) { return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance); },
+            "sinks and fixed points: (seconds, end, distance) of the part released at rest at the target")
         .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)")
-        .def_property_readonly("pulls", [](const DesignSummary& s) {
-            std::vector<std::tuple<double, Vec2, Eigen::Vector2cd>> r;
-            for (const auto& p : s.pulls) r.emplace_back(p.theta, p.zero, p.eigenvalues);
-            return r;
-        }, "a rigid part's sink: (theta, where the position's field vanishes, its eigenvalues) per orientation");
-    m.def("design",
-          [](const Scene& part, std::optional<std::pair<double, double>> sink,
-             std::optional<std::pair<double, double>> transport, std::optional<std::tuple<double, double, double>> fixed_point,
-             std::optional<double> orient, std::optional<std::tuple<double, double, double>> line_sink,
-             double lin_limit, double ang_limit, double period,
-             std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold,
-             double max_coning, std::vector<std::string> axes, int max_harmonic, std::optional<std::string> target) {
-              const DesignTarget t =
-                  design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink, target, part.part.point);
-              DesignOptions o;   // (judged in the library: validate_design_options, as for the CLI and campaigns)
-              o.lin_limit = lin_limit;
-              o.ang_limit = ang_limit;
-              o.period = period;
-              o.seed = seed;
-              o.starts = starts;
-              o.local_evaluations = local_evaluations;
-              o.verify_starts = verify_starts;
-              o.threads = threads;
-              o.hold = hold;
-              o.max_coning = max_coning;
-              for (const std::string& name : axes) {
-                  int k = 0;
-                  while (k < 6 && name != axis_name(static_cast<Axis>(k))) ++k;
-                  require(k < 6, "axes: expected names among x, y, z, rx, ry, rz, got '" + name + "'");
-                  o.axes.push_back(static_cast<Axis>(k));
-              }
-              o.max_harmonic = max_harmonic;
-              py::gil_scoped_release free;
-              try {
-                  return design(part, t, o);
-              } catch (const std::invalid_argument& e) {
-                  py::gil_scoped_acquire hold;
-                  throw py::value_error(e.what());
-              }
-          },
-          py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
-          py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
-          py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0,
-          py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0, py::arg("local_evaluations") = 400,
-          py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0, py::arg("max_coning") = -1.0,
-          py::arg("axes") = std::vector<std::string>{}, py::arg("max_harmonic") = 0, py::arg("target") = py::none(),
-          "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
-          "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
-          "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
-          "sink=(x, y) for a rigid part: its position ends at\n"
-          "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
-          "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
-          "transport=(vx, vy) a uniform velocity over the plate (also a rigid part with one friction coefficient). Rigid parts: orient=theta for a part whose\n"
-          "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
-          "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
-          "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
-          "pair: theta and theta + pi both stable, unique False; see the README). axes=['x', ...] and\n"
-          "max_harmonic=n narrow each target's motion family (the others stay zero; an empty family is a ValueError).\n"
-          "target='KIND NUMBERS' is any target as the command line's --target writes it (e.g. 'sink 0.02 -0.01'),\n"
-          "judged by the same parser: what one refuses, the other refuses with the same message.");
+        .def_property_readonly(
+            "pulls",
+            [](const DesignSummary& s) {
+                std::vector<std::tuple<double, Vec2, Eigen::Vector2cd>> r;
+                for (const auto& p : s.pulls) r.emplace_back(p.theta, p.zero, p.eigenvalues);
+                return r;
+            },
+            "a rigid part's sink: (theta, where the position's field vanishes, its eigenvalues) per orientation");
+    m.def(
+        "design",
+        [](const Scene& part, std::optional<std::pair<double, double>> sink, std::optional<std::pair<double, double>> transport,
+           std::optional<std::tuple<double, double, double>> fixed_point, std::optional<double> orient,
+           std::optional<std::tuple<double, double, double>> line_sink, double lin_limit, double ang_limit, double period,
+           std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold, double max_coning,
+           std::vector<std::string> axes, int max_harmonic, std::optional<std::string> target) {
+            const DesignTarget t =
+                design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink, target, part.part.point);
+            DesignOptions o;   // (judged in the library: validate_design_options, as for the CLI and campaigns)
+            o.lin_limit = lin_limit;
+            o.ang_limit = ang_limit;
+            o.period = period;
+            o.seed = seed;
+            o.starts = starts;
+            o.local_evaluations = local_evaluations;
+            o.verify_starts = verify_starts;
+            o.threads = threads;
+            o.hold = hold;
+            o.max_coning = max_coning;
+            for (const std::string& name : axes) {
+                int k = 0;
+                while (k < 6 && name != axis_name(static_cast<Axis>(k))) ++k;
+                require(k < 6, "axes: expected names among x, y, z, rx, ry, rz, got '" + name + "'");
+                o.axes.push_back(static_cast<Axis>(k));
+            }
+            o.max_harmonic = max_harmonic;
+            py::gil_scoped_release free;
+            try {
+                return design(part, t, o);
+            } catch (const std::invalid_argument& e) {
+                py::gil_scoped_acquire hold;
+                throw py::value_error(e.what());
+            }
+        },
+        py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
+        py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
+        py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0, py::arg("period") = 0.0, py::arg("seed") = 1,
+        py::arg("starts") = 0, py::arg("local_evaluations") = 400, py::arg("verify_starts") = 20, py::arg("threads") = 0,
+        py::arg("hold") = 120.0, py::arg("max_coning") = -1.0, py::arg("axes") = std::vector<std::string>{},
+        py::arg("max_harmonic") = 0, py::arg("target") = py::none(),
+        "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
+        "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
+        "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
+        "sink=(x, y) for a rigid part: its position ends at\n"
+        "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
+        "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
+        "transport=(vx, vy) a uniform velocity over the plate (also a rigid part with one friction coefficient). Rigid parts: "
+        "orient=theta for a part whose\n"
+        "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
+        "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
+        "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
+        "pair: theta and theta + pi both stable, unique False; see the README). axes=['x', ...] and\n"
+        "max_harmonic=n narrow each target's motion family (the others stay zero; an empty family is a ValueError).\n"
+        "target='KIND NUMBERS' is any target as the command line's --target writes it (e.g. 'sink 0.02 -0.01'),\n"
+        "judged by the same parser: what one refuses, the other refuses with the same message.");
     m.def(
         "orientation_harmonics",
         [](const Scene& sc, std::array<double, 2> at, int n, double tol, double rtol) {
@@ -183,9 +197,10 @@ void bind_design(py::module_& m) {
         "theta' at position `at` on n orientations as M + sum_k B_k sin(k theta + phi_k): {defined, mean (M),\n"
         "amplitude (B_0 = |M|, B_1 .. B_n/2), first (B_1), rest (|M| + B_2 + ...), one_stable (B_1^2 > rest^2 +\n"
         "(sum_k>=2 k B_k)^2: exactly one stable orientation)} [rad/s]; what one orientation needs (design.hpp).");
-    m.def("coning_rate", [](const Scene& sc) { return coning_rate(sc.plate); }, py::arg("scene"),
-          "The plate's steady yaw drift from rx and ry out of phase [rad/s], which the asymptotic field does\n"
-          "not see and the full dynamics does: sum_n Im(A_rx,n conj A_ry,n) / (2 (n w)^3).");
+    m.def(
+        "coning_rate", [](const Scene& sc) { return coning_rate(sc.plate); }, py::arg("scene"),
+        "The plate's steady yaw drift from rx and ry out of phase [rad/s], which the asymptotic field does\n"
+        "not see and the full dynamics does: sum_n Im(A_rx,n conj A_ry,n) / (2 (n w)^3).");
 }
 
-}  // namespace plate::python
+}   // namespace plate::python

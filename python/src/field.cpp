@@ -23,87 +23,97 @@ py::array_t<double> field_array(const Field& f, int what) {
     return array(d, {g.nx, g.ny, g.nth, 3});
 }
 
-}  // namespace
+}   // namespace
 
 void bind_field(py::module_& m) {
     py::class_<PyField>(m, "Field", "The asymptotic twist field on a grid (point parts: velocity field, ntheta = 1).")
-        .def_property_readonly("x", [](const PyField& f) {
-            std::vector<double> v;
-            for (int i = 0; i < f.f.grid.nx; ++i) v.push_back(f.f.grid.at(i, 0, 0)[0]);
-            return array(v, {f.f.grid.nx});
-        })
-        .def_property_readonly("y", [](const PyField& f) {
-            std::vector<double> v;
-            for (int j = 0; j < f.f.grid.ny; ++j) v.push_back(f.f.grid.at(0, j, 0)[1]);
-            return array(v, {f.f.grid.ny});
-        })
-        .def_property_readonly("theta", [](const PyField& f) {
-            std::vector<double> v;
-            for (int k = 0; k < f.f.grid.nth; ++k) v.push_back(f.f.grid.at(0, 0, k)[2]);
-            return array(v, {f.f.grid.nth});
-        })
-        .def_property_readonly("q", [](const PyField& f) { return field_array(f.f, 0); },
-                               "configurations, shape (nx, ny, ntheta, 3)")
-        .def_property_readonly("twist", [](const PyField& f) { return field_array(f.f, 1); },
-                               "asymptotic twists, shape (nx, ny, ntheta, 3); NaN where undefined")
-        .def_property_readonly("stick_fraction", [](const PyField& f) { return field_array(f.f, 2); },
-                               "per contact, shape (nx, ny, ntheta, 3)")
-        .def_property_readonly("converged", [](const PyField& f) {
-            py::array_t<bool> a({f.f.grid.nx, f.f.grid.ny, f.f.grid.nth});
-            for (std::size_t i = 0; i < f.f.points.size(); ++i) a.mutable_data()[i] = f.f.points[i].converged;
-            return a;
-        })
-        .def_property_readonly("stops", [](const PyField& f) {
-            std::vector<std::string> s;
-            for (const FieldPoint& p : f.f.points) s.push_back(stop_name(p.stop));
-            return s;
-        }, "why each configuration has no twist ('none' where it has), grid order")
+        .def_property_readonly("x",
+                               [](const PyField& f) {
+                                   std::vector<double> v;
+                                   for (int i = 0; i < f.f.grid.nx; ++i) v.push_back(f.f.grid.at(i, 0, 0)[0]);
+                                   return array(v, {f.f.grid.nx});
+                               })
+        .def_property_readonly("y",
+                               [](const PyField& f) {
+                                   std::vector<double> v;
+                                   for (int j = 0; j < f.f.grid.ny; ++j) v.push_back(f.f.grid.at(0, j, 0)[1]);
+                                   return array(v, {f.f.grid.ny});
+                               })
+        .def_property_readonly("theta",
+                               [](const PyField& f) {
+                                   std::vector<double> v;
+                                   for (int k = 0; k < f.f.grid.nth; ++k) v.push_back(f.f.grid.at(0, 0, k)[2]);
+                                   return array(v, {f.f.grid.nth});
+                               })
+        .def_property_readonly(
+            "q", [](const PyField& f) { return field_array(f.f, 0); }, "configurations, shape (nx, ny, ntheta, 3)")
+        .def_property_readonly(
+            "twist", [](const PyField& f) { return field_array(f.f, 1); },
+            "asymptotic twists, shape (nx, ny, ntheta, 3); NaN where undefined")
+        .def_property_readonly(
+            "stick_fraction", [](const PyField& f) { return field_array(f.f, 2); }, "per contact, shape (nx, ny, ntheta, 3)")
+        .def_property_readonly("converged",
+                               [](const PyField& f) {
+                                   py::array_t<bool> a({f.f.grid.nx, f.f.grid.ny, f.f.grid.nth});
+                                   for (std::size_t i = 0; i < f.f.points.size(); ++i)
+                                       a.mutable_data()[i] = f.f.points[i].converged;
+                                   return a;
+                               })
+        .def_property_readonly(
+            "stops",
+            [](const PyField& f) {
+                std::vector<std::string> s;
+                for (const FieldPoint& p : f.f.points) s.push_back(stop_name(p.stop));
+                return s;
+            },
+            "why each configuration has no twist ('none' where it has), grid order")
         .def_property_readonly("seconds", [](const PyField& f) { return f.f.seconds; })
         .def_property_readonly("rhs_evaluations", [](const PyField& f) { return f.f.rhs_evals; })
         .def_property_readonly("threads", [](const PyField& f) { return f.f.threads; })
-        .def_property_readonly("summary", [](const PyField& f) { return json_to_python(to_json(f.scene, f.f)); },
-                               "the command line's JSON (`plate field`) as a dict");
-    m.def("field",
-          [](const Scene& sc, int grid, std::optional<int> nx, std::optional<int> ny, std::optional<int> ntheta,
-             std::pair<double, double> x, std::pair<double, double> y, double theta0, int threads, double tol,
-             double rtol, int max_periods, const std::string& solver, long max_rhs, long max_work) {
-              GridSpec g;
-              g.nx = nx.value_or(grid);
-              g.ny = ny.value_or(grid);
-              g.nth = sc.part.point ? 1 : ntheta.value_or(grid);
-              require(g.nx >= 1 && g.ny >= 1 && g.nth >= 1 && g.nx <= 201 && g.ny <= 201 && g.nth <= 720,
-                      "grid: expected 1..201 points along x and y and 1..720 along theta");
-              require(std::isfinite(x.first) && std::isfinite(x.second) && x.second >= x.first,
-                      "x: expected (MIN, MAX) with MIN <= MAX");
-              require(std::isfinite(y.first) && std::isfinite(y.second) && y.second >= y.first,
-                      "y: expected (MIN, MAX) with MIN <= MAX");
-              require(threads >= 0, "threads: expected >= 0 (0: all cores)");
-              require(max_work >= 0, "max_work: expected >= 0 (0: no budget)");
-              std::tie(g.x0, g.x1) = x;
-              std::tie(g.y0, g.y1) = y;
-              g.th0 = theta0;
-              FieldOptions o;
-              o.cycle = cycle_options(tol, rtol, max_periods, solver, max_rhs);
-              o.threads = threads;
-              o.max_rhs_evaluations = max_work;
-              PyField f{sc, {}};
-              {
-                  py::gil_scoped_release free;
-                  f.f = compute_field(sc, g, o);
-              }
-              if (f.f.budget_spent)
-                  throw std::runtime_error("the work budget of max_work = " + std::to_string(max_work) +
-                                           " right-hand sides was spent before the field was complete");
-              return f;
-          },
-          py::arg("scene"), py::kw_only(), py::arg("grid") = 7, py::arg("nx") = py::none(), py::arg("ny") = py::none(),
-          py::arg("ntheta") = py::none(), py::arg("x") = std::make_pair(-0.05, 0.05),
-          py::arg("y") = std::make_pair(-0.05, 0.05), py::arg("theta0") = 0.0, py::arg("threads") = 0,
-          py::arg("tol") = 1e-7, py::arg("rtol") = 1e-8, py::arg("max_periods") = 400, py::arg("solver") = "shooting",
-          py::arg("max_rhs") = 20'000'000L, py::arg("max_work") = 0L,
-          "The asymptotic twist field on a regular grid over (s_x, s_y, theta), theta covering a full turn;\n"
-          "configurations in parallel on `threads` cores (0: all). max_work: a budget in right-hand sides\n"
-          "for the whole field (0: none); a field that spends it raises RuntimeError.");
+        .def_property_readonly(
+            "summary", [](const PyField& f) { return json_to_python(to_json(f.scene, f.f)); },
+            "the command line's JSON (`plate field`) as a dict");
+    m.def(
+        "field",
+        [](const Scene& sc, int grid, std::optional<int> nx, std::optional<int> ny, std::optional<int> ntheta,
+           std::pair<double, double> x, std::pair<double, double> y, double theta0, int threads, double tol, double rtol,
+           int max_periods, const std::string& solver, long max_rhs, long max_work) {
+            GridSpec g;
+            g.nx = nx.value_or(grid);
+            g.ny = ny.value_or(grid);
+            g.nth = sc.part.point ? 1 : ntheta.value_or(grid);
+            require(g.nx >= 1 && g.ny >= 1 && g.nth >= 1 && g.nx <= 201 && g.ny <= 201 && g.nth <= 720,
+                    "grid: expected 1..201 points along x and y and 1..720 along theta");
+            require(std::isfinite(x.first) && std::isfinite(x.second) && x.second >= x.first,
+                    "x: expected (MIN, MAX) with MIN <= MAX");
+            require(std::isfinite(y.first) && std::isfinite(y.second) && y.second >= y.first,
+                    "y: expected (MIN, MAX) with MIN <= MAX");
+            require(threads >= 0, "threads: expected >= 0 (0: all cores)");
+            require(max_work >= 0, "max_work: expected >= 0 (0: no budget)");
+            std::tie(g.x0, g.x1) = x;
+            std::tie(g.y0, g.y1) = y;
+            g.th0 = theta0;
+            FieldOptions o;
+            o.cycle = cycle_options(tol, rtol, max_periods, solver, max_rhs);
+            o.threads = threads;
+            o.max_rhs_evaluations = max_work;
+            PyField f{sc, {}};
+            {
+                py::gil_scoped_release free;
+                f.f = compute_field(sc, g, o);
+            }
+            if (f.f.budget_spent)
+                throw std::runtime_error("the work budget of max_work = " + std::to_string(max_work) +
+                                         " right-hand sides was spent before the field was complete");
+            return f;
+        },
+        py::arg("scene"), py::kw_only(), py::arg("grid") = 7, py::arg("nx") = py::none(), py::arg("ny") = py::none(),
+        py::arg("ntheta") = py::none(), py::arg("x") = std::make_pair(-0.05, 0.05), py::arg("y") = std::make_pair(-0.05, 0.05),
+        py::arg("theta0") = 0.0, py::arg("threads") = 0, py::arg("tol") = 1e-7, py::arg("rtol") = 1e-8,
+        py::arg("max_periods") = 400, py::arg("solver") = "shooting", py::arg("max_rhs") = 20'000'000L, py::arg("max_work") = 0L,
+        "The asymptotic twist field on a regular grid over (s_x, s_y, theta), theta covering a full turn;\n"
+        "configurations in parallel on `threads` cores (0: all). max_work: a budget in right-hand sides\n"
+        "for the whole field (0: none); a field that spends it raises RuntimeError.");
 }
 
 void bind_fixed_points(py::module_& m) {
@@ -113,8 +123,8 @@ void bind_fixed_points(py::module_& m) {
         .def_property_readonly("stability", [](const FixedPoint& p) { return stability_name(p.stability); })
         .def_readonly("residual", &FixedPoint::residual)
         .def("__repr__", [](const FixedPoint& p) {
-            return "<plate.FixedPoint " + std::string(stability_name(p.stability)) + " at (" + std::to_string(p.q[0]) +
-                   ", " + std::to_string(p.q[1]) + ", " + std::to_string(p.q[2]) + ")>";
+            return "<plate.FixedPoint " + std::string(stability_name(p.stability)) + " at (" + std::to_string(p.q[0]) + ", " +
+                   std::to_string(p.q[1]) + ", " + std::to_string(p.q[2]) + ")>";
         });
     py::class_<FixedLine>(m, "FixedLine")
         .def_property_readonly("points", [](const FixedLine& l) { return l.points; })
@@ -128,23 +138,25 @@ void bind_fixed_points(py::module_& m) {
         .def_property_readonly("sentence", [](const PyFixedPoints& f) { return fixed_points_sentence(f.fp); })
         .def_property_readonly("undefined_cells", [](const PyFixedPoints& f) { return f.fp.undefined_cells; })
         .def_property_readonly("stuck_cells", [](const PyFixedPoints& f) { return f.fp.stuck_cells; })
-        .def_property_readonly("summary", [](const PyFixedPoints& f) { return json_to_python(to_json(f.scene, f.fp)); },
-                               "the command line's JSON (`plate fixed-points`) as a dict");
-    m.def("fixed_points",
-          [](const PyField& f, double ftol, long max_rhs) {
-              FixedPointOptions o;
-              require(ftol > 0, "ftol: expected a number > 0");
-              require(max_rhs >= 0, "max_rhs: expected >= 0 (0: no budget)");
-              o.ftol = ftol;
-              o.max_rhs_evaluations = max_rhs;
-              PyFixedPoints r{f.scene, {}};
-              py::gil_scoped_release free;
-              r.fp = find_fixed_points(f.scene, f.f, o);
-              return r;
-          },
-          py::arg("field"), py::kw_only(), py::arg("ftol") = 1e-6, py::arg("max_rhs") = 20'000'000L,
-          "Zeros of a field (from plate.field): candidate cells refined by Gauss-Newton, classified by the\n"
-          "Jacobian's eigenvalues; curves of zeros as lines.");
+        .def_property_readonly(
+            "summary", [](const PyFixedPoints& f) { return json_to_python(to_json(f.scene, f.fp)); },
+            "the command line's JSON (`plate fixed-points`) as a dict");
+    m.def(
+        "fixed_points",
+        [](const PyField& f, double ftol, long max_rhs) {
+            FixedPointOptions o;
+            require(ftol > 0, "ftol: expected a number > 0");
+            require(max_rhs >= 0, "max_rhs: expected >= 0 (0: no budget)");
+            o.ftol = ftol;
+            o.max_rhs_evaluations = max_rhs;
+            PyFixedPoints r{f.scene, {}};
+            py::gil_scoped_release free;
+            r.fp = find_fixed_points(f.scene, f.f, o);
+            return r;
+        },
+        py::arg("field"), py::kw_only(), py::arg("ftol") = 1e-6, py::arg("max_rhs") = 20'000'000L,
+        "Zeros of a field (from plate.field): candidate cells refined by Gauss-Newton, classified by the\n"
+        "Jacobian's eigenvalues; curves of zeros as lines.");
 }
 
-}  // namespace plate::python
+}   // namespace plate::python

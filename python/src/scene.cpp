@@ -11,15 +11,19 @@ void bind_scene(py::module_& m) {
         .def_property_readonly("point_part", [](const Scene& s) { return s.part.point; })
         .def_property_readonly("thin", [](const Scene& s) { return !s.part.point && s.part.thin(); })
         .def_property_readonly("mass", [](const Scene& s) { return s.part.m; })
-        .def_property_readonly("rho", [](const Scene& s) { return s.part.rho(); },
-                               "radius of gyration sqrt(J_zz/m) [m] (1 for a point part)")
+        .def_property_readonly(
+            "rho", [](const Scene& s) { return s.part.rho(); }, "radius of gyration sqrt(J_zz/m) [m] (1 for a point part)")
         .def_property_readonly("period", [](const Scene& s) { return s.plate.T; })
         .def_property_readonly("v_ref", &Scene::v_ref, "the slip-speed scale tolerances are relative to [m/s]")
         .def_property_readonly("warnings", &scene_warnings,
                                "admissible but outside the intended regime (the command line prints them)")
-        .def("to_json", [](const Scene& s) { return scene_to_json(s).dump(); }, "the scene in the file form")
+        .def(
+            "to_json", [](const Scene& s) { return scene_to_json(s).dump(); }, "the scene in the file form")
         .def("__repr__", [](const Scene& s) {
-            return "<plate.Scene '" + s.name + "' " + (s.part.point ? "point part" : s.part.thin() ? "thin part" : "thick part") +
+            return "<plate.Scene '" + s.name + "' " +
+                   (s.part.point    ? "point part"
+                    : s.part.thin() ? "thin part"
+                                    : "thick part") +
                    ", T = " + std::to_string(s.plate.T) + " s, " + std::to_string(s.plate.harmonics.size()) + " harmonics>";
         });
     m.def("load_scene", &load_scene, py::arg("path"), "Reads a scene file (raises plate.InputError).");
@@ -32,7 +36,8 @@ void bind_scene(py::module_& m) {
         .def_readonly("t", &PyStop::t, "[s]")
         .def_readonly("message", &PyStop::message)
         .def("__bool__", [](const PyStop& s) { return s.reason != "none"; })
-        .def("__repr__", [](const PyStop& s) { return "<plate.Stop " + s.reason + (s.message.empty() ? "" : ": " + s.message) + ">"; });
+        .def("__repr__",
+             [](const PyStop& s) { return "<plate.Stop " + s.reason + (s.message.empty() ? "" : ": " + s.message) + ">"; });
 }
 
-}  // namespace plate::python
+}   // namespace plate::python

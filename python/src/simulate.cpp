@@ -22,71 +22,83 @@ py::array_t<double> samples_array(const Trajectory& tr, int what) {
     return array(d, {static_cast<py::ssize_t>(tr.samples.size()), 3});
 }
 
-}  // namespace
+}   // namespace
 
 void bind_simulate(py::module_& m) {
     py::class_<PyTrajectory>(m, "Trajectory", "Samples of a simulation, with the contact mode on each step.")
-        .def_property_readonly("t", [](const PyTrajectory& p) {
-            std::vector<double> t;
-            for (const Sample& s : p.tr.samples) t.push_back(s.t);
-            return array(t, {static_cast<py::ssize_t>(t.size())});
-        })
-        .def_property_readonly("q", [](const PyTrajectory& p) { return samples_array(p.tr, 0); }, "(n, 3): s_x, s_y, theta")
-        .def_property_readonly("qd", [](const PyTrajectory& p) { return samples_array(p.tr, 1); },
-                               "(n, 3): the part's twist relative to the plate")
-        .def_property_readonly("normal_forces", [](const PyTrajectory& p) { return samples_array(p.tr, 2); }, "(n, 3) [N]")
-        .def_property_readonly("mode", [](const PyTrajectory& p) {
-            std::vector<std::string> m;
-            for (const Sample& s : p.tr.samples) m.push_back(mode_name(s.mode));
-            return m;
-        }, "the contact mode on the step that ended at each sample: slide, pivot1-3, stuck")
-        .def_property_readonly("events", [](const PyTrajectory& p) {
-            std::vector<std::tuple<double, std::string, std::string>> e;
-            for (const ModeEvent& ev : p.tr.events) e.emplace_back(ev.t, mode_name(ev.from), mode_name(ev.to));
-            return e;
-        }, "every change of contact mode: (t, from, to)")
-        .def_property_readonly("held_time", [](const PyTrajectory& p) {
-            return std::vector<double>(p.tr.held_time.begin(), p.tr.held_time.begin() + p.scene.part.contacts());
-        }, "time each contact had zero slip [s]")
+        .def_property_readonly("t",
+                               [](const PyTrajectory& p) {
+                                   std::vector<double> t;
+                                   for (const Sample& s : p.tr.samples) t.push_back(s.t);
+                                   return array(t, {static_cast<py::ssize_t>(t.size())});
+                               })
+        .def_property_readonly(
+            "q", [](const PyTrajectory& p) { return samples_array(p.tr, 0); }, "(n, 3): s_x, s_y, theta")
+        .def_property_readonly(
+            "qd", [](const PyTrajectory& p) { return samples_array(p.tr, 1); }, "(n, 3): the part's twist relative to the plate")
+        .def_property_readonly(
+            "normal_forces", [](const PyTrajectory& p) { return samples_array(p.tr, 2); }, "(n, 3) [N]")
+        .def_property_readonly(
+            "mode",
+            [](const PyTrajectory& p) {
+                std::vector<std::string> m;
+                for (const Sample& s : p.tr.samples) m.push_back(mode_name(s.mode));
+                return m;
+            },
+            "the contact mode on the step that ended at each sample: slide, pivot1-3, stuck")
+        .def_property_readonly(
+            "events",
+            [](const PyTrajectory& p) {
+                std::vector<std::tuple<double, std::string, std::string>> e;
+                for (const ModeEvent& ev : p.tr.events) e.emplace_back(ev.t, mode_name(ev.from), mode_name(ev.to));
+                return e;
+            },
+            "every change of contact mode: (t, from, to)")
+        .def_property_readonly(
+            "held_time",
+            [](const PyTrajectory& p) {
+                return std::vector<double>(p.tr.held_time.begin(), p.tr.held_time.begin() + p.scene.part.contacts());
+            },
+            "time each contact had zero slip [s]")
         .def_property_readonly("stop", [](const PyTrajectory& p) { return to_py(p.tr.stop); })
         .def_property_readonly("steps", [](const PyTrajectory& p) { return p.tr.stats.steps; })
         .def_property_readonly("dynamics", [](const PyTrajectory& p) { return p.dynamics; });
-    m.def("simulate",
-          [](const Scene& sc, const std::vector<double>& start, double time, const std::string& dynamics,
-             std::optional<std::vector<double>> twist, std::optional<double> sample, double rtol, long max_steps,
-             double tol) {
-              require(dynamics == "full" || dynamics == "u" || dynamics == "field",
-                      "dynamics: expected 'full', 'u' or 'field', got '" + dynamics + "'");
-              const Vec3 q0 = config(sc, start, "start");
-              const Vec3 qd0 = twist ? config(sc, *twist, "twist") : Vec3::Zero();
-              const double dt = sample.value_or(sc.plate.T / 4);
-              require(std::isfinite(time) && time > 0, "time: expected a number > 0");
-              require(std::isfinite(dt) && dt > 0, "sample: expected a number > 0");
-              require(std::ceil(time / dt) + 1 <= 1e7, "time / sample: more than 10^7 rows; sample less often");
-              require(rtol > 0 && rtol < 1e-2, "rtol: expected a number in (0, 1e-2)");
-              require(max_steps >= 1, "max_steps: expected >= 1");
-              require(dynamics != "field" || qd0.isZero(), "twist: has no meaning for dynamics='field'");
-              PyTrajectory p{sc, {}, dynamics};
-              py::gil_scoped_release free;
-              if (dynamics == "field") {
-                  LimitCycleOptions lo;
-                  lo.tol = tol;
-                  p.tr = field_curve(sc, q0, time, dt, lo);
-              } else {
-                  IntegrationOptions io;
-                  io.rtol = rtol;
-                  io.max_steps = max_steps;
-                  p.tr = simulate(sc, dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
-              }
-              return p;
-          },
-          py::arg("scene"), py::arg("start"), py::arg("time"), py::kw_only(), py::arg("dynamics") = "full",
-          py::arg("twist") = py::none(), py::arg("sample") = py::none(), py::arg("rtol") = 1e-9,
-          py::arg("max_steps") = 20'000'000L, py::arg("tol") = 1e-7,
-          "A trajectory from configuration `start` with the part's twist `twist` relative to the plate (default:\n"
-          "at rest) for `time` seconds, sampled every `sample` (default T/4): 'full' dynamics (31), 'u'\n"
-          "U-dynamics (32) or the 'field' integral curve. Stick-slip is simulated through. A run that leaves\n"
-          "the model (a normal force reaches zero) ends there: trajectory.stop says when and which contact.");
+    m.def(
+        "simulate",
+        [](const Scene& sc, const std::vector<double>& start, double time, const std::string& dynamics,
+           std::optional<std::vector<double>> twist, std::optional<double> sample, double rtol, long max_steps, double tol) {
+            require(dynamics == "full" || dynamics == "u" || dynamics == "field",
+                    "dynamics: expected 'full', 'u' or 'field', got '" + dynamics + "'");
+            const Vec3 q0 = config(sc, start, "start");
+            const Vec3 qd0 = twist ? config(sc, *twist, "twist") : Vec3::Zero();
+            const double dt = sample.value_or(sc.plate.T / 4);
+            require(std::isfinite(time) && time > 0, "time: expected a number > 0");
+            require(std::isfinite(dt) && dt > 0, "sample: expected a number > 0");
+            require(std::ceil(time / dt) + 1 <= 1e7, "time / sample: more than 10^7 rows; sample less often");
+            require(rtol > 0 && rtol < 1e-2, "rtol: expected a number in (0, 1e-2)");
+            require(max_steps >= 1, "max_steps: expected >= 1");
+            require(dynamics != "field" || qd0.isZero(), "twist: has no meaning for dynamics='field'");
+            PyTrajectory p{sc, {}, dynamics};
+            py::gil_scoped_release free;
+            if (dynamics == "field") {
+                LimitCycleOptions lo;
+                lo.tol = tol;
+                p.tr = field_curve(sc, q0, time, dt, lo);
+            } else {
+                IntegrationOptions io;
+                io.rtol = rtol;
+                io.max_steps = max_steps;
+                p.tr = simulate(sc, dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
+            }
+            return p;
+        },
+        py::arg("scene"), py::arg("start"), py::arg("time"), py::kw_only(), py::arg("dynamics") = "full",
+        py::arg("twist") = py::none(), py::arg("sample") = py::none(), py::arg("rtol") = 1e-9, py::arg("max_steps") = 20'000'000L,
+        py::arg("tol") = 1e-7,
+        "A trajectory from configuration `start` with the part's twist `twist` relative to the plate (default:\n"
+        "at rest) for `time` seconds, sampled every `sample` (default T/4): 'full' dynamics (31), 'u'\n"
+        "U-dynamics (32) or the 'field' integral curve. Stick-slip is simulated through. A run that leaves\n"
+        "the model (a normal force reaches zero) ends there: trajectory.stop says when and which contact.");
 }
 
-}  // namespace plate::python
+}   // namespace plate::python

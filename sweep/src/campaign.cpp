@@ -57,8 +57,7 @@ struct Reader {
     }
     std::vector<double> numbers(const json& v, const std::string& field, std::size_t lo, std::size_t hi) const {
         if (!v.is_array() || v.size() < lo || v.size() > hi)
-            fail(field, "expected an array of " + std::to_string(lo) + (lo < hi ? " to " + std::to_string(hi) : "") +
-                            " numbers");
+            fail(field, "expected an array of " + std::to_string(lo) + (lo < hi ? " to " + std::to_string(hi) : "") + " numbers");
         std::vector<double> x;
         for (std::size_t i = 0; i < v.size(); ++i) x.push_back(number(v[i], field + "[" + std::to_string(i) + "]"));
         return x;
@@ -140,10 +139,12 @@ void read_parameters(const Reader& r, const json& file, const std::string& scene
         q.pointer = r.text(r.need(p, f, "pointer"), f + ".pointer");
         try {
             const json::json_pointer ptr(q.pointer);
-            const bool numbers = c.base.contains(ptr) && c.base.at(ptr).is_array() && !c.base.at(ptr).empty() &&
-                                 std::all_of(c.base.at(ptr).begin(), c.base.at(ptr).end(), [](const json& x) { return x.is_number(); });
+            const bool numbers =
+                c.base.contains(ptr) && c.base.at(ptr).is_array() && !c.base.at(ptr).empty() &&
+                std::all_of(c.base.at(ptr).begin(), c.base.at(ptr).end(), [](const json& x) { return x.is_number(); });
             if (!c.base.contains(ptr) || !(c.base.at(ptr).is_number() || numbers))
-                r.fail(f + ".pointer", "'" + q.pointer + "' addresses no number (or array of numbers) of the base scene " + scene_source);
+                r.fail(f + ".pointer",
+                       "'" + q.pointer + "' addresses no number (or array of numbers) of the base scene " + scene_source);
         } catch (const json::exception&) {
             r.fail(f + ".pointer", "'" + q.pointer + "' is no JSON pointer (RFC 6901, e.g. /plate/harmonics/0/amp)");
         }
@@ -160,7 +161,10 @@ void read_parameters(const Reader& r, const json& file, const std::string& scene
             const double a = r.number(r.need(p, f, "from"), f + ".from"), b = r.number(r.need(p, f, "to"), f + ".to");
             const long n = r.whole(r.need(p, f, "count"), f + ".count", 1, kMaxCases);
             if (n == 1 && a != b) r.fail(f + ".count", "1 value needs from == to");
-            for (long k = 0; k < n; ++k) q.values.push_back(n == 1 ? a : k == n - 1 ? b : a + (b - a) * static_cast<double>(k) / static_cast<double>(n - 1));
+            for (long k = 0; k < n; ++k)
+                q.values.push_back(n == 1       ? a
+                                   : k == n - 1 ? b
+                                                : a + (b - a) * static_cast<double>(k) / static_cast<double>(n - 1));
         }
         c.parameters.push_back(q);
     }
@@ -207,7 +211,8 @@ void read_design(const Reader& r, const json& g, const Scene& base, Campaign& c)
     if (!t.is_array() || t.size() < 2 || t.size() > 5 || !t[0].is_string())
         r.fail("compute.design.target", "expected [KIND, numbers...]: " + design_target_usage());
     std::vector<double> values;
-    for (std::size_t i = 1; i < t.size(); ++i) values.push_back(r.number(t[i], "compute.design.target[" + std::to_string(i) + "]"));
+    for (std::size_t i = 1; i < t.size(); ++i)
+        values.push_back(r.number(t[i], "compute.design.target[" + std::to_string(i) + "]"));
     try {
         c.design = parse_design_target(t[0].get<std::string>(), values, base.part.point);
     } catch (const std::invalid_argument& e) {
@@ -220,10 +225,12 @@ void read_design(const Reader& r, const json& g, const Scene& base, Campaign& c)
     }
     if (g.contains("starts")) c.design_options.starts = static_cast<int>(r.whole(g["starts"], "compute.design.starts", 1, 10000));
     if (g.contains("evaluations"))
-        c.design_options.local_evaluations = static_cast<int>(r.whole(g["evaluations"], "compute.design.evaluations", 1, 1'000'000));
-    if (g.contains("seed")) c.design_options.seed = static_cast<std::uint64_t>(r.whole(g["seed"], "compute.design.seed", 0, 1L << 52));
+        c.design_options.local_evaluations =
+            static_cast<int>(r.whole(g["evaluations"], "compute.design.evaluations", 1, 1'000'000));
+    if (g.contains("seed"))
+        c.design_options.seed = static_cast<std::uint64_t>(r.whole(g["seed"], "compute.design.seed", 0, 1L << 52));
     c.design_options.threads = 1;   // one case, one thread: the farm shares the cases
-    try {   // (the limits and the target judged once, in the library, on the base scene)
+    try {                           // (the limits and the target judged once, in the library, on the base scene)
         validate_design_options(c.design_options);
         validate_design_target(*c.design, base, c.design_options);
     } catch (const std::invalid_argument& e) {
@@ -260,13 +267,15 @@ void read_compute(const Reader& r, const json& file, const Scene& base, Campaign
         r.only(y, "compute.cycle", {"tol", "rtol", "max_periods", "max_rhs"});
         if (y.contains("tol")) c.cycle.tol = r.number(y["tol"], "compute.cycle.tol");
         if (y.contains("rtol")) c.cycle.integration.rtol = r.number(y["rtol"], "compute.cycle.rtol");
-        if (y.contains("max_periods")) c.cycle.max_periods = static_cast<int>(r.whole(y["max_periods"], "compute.cycle.max_periods", 2, 100000));
+        if (y.contains("max_periods"))
+            c.cycle.max_periods = static_cast<int>(r.whole(y["max_periods"], "compute.cycle.max_periods", 2, 100000));
         if (y.contains("max_rhs"))
             c.cycle.max_rhs_evaluations = r.whole(y["max_rhs"], "compute.cycle.max_rhs", 1000, 1'000'000'000'000L);
         if (!(c.cycle.tol > 0) || !(c.cycle.integration.rtol > 0 && c.cycle.integration.rtol < 1e-2))
             r.fail("compute.cycle", "tol must be > 0 and rtol in (0, 1e-2)");
     }
-    if (c.twist_at.empty() && !c.field && !c.design) r.fail("compute", "nothing to compute (twist_at, field, fixed_points or design)");
+    if (c.twist_at.empty() && !c.field && !c.design)
+        r.fail("compute", "nothing to compute (twist_at, field, fixed_points or design)");
 }
 
 // A parameter named like a column the case itself fills would be overwritten by it.
@@ -283,7 +292,7 @@ void check_parameter_names(const Reader& r, const Campaign& c) {
                    "'" + c.parameters[i].name + "' is a column the table fills itself; choose another name");
 }
 
-}  // namespace
+}   // namespace
 
 int Campaign::cases() const {
     if (random) return samples;
@@ -315,7 +324,7 @@ Campaign load_campaign(const std::string& path) {
 }
 
 std::string fingerprint(const Campaign& c) {
-    const std::string s = c.file.dump();   // (keys sorted: a canonical text)
+    const std::string s = c.file.dump();        // (keys sorted: a canonical text)
     std::uint64_t h = 1469598103934665603ULL;   // FNV-1a
     for (unsigned char ch : s) {
         h ^= ch;
@@ -390,4 +399,4 @@ std::vector<std::string> columns(const Campaign& c) {
     return col;
 }
 
-}  // namespace plate::sweep
+}   // namespace plate::sweep

@@ -38,7 +38,8 @@ public:
                 }
             }
         };
-        const int n = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(threads_), std::max<std::size_t>(todo.size(), 1)));
+        const int n =
+            static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(threads_), std::max<std::size_t>(todo.size(), 1)));
         std::vector<std::thread> pool;
         for (int t = 1; t < n; ++t) pool.emplace_back(worker);
         worker();
@@ -55,13 +56,12 @@ int env_int(const char* name) {
     return v ? std::atoi(v) : 0;
 }
 
-}  // namespace
+}   // namespace
 
 std::unique_ptr<Farm> thread_farm(int threads) { return std::make_unique<ThreadFarm>(threads); }
 
 TaskRunner farm_tasks(Farm& farm) {
-    return [&farm](int n, const std::function<std::string(int)>& work,
-                   const std::function<void(int, const std::string&)>& done) {
+    return [&farm](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
         std::vector<int> todo;
         if (farm.root())
             for (int i = 0; i < n; ++i) todo.push_back(i);
@@ -101,4 +101,4 @@ std::unique_ptr<Farm> mpi_farm(int) {
 }
 #endif
 
-}  // namespace plate::sweep
+}   // namespace plate::sweep

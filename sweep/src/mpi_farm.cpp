@@ -123,8 +123,10 @@ public:
              const std::function<void(int, const std::string&)>& done) override {
         std::exception_ptr failure;   // a done() that threw (a journal that cannot be written): the
         try {                         // caller reports it and aborts every rank
-            if (rank_ == 0) root(todo, work, done);
-            else worker(work);
+            if (rank_ == 0)
+                root(todo, work, done);
+            else
+                worker(work);
         } catch (...) {
             failure = std::current_exception();
         }
@@ -137,7 +139,7 @@ private:
     // ranks. done() is called under one mutex from both.
     void root(const std::vector<int>& todo, const std::function<std::string(int)>& work,
               const std::function<void(int, const std::string&)>& done) {
-        std::mutex m;                 // the list's cursor, done(), the failure
+        std::mutex m;   // the list's cursor, done(), the failure
         std::size_t next = 0;
         std::exception_ptr failure;
         auto take = [&] { return !failure && next < todo.size() ? todo[next++] : -1; };
@@ -226,7 +228,8 @@ private:
                 idle = false;
                 int i = -1;
                 MPI_Recv(&i, 1, MPI_INT, 0, kAssign, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                if (i < 0) ++stops;
+                if (i < 0)
+                    ++stops;
                 else {
                     local.push(i);
                     ++busy;
@@ -248,9 +251,9 @@ private:
     int rank_ = 0, ranks_ = 1, threads_ = 1, workers_ = 1;
 };
 
-}  // namespace
+}   // namespace
 
 bool mpi_built() { return true; }
 std::unique_ptr<Farm> mpi_farm(int threads) { return std::make_unique<MpiFarm>(threads); }
 
-}  // namespace plate::sweep
+}   // namespace plate::sweep

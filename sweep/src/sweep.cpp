@@ -35,7 +35,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double num_or_nan(double x) { return std::isfinite(x) ? x : kNaN; }
 
-}  // namespace
+}   // namespace
 
 Row run_case(const Campaign& c, int index) {
     Row row;
@@ -98,9 +98,11 @@ Row run_case(const Campaign& c, int index) {
             row["field_max_speed"] = defined ? max_speed : kNaN;
             if (!point) row["field_mean_abs_omega"] = num_or_nan(omega * m);
             row["field_mean_stick"] = num_or_nan(stick * m);
-            if (lost > 0) notes.push_back("contact lost at " + std::to_string(lost) + " of " + std::to_string(n) + " field configurations");
+            if (lost > 0)
+                notes.push_back("contact lost at " + std::to_string(lost) + " of " + std::to_string(n) + " field configurations");
             if (defined + lost < n)
-                reasons.push_back(std::to_string(n - defined - lost) + " of " + std::to_string(n) + " field configurations without a cycle");
+                reasons.push_back(std::to_string(n - defined - lost) + " of " + std::to_string(n) +
+                                  " field configurations without a cycle");
             if (c.fixed_points) {
                 FixedPointOptions fpo;
                 fpo.cycle = c.cycle;
@@ -193,7 +195,7 @@ void sync_dir(const fs::path& dir) {
 json journal_header(const Campaign& c) {
     return {{"journal", "plate sweep"}, {"campaign", c.name}, {"fingerprint", fingerprint(c)}, {"cases", c.cases()}};
 }
-}  // namespace
+}   // namespace
 
 Journal::Journal(const std::string& dir, const Campaign& c) : done_(static_cast<std::size_t>(c.cases()), 0) {
     try {
@@ -242,7 +244,9 @@ void Journal::open(const std::string& dir, const Campaign& c) {
             }
         }
         if (!ok) {
-            if (!last) throw InputError(path_ + ":" + std::to_string(line_no) + ": not a journal line (the journal is damaged; remove it to start again)");
+            if (!last)
+                throw InputError(path_ + ":" + std::to_string(line_no) +
+                                 ": not a journal line (the journal is damaged; remove it to start again)");
             ++dropped_;
             break;
         }
@@ -349,10 +353,14 @@ std::string svg_num(double x) {
 std::string xml(const std::string& s) {
     std::string o;
     for (char ch : s) {
-        if (ch == '<') o += "&lt;";
-        else if (ch == '>') o += "&gt;";
-        else if (ch == '&') o += "&amp;";
-        else o += ch;
+        if (ch == '<')
+            o += "&lt;";
+        else if (ch == '>')
+            o += "&gt;";
+        else if (ch == '&')
+            o += "&amp;";
+        else
+            o += ch;
     }
     return o;
 }
@@ -364,9 +372,7 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
         std::string title;
         std::function<double(const Row&)> value;
     };
-    auto get = [](const Row& r, const std::string& k) {
-        return r.contains(k) && r[k].is_number() ? r[k].get<double>() : kNaN;
-    };
+    auto get = [](const Row& r, const std::string& k) { return r.contains(k) && r[k].is_number() ? r[k].get<double>() : kNaN; };
     std::vector<Panel> panels;
     if (c.fixed_points) {
         panels.push_back({"stable fixed points found", [=](const Row& r) { return get(r, "fp_stable"); }});
@@ -376,9 +382,8 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
         panels.push_back({"mean speed over the field [mm/s]", [=](const Row& r) { return 1e3 * get(r, "field_mean_speed"); }});
         panels.push_back({"mean stick fraction over the field", [=](const Row& r) { return get(r, "field_mean_stick"); }});
     } else if (!c.twist_at.empty()) {
-        panels.push_back({"speed at configuration 0 [mm/s]", [=](const Row& r) {
-                              return 1e3 * std::hypot(get(r, "twist0_vx"), get(r, "twist0_vy"));
-                          }});
+        panels.push_back({"speed at configuration 0 [mm/s]",
+                          [=](const Row& r) { return 1e3 * std::hypot(get(r, "twist0_vx"), get(r, "twist0_vy")); }});
         panels.push_back({"stick fraction at configuration 0", [=](const Row& r) { return get(r, "twist0_stick"); }});
     } else {
         panels.push_back({"design verified (1) or not (0)", [=](const Row& r) {
@@ -420,7 +425,8 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
         }
         if (!(hi > lo)) hi = lo + 1;
         if (!std::isfinite(lo)) lo = 0, hi = 1;
-        s << "<text x=\"" << x0 + pw / 2 << "\" y=\"" << y0 - 12 << "\" text-anchor=\"middle\">" << xml(panels[k].title) << "</text>\n";
+        s << "<text x=\"" << x0 + pw / 2 << "\" y=\"" << y0 - 12 << "\" text-anchor=\"middle\">" << xml(panels[k].title)
+          << "</text>\n";
         s << "<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << pw << "\" height=\"" << ph
           << "\" fill=\"#eee\" stroke=\"#888\"/>\n";
         auto X = [&](double x) { return x0 + (xr.second > xr.first ? (x - xr.first) / (xr.second - xr.first) : 0.5) * pw; };
@@ -434,7 +440,8 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
             if (c.random) {
                 cx = X(px);
                 cy = Y(py);
-                s << "<circle cx=\"" << cx << "\" cy=\"" << cy << "\" r=\"4\" fill=\"" << fill << "\" stroke=\"#333\" stroke-width=\"0.5\"/>\n";
+                s << "<circle cx=\"" << cx << "\" cy=\"" << cy << "\" r=\"4\" fill=\"" << fill
+                  << "\" stroke=\"#333\" stroke-width=\"0.5\"/>\n";
                 cw = ch = 8;
             } else {
                 const int idx = r["case"].get<int>();
@@ -444,16 +451,18 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
                 ch = static_cast<double>(ph) / ny;
                 cx = x0 + (ix + 0.5) * cw;
                 cy = y0 + ph - (iy + 0.5) * ch;
-                s << "<rect x=\"" << x0 + ix * cw << "\" y=\"" << y0 + ph - (iy + 1) * ch << "\" width=\"" << cw << "\" height=\"" << ch
-                  << "\" fill=\"" << fill << "\"><title>case " << idx << ": " << svg_num(val[i]) << "</title></rect>\n";
+                s << "<rect x=\"" << x0 + ix * cw << "\" y=\"" << y0 + ph - (iy + 1) * ch << "\" width=\"" << cw << "\" height=\""
+                  << ch << "\" fill=\"" << fill << "\"><title>case " << idx << ": " << svg_num(val[i]) << "</title></rect>\n";
             }
             if (failed)
-                s << "<path d=\"M" << cx - cw / 4 << " " << cy - ch / 4 << "L" << cx + cw / 4 << " " << cy + ch / 4 << "M" << cx - cw / 4
-                  << " " << cy + ch / 4 << "L" << cx + cw / 4 << " " << cy - ch / 4 << "\" stroke=\"#900\" stroke-width=\"1.2\"/>\n";
+                s << "<path d=\"M" << cx - cw / 4 << " " << cy - ch / 4 << "L" << cx + cw / 4 << " " << cy + ch / 4 << "M"
+                  << cx - cw / 4 << " " << cy + ch / 4 << "L" << cx + cw / 4 << " " << cy - ch / 4
+                  << "\" stroke=\"#900\" stroke-width=\"1.2\"/>\n";
         }
         // Axes: the parameters' ranges; a colour bar with the value range.
         s << "<text x=\"" << x0 << "\" y=\"" << y0 + ph + 16 << "\">" << svg_num(xr.first) << "</text>\n"
-          << "<text x=\"" << x0 + pw << "\" y=\"" << y0 + ph + 16 << "\" text-anchor=\"end\">" << svg_num(xr.second) << "</text>\n"
+          << "<text x=\"" << x0 + pw << "\" y=\"" << y0 + ph + 16 << "\" text-anchor=\"end\">" << svg_num(xr.second)
+          << "</text>\n"
           << "<text x=\"" << x0 + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">" << xml(c.parameters[0].name)
           << "</text>\n";
         if (two)
@@ -463,17 +472,18 @@ std::string summary_svg(const Campaign& c, const std::vector<const Row*>& rows) 
               << xml(c.parameters[1].name) << "</text>\n";
         const int bx = x0 + pw + 10;
         for (int b = 0; b < 40; ++b)
-            s << "<rect x=\"" << bx << "\" y=\"" << y0 + ph - (b + 1) * ph / 40.0 << "\" width=\"14\" height=\"" << ph / 40.0 + 0.5
-              << "\" fill=\"" << colour((b + 0.5) / 40) << "\"/>\n";
-        s << "<text x=\"" << bx + 18 << "\" y=\"" << y0 + ph << "\">" << svg_num(lo) << "</text>\n<text x=\"" << bx + 18 << "\" y=\""
-          << y0 + 10 << "\">" << svg_num(hi) << "</text>\n";
+            s << "<rect x=\"" << bx << "\" y=\"" << y0 + ph - (b + 1) * ph / 40.0 << "\" width=\"14\" height=\""
+              << ph / 40.0 + 0.5 << "\" fill=\"" << colour((b + 0.5) / 40) << "\"/>\n";
+        s << "<text x=\"" << bx + 18 << "\" y=\"" << y0 + ph << "\">" << svg_num(lo) << "</text>\n<text x=\"" << bx + 18
+          << "\" y=\"" << y0 + 10 << "\">" << svg_num(hi) << "</text>\n";
     }
-    s << "<text x=\"" << left0 << "\" y=\"" << H - 14 << "\" fill=\"#555\">grey: no value; red cross: the case failed (see its reason in "
+    s << "<text x=\"" << left0 << "\" y=\"" << H - 14
+      << "\" fill=\"#555\">grey: no value; red cross: the case failed (see its reason in "
       << "table.csv)</text>\n</svg>\n";
     return s.str();
 }
 
-}  // namespace
+}   // namespace
 
 void write_tables(const std::string& dir, const Campaign& c, const Journal& j) {
     std::vector<const Journal::Entry*> by_case(static_cast<std::size_t>(c.cases()), nullptr);
@@ -486,7 +496,8 @@ void write_tables(const std::string& dir, const Campaign& c, const Journal& j) {
         for (std::size_t k = 0; k < col.size(); ++k) o << (k ? "," : "") << col[k];
         o << "\n";
         for (const auto* e : by_case) {
-            for (std::size_t k = 0; k < col.size(); ++k) o << (k ? "," : "") << csv_cell(e->row.contains(col[k]) ? e->row[col[k]] : Row());
+            for (std::size_t k = 0; k < col.size(); ++k)
+                o << (k ? "," : "") << csv_cell(e->row.contains(col[k]) ? e->row[col[k]] : Row());
             o << "\n";
         }
     });
@@ -496,7 +507,8 @@ void write_tables(const std::string& dir, const Campaign& c, const Journal& j) {
     write_file_atomic((d / "timing.csv").string(), [&](std::ostream& o) {
         o << "case,rank,seconds,rhs_evaluations\n";
         for (const auto* e : by_case)
-            o << e->index << "," << e->rank << "," << csv_cell(Row(e->seconds)) << "," << csv_cell(e->row["rhs_evaluations"]) << "\n";
+            o << e->index << "," << e->rank << "," << csv_cell(Row(e->seconds)) << "," << csv_cell(e->row["rhs_evaluations"])
+              << "\n";
     });
     std::vector<const Row*> rows;
     for (const auto* e : by_case) rows.push_back(&e->row);
@@ -569,4 +581,4 @@ SweepSummary run_sweep(const std::string& campaign_file, const SweepOptions& opt
     return s;
 }
 
-}  // namespace plate::sweep
+}   // namespace plate::sweep

@@ -76,4 +76,4 @@ inline Eigen::Matrix2d jacobian(const Scene& sc, const Vec2& s) {
     return J;
 }
 
-}  // namespace design_tests
+}   // namespace design_tests

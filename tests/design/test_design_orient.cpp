@@ -9,9 +9,10 @@
 using namespace plate;
 using namespace design_tests;
 
-TEST_CASE("a translating plate: the same twist everywhere, full = U dynamics, no turn with one friction "
-          "coefficient, a weathervane with a rubber foot",
-          "[design][orient]") {
+TEST_CASE(
+    "a translating plate: the same twist everywhere, full = U dynamics, no turn with one friction "
+    "coefficient, a weathervane with a rubber foot",
+    "[design][orient]") {
     // foot.json: fig4's triangle (mirror symmetric about its y axis) with its lone contact, on that
     // axis, at mu 0.6 and the pair at 0.2; the plate shaken along x with a heave in phase (x 15, z 7
     // m/s^2), mirror symmetric about the x axis.

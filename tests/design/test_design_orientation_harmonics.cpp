@@ -96,9 +96,9 @@ TEST_CASE("orientation harmonics: what a plate can give a rigid part's orientati
         const double a1 = 20, c = 9.5, a3 = 7.3, d = std::sqrt(27.0) * c, q = kPi / 2, flip = sense3 < 0 ? kPi : 0;
         PlateMotion u;
         u.T = fig4.plate.T;
-        u.harmonics = {{Axis::x, 1, a1, q},         {Axis::y, 1, a1, 0},          {Axis::rx, 1, c, q + 6.30},
-                       {Axis::ry, 1, c, 6.30},      {Axis::x, 3, a3, q + 3.06},   {Axis::y, 3, a3, 3.06 + flip},
-                       {Axis::rx, 3, d, q + 6.33},  {Axis::ry, 3, d, 6.33 + flip}};
+        u.harmonics = {{Axis::x, 1, a1, q},        {Axis::y, 1, a1, 0},          {Axis::rx, 1, c, q + 6.30},
+                       {Axis::ry, 1, c, 6.30},     {Axis::x, 3, a3, q + 3.06},   {Axis::y, 3, a3, 3.06 + flip},
+                       {Axis::rx, 3, d, q + 6.33}, {Axis::ry, 3, d, 6.33 + flip}};
         return u;
     };
     Scene sym = fig4;

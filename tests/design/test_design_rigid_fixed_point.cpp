@@ -166,7 +166,8 @@ TEST_CASE("the half-turn pair broken by rz about its centre: fig4's fixed point 
         for (int k = (falls[0] + 1) % n; w[k] <= 0 && !target_well[k]; k = (k + 1) % n) target_well[k] = true;
         double lowest_other = HUGE_VAL;
         for (int k = 0; k < n; ++k)
-            if (!target_well[k] && w[k] <= w[(k + n - 1) % n] && w[k] < w[(k + 1) % n]) lowest_other = std::min(lowest_other, w[k]);
+            if (!target_well[k] && w[k] <= w[(k + n - 1) % n] && w[k] < w[(k + 1) % n])
+                lowest_other = std::min(lowest_other, w[k]);
         INFO("the shallowest other well " << lowest_other << " rad/s");
         CHECK(lowest_other >= 0.0015);
     }
@@ -182,8 +183,7 @@ TEST_CASE("the half-turn pair broken by rz about its centre: fig4's fixed point 
     CHECK(s.held.end_distance <= o.verify_distance);
 }
 
-TEST_CASE("a half-turn pair's basin cap: of the region's part that is its own image, at most half",
-          "[design][rigid]") {
+TEST_CASE("a half-turn pair's basin cap: of the region's part that is its own image, at most half", "[design][rigid]") {
     // Closed forms for |s_x|, |s_y| <= a: about the region's centre the whole region is its own image
     // (1/2); about a point on its edge nothing is (1); in between (2a - 2|D_x|)(2a - 2|D_y|) / (4 a^2)
     // of it is, half of which may go to the target.

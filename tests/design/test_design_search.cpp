@@ -67,8 +67,9 @@ TEST_CASE("a design whose tasks arrive as text from elsewhere is the same design
     CHECK(a.cycles >= 2 * a.evaluations);   // (every sink evaluation: at least the Jacobian's two cycles)
 }
 
-TEST_CASE("the allowed axes and harmonics narrow the search: the designed motion uses nothing else, and an empty family fails cleanly",
-          "[design]") {
+TEST_CASE(
+    "the allowed axes and harmonics narrow the search: the designed motion uses nothing else, and an empty family fails cleanly",
+    "[design]") {
     const Scene part = scene("fig1_point");
     DesignTarget t = transport(Vec2(0.02, 0));
     DesignOptions o = searched(8, 200, 6);

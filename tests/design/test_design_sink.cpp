@@ -102,7 +102,8 @@ TEST_CASE("without the hold a sink cones: released at the target the part walks 
     REQUIRE(s.verified);   // (verified without a hold)
     CHECK(std::isinf(sink_coning_limit(t.at, o)));
     // ... and says so: no hold means no coning limit, not a held sink.
-    CHECK(std::any_of(s.notes.begin(), s.notes.end(), [](const std::string& n) { return n.find("coning not limited") != std::string::npos; }));
+    CHECK(std::any_of(s.notes.begin(), s.notes.end(),
+                      [](const std::string& n) { return n.find("coning not limited") != std::string::npos; }));
     CHECK(std::abs(s.coning) > 7.3e-4);
     const double hold = 400;
     const Trajectory held = simulate(s.scene, Dynamics::Full, Vec3(t.at.x(), t.at.y(), 0), Vec3::Zero(), hold, 10);
@@ -186,7 +187,8 @@ TEST_CASE("an impossible target fails cleanly, never reported as done", "[design
         DesignTarget turn;
         turn.kind = DesignTargetKind::Orient;
         CHECK_THROWS_WITH(design(part, turn, o), Catch::Contains("no orientation"));
-        DesignTarget rigid_transport = transport(Vec2(0.01, 0));   // (a weathervane's velocity turns with it; a turn needs a whirl)
+        DesignTarget rigid_transport =
+            transport(Vec2(0.01, 0));   // (a weathervane's velocity turns with it; a turn needs a whirl)
         CHECK_THROWS_WITH(design(scene("foot"), rigid_transport, o), Catch::Contains("friction differs"));
         rigid_transport.omega = 0.1;
         CHECK_THROWS_WITH(design(scene("fig4"), rigid_transport, o), Catch::Contains("transport with a turn"));
@@ -245,7 +247,8 @@ TEST_CASE("a rigid part's sink: its position ends at the target whatever its ori
         for (int d = 0; d < 2; ++d) {
             Vec3 e = Vec3::Zero();
             e[d] = 1e-3;
-            J.col(d) = (xi(s.scene, Vec3(t.at.x(), t.at.y(), th) + e) - xi(s.scene, Vec3(t.at.x(), t.at.y(), th) - e)).head<2>() / 2e-3;
+            J.col(d) =
+                (xi(s.scene, Vec3(t.at.x(), t.at.y(), th) + e) - xi(s.scene, Vec3(t.at.x(), t.at.y(), th) - e)).head<2>() / 2e-3;
         }
         const Eigen::Vector2cd ev = J.eigenvalues();
         INFO("theta " << th << ": v " << v.head<2>().transpose() << ", eigenvalues " << ev.transpose());

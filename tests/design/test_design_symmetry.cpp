@@ -42,10 +42,10 @@ TEST_CASE("adding -alpha x D to the linear acceleration shifts the field by D", 
         shifted.plate = shift_motion(sc.plate, D);
         // A wrong shift: only the horizontal part of -alpha x D (the vertical one dropped).
         Scene wrong = shifted;
-        wrong.plate.harmonics.erase(std::remove_if(wrong.plate.harmonics.begin() + sc.plate.harmonics.size(),
-                                                   wrong.plate.harmonics.end(),
-                                                   [](const Harmonic& h) { return h.axis == Axis::z; }),
-                                    wrong.plate.harmonics.end());
+        wrong.plate.harmonics.erase(
+            std::remove_if(wrong.plate.harmonics.begin() + sc.plate.harmonics.size(), wrong.plate.harmonics.end(),
+                           [](const Harmonic& h) { return h.axis == Axis::z; }),
+            wrong.plate.harmonics.end());
         const bool has_vertical = wrong.plate.harmonics.size() < shifted.plate.harmonics.size();
         for (const Vec3& q : {Vec3(0.03, -0.02, 1.0), Vec3(0.0, 0.0, 0.3)}) {
             const Vec3 v = xi(sc, q);
@@ -149,7 +149,7 @@ TEST_CASE("tilt drift: rotations about two axes a quarter period apart turn the 
     REQUIRE_FALSE(tr.samples.empty());
     const Vec3 end = tr.samples.back().q;
     INFO("end " << end.transpose() << ", drift " << tilt_drift_rate(sc.plate).transpose());
-    CHECK(end.head<2>().norm() > 0.01);   // it slid off downhill:
+    CHECK(end.head<2>().norm() > 0.01);                   // it slid off downhill:
     CHECK(std::abs(end.y()) < 0.1 * std::abs(end.x()));   // along x (the tilt is about y)
     // the sign, as coning_rate's, is the world's axes' turn seen from the plate: the plate itself turns
     // about y at -d_y, and a turn about +y lowers its +x side, so with d_y < 0 the part slides to +x

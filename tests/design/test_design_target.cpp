@@ -56,8 +56,8 @@ struct Run {
 Run cli_design(const std::string& scene, const Words& w) {
     const fs::path dir = fs::temp_directory_path() / ("plate_target_" + std::to_string(::getpid()));
     fs::create_directories(dir);
-    const std::string cmd = std::string(PLATE_EXE) + " design " + kScenes + scene + ".json --target " + w.text() +
-                            " --out " + (dir / "x.json").string() + " > /dev/null 2> " + (dir / "err").string();
+    const std::string cmd = std::string(PLATE_EXE) + " design " + kScenes + scene + ".json --target " + w.text() + " --out " +
+                            (dir / "x.json").string() + " > /dev/null 2> " + (dir / "err").string();
     const int st = std::system(cmd.c_str());
     std::ifstream in(dir / "err");
     std::stringstream e;
@@ -72,11 +72,12 @@ Run cli_design(const std::string& scene, const Words& w) {
 std::string campaign_refusal(const std::string& scene, const Words& w) {
     nlohmann::json target = nlohmann::json::array({w.kind});
     for (double v : w.values) target.push_back(v);
-    const nlohmann::json file = {{"name", "t"},
-                                 {"scene", kScenes + scene + ".json"},
-                                 {"sampling", "grid"},
-                                 {"parameters", nlohmann::json::array({{{"name", "g"}, {"pointer", "/gravity"}, {"values", {9.81}}}})},
-                                 {"compute", {{"design", {{"target", target}}}}}};
+    const nlohmann::json file = {
+        {"name", "t"},
+        {"scene", kScenes + scene + ".json"},
+        {"sampling", "grid"},
+        {"parameters", nlohmann::json::array({{{"name", "g"}, {"pointer", "/gravity"}, {"values", {9.81}}}})},
+        {"compute", {{"design", {{"target", target}}}}}};
     try {
         (void)sweep::campaign_from_json(file, "t.json");
     } catch (const std::exception& e) {
@@ -85,17 +86,17 @@ std::string campaign_refusal(const std::string& scene, const Words& w) {
     return "";
 }
 
-}  // namespace
+}   // namespace
 
 TEST_CASE("A target the command line refuses, campaigns and the library refuse with the same message", "[design][target]") {
     // Wrong words (kind, count) and targets this part cannot have (outside the region, a line sink
     // for a rigid part, an orientation for a point part, a transport without velocity or with a turn).
     const std::vector<std::pair<std::string, Words>> bad = {
-        {"fig1_point", {"wobble", {0, 0}}},         {"fig1_point", {"sink", {0.02}}},
-        {"fig4", {"fixed-point", {0.02, -0.01}}},   {"fig1_point", {"line-sink", {0, 0}}},
+        {"fig1_point", {"wobble", {0, 0}}},          {"fig1_point", {"sink", {0.02}}},
+        {"fig4", {"fixed-point", {0.02, -0.01}}},    {"fig1_point", {"line-sink", {0, 0}}},
         {"fig1_point", {"transport", {1, 2, 3, 4}}}, {"fig1_point", {"sink", {0.2, 0}}},
-        {"fig4", {"line-sink", {0, 0, 0.5}}},       {"fig1_point", {"orient", {1.0}}},
-        {"fig1_point", {"transport", {0, 0}}},      {"fig1_point", {"transport", {0.01, 0, 0.5}}},
+        {"fig4", {"line-sink", {0, 0, 0.5}}},        {"fig1_point", {"orient", {1.0}}},
+        {"fig1_point", {"transport", {0, 0}}},       {"fig1_point", {"transport", {0.01, 0, 0.5}}},
     };
     for (const auto& [scene, w] : bad) {
         INFO(scene << ": --target " << w.text());
@@ -114,12 +115,12 @@ TEST_CASE("A target the command line refuses, campaigns and the library refuse w
 
 TEST_CASE("A target's words round-trip through the parser, every kind", "[design][target]") {
     for (const bool point : {true, false})
-        for (const Words& w : std::vector<Words>{{"sink", {0.01, -0.02}},
-                                                 {"fixed-point", point ? std::vector<double>{0.01, 0.02}
-                                                                       : std::vector<double>{0.01, 0.02, 0.3}},
-                                                 {"orient", {-1.25}},
-                                                 {"line-sink", {0.01, 0, 0.6}},
-                                                 {"transport", {0.02, -0.01}}}) {
+        for (const Words& w :
+             std::vector<Words>{{"sink", {0.01, -0.02}},
+                                {"fixed-point", point ? std::vector<double>{0.01, 0.02} : std::vector<double>{0.01, 0.02, 0.3}},
+                                {"orient", {-1.25}},
+                                {"line-sink", {0.01, 0, 0.6}},
+                                {"transport", {0.02, -0.01}}}) {
             const DesignTarget t = parse_design_target(w.kind, w.values, point);
             CHECK(design_target_kind(t) == w.kind);
             CHECK(design_target_values(t, point) == w.values);

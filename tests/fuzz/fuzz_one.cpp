@@ -62,7 +62,7 @@ bool number(const std::string& s, double& x) {
     return !s.empty() && *end == '\0';
 }
 
-}  // namespace
+}   // namespace
 
 Outcome run_one(const std::string& input) {
     Outcome o;
@@ -134,7 +134,10 @@ Outcome run_one(const std::string& input) {
         auto nonfinite_word = [](const std::string& t) {
             std::size_t i = 0;
             while (i < t.size()) {
-                if (!std::isalpha(static_cast<unsigned char>(t[i])) && t[i] != '_') { ++i; continue; }
+                if (!std::isalpha(static_cast<unsigned char>(t[i])) && t[i] != '_') {
+                    ++i;
+                    continue;
+                }
                 std::size_t j = i;
                 while (j < t.size() && (std::isalpha(static_cast<unsigned char>(t[j])) || t[j] == '_')) ++j;
                 std::string w = t.substr(i, j - i);
@@ -146,7 +149,8 @@ Outcome run_one(const std::string& input) {
         };
         const std::string file = fs::exists(out) ? slurp(out) : std::string(), printed = so.str();
         for (const std::string* text : {&printed, &file})
-            if (nonfinite_word(*text)) fail("NaN or Inf in the output of a run that exited 0", detail + "\noutput:\n" + text->substr(0, 2000));
+            if (nonfinite_word(*text))
+                fail("NaN or Inf in the output of a run that exited 0", detail + "\noutput:\n" + text->substr(0, 2000));
         for (const std::string* text : {&printed, &file}) {
             if (text->empty() || ((*text)[0] != '{' && (*text)[0] != '[')) continue;
             const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
@@ -182,4 +186,4 @@ void cleanup() {
     fs::remove_all(workdir(), ec);
 }
 
-}  // namespace plate::fuzz
+}   // namespace plate::fuzz

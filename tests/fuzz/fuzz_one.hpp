@@ -12,8 +12,8 @@
 // Work is bounded so that a run takes milliseconds, not minutes, through the program's own budgets:
 // grids at most 3 per axis (2 if none is given), at most 40 periods and 3e5 right-hand sides per
 // cycle, 3e6 per field or fixed-point search, 10^5 steps and 0.5 s of simulated time per
-// trajectory, 2 threads (inputs asking for more are skipped). report, bench and proofs read no scene and run for minutes by design; their options
-// go through the same parser as the commands fuzzed here, so they are left out. Arguments with a
+// trajectory, 2 threads (inputs asking for more are skipped). report, bench and proofs read no scene and run for minutes by
+// design; their options go through the same parser as the commands fuzzed here, so they are left out. Arguments with a
 // '/' are skipped (a mutant must not write outside the harness's folder).
 #pragma once
 
@@ -38,4 +38,4 @@ void cleanup();
 constexpr int kSecondsPerInput = 60;
 void set_seconds_per_input(int seconds);
 
-}  // namespace plate::fuzz
+}   // namespace plate::fuzz

@@ -42,8 +42,8 @@ struct Mutator {
     bool coin(double p) { return std::uniform_real_distribution<double>(0, 1)(rng) < p; }
 
     double special(double x) {
-        const double v[] = {0.0, -0.0, 1.0, -1.0, 1e-300, -1e-300, 1e300, -1e300, 1.7e308, 4.9e-324, 1e9, 1e-9,
-                            x * 10, x / 10, -x, x * 1e6, x * 1e-6, x + 1e-12, 2147483648.0, 3.0, 7.0, 0.5};
+        const double v[] = {0.0,  -0.0,   1.0,    -1.0, 1e-300,  -1e-300,  1e300,     -1e300,       1.7e308, 4.9e-324, 1e9,
+                            1e-9, x * 10, x / 10, -x,   x * 1e6, x * 1e-6, x + 1e-12, 2147483648.0, 3.0,     7.0,      0.5};
         return v[pick(sizeof v / sizeof *v)];
     }
     // All node pointers of a JSON tree (pre-order).
@@ -59,18 +59,37 @@ struct Mutator {
         nodes(doc, all);
         json& n = *all[pick(all.size())];
         switch (pick(9)) {
-            case 0: if (n.is_number()) n = special(n.get<double>()); else n = special(1.0); break;
-            case 1: n = "text"; break;
-            case 2: n = nullptr; break;
-            case 3: n = json::array(); break;
-            case 4: n = json::object(); break;
+            case 0:
+                if (n.is_number())
+                    n = special(n.get<double>());
+                else
+                    n = special(1.0);
+                break;
+            case 1:
+                n = "text";
+                break;
+            case 2:
+                n = nullptr;
+                break;
+            case 3:
+                n = json::array();
+                break;
+            case 4:
+                n = json::object();
+                break;
             case 5:   // drop a field or an entry
-                if (n.is_object() && !n.empty()) { auto it = n.begin(); std::advance(it, pick(n.size())); n.erase(it); }
-                else if (n.is_array() && !n.empty()) n.erase(n.begin() + static_cast<long>(pick(n.size())));
+                if (n.is_object() && !n.empty()) {
+                    auto it = n.begin();
+                    std::advance(it, pick(n.size()));
+                    n.erase(it);
+                } else if (n.is_array() && !n.empty())
+                    n.erase(n.begin() + static_cast<long>(pick(n.size())));
                 break;
             case 6:   // an unknown field, or a repeated entry
-                if (n.is_object()) n["extra"] = 1;
-                else if (n.is_array() && !n.empty()) n.push_back(n[pick(n.size())]);
+                if (n.is_object())
+                    n["extra"] = 1;
+                else if (n.is_array() && !n.empty())
+                    n.push_back(n[pick(n.size())]);
                 break;
             case 7:   // an integer field gets a special value, saturated to long long's range: a cast of
                       // 1.7e308 to it is undefined behaviour (clang's UBSan, float-cast-overflow)
@@ -89,12 +108,53 @@ struct Mutator {
         }
     }
     void mutate_args(std::vector<std::string>& a) {
-        static const std::vector<std::string> options = {
-            "--at", "--from", "--tol", "--rtol", "--max-periods", "--cycle-solver", "--grid", "--nx", "--ny", "--ntheta",
-            "--x", "--y", "--theta0", "--threads", "--out", "--dynamics", "--time", "--dt", "--seed", "--thin", "--point",
-            "--help", "--format", "--verify", "--cold", "field", "full", "u", "auto", "shooting", "anderson", "OUT",
-            "SCENE", "-1", "0", "1e308", "nan", "inf", "-0", "0x10", "1e-320", "2", "3"};
-        if (a.empty()) { a.push_back("twist"); return; }
+        static const std::vector<std::string> options = {"--at",
+                                                         "--from",
+                                                         "--tol",
+                                                         "--rtol",
+                                                         "--max-periods",
+                                                         "--cycle-solver",
+                                                         "--grid",
+                                                         "--nx",
+                                                         "--ny",
+                                                         "--ntheta",
+                                                         "--x",
+                                                         "--y",
+                                                         "--theta0",
+                                                         "--threads",
+                                                         "--out",
+                                                         "--dynamics",
+                                                         "--time",
+                                                         "--dt",
+                                                         "--seed",
+                                                         "--thin",
+                                                         "--point",
+                                                         "--help",
+                                                         "--format",
+                                                         "--verify",
+                                                         "--cold",
+                                                         "field",
+                                                         "full",
+                                                         "u",
+                                                         "auto",
+                                                         "shooting",
+                                                         "anderson",
+                                                         "OUT",
+                                                         "SCENE",
+                                                         "-1",
+                                                         "0",
+                                                         "1e308",
+                                                         "nan",
+                                                         "inf",
+                                                         "-0",
+                                                         "0x10",
+                                                         "1e-320",
+                                                         "2",
+                                                         "3"};
+        if (a.empty()) {
+            a.push_back("twist");
+            return;
+        }
         const std::size_t i = pick(a.size());
         switch (pick(5)) {
             case 0: {
@@ -110,10 +170,18 @@ struct Mutator {
                 }
                 break;
             }
-            case 1: if (i > 0) a.erase(a.begin() + static_cast<long>(i)); break;
-            case 2: a.insert(a.begin() + static_cast<long>(i), a[i]); break;
-            case 3: a.insert(a.begin() + static_cast<long>(std::max<std::size_t>(i, 1)), options[pick(options.size())]); break;
-            case 4: std::swap(a[i], a[pick(a.size())]); break;
+            case 1:
+                if (i > 0) a.erase(a.begin() + static_cast<long>(i));
+                break;
+            case 2:
+                a.insert(a.begin() + static_cast<long>(i), a[i]);
+                break;
+            case 3:
+                a.insert(a.begin() + static_cast<long>(std::max<std::size_t>(i, 1)), options[pick(options.size())]);
+                break;
+            case 4:
+                std::swap(a[i], a[pick(a.size())]);
+                break;
         }
     }
     std::string mutate(const std::string& input) {
@@ -124,7 +192,10 @@ struct Mutator {
             const std::size_t what = pick(10);
             if (what < 5) {
                 json doc = json::parse(body, nullptr, false);
-                if (doc.is_discarded()) { what == 0 ? void() : bytes(body); continue; }
+                if (doc.is_discarded()) {
+                    what == 0 ? void() : bytes(body);
+                    continue;
+                }
                 mutate_json(doc);
                 body = doc.dump(coin(0.5) ? 2 : -1);
             } else if (what < 8) {
@@ -141,18 +212,29 @@ struct Mutator {
         return head + "\n" + body;
     }
     void bytes(std::string& s) {
-        if (s.empty()) { s = "{"; return; }
+        if (s.empty()) {
+            s = "{";
+            return;
+        }
         const std::size_t i = pick(s.size());
         switch (pick(4)) {
-            case 0: s[i] = static_cast<char>(pick(256)); break;
-            case 1: s.insert(i, 1, "{}[],:\"0e-.\\"[pick(13)]); break;
-            case 2: s.erase(i, 1 + pick(8)); break;
-            case 3: s.resize(i); break;
+            case 0:
+                s[i] = static_cast<char>(pick(256));
+                break;
+            case 1:
+                s.insert(i, 1, "{}[],:\"0e-.\\"[pick(13)]);
+                break;
+            case 2:
+                s.erase(i, 1 + pick(8));
+                break;
+            case 3:
+                s.resize(i);
+                break;
         }
     }
 };
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     if (argc < 2) {
@@ -164,11 +246,18 @@ int main(int argc, char** argv) {
     std::string save;
     for (int i = 2; i + 1 < argc; i += 2) {
         const std::string k = argv[i];
-        if (k == "--mutants") mutants = std::atol(argv[i + 1]);
-        else if (k == "--seed") seed = std::strtoull(argv[i + 1], nullptr, 10);
-        else if (k == "--save") save = argv[i + 1];
-        else if (k == "--seconds") plate::fuzz::set_seconds_per_input(std::atoi(argv[i + 1]));
-        else { std::fprintf(stderr, "unknown option %s\n", k.c_str()); return 2; }
+        if (k == "--mutants")
+            mutants = std::atol(argv[i + 1]);
+        else if (k == "--seed")
+            seed = std::strtoull(argv[i + 1], nullptr, 10);
+        else if (k == "--save")
+            save = argv[i + 1];
+        else if (k == "--seconds")
+            plate::fuzz::set_seconds_per_input(std::atoi(argv[i + 1]));
+        else {
+            std::fprintf(stderr, "unknown option %s\n", k.c_str());
+            return 2;
+        }
     }
     // Every file under CORPUS_DIR is replayed; the seeds at its top level (hand-written, valid
     // commands on the shipped scenes) are the mutants' parents. found/ holds what libFuzzer added
@@ -178,7 +267,10 @@ int main(int argc, char** argv) {
     for (const auto& e : fs::recursive_directory_iterator(argv[1]))
         if (e.is_regular_file()) files.push_back(e.path());
     std::sort(files.begin(), files.end());
-    if (files.empty()) { std::fprintf(stderr, "%s: empty corpus\n", argv[1]); return 2; }
+    if (files.empty()) {
+        std::fprintf(stderr, "%s: empty corpus\n", argv[1]);
+        return 2;
+    }
     std::vector<std::string> corpus, parents;
     for (const auto& f : files) {
         corpus.push_back(slurp(f));
@@ -188,8 +280,10 @@ int main(int argc, char** argv) {
     std::map<int, long> codes;
     long skipped = 0;
     auto tally = [&](const plate::fuzz::Outcome& o) {
-        if (o.verdict == plate::fuzz::Verdict::Skipped) ++skipped;
-        else ++codes[o.code];
+        if (o.verdict == plate::fuzz::Verdict::Skipped)
+            ++skipped;
+        else
+            ++codes[o.code];
     };
     for (const auto& in : corpus) tally(plate::fuzz::run_one(in));
     std::printf("corpus: %zu inputs replayed\n", corpus.size());
@@ -204,8 +298,8 @@ int main(int argc, char** argv) {
             std::ofstream(fs::path(save) / ("mutant-" + std::to_string(seed) + "-" + std::to_string(n)), std::ios::binary) << in;
         }
     }
-    std::printf("mutants: %ld (seed %llu); skipped %ld (outside the work bounds)", mutants,
-                static_cast<unsigned long long>(seed), skipped);
+    std::printf("mutants: %ld (seed %llu); skipped %ld (outside the work bounds)", mutants, static_cast<unsigned long long>(seed),
+                skipped);
     for (const auto& [c, k] : codes) std::printf("; exit %d: %ld", c, k);
     std::printf("\nno crash, hang, unexplained failure, non-finite output or partial file\n");
     plate::fuzz::cleanup();

@@ -33,8 +33,7 @@ PlateMotion shift_motion(const PlateMotion& u, const Vec2& D);
 // A plate motion from coefficients, the designs' parameter layout: per axis a (of `axes`) and harmonic
 // h (of `harmonics`), u = c cos(n w t) + s sin(n w t) with c = p[2 (a H + h)], s = p[2 (a H + h) + 1]
 // (H = harmonics.size()), i.e. amp sin(n w t + phase); zero amplitudes are left out.
-PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& axes, const std::vector<int>& harmonics,
-                        double T);
+PlateMotion motion_from(const std::vector<double>& p, const std::vector<Axis>& axes, const std::vector<int>& harmonics, double T);
 
 // CONING. The plate's angular acceleration is periodic with zero-mean angular velocity, but rotations
 // do not commute: rx and ry out of phase (circular tilting, fig4's) make the plate's orientation
@@ -79,19 +78,19 @@ struct OrientationHarmonics {
     double mean = 0;                 // M [rad/s]
     std::vector<double> amplitude;   // B_k for k = 0..n/2 [rad/s] (amplitude[0] = |M|)
     double first() const { return amplitude.size() > 1 ? amplitude[1] : 0.0; }
-    double rest() const;             // |M| + B_2 + ... + B_{n/2}
-    double slope_bound() const;      // sum_{k>=2} k B_k >= |d theta' / d theta - B_1 cos(theta + phi_1)|
-    bool one_stable() const;         // B_1^2 > rest()^2 + slope_bound()^2: exactly one stable orientation
+    double rest() const;          // |M| + B_2 + ... + B_{n/2}
+    double slope_bound() const;   // sum_{k>=2} k B_k >= |d theta' / d theta - B_1 cos(theta + phi_1)|
+    bool one_stable() const;      // B_1^2 > rest()^2 + slope_bound()^2: exactly one stable orientation
 };
 // theta' on the ring theta_k = 2 pi k / n (n >= 4) as harmonics.
 OrientationHarmonics harmonics_of(const std::vector<double>& theta_dot);
 OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n = 12);
 
 struct DesignOptions {
-    double lin_limit = 20;     // largest amplitude of a linear-acceleration harmonic [m/s^2]
-    double ang_limit = 150;    // of an angular-acceleration harmonic [rad/s^2]
-    double period = 0;         // plate period T [s]; 0: the part scene's
-    double region = 0.05;      // the plate region |s_x|, |s_y| <= region [m]
+    double lin_limit = 20;    // largest amplitude of a linear-acceleration harmonic [m/s^2]
+    double ang_limit = 150;   // of an angular-acceleration harmonic [rad/s^2]
+    double period = 0;        // plate period T [s]; 0: the part scene's
+    double region = 0.05;     // the plate region |s_x|, |s_y| <= region [m]
     // No flight: g + the vertical acceleration of every plate point in the region (for a rigid part
     // widened by its contacts' reach from its centre of mass) stays at or above this fraction of g,
     // all period long (a constraint of the search, never a penalty).
@@ -106,7 +105,7 @@ struct DesignOptions {
     // measure what gradients buy (bench_design).
     enum class Local { Cobyla, SlsqpFiniteDifferences };
     Local local = Local::Cobyla;
-    int threads = 0;           // starts in parallel (0: all cores)
+    int threads = 0;   // starts in parallel (0: all cores)
     // Shares the starts, the verification field's planes and the verification runs (set: `threads`
     // is not used; e.g. sweep::farm_tasks over MPI ranks). The design is the same either way.
     TaskRunner tasks;
@@ -149,41 +148,41 @@ struct DesignOptions {
         LimitCycleOptions o;
         o.tol = 1e-6;
         o.integration.rtol = 1e-7;
-        o.max_periods = 60;                    // a candidate cannot cost seconds
+        o.max_periods = 60;   // a candidate cannot cost seconds
         o.max_rhs_evaluations = 200'000;
         return o;
     }
 };
 
 struct DesignStartRun {
-    double x = 0, y = 0;        // the start [m]
-    double theta = 0;           // (rigid parts: drawn uniformly over the turn)
-    Vec3 end = Vec3::Zero();    // where the run ended
-    double end_distance = 0;    // from the target after `seconds` of full dynamics [m] (rigid: the
-                                // larger of the position's and the angle's, 0.05 rad counted as 5 mm;
-                                // transport: from where the target velocity takes it over [from, seconds])
+    double x = 0, y = 0;       // the start [m]
+    double theta = 0;          // (rigid parts: drawn uniformly over the turn)
+    Vec3 end = Vec3::Zero();   // where the run ended
+    double end_distance = 0;   // from the target after `seconds` of full dynamics [m] (rigid: the
+                               // larger of the position's and the angle's, 0.05 rad counted as 5 mm;
+                               // transport: from where the target velocity takes it over [from, seconds])
     double seconds = 0;
-    double from = 0;            // transport: the run's second half only, past the start-up's lag [s]
+    double from = 0;               // transport: the run's second half only, past the start-up's lag [s]
     Vec3 at_from = Vec3::Zero();   // where the run was at `from`
-    std::string stop;           // why the run stopped early, if it did
+    std::string stop;              // why the run stopped early, if it did
 };
 
 struct DesignSummary {
-    bool verified = false;      // the design passed every check below
-    bool unique = false;        // one stable fixed point on the grid, at the target
-    std::string failure;        // why not verified
-    Scene scene;                // the part with the designed plate motion
+    bool verified = false;   // the design passed every check below
+    bool unique = false;     // one stable fixed point on the grid, at the target
+    std::string failure;     // why not verified
+    Scene scene;             // the part with the designed plate motion
     // The search, at the centre before the shift (rigid fixed points: at the fixed point found near
     // it, central differences of 3 mm and 0.1 rad, ~1 % from the grid's refinement): the field's
     // Jacobian there and its convergence rate (-max Re of the eigenvalues) [1/s].
     double rate = 0;
-    Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();     // (point parts)
-    Eigen::Vector3cd eigenvalues3 = Eigen::Vector3cd::Zero();    // (rigid parts)
-    int starts = 0;             // the search's starts
-    long evaluations = 0;       // objective evaluations (each a few limit cycles)
-    long cycles = 0;            // limit cycles computed in the search
+    Eigen::Vector2cd eigenvalues = Eigen::Vector2cd::Zero();    // (point parts)
+    Eigen::Vector3cd eigenvalues3 = Eigen::Vector3cd::Zero();   // (rigid parts)
+    int starts = 0;                                             // the search's starts
+    long evaluations = 0;                                       // objective evaluations (each a few limit cycles)
+    long cycles = 0;                                            // limit cycles computed in the search
     // Verification.
-    FixedPoints fixed_points;   // of the designed field on the grid
+    FixedPoints fixed_points;          // of the designed field on the grid
     Vec3 fixed_point = Vec3::Zero();   // the stable one nearest the target (a rigid part's sink: where
                                        // its position's field vanishes at the grid's first orientation)
     Eigen::Vector3cd fixed_point_eigenvalues = Eigen::Vector3cd::Zero();
@@ -206,8 +205,8 @@ struct DesignSummary {
     // Hold (sinks and fixed points): released at rest at the target, where the part is after
     // DesignOptions::hold seconds of full dynamics and how far that is (measured as end_distance).
     DesignStartRun held;
-    double coning = 0;                  // the design's coning rate psi' [rad/s] (coning_rate)
-    double min_vertical_margin = 0;     // min over the period and the flight check's square of (g + a_z) / g
+    double coning = 0;                // the design's coning rate psi' [rad/s] (coning_rate)
+    double min_vertical_margin = 0;   // min over the period and the flight check's square of (g + a_z) / g
     // A rigid part's sink (position only: the part may turn as it pleases): at the target, per
     // orientation of the verification grid, where the position's velocity field vanishes and its
     // Jacobian's eigenvalues there.
@@ -227,10 +226,10 @@ struct DesignSummary {
     // (a rigid part: also its largest |theta'| on the grid, transport_turn [rad/s]).
     Vec2 transport_mean = Vec2::Zero();
     double transport_turn = 0;
-    double transport_spread = 0;       // [m/s]
-    double transport_tolerance = 0;    // accepted |mean - target| [m/s]
+    double transport_spread = 0;      // [m/s]
+    double transport_tolerance = 0;   // accepted |mean - target| [m/s]
     double seconds = 0;
-    std::vector<std::string> notes;     // the symmetries used, and what they imply
+    std::vector<std::string> notes;   // the symmetries used, and what they imply
 };
 
 // The largest coning rate a sink at `at` may have (DesignOptions::max_coning if set): the sink turns
@@ -261,4 +260,4 @@ int default_starts(const Scene& part_scene, const DesignTarget& target);
 // period when opt.period is 0). Throws std::invalid_argument for a target the part cannot have.
 DesignSummary design(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt = {});
 
-}  // namespace plate
+}   // namespace plate

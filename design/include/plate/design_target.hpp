@@ -85,15 +85,15 @@ void validate_design_target(const DesignTarget& t, const Scene& part_scene, cons
 // --- new kinds of target --------------------------------------------------------------------------
 
 // Designs for `target` with the plate period T (validated: the options, the period, the region).
-using Designer = std::function<DesignSummary(const Scene& part_scene, const DesignTarget& target,
-                                             const DesignOptions& opt, double T)>;
+using Designer =
+    std::function<DesignSummary(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T)>;
 struct DesignTargetType {
-    std::string name;           // the KIND word
-    std::string numbers;        // what follows it, for the usage ("X Y")
-    int count = 0;              // how many numbers
-    bool point = true;          // for point parts
-    bool rigid = true;          // for rigid parts
-    int default_starts = 16;    // the search's starts when DesignOptions::starts is 0
+    std::string name;          // the KIND word
+    std::string numbers;       // what follows it, for the usage ("X Y")
+    int count = 0;             // how many numbers
+    bool point = true;         // for point parts
+    bool rigid = true;         // for rigid parts
+    int default_starts = 16;   // the search's starts when DesignOptions::starts is 0
     Designer design;
 };
 // Adds a kind of target (std::invalid_argument if the name is taken); parse_design_target and design()
@@ -107,4 +107,4 @@ void register_design_target(DesignTargetType type);
 nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_scene, const DesignTarget& t,
                                    const DesignOptions& opt, const std::string& scene_path);
 
-}  // namespace plate
+}   // namespace plate

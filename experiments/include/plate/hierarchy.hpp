@@ -27,18 +27,18 @@ Scene simplified(const Scene& scene, PartModel p);
 struct Rung {
     PartModel part = PartModel::Thick;
     Dynamics dynamics = Dynamics::Full;
-    double error = 0;      // final-configuration error against the most complete model:
-                           // max(|ds| / rho, |dtheta| [rad]); a point part's theta stays at theta0
-    double seconds = 0;    // its cost
-    long work = 0;         // and in right-hand-side evaluations (deterministic)
-    bool ok = false;       // it ran to the end (no stop)
-    std::string note;      // why not ok
+    double error = 0;           // final-configuration error against the most complete model:
+                                // max(|ds| / rho, |dtheta| [rad]); a point part's theta stays at theta0
+    double seconds = 0;         // its cost
+    long work = 0;              // and in right-hand-side evaluations (deterministic)
+    bool ok = false;            // it ran to the end (no stop)
+    std::string note;           // why not ok
     std::string name() const;   // e.g. "thin / u"
 };
 
 struct ModelChoice {
     double tol = 0;
-    Rung picked;               // the cheapest with error <= tol (the reference itself if none)
+    Rung picked;   // the cheapest with error <= tol (the reference itself if none)
     bool any_simplification = false;
     std::vector<Rung> rungs;   // all, cheapest first; the last is the reference (error 0)
     std::string explain() const;
@@ -71,21 +71,19 @@ ModelChoice choose_model(const Scene& scene, const Vec3& q0, double duration, do
 // A rung's prediction is kSafety times the sum of its simplifications' terms.
 struct ModelEstimate {
     double duration = 0;
-    bool ok = false;            // the cycles converged (else no prediction: auto keeps the reference)
+    bool ok = false;   // the cycles converged (else no prediction: auto keeps the reference)
     std::string note;
-    double xi = 0;              // scaled |xi| of the own part [1/s]
+    double xi = 0;   // scaled |xi| of the own part [1/s]
     double e_point = 0, e_thin = 0, eps_U = 0, offset = 0, excursion = 0;
-    double transient = 0;       // scaled displacement of the run from rest until its cycle
-    double u_transient = 0;     // U against full at the end of that transient (both simulated through it)
-    double lambda = 0;          // the field's largest growth rate at q0 (>= 0) [1/s]
-    long work = 0;              // right-hand-side evaluations the estimate cost
-    double growth() const;      // (e^{lambda D} - 1) / (lambda D): Gronwall's factor on the drift terms
+    double transient = 0;     // scaled displacement of the run from rest until its cycle
+    double u_transient = 0;   // U against full at the end of that transient (both simulated through it)
+    double lambda = 0;        // the field's largest growth rate at q0 (>= 0) [1/s]
+    long work = 0;            // right-hand-side evaluations the estimate cost
+    double growth() const;    // (e^{lambda D} - 1) / (lambda D): Gronwall's factor on the drift terms
     static constexpr double kSafety = 4;
     double part_term(PartModel p, PartModel own) const;
     double dynamics_term(Dynamics d) const;
-    double predicted(PartModel p, PartModel own, Dynamics d) const {
-        return kSafety * (part_term(p, own) + dynamics_term(d));
-    }
+    double predicted(PartModel p, PartModel own, Dynamics d) const { return kSafety * (part_term(p, own) + dynamics_term(d)); }
 };
 ModelEstimate estimate_model_errors(const Scene& scene, const Vec3& q0, double duration);
 
@@ -95,11 +93,11 @@ ModelEstimate estimate_model_errors(const Scene& scene, const Vec3& q0, double d
 struct APrioriChoice {
     ModelEstimate estimate;
     Rung picked;
-    double predicted = 0;       // of the picked rung
+    double predicted = 0;   // of the picked rung
     bool verified = false;
-    double measured = 0;        // with verify: the picked rung's error against the reference
+    double measured = 0;   // with verify: the picked rung's error against the reference
     double reference_seconds = 0;
-    long reference_work = 0;    // with verify: the reference's right-hand-side evaluations
+    long reference_work = 0;   // with verify: the reference's right-hand-side evaluations
     std::string explain() const;
 };
 APrioriChoice choose_model_a_priori(const Scene& scene, const Vec3& q0, double duration, double tol, bool verify);
@@ -107,4 +105,4 @@ APrioriChoice choose_model_a_priori(const Scene& scene, const Vec3& q0, double d
 // part under full dynamics when none is, or when the estimate failed). Returns its prediction.
 double a_priori_pick(const Scene& scene, const ModelEstimate& estimate, double tol, PartModel& part, Dynamics& dynamics);
 
-}  // namespace plate
+}   // namespace plate

@@ -31,9 +31,9 @@ enum class Method {
 
 struct MethodInfo {
     Method method;
-    const char* name;     // e.g. "odeint-dopri5"
-    int order;            // convergence order of one fixed step on smooth problems; 0: variable order
-                          // (extrapolation, multistep), no fixed-step form
+    const char* name;   // e.g. "odeint-dopri5"
+    int order;          // convergence order of one fixed step on smooth problems; 0: variable order
+                        // (extrapolation, multistep), no fixed-step form
     bool adaptive;
     bool needs_jacobian;
 };
@@ -51,18 +51,18 @@ struct OdeSystem {
 };
 
 struct MethodOptions {
-    double tol = 1e-8;          // adaptive: absolute and relative tolerance (scale the state to O(1))
-    double h = 0;               // fixed-step methods: the step; adaptive: first step (0: (t1-t0)/1000)
-    double h_min = 0;           // adaptive: a step below this is a failure (0: 1e-14 (t1 - t0))
+    double tol = 1e-8;   // adaptive: absolute and relative tolerance (scale the state to O(1))
+    double h = 0;        // fixed-step methods: the step; adaptive: first step (0: (t1-t0)/1000)
+    double h_min = 0;    // adaptive: a step below this is a failure (0: 1e-14 (t1 - t0))
     long max_steps = 5'000'000;
     long max_evals = 50'000'000;   // right-hand sides, then a failure (never hangs)
-    bool fixed = false;         // steps of exactly h with the method's own formula, no error control
-                                // (for convergence-order tests; only methods with order > 0)
+    bool fixed = false;            // steps of exactly h with the method's own formula, no error control
+                                   // (for convergence-order tests; only methods with order > 0)
 };
 
 struct MethodRun {
     bool ok = true;
-    std::string failure;        // empty when ok: "step-size collapse at t = ...", ...
+    std::string failure;   // empty when ok: "step-size collapse at t = ...", ...
     long rhs_evals = 0;
     long jac_evals = 0;
     long steps = 0;
@@ -71,7 +71,7 @@ struct MethodRun {
 
 // Integrates y (in/out, n values) from t0 to t1 exactly. `run` accumulates (several calls add up).
 // Returns run.ok.
-bool integrate(Method m, const OdeSystem& sys, double t0, double t1, std::vector<double>& y,
-               const MethodOptions& opt, MethodRun& run);
+bool integrate(Method m, const OdeSystem& sys, double t0, double t1, std::vector<double>& y, const MethodOptions& opt,
+               MethodRun& run);
 
-}  // namespace plate
+}   // namespace plate

@@ -34,19 +34,18 @@ struct MoreauJeanOptions {
 };
 
 struct MoreauJeanSummary {
-    Vec3 q = Vec3::Zero();          // (s_x, s_y, theta) at the end; theta continuous from q0
-    Vec3 qd = Vec3::Zero();         // (s_x', s_y', theta') at the end
+    Vec3 q = Vec3::Zero();    // (s_x, s_y, theta) at the end; theta continuous from q0
+    Vec3 qd = Vec3::Zero();   // (s_x', s_y', theta') at the end
     long steps = 0;
-    double mean_iterations = 0;     // NSGS sweeps per step
-    long solver_failures = 0;       // steps whose solve did not reach solver_tol
-    double max_residual = 0;        // the largest final error of a step's solve (Siconos' natural-map residual
-                                    // over max(|q|, |r|, |u|))
-    double max_gap = 0;             // largest height of a contact above the plate [m] (lift-off)
+    double mean_iterations = 0;   // NSGS sweeps per step
+    long solver_failures = 0;     // steps whose solve did not reach solver_tol
+    double max_residual = 0;      // the largest final error of a step's solve (Siconos' natural-map residual
+                                  // over max(|q|, |r|, |u|))
+    double max_gap = 0;           // largest height of a contact above the plate [m] (lift-off)
 };
 
 // The part at rest relative to the plate at q0 at t = 0, for `duration` seconds.
 // Throws std::invalid_argument for a non-positive duration or step count.
-MoreauJeanSummary moreau_jean_u(const Scene& scene, const Vec3& q0, double duration,
-                                const MoreauJeanOptions& opt = {});
+MoreauJeanSummary moreau_jean_u(const Scene& scene, const Vec3& q0, double duration, const MoreauJeanOptions& opt = {});
 
-}  // namespace plate
+}   // namespace plate

@@ -21,8 +21,8 @@ struct Solver {
     bool engine = false;
     Method method = Method::Dopri5;
     FrictionLaw law = FrictionLaw::Coulomb;
-    double law_eps = 1e-3;     // regularisation width, relative to Scene::v_ref()
-    std::string label() const; // e.g. "engine: dopri5 + events", "gsl-rk8pd / tanh 1e-3"
+    double law_eps = 1e-3;       // regularisation width, relative to Scene::v_ref()
+    std::string label() const;   // e.g. "engine: dopri5 + events", "gsl-rk8pd / tanh 1e-3"
 };
 
 // The solvers of the study: every method with exact Coulomb friction, the engine, and
@@ -33,14 +33,14 @@ std::vector<double> study_knobs(const Solver& s, bool full);
 
 struct RunResult {
     bool ok = false;
-    std::string failure;        // why not ok: the method's own failure, a model stop, "wrong answer"
-    double knob = 0;            // tolerance, or steps per period
+    std::string failure;   // why not ok: the method's own failure, a model stop, "wrong answer"
+    double knob = 0;       // tolerance, or steps per period
     long rhs_evals = 0;
     long jac_evals = 0;
     double seconds = 0;
-    std::vector<double> value;  // the answer: a twist (3) or samples of q (3 per sample)
-    double error = 0;           // against the reference (filled by the caller)
-    double error_max = 0;       // trajectories: largest error along the path
+    std::vector<double> value;   // the answer: a twist (3) or samples of q (3 per sample)
+    double error = 0;            // against the reference (filled by the caller)
+    double error_max = 0;        // trajectories: largest error along the path
 };
 
 // (a), (c): the asymptotic twist (36) at q0, reduced U-dynamics, period by period from rest until
@@ -50,8 +50,8 @@ RunResult twist_run(const Scene& scene, const Vec3& q0, const Solver& s, double 
 
 // (b): a full-dynamics trajectory from rest at q0 for `duration` s, q sampled every sample_dt
 // from the breakaway time (all solvers start there, from the same state).
-RunResult trajectory_run(const Scene& scene, const Vec3& q0, double duration, double sample_dt, const Solver& s,
-                         double knob, long max_evals = 50'000'000);
+RunResult trajectory_run(const Scene& scene, const Vec3& q0, double duration, double sample_dt, const Solver& s, double knob,
+                         long max_evals = 50'000'000);
 
 // Errors: twists relative to (v_ref, v_ref, v_ref / rho); configurations relative to (rho, rho, 1 rad).
 double twist_error(const Scene& scene, const std::vector<double>& a, const std::vector<double>& b);
@@ -75,18 +75,18 @@ void path_error(const Scene& scene, const std::vector<double>& a, const std::vec
 // limit from the previous triple: what the reference itself is worth.
 struct RegularisedOptions {
     std::vector<double> eps{1e-5, 1e-6, 1e-7, 1e-8};   // relative to Scene::v_ref(), decreasing geometrically
-    double tol = 1e-12;          // bsimp, on the state scaled by (v_ref, v_ref, v_ref / rho)
-    double cycle_tol = 1e-11;    // the cycle's error estimate, relative to v_ref
+    double tol = 1e-12;                                // bsimp, on the state scaled by (v_ref, v_ref, v_ref / rho)
+    double cycle_tol = 1e-11;                          // the cycle's error estimate, relative to v_ref
     int max_periods = 400;
 };
 struct RegularisedReference {
     bool ok = false;
     std::string failure;
-    std::vector<Vec3> twists;    // per eps [m/s, m/s, rad/s]
-    std::vector<int> periods;    // per eps
-    double order = 0;            // observed p
+    std::vector<Vec3> twists;                                                // per eps [m/s, m/s, rad/s]
+    std::vector<int> periods;                                                // per eps
+    double order = 0;                                                        // observed p
     Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());   // extrapolated to eps = 0
-    double error = 0;            // relative to (v_ref, v_ref, v_ref / rho), max over components
+    double error = 0;   // relative to (v_ref, v_ref, v_ref / rho), max over components
     long rhs_evals = 0;
     double seconds = 0;
 };
@@ -105,22 +105,20 @@ struct RandomStickCase {
     std::uint64_t seed = 0;
     Scene scene;
     Vec3 q0 = Vec3::Zero();
-    double ratio = 0;            // the largest x, y harmonic amplitude / (mu g)
-    LimitCycleSummary cycle;     // the engine's
+    double ratio = 0;          // the largest x, y harmonic amplitude / (mu g)
+    LimitCycleSummary cycle;   // the engine's
     bool reference_ok = false;
-    std::string failure;         // why not (either)
-    double held = 0;             // largest stick fraction of a contact over the engine's cycle
+    std::string failure;   // why not (either)
+    double held = 0;       // largest stick fraction of a contact over the engine's cycle
     Vec3 reference_twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-    double error = 0;            // |engine - reference|, relative to (v_ref, v_ref, v_ref / rho)
-    double reference_error = 0;  // the reference's own
+    double error = 0;             // |engine - reference|, relative to (v_ref, v_ref, v_ref / rho)
+    double reference_error = 0;   // the reference's own
     bool converged() const { return cycle.converged; }
 };
-RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& opt = {},
-                                  const RegularisedOptions& ref = {});
+RandomStickCase random_stick_case(std::uint64_t seed, const LimitCycleOptions& opt = {}, const RegularisedOptions& ref = {});
 
 // The OdeSystem of the reduced U-dynamics at q0 in scaled coordinates, y = [q'/v, Q/(v T)], with
 // the generated Jacobian (twist_jacobian); exposed for tests of the methods.
-OdeSystem reduced_system(const Scene& scene, const Vec3& q0, FrictionLaw law, double law_eps_abs,
-                         std::vector<double>& scale);
+OdeSystem reduced_system(const Scene& scene, const Vec3& q0, FrictionLaw law, double law_eps_abs, std::vector<double>& scale);
 
-}  // namespace plate
+}   // namespace plate

@@ -38,8 +38,7 @@ struct PlateState {
     Vec3 wd = Vec3::Zero();       // omega1', in W   (u, eq. 11)
 };
 
-PlateState plate_state(const PlateMotion& plate, double t, Dynamics level,
-                       const Mat3& R1 = Mat3::Identity());
+PlateState plate_state(const PlateMotion& plate, double t, Dynamics level, const Mat3& R1 = Mat3::Identity());
 
 namespace detail {
 struct WorkspaceInternals;   // numeric/src/workspace.hpp
@@ -60,7 +59,7 @@ public:
 private:
     std::unique_ptr<T> p_;
 };
-}  // namespace detail
+}   // namespace detail
 
 // Workspace ("Data"): the settings and results of an evaluation, and its scratch. Preallocated; the
 // evaluation itself does not allocate. A workspace serves one Scene at a time: the part's
@@ -82,17 +81,17 @@ struct Workspace {
     double law_eps = 0;
 
     // Results of the last evaluation.
-    Vec3 qdd = Vec3::Zero();               // [s_x'', s_y'', theta'']
-    Vec3 n = Vec3::Zero();                 // [N1, N2, N3] (point part: N1 only)
-    std::array<Vec2, 3> slip = zeros<Vec2>();            // sliding velocity of each contact, P frame (text after 14)
-    Vec6 b = Vec6::Zero();                 // b of the last evaluation, except on the reduced U path
-    std::array<Vec2, 3> f_held = zeros<Vec2>();          // static friction of held contacts (pivot, stuck) [N], P frame
-    Vec2 F_needed = Vec2::Zero();          // stuck: the friction total that keeps the part with the plate
-    double tau_needed = 0;                 // stuck: its moment about s (z)
-    std::array<Vec2, 3> r = zeros<Vec2>();               // R2 c_i (horizontal) at the kernels' last theta
-    Mat6 A = Mat6::Zero();                 // accelerations_reference: A of (31)
-    long evals = 0;                        // number of evaluations (right-hand sides)
-    int creep_iterations = 0;              // Newton iterations of the last creep solve (diagnostics)
+    Vec3 qdd = Vec3::Zero();                      // [s_x'', s_y'', theta'']
+    Vec3 n = Vec3::Zero();                        // [N1, N2, N3] (point part: N1 only)
+    std::array<Vec2, 3> slip = zeros<Vec2>();     // sliding velocity of each contact, P frame (text after 14)
+    Vec6 b = Vec6::Zero();                        // b of the last evaluation, except on the reduced U path
+    std::array<Vec2, 3> f_held = zeros<Vec2>();   // static friction of held contacts (pivot, stuck) [N], P frame
+    Vec2 F_needed = Vec2::Zero();                 // stuck: the friction total that keeps the part with the plate
+    double tau_needed = 0;                        // stuck: its moment about s (z)
+    std::array<Vec2, 3> r = zeros<Vec2>();        // R2 c_i (horizontal) at the kernels' last theta
+    Mat6 A = Mat6::Zero();                        // accelerations_reference: A of (31)
+    long evals = 0;                               // number of evaluations (right-hand sides)
+    int creep_iterations = 0;                     // Newton iterations of the last creep solve (diagnostics)
 
     // numeric's scratch (numeric/src/workspace.hpp: detail::kernels(ws), detail::stick_slip(ws)).
     detail::WorkspaceInternals& internals() { return *internals_; }
@@ -109,20 +108,19 @@ private:
 // point part the explicit solution. In the reduced U-dynamics the configuration is frozen: what
 // depends on it alone is computed once per configuration (the generated reduced_U_*_config
 // kernels), and an evaluation does only what the slip directions and u(t) change.
-void accelerations(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
-                   const PlateState& plate, Workspace& ws);
+void accelerations(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate, Workspace& ws);
 
 // d q''/d q' of the U- and reduced U-dynamics (32)/(35) at (q, q'): from the generated factors
 // dA_du and dslip_dqd and the friction law's d u_i/d v_i (b~ does not depend on q', so
 // d z/d q' = -A^-1 (dA/dq') z). Evaluates the accelerations first (ws holds them after). For the
 // implicit integrators; throws std::invalid_argument for full dynamics.
-void twist_jacobian(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate,
-                    Workspace& ws, Mat3& dqdd_dqd);
+void twist_jacobian(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate, Workspace& ws,
+                    Mat3& dqdd_dqd);
 
 // The hand-written reference implementation of the same equations (generic 6x6 Eigen solve),
 // kept to check the generated kernels against.
-void accelerations_reference(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
-                             const PlateState& plate, Workspace& ws);
+void accelerations_reference(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate,
+                             Workspace& ws);
 
 // Sliding velocity of each contact: s' + omega2^ R2 c_i (horizontal; P frame).
 void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v);
@@ -143,4 +141,4 @@ Vec6 rhs_b(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, co
 //  it vanishes for J_xz = J_yz = 0: the parts of fig1, fig4-fig6 and the stick-slip scenes, not
 //  fig3_random's random part (its theta'^2 (-J_yz, J_xz, 0) is then left to the full dynamics).
 
-}  // namespace plate
+}   // namespace plate

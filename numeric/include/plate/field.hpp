@@ -29,7 +29,7 @@ struct GridSpec {
 
 struct FieldPoint {
     Vec3 q = Vec3::Zero();
-    Vec3 twist = Vec3::Zero();     // xi_a(q) (36); NaN where undefined
+    Vec3 twist = Vec3::Zero();   // xi_a(q) (36); NaN where undefined
     bool converged = false;
     int periods = 0;
     double residual = 0;
@@ -45,14 +45,14 @@ struct Field {
     std::vector<FieldPoint> points;   // GridSpec::index order
     double seconds = 0;               // wall time
     long rhs_evals = 0;
-    int threads = 0;                  // (0: FieldOptions::tasks shared the work)
-    bool budget_spent = false;        // FieldOptions::max_rhs_evaluations was exceeded
+    int threads = 0;             // (0: FieldOptions::tasks shared the work)
+    bool budget_spent = false;   // FieldOptions::max_rhs_evaluations was exceeded
 };
 
 struct FieldOptions {
     LimitCycleOptions cycle;
-    int threads = 0;           // 0: all cores
-    bool warm_start = true;    // start each theta from the previous theta's cycle
+    int threads = 0;                                     // 0: all cores
+    bool warm_start = true;                              // start each theta from the previous theta's cycle
     std::function<void(int done, int total)> progress;   // called from worker threads, serialised
     // The field's work budget in right-hand sides (0: none). Once spent, the configurations not yet
     // started are left undefined with stop StepLimit and Field::budget_spent is set (which ones
@@ -85,10 +85,10 @@ enum class Stability { Stable, Unstable, Saddle };
 const char* stability_name(Stability s);
 
 struct FixedPoint {
-    Vec3 q = Vec3::Zero();                 // theta in (-pi, pi]
+    Vec3 q = Vec3::Zero();                                     // theta in (-pi, pi]
     Eigen::Vector3cd eigenvalues = Eigen::Vector3cd::Zero();   // of the field's Jacobian (point part: 2 used)
     Stability stability = Stability::Saddle;
-    double residual = 0;                   // |xi_a(q)| [m/s, angular times rho]
+    double residual = 0;   // |xi_a(q)| [m/s, angular times rho]
 };
 
 // A curve of fixed points (Fig. 1): sampled points, its direction, and the stability given by
@@ -98,7 +98,7 @@ struct FixedLine {
     Vec3 direction = Vec3::Zero();
     Stability stability = Stability::Saddle;
     Eigen::Vector3cd eigenvalues = Eigen::Vector3cd::Zero();   // at the first point; the one nearest 0 is along the line
-    double length = 0;                     // in (s_x, s_y, rho theta) [m]
+    double length = 0;                                         // in (s_x, s_y, rho theta) [m]
 };
 
 struct FixedPointOptions {
@@ -107,9 +107,9 @@ struct FixedPointOptions {
     // fail at random, so the refinement runs at rtol <= 1e-3 ftol and cycle tol <= 1e-2 ftol whatever
     // this asks for. (docs/decisions.md, Fixed-point refinement at a tighter tolerance than the field)
     LimitCycleOptions cycle;
-    double ftol = 1e-6;      // |xi_a| accepted as zero, relative to v_ref
+    double ftol = 1e-6;   // |xi_a| accepted as zero, relative to v_ref
     int max_newton = 25;
-    double null_ratio = 0.02;  // singular value ratio that makes a line candidate
+    double null_ratio = 0.02;   // singular value ratio that makes a line candidate
     // Bounded work: no further cell is searched once the refinement's cycles have spent this many
     // right-hand-side evaluations (0: no bound; deterministic, unlike a time limit); the cells left
     // are counted and the summary says so. (The scale: docs/decisions.md, Fixed-point refinement at a
@@ -120,14 +120,14 @@ struct FixedPointOptions {
 struct FixedPoints {
     std::vector<FixedPoint> points;
     std::vector<FixedLine> lines;
-    int candidates = 0;      // grid cells where every component changes sign
-    int cells = 0;           // grid cells searched
-    int undefined_cells = 0; // cells skipped because a corner's twist is undefined (no cycle there)
-    int unsearched_cells = 0;  // cells left when the evaluation budget was spent
-    int stuck_cells = 0;     // cells with a corner where the part is stuck all period (twist exactly 0:
-                             // every configuration there is fixed; a region, not points to refine)
-    long evaluations = 0;    // field evaluations spent refining
-    long rhs_evaluations = 0;  // their cycles' right-hand-side evaluations
+    int candidates = 0;         // grid cells where every component changes sign
+    int cells = 0;              // grid cells searched
+    int undefined_cells = 0;    // cells skipped because a corner's twist is undefined (no cycle there)
+    int unsearched_cells = 0;   // cells left when the evaluation budget was spent
+    int stuck_cells = 0;        // cells with a corner where the part is stuck all period (twist exactly 0:
+                                // every configuration there is fixed; a region, not points to refine)
+    long evaluations = 0;       // field evaluations spent refining
+    long rhs_evaluations = 0;   // their cycles' right-hand-side evaluations
 };
 
 // Zeros of the field: candidate cells of `field` (every component changes sign), refined by
@@ -143,10 +143,10 @@ std::string fixed_points_sentence(const FixedPoints& fp);
 // --- integral curves -----------------------------------------------------------------------
 // q' = xi_a(q) from q0 (classical RK4, step h), sampled every sample_dt. Stops where the field
 // is undefined (the stop says why).
-Trajectory field_curve(const Scene& scene, const Vec3& q0, double duration, double sample_dt,
-                       const LimitCycleOptions& opt = {}, double h = 0.05);
+Trajectory field_curve(const Scene& scene, const Vec3& q0, double duration, double sample_dt, const LimitCycleOptions& opt = {},
+                       double h = 0.05);
 
 // Wraps theta to (-pi, pi].
 double wrap_angle(double th);
 
-}  // namespace plate
+}   // namespace plate

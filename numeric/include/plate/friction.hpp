@@ -89,11 +89,11 @@ Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v)
 // The optimal distribution is unique at a smooth boundary point: f_i = gamma mu_i N_i G_i^T d/|G_i^T d|.
 // (mu_i: the static coefficients.)
 struct FrictionGauge {
-    double gamma = 0;               // 0 for w = 0; inf if no friction can supply w
-    std::array<Vec2, 3> f = zeros<Vec2>();        // the optimal friction distribution [N], P frame
-    int pivot = -1;                 // contact whose force lies inside its disk at the optimum, if any
-    Vec3 direction = Vec3::Zero();  // d: the twist (s_x', s_y', theta') the needed friction opposes
-    int iterations = 0;             // Newton iterations (0: closed form)
+    double gamma = 0;                        // 0 for w = 0; inf if no friction can supply w
+    std::array<Vec2, 3> f = zeros<Vec2>();   // the optimal friction distribution [N], P frame
+    int pivot = -1;                          // contact whose force lies inside its disk at the optimum, if any
+    Vec3 direction = Vec3::Zero();           // d: the twist (s_x', s_y', theta') the needed friction opposes
+    int iterations = 0;                      // Newton iterations (0: closed form)
 };
 FrictionGauge friction_gauge(const Part& part, double theta, const Vec3& n, const Vec2& F, double tau);
 
@@ -103,4 +103,4 @@ FrictionGauge friction_gauge(const Part& part, double theta, const Vec3& n, cons
 // includes plate_kernels.hpp for the type.)
 gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho);
 
-}  // namespace plate
+}   // namespace plate

@@ -50,9 +50,9 @@ inline IntegrationOptions cycle_integration() {
 
 struct LimitCycleOptions {
     IntegrationOptions integration = cycle_integration();
-    double tol = 1e-7;          // accepted distance to the cycle, relative to v_ref
-    int max_periods = 400;      // then "not converged"
-    bool record = false;        // keep every accepted step (for plots and tests)
+    double tol = 1e-7;       // accepted distance to the cycle, relative to v_ref
+    int max_periods = 400;   // then "not converged"
+    bool record = false;     // keep every accepted step (for plots and tests)
     // Observation 1 makes the cycle independent of the initial twist. When contact is lost in the
     // transient (a part released at rest can tip where its sliding cycle does not), start again from
     // other twists (slip speed v_ref along x, then y, then a spin) up to this many times. A cycle
@@ -71,12 +71,12 @@ struct LimitCycleOptions {
 
 struct LimitCycleSummary {
     bool converged = false;
-    int periods = 0;            // periods integrated
-    double residual = 0;        // last r_k, relative to v_ref
-    double error_estimate = 0;  // r_k c/(1-c), relative to v_ref
-    double contraction = 0;     // c, per period
-    Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // xi_a (36)
-    Vec3 qd_start = Vec3::Zero();  // the cycle's start (a warm start): the last period's start; shooting: its Newton update
+    int periods = 0;                                                         // periods integrated
+    double residual = 0;                                                     // last r_k, relative to v_ref
+    double error_estimate = 0;                                               // r_k c/(1-c), relative to v_ref
+    double contraction = 0;                                                  // c, per period
+    Vec3 twist = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());   // xi_a (36)
+    Vec3 qd_start = Vec3::Zero();   // the cycle's start (a warm start): the last period's start; shooting: its Newton update
     // Shooting: the monodromy dP/dx (its eigenvalues are the cycle's Floquet multipliers; all zero
     // for a cycle in which the part sticks as a whole) in the
     // scaled twist (v_ref, v_ref, v_ref / rho), at the start where it was last computed.
@@ -91,15 +91,13 @@ struct LimitCycleSummary {
     std::array<double, 3> stick_fraction{};
     Mode start_mode;
     std::vector<ModeEvent> mode_events;
-    bool stuck_all_period() const {
-        return converged && start_mode.kind == ModeKind::Stuck && mode_events.empty();
-    }
+    bool stuck_all_period() const { return converged && start_mode.kind == ModeKind::Stuck && mode_events.empty(); }
     StopEvent stop;
-    Stats stats;                   // accumulated over restarts
-    int restarts = 0;              // starts abandoned because contact was lost in the transient
+    Stats stats;                              // accumulated over restarts
+    int restarts = 0;                         // starts abandoned because contact was lost in the transient
     std::vector<StopEvent> transient_stops;   // why each abandoned start stopped
-    std::vector<Sample> path;      // with record: every accepted step from t = 0
-    std::string note;              // why no cycle was sought, if so
+    std::vector<Sample> path;                 // with record: every accepted step from t = 0
+    std::string note;                         // why no cycle was sought, if so
 
     bool contact_lost() const { return stop.reason == StopReason::ContactLost; }
     bool sticking() const { return stop.reason == StopReason::Sticking; }
@@ -111,7 +109,7 @@ LimitCycleSummary limit_cycle(const Scene& scene, const Vec3& q0, const LimitCyc
 
 // The period map of the reduced U-dynamics at q0: the twist at t = T from qd0 at t = 0.
 // Returns false (and leaves `out` unchanged) if the period leaves the model (stop says why).
-bool period_map(const Scene& scene, const Vec3& q0, const Vec3& qd0, Vec3& out,
-                const IntegrationOptions& opt = {}, StopEvent* stop = nullptr);
+bool period_map(const Scene& scene, const Vec3& q0, const Vec3& qd0, Vec3& out, const IntegrationOptions& opt = {},
+                StopEvent* stop = nullptr);
 
-}  // namespace plate
+}   // namespace plate

@@ -34,10 +34,10 @@ class ContactFriction;   // friction.hpp
 // A point part has only m and mu (one contact at the centre of mass, no rotation).
 struct Part {
     bool point = false;
-    double m = 0;                 // mass [kg]
-    Mat3 J = Mat3::Zero();        // rotational inertia about s, in S [kg m^2]
+    double m = 0;                            // mass [kg]
+    Mat3 J = Mat3::Zero();                   // rotational inertia about s, in S [kg m^2]
     std::array<Vec3, 3> c = zeros<Vec3>();   // contacts c_i in S [m]; all share one z (flat plate)
-    Vec3 mu = Vec3::Zero();       // friction coefficients mu_ki, as set (read them through friction())
+    Vec3 mu = Vec3::Zero();                  // friction coefficients mu_ki, as set (read them through friction())
 
     int contacts() const { return point ? 1 : 3; }
     // The contacts' kinetic and static friction coefficients (friction.hpp, which defines it).
@@ -64,7 +64,7 @@ struct Harmonic {
 // u(t) = [p''(t); omega1'(t)] in W (eq. 11). The plate's velocity and position are the
 // unique zero-mean periodic integrals (Section III-H: the plate state x_plate0 follows from u).
 struct PlateMotion {
-    double T = 0;                     // period [s]
+    double T = 0;   // period [s]
     std::vector<Harmonic> harmonics;
 
     double omega() const { return 2 * kPi / T; }
@@ -93,4 +93,4 @@ struct Scene {
     double v_ref() const;
 };
 
-}  // namespace plate
+}   // namespace plate

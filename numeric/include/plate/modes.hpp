@@ -47,8 +47,8 @@ enum class ModeKind { Slide = 0, Pivot = 1, Stuck = 2 };
 
 struct Mode {
     ModeKind kind = ModeKind::Slide;
-    int k = -1;          // the pivot contact (0-based), Pivot only
-    double sense = 0;    // Pivot: sign of theta' while the mode holds (+1 / -1)
+    int k = -1;         // the pivot contact (0-based), Pivot only
+    double sense = 0;   // Pivot: sign of theta' while the mode holds (+1 / -1)
     bool operator==(const Mode& o) const { return kind == o.kind && k == o.k; }
     bool operator!=(const Mode& o) const { return !(*this == o); }
     // Does contact i have zero slip in this mode?
@@ -87,12 +87,12 @@ struct ModeChoice {
     Mode mode;
     bool lost = false;
     int lost_contact = -1;
-    double gamma = 0;            // the gauge (zero twist) or |f_k|/(mu_k N_k) (pivot test)
+    double gamma = 0;   // the gauge (zero twist) or |f_k|/(mu_k N_k) (pivot test)
 };
-// Clears the creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the gauge crossed 1), so break away even if
-// the gauge is 1 to rounding.
-ModeChoice choose_mode(const Scene& scene, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& plate,
-                       unsigned zero, Workspace& ws, bool hold = true);
+// Clears the creep (the engine marks the contacts that break away). hold = false: the state has just left the stuck set (the
+// gauge crossed 1), so break away even if the gauge is 1 to rounding.
+ModeChoice choose_mode(const Scene& scene, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& plate, unsigned zero,
+                       Workspace& ws, bool hold = true);
 
 // Would contact k stay stuck if its sliding velocity were zero now? The pivot mode's dynamics
 // (Newton-Euler with contact k carrying an unknown tangential force F, the others sliding,
@@ -100,18 +100,16 @@ ModeChoice choose_mode(const Scene& scene, Dynamics level, const Vec3& q, Vec3& 
 // part: the stuck mode's statics.
 struct StickTest {
     bool sticks = false;
-    double friction_needed = 0;   // |F| [N]
-    double friction_available = 0;  // mu_sk N_k [N] (stick_test_all: sum_i mu_si max(N_i, 0))
+    double friction_needed = 0;      // |F| [N]
+    double friction_available = 0;   // mu_sk N_k [N] (stick_test_all: sum_i mu_si max(N_i, 0))
 };
-StickTest stick_test(const Scene& scene, Dynamics level, int k, const Vec3& q, const Vec3& qd,
-                     const PlateState& plate);
+StickTest stick_test(const Scene& scene, Dynamics level, int k, const Vec3& q, const Vec3& qd, const PlateState& plate);
 
 // Would the whole part stay stuck to the plate (every contact at zero slip, q'' = 0)? The needed
 // frictional wrench (f_xy, tau_z) follows from b; the normal forces then follow exactly from the z
 // force and the x, y torques (the friction total is known, so its moment about the raised centre of
 // mass is too). The part sticks if the normal forces are >= 0 and the friction-disk gauge of that
 // wrench is <= 1 (friction_gauge: exact, by duality).
-StickTest stick_test_all(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd,
-                         const PlateState& plate);
+StickTest stick_test_all(const Scene& scene, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& plate);
 
-}  // namespace plate
+}   // namespace plate

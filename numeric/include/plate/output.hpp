@@ -49,4 +49,4 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
 // .tmp name: nothing that looks complete.)
 void install_interrupt_cleanup();
 
-}  // namespace plate
+}   // namespace plate

@@ -10,10 +10,10 @@
 namespace plate {
 
 struct RandomSceneOptions {
-    bool thin = false;          // contacts in the plane of s, J_xz = J_yz = 0 (Theorem 1)
-    bool point = false;         // point part
-    int max_harmonic = 2;       // harmonics n = 1..max_harmonic per axis
-    double config_radius = 0.03;  // the part is meant for |s| <= this; contact is kept there
+    bool thin = false;             // contacts in the plane of s, J_xz = J_yz = 0 (Theorem 1)
+    bool point = false;            // point part
+    int max_harmonic = 2;          // harmonics n = 1..max_harmonic per axis
+    double config_radius = 0.03;   // the part is meant for |s| <= this; contact is kept there
 };
 
 class Rng {
@@ -34,4 +34,4 @@ private:
 
 Scene random_scene(std::uint64_t seed, const RandomSceneOptions& opt = {});
 
-}  // namespace plate
+}   // namespace plate

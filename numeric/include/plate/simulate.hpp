@@ -22,11 +22,11 @@
 namespace plate {
 
 struct IntegrationOptions {
-    double rtol = 1e-9;        // local error tolerance on the scaled state (see engine)
-    double slip_eps = 1e-6;    // slip speed counted as zero, relative to Scene::v_ref()
-    double h_min = 1e-12;      // smallest step, relative to the period T
-    double h0 = 0;             // first step, relative to T; 0: a small one from rtol (a neighbouring
-                               // run's LimitCycleSummary::step_hint saves the ramp-up)
+    double rtol = 1e-9;       // local error tolerance on the scaled state (see engine)
+    double slip_eps = 1e-6;   // slip speed counted as zero, relative to Scene::v_ref()
+    double h_min = 1e-12;     // smallest step, relative to the period T
+    double h0 = 0;            // first step, relative to T; 0: a small one from rtol (a neighbouring
+                              // run's LimitCycleSummary::step_hint saves the ramp-up)
     // The work budget of one run: accepted steps, and right-hand sides (rejected tries, event
     // location, creep solves) at ten per step; then StepLimit.
     long max_steps = 20'000'000;
@@ -45,8 +45,8 @@ const char* stop_name(StopReason r);
 
 struct StopEvent {
     StopReason reason = StopReason::None;
-    int contact = -1;     // 0-based contact index (ContactLost, Sticking)
-    double t = 0;         // time of the event [s]
+    int contact = -1;               // 0-based contact index (ContactLost, Sticking)
+    double t = 0;                   // time of the event [s]
     std::string describe() const;   // e.g. "contact 2 lost at t = 0.0312 s"
 };
 
@@ -86,7 +86,7 @@ struct Trajectory {
     std::vector<Sample> samples;   // every sample_dt, and the stop time
     StopEvent stop;
     Stats stats;
-    std::vector<ModeEvent> events;   // every change of contact mode
+    std::vector<ModeEvent> events;       // every change of contact mode
     std::array<double, 3> held_time{};   // time each contact had zero slip [s]
 };
 
@@ -100,8 +100,8 @@ double breakaway_time(const Scene& scene, const Vec3& q0, double t0, Dynamics le
 // the plate) at t = 0 for `duration` seconds, through stick-slip. Full dynamics start the plate on
 // its zero-mean periodic motion (PlateMotion::velocity/displacement). A start at rest (qd0 = 0) is
 // stuck while friction can hold the part.
-Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration,
-                    double sample_dt, const IntegrationOptions& opt = {});
+Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
+                    const IntegrationOptions& opt = {});
 
 // STROBOSCOPIC AVERAGING of the full dynamics (a heterogeneous multiscale method, after Calvo,
 // Chartier, Murua and Sanz-Serna's stroboscopic averaging). Over one period the configuration q and
@@ -117,18 +117,18 @@ Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Ve
 // coning, the tilt's and the rotating frame's second-order drifts, stick-slip within a burst. The
 // start is integrated directly (the transient from qd0): at least start_periods, and on until the
 // twist at the periods' starts changes by at most macro_tol of its scales over a period (the bursts'
-// relax periods assume a settled twist); so is a last partial period. Samples every sample_dt: the start's own, then cubic Hermite interpolants of the macro points
-// (their qd and n NaN). A burst that stops ends the averaging: the rest is integrated directly from
-// the last accepted macro point, so a stop (contact lost) is reported with its real time and state
-// (a stopped predictor at K > 1 is only a rejected step). Stats are the bursts' (steps and rejected:
-// also the macro steps'); events and held_time are not kept; opt.max_steps bounds each burst.
+// relax periods assume a settled twist); so is a last partial period. Samples every sample_dt: the start's own, then cubic
+// Hermite interpolants of the macro points (their qd and n NaN). A burst that stops ends the averaging: the rest is integrated
+// directly from the last accepted macro point, so a stop (contact lost) is reported with its real time and state (a stopped
+// predictor at K > 1 is only a rejected step). Stats are the bursts' (steps and rejected: also the macro steps'); events and
+// held_time are not kept; opt.max_steps bounds each burst.
 struct AveragingOptions {
     double macro_tol = 1e-3;      // local error of a macro step, relative to (rho, rho, 1 rad)
     int max_macro_periods = 40;   // the largest K
     int relax_periods = 2;
-    int start_periods = 5;        // at least (also the first K); 0: no direct start
+    int start_periods = 5;   // at least (also the first K); 0: no direct start
 };
 Trajectory simulate_averaged(const Scene& scene, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
                              const IntegrationOptions& opt = {}, const AveragingOptions& avg = {});
 
-}  // namespace plate
+}   // namespace plate

@@ -25,4 +25,4 @@ TaskRunner thread_tasks(int threads);
 std::string exact_text(double x);
 double exact_value(const std::string& text);   // throws std::invalid_argument on anything else
 
-}  // namespace plate
+}   // namespace plate

@@ -57,4 +57,4 @@ bool mpi_launched();
 // Throws std::runtime_error when the program was built without MPI.
 std::unique_ptr<Farm> mpi_farm(int threads);
 
-}  // namespace plate::sweep
+}   // namespace plate::sweep

@@ -45,17 +45,17 @@ using Row = nlohmann::ordered_json;   // one case's results, in column order
 
 struct Parameter {
     std::string name;
-    std::string pointer;            // RFC 6901, into the scene file's JSON
-    std::vector<double> values;     // grid sampling: the values, in order
-    double from = 0, to = 0;        // random sampling: uniform on [from, to]
+    std::string pointer;          // RFC 6901, into the scene file's JSON
+    std::vector<double> values;   // grid sampling: the values, in order
+    double from = 0, to = 0;      // random sampling: uniform on [from, to]
 };
 
 struct Campaign {
     std::string name;
-    std::string source;             // the campaign file (for messages)
-    nlohmann::json base;            // the base scene, as its file reads
-    bool random = false;            // else the Cartesian grid, the first parameter slowest
-    int samples = 0;                // random sampling: cases
+    std::string source;    // the campaign file (for messages)
+    nlohmann::json base;   // the base scene, as its file reads
+    bool random = false;   // else the Cartesian grid, the first parameter slowest
+    int samples = 0;       // random sampling: cases
     std::uint64_t seed = 1;
     std::vector<Parameter> parameters;
     // What each case computes.
@@ -65,7 +65,7 @@ struct Campaign {
     LimitCycleOptions cycle;
     std::optional<DesignTarget> design;
     DesignOptions design_options;
-    nlohmann::json file;            // the campaign, its scene inlined: what every rank computes from
+    nlohmann::json file;   // the campaign, its scene inlined: what every rank computes from
 
     int cases() const;
 };
@@ -138,20 +138,20 @@ void write_tables(const std::string& dir, const Campaign& c, const Journal& j);
 class Farm;   // farm.hpp
 
 struct SweepOptions {
-    std::string out;                                  // DIR
-    std::function<void(int done, int total)> progress;  // serialised
+    std::string out;                                     // DIR
+    std::function<void(int done, int total)> progress;   // serialised
 };
 
 struct SweepSummary {
     int cases = 0;
-    int resumed = 0;       // found in the journal
-    int computed = 0;      // in this run
-    int failed = 0;        // rows with status "failed" (all cases)
-    int torn = 0;          // torn journal lines dropped
-    double seconds = 0;    // this run's wall time
+    int resumed = 0;           // found in the journal
+    int computed = 0;          // in this run
+    int failed = 0;            // rows with status "failed" (all cases)
+    int torn = 0;              // torn journal lines dropped
+    double seconds = 0;        // this run's wall time
     double busy_seconds = 0;   // sum of this run's case times
-    int workers = 0;       // threads over all ranks
-    std::string farm;      // how the cases were shared
+    int workers = 0;           // threads over all ranks
+    std::string farm;          // how the cases were shared
 };
 
 // Collective over the farm. Rank 0 reads the campaign file, opens the journal under opt.out and
@@ -164,4 +164,4 @@ struct Reported : std::runtime_error {
 };
 SweepSummary run_sweep(const std::string& campaign_file, const SweepOptions& opt, Farm& farm);
 
-}  // namespace plate::sweep
+}   // namespace plate::sweep
