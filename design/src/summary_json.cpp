@@ -18,7 +18,7 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     j["target"] = {{"kind", design_target_kind(t)}};
     if (transport)
         j["target"]["velocity"] = {t.velocity.x(), t.velocity.y()};
-    else if (t.kind != DesignTargetKind::Orient)
+    else if (t.kind != DesignTargetKind::Orient && t.kind != DesignTargetKind::Registered)
         j["target"]["at"] = {t.at.x(), t.at.y()};
     if (rigid) j["target"]["theta"] = t.theta;
     if (t.kind == DesignTargetKind::LineSink) j["target"]["direction"] = t.theta;

@@ -60,7 +60,8 @@ def test_a_bad_scene_raises_InputError_with_the_command_lines_message(tmp_path, 
 @pytest.mark.parametrize("scene, words", [
     ("fig1_point", "wobble 0 0"), ("fig1_point", "sink 0.02"), ("fig4", "fixed-point 0.02 -0.01"),
     ("fig1_point", "transport 1 2 3 4"), ("fig1_point", "sink 0.2 0"), ("fig4", "line-sink 0 0 0.5"),
-    ("fig1_point", "orient 1"), ("fig1_point", "transport 0.01 0 0.5"),
+    ("fig1_point", "orient 1"), ("fig1_point", "transport 0.01 0 0.5"), ("fig1_point", "line-sink 0 0"),
+    ("fig1_point", "transport 0 0"), ("fig4", "orient"),
 ])
 def test_a_target_the_command_line_refuses_python_refuses_with_the_same_message(tmp_path, scene, words):
     # One parser, in the library: target='KIND NUMBERS' and the keywords alike.

@@ -208,7 +208,7 @@ void read_design(const Reader& r, const json& g, const Scene& base, Campaign& c)
     r.only(g, "compute.design", {"target", "limits", "starts", "evaluations", "seed"});
     // [KIND, numbers...]: the library's parser and judgement, as the CLI's --target and Python's target=
     const json& t = r.need(g, "compute.design", "target");
-    if (!t.is_array() || t.size() < 2 || t.size() > 5 || !t[0].is_string())
+    if (!t.is_array() || t.empty() || t.size() > 100 || !t[0].is_string())   // (the count: the parser's)
         r.fail("compute.design.target", "expected [KIND, numbers...]: " + design_target_usage());
     std::vector<double> values;
     for (std::size_t i = 1; i < t.size(); ++i)

@@ -92,11 +92,18 @@ TEST_CASE("A target the command line refuses, campaigns and the library refuse w
     // Wrong words (kind, count) and targets this part cannot have (outside the region, a line sink
     // for a rigid part, an orientation for a point part, a transport without velocity or with a turn).
     const std::vector<std::pair<std::string, Words>> bad = {
-        {"fig1_point", {"wobble", {0, 0}}},          {"fig1_point", {"sink", {0.02}}},
-        {"fig4", {"fixed-point", {0.02, -0.01}}},    {"fig1_point", {"line-sink", {0, 0}}},
-        {"fig1_point", {"transport", {1, 2, 3, 4}}}, {"fig1_point", {"sink", {0.2, 0}}},
-        {"fig4", {"line-sink", {0, 0, 0.5}}},        {"fig1_point", {"orient", {1.0}}},
-        {"fig1_point", {"transport", {0, 0}}},       {"fig1_point", {"transport", {0.01, 0, 0.5}}},
+        {"fig1_point", {"wobble", {0, 0}}},
+        {"fig1_point", {"sink", {0.02}}},
+        {"fig4", {"fixed-point", {0.02, -0.01}}},
+        {"fig1_point", {"line-sink", {0, 0}}},
+        {"fig1_point", {"transport", {1, 2, 3, 4}}},
+        {"fig1_point", {"sink", {0.2, 0}}},
+        {"fig4", {"line-sink", {0, 0, 0.5}}},
+        {"fig1_point", {"orient", {1.0}}},
+        {"fig1_point", {"transport", {0, 0}}},
+        {"fig1_point", {"transport", {0.01, 0, 0.5}}},
+        {"fig4", {"orient", {}}},
+        {"fig1_point", {"line-sink", {0, 0, 0.5, 1, 2, 3}}},
     };
     for (const auto& [scene, w] : bad) {
         INFO(scene << ": --target " << w.text());
@@ -107,10 +114,22 @@ TEST_CASE("A target the command line refuses, campaigns and the library refuse w
         CHECK(cli.err.find(message) != std::string::npos);
         CHECK(campaign_refusal(scene, w).find(message) != std::string::npos);
     }
-    // ... and a good target is taken by all three.
-    CHECK(library_refusal({"sink", {0.02, -0.01}}, load_scene(kScenes + "fig1_point.json")).empty());
-    CHECK(campaign_refusal("fig1_point", {"sink", {0.02, -0.01}}).empty());
-    CHECK(campaign_refusal("fig4", {"fixed-point", {0.02, -0.01, 0.5}}).empty());
+    // ... and good targets of every kind are taken by the library and campaigns alike (the CLI's and
+    // Python's acceptance: their design tests).
+    const std::vector<std::pair<std::string, Words>> good = {
+        {"fig1_point", {"sink", {0.02, -0.01}}},
+        {"fig4", {"fixed-point", {0.02, -0.01, 0.5}}},
+        {"fig1_point", {"fixed-point", {0.02, -0.01}}},
+        {"fig1_point", {"line-sink", {0, 0, 0.5}}},
+        {"fig1_point", {"transport", {0.02, 0}}},
+        {"foot", {"orient", {1.0}}},
+        {"fig4", {"sink", {0.01, 0.01}}},
+    };
+    for (const auto& [scene, w] : good) {
+        INFO(scene << ": --target " << w.text());
+        CHECK(library_refusal(w, load_scene(kScenes + scene + ".json")).empty());
+        CHECK(campaign_refusal(scene, w).empty());
+    }
 }
 
 TEST_CASE("A target's words round-trip through the parser, every kind", "[design][target]") {
@@ -164,6 +183,8 @@ TEST_CASE("A kind of target registered outside the library is parsed, dispatched
     CHECK(t.kind == DesignTargetKind::Registered);
     CHECK_THROWS_WITH(validate_design_target(t, load_scene(kScenes + "fig4.json"), DesignOptions{}),
                       Catch::Contains("point parts only"));
+    CHECK_THROWS_WITH(design(load_scene(kScenes + "fig4.json"), t, DesignOptions{}),   // (design() judges it too)
+                      Catch::Contains("point parts only"));
     DesignOptions o;
     o.hold = 2;
     const DesignSummary d = design(part, t, o);
@@ -173,5 +194,6 @@ TEST_CASE("A kind of target registered outside the library is parsed, dispatched
     const nlohmann::json j = design_summary_json(d, part, t, o, "still.json");
     CHECK(j["target"]["kind"] == "still");
     CHECK(j["target"]["values"] == nlohmann::json({0.01, -0.02}));
+    CHECK_FALSE(j["target"].contains("at"));
     CHECK(j["hold"]["end_distance"].get<double>() < 1e-12);
 }
