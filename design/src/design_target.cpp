@@ -39,6 +39,17 @@ std::string number_text(double x) {
 
 }   // namespace
 
+namespace design_detail {
+
+const DesignTargetType* registered(const std::string& name) {
+    std::lock_guard<std::mutex> lock(registry_mutex);
+    for (const DesignTargetType& r : registry())
+        if (r.name == name) return &r;   // (entries never move or go: the pointer stays valid)
+    return nullptr;
+}
+
+}   // namespace design_detail
+
 std::string design_target_usage() {
     std::string s =
         "sink X Y, fixed-point X Y (point part) or X Y THETA (rigid part), orient THETA, line-sink X Y PHI "
@@ -53,17 +64,12 @@ DesignTarget parse_design_target(const std::string& kind, const std::vector<doub
     const BuiltIn* b = nullptr;
     for (const BuiltIn& x : kBuiltIn)
         if (kind == x.name) b = &x;
-    if (!b) {
-        std::lock_guard<std::mutex> lock(registry_mutex);
-        for (const DesignTargetType& r : registry())
-            if (r.name == kind) {
-                if (static_cast<int>(v.size()) != r.count)
-                    throw std::invalid_argument(kind + ": expected " + kind + " " + r.numbers);
-                t.kind = DesignTargetKind::Registered;
-                t.name = kind;
-                t.values = v;
-                return t;
-            }
+    if (const DesignTargetType* r = b ? nullptr : registered(kind)) {
+        if (static_cast<int>(v.size()) != r->count) throw std::invalid_argument(kind + ": expected " + kind + " " + r->numbers);
+        t.kind = DesignTargetKind::Registered;
+        t.name = kind;
+        t.values = v;
+        return t;
     }
     if (!b) throw std::invalid_argument(kind + ": expected " + design_target_usage());
     const std::size_t want = b->kind == DesignTargetKind::Orient ? 1
@@ -147,15 +153,11 @@ void validate_design_target(const DesignTarget& target, const Scene& part_scene,
     if (!(T > 0)) throw std::invalid_argument("no plate period (give one)");
     const bool rigid = !part_scene.part.point;
     if (target.kind == DesignTargetKind::Registered) {
-        std::lock_guard<std::mutex> lock(registry_mutex);
-        for (const DesignTargetType& r : registry())
-            if (r.name == target.name) {
-                if (rigid ? !r.rigid : !r.point)
-                    throw std::invalid_argument("a " + r.name + " target is built for " + (rigid ? "point" : "rigid") +
-                                                " parts only");
-                return;
-            }
-        throw std::invalid_argument("unknown target '" + target.name + "'");
+        const DesignTargetType* r = registered(target.name);
+        if (!r) throw std::invalid_argument("unknown target '" + target.name + "'");
+        if (rigid ? !r->rigid : !r->point)
+            throw std::invalid_argument("a " + r->name + " target is built for " + (rigid ? "point" : "rigid") + " parts only");
+        return;
     }
     if (target.kind == DesignTargetKind::Transport) {
         if (!(target.velocity.norm() > 0)) throw std::invalid_argument("a transport target needs a velocity");
@@ -187,15 +189,5 @@ void register_design_target(DesignTargetType type) {
     registry().push_back(std::move(type));
 }
 
-namespace design_detail {
-
-const DesignTargetType* registered(const std::string& name) {
-    std::lock_guard<std::mutex> lock(registry_mutex);
-    for (const DesignTargetType& r : registry())
-        if (r.name == name) return &r;   // (entries never move or go: the pointer stays valid)
-    return nullptr;
-}
-
-}   // namespace design_detail
 
 }   // namespace plate
