@@ -94,7 +94,17 @@ void write_report(const ReportOptions& opt) {
         html << "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " << esc(opt.out)
              << "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
                 "load balance, the cost of a 1 000-core campaign).</p>\n";
-    html << kCampaignsEnd << "\n" << kPageCheck << "</body></html>\n";
+    html << kCampaignsEnd << "\n";
+    // The mutation catalogue's score (scripts/mutants.py --report) keeps its section between these.
+    html << kMutationsBegin;
+    const fs::path mutations = c.dir / "data" / "mutations_section.html";
+    if (fs::exists(mutations))
+        html << std::ifstream(mutations).rdbuf();
+    else
+        html << "<h2>Mutation score</h2><p>Not run yet: <code>scripts/mutants.py --report " << esc(opt.out)
+             << "</code> writes this section (one-line physics bugs from tests/mutations/catalogue.json, each applied to a "
+                "scratch copy, and the tests that caught it).</p>\n";
+    html << kMutationsEnd << "\n" << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
 }
 

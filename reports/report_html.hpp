@@ -124,6 +124,9 @@ inline const char* kCampaignsBegin = "<!-- campaigns:begin -->";
 inline const char* kCampaignsEnd = "<!-- campaigns:end -->";
 inline const char* kPeersBegin = "<!-- peers:begin -->";
 inline const char* kPeersEnd = "<!-- peers:end -->";
+// ... and the mutation catalogue's score (scripts/mutants.py --report) between these.
+inline const char* kMutationsBegin = "<!-- mutations:begin -->";
+inline const char* kMutationsEnd = "<!-- mutations:end -->";
 
 // First in <head>: records every error the page meets (script errors, resources that fail to load,
 // console.error, rejected promises) for the browser check.

@@ -6,6 +6,7 @@ pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-d
       python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev
       clang libclang-rt-dev   # (the sanitizer build, scripts/test-sanitizers.sh)
       clang-format            # (the format check, scripts/check-format.sh)
+      ccache                  # (the mutation catalogue's scratch build reuses the build's objects)
       libopenmpi-dev openmpi-bin
       libbullet-dev libode-dev libmujoco-dev   # (these three: the peer engines, optional to the build)
       libsiconos-numerics-dev)   # (the Moreau-Jean stick-slip reference, tests/test_siconos.cpp; optional)
