@@ -76,7 +76,10 @@ TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     CHECK(j["stick_fraction"] == nlohmann::json::array({0.0, 0.0, 0.0}));   // fig4 never sticks
     CHECK(j["mode_sequence"].size() == 1);
     CHECK(j["mode_sequence"][0]["mode"] == "slide");
-    CHECK(j["periods"].get<int>() > 1);
+    // An attracting cycle, reached to the cycle tolerance (--tol 1e-7 of v_ref; measured: contraction
+    // 0.57 per period, residual 2.6e-11): an expanding map or an unconverged cycle fails these.
+    CHECK(j["contraction_per_period"].get<double>() < 1);
+    CHECK(j["residual"].get<double>() < 1e-7);
     CHECK(j["min_normal_force"].get<double>() > 0);
     const Run p = run("twist " + kScenes + "fig1_point.json --at 0.02 0.01");
     REQUIRE(p.code == 0);
@@ -166,12 +169,23 @@ TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the t
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    for (const char* c :
-         {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench ", "design ", "proofs ", "report "}) {
-        const Run r = run(std::string(c) + "--help");
+    const std::string commands[] = {"twist", "field",  "fixed-points", "simulate", "random-scene",
+                                    "bench", "design", "proofs",       "report",   "sweep"};
+    const Run top = run("--help");
+    CHECK(top.code == 0);
+    // The program's help names every exit code a command can return.
+    for (const char* code : {"0 ok", "2 bad input", "3 a simulation left the model", "4 a design", "5 a check of plate proofs"})
+        CHECK(top.out.find(code) != std::string::npos);
+    for (const std::string& c : commands) {
+        INFO(c);
+        CHECK(top.out.find("\n  " + c + " ") != std::string::npos);   // listed among the commands
+        const Run r = run(c + " --help");
         CHECK(r.code == 0);
-        CHECK(r.out.find("usage") != std::string::npos);
+        CHECK(r.out.find("usage: plate " + c + " ") != std::string::npos);   // its own help, not another's
     }
+    // The commands with a verdict of their own say which exit code it sets.
+    CHECK(run("design --help").out.find("exit 4") != std::string::npos);
+    CHECK(run("proofs --help").out.find("exit code 5 when a verdict fails") != std::string::npos);
 }
 
 TEST_CASE("bad input: exit code 2, the file and the field named, no output file", "[cli][input]") {
@@ -269,10 +283,28 @@ TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]"
     const Run r = run("proofs --thin 6 --thick 3 --surfaces 3 --seed 100");
     REQUIRE(r.code == 0);
     const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["passed"] == true);
+    CHECK(j["failed"].empty());
     CHECK(j["thin"]["cases"] == 6);
     CHECK(j["thin"]["passed"] == true);
+    CHECK(j["thin"]["dynamics_tie"]["samples"] == 60);
+    // Signed margins (measured for these seeds: -7e-4, 4e-10): V fell at every step, the cycles coincide.
+    CHECK(j["thin"]["worst_increase_over_bound"].get<double>() < 0);
+    CHECK(j["thin"]["max_cycle_spread_over_v_ref"].get<double>() < 1e-8);
+    // Thick parts are beyond the theorem: observations, no verdict, and no tie (it solves thin statics).
     CHECK(j["thick"]["cases"] == 3);
-    CHECK(j["limit_surfaces"]["convex_and_normal"] == 3);
+    CHECK_FALSE(j["thick"].contains("passed"));
+    CHECK_FALSE(j["thick"].contains("dynamics_tie"));
+    CHECK(j["thick"]["observation"].get<std::string>().rfind("beyond Theorem 1", 0) == 0);
+    // The checks that hold by construction apart, with their margins (measured 2e-3, 4e-3 of sum mu N).
+    const auto& ls = j["limit_surfaces"];
+    CHECK(ls["holds_by_construction"]["convex_and_normal"] == 3);
+    CHECK(ls["holds_by_construction"]["max_work_margin"].get<double>() > 0);
+    CHECK(ls["holds_by_construction"]["monotonicity_margin"].get<double>() > 0);
+    CHECK_FALSE(ls.contains("convex_and_normal"));
+    CHECK(ls["on_friction_set"] == 3);
+    CHECK(ls["support_margin"].get<double>() > 0);
+    CHECK(ls["passed"] == true);
     // The conditioning the help promises: cond(A) grows like L/e toward collinear contacts (each tenth
     // of e at least 5x), and A is singular at e = 0 (smallest singular value at rounding).
     const auto& c = j["conditioning_of_A"];
@@ -282,6 +314,35 @@ TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]"
         CHECK(c[i]["max_condition"].get<double>() > 5 * c[i - 1]["max_condition"].get<double>());
     }
     CHECK(c[4]["min_singular_over_max"].get<double>() < 1e-12);
+}
+
+TEST_CASE("plate proofs exits 5 when a verdict fails, its JSON written and the failed checks named", "[cli][proofs]") {
+    const fs::path out = tmpdir() / "proofs-wrong.json";
+    // Friction that pushes: the relative twist grows, Theorem 1's contraction fails; the limit surfaces
+    // (which never integrate) pass.
+    const Run push =
+        run("proofs --thin 4 --thick 0 --surfaces 2 --seed 100 --wrong-model pushing-friction --out " + out.string());
+    CHECK(push.code == 5);
+    CHECK(push.err.find("plate proofs: failed: [\"thin\"]") != std::string::npos);
+    REQUIRE(fs::exists(out));
+    const auto j = nlohmann::json::parse(slurp(out));
+    CHECK(j["passed"] == false);
+    CHECK(j["failed"] == nlohmann::json::array({"thin"}));
+    CHECK(j["wrong_model"] == "pushing-friction");
+    CHECK(j["thin"]["passed"] == false);
+    CHECK(j["thin"]["worst_increase_over_bound"].get<double>() > 1);   // signed: V rose past its error bound
+    CHECK(j["limit_surfaces"]["passed"] == true);
+    // Contact 3's mu 1 % off in the dynamics under test: both ties fail.
+    const Run mu3 = run("proofs --thin 2 --thick 0 --surfaces 2 --seed 100 --wrong-model mu3");
+    CHECK(mu3.code == 5);
+    const auto k = nlohmann::json::parse(mu3.out);
+    CHECK(k["failed"] == nlohmann::json::array({"thin", "limit_surfaces"}));
+    CHECK(k["limit_surfaces"]["dynamics_tie"]["failure"].get<std::string>().rfind("wrench", 0) == 0);
+    // A campaign that checks nothing has no verdict to fail; an unknown wrong model is a usage error.
+    CHECK(run("proofs --thin 0 --thick 0 --surfaces 0").code == 0);
+    const Run bad = run("proofs --thin 1 --thick 0 --surfaces 0 --wrong-model gravity");
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--wrong-model") != std::string::npos);
 }
 
 TEST_CASE("plate report writes index.html whose every figure exists", "[cli][report]") {
