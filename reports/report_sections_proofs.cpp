@@ -76,10 +76,10 @@ namespace {
 // V per period, log scale: a few thin cases and the worst thick one.
 void plot_V(Ctx& c, const proofs::ContractionSummary& thin, const proofs::ContractionSummary& thick) {
     auto o = c.data("V.dat");
-    int cols = 0;
     std::vector<const proofs::ContractionCase*> show;
     for (const auto& d : thin.details)
         if (d.valid && show.size() < 5) show.push_back(&d);
+    const int thin_shown = static_cast<int>(show.size());
     for (const auto& d : thick.details)
         if (d.seed == thick.worst_seed && d.valid) show.push_back(&d);
     std::size_t len = 0;
@@ -90,15 +90,22 @@ void plot_V(Ctx& c, const proofs::ContractionSummary& thin, const proofs::Contra
         o << '\n';
     }
     o.close();
-    cols = static_cast<int>(show.size());
+    const int cols = static_cast<int>(show.size());
     std::string s = "set logscale y\nset format y '10^{%L}'\nset xlabel 'period'\nset ylabel 'V / V_0'\nset key top right\nplot ";
     for (int i = 0; i < cols; ++i)
         s += std::string(i ? ", " : "") + "'data/V.dat' u 1:" + std::to_string(i + 2) + " w lp pt 7 ps 0.4 t '" +
-             (i + 1 == cols && show.back()->seed == thick.worst_seed ? "thick, seed " : "thin, seed ") +
-             std::to_string(show[i]->seed) + "'";
+             (i >= thin_shown ? "thick, seed " : "thin, seed ") + std::to_string(show[i]->seed) + "'";
+    // The caption says what the thin curves show: the largest per-period factor of |xi_rel|, up to
+    // the period where V reaches 1e-16 V0 (rounding).
+    double worst_factor = 0;
+    for (int i = 0; i < thin_shown; ++i) {
+        const auto& V = show[i]->V_periods;
+        for (std::size_t k = 1; k < V.size() && V[k - 1] > 1e-16 * show[i]->V0; ++k)
+            worst_factor = std::max(worst_factor, std::sqrt(V[k] / V[k - 1]));
+    }
     c.plot("lyapunov_V", s + "\n",
-           "V(t) = ½|ξ<sub>rel</sub>|² at period boundaries, log scale: thin parts contract "
-           "geometrically; the worst thick case shown last.");
+           "V(t) = ½|ξ<sub>rel</sub>|² at period boundaries, log scale. " + contraction_caption(thin_shown, worst_factor) +
+               (cols > thin_shown ? " The worst thick case shown last." : ""));
 }
 
 // Theorem 1 on thin parts and the same campaign beyond it on thick ones: the table, the tie to the
@@ -304,13 +311,23 @@ void section_fig3(Ctx& c, const fs::path& src) {
     const double v = sc.v_ref(), w = v / sc.part.rho();
     const LimitCycleSummary a = limit_cycle(sc, q, lo, Vec3(v, -0.5 * v, 0.5 * w));
     const LimitCycleSummary b = limit_cycle(sc, q, lo, Vec3(-0.8 * v, 0.8 * v, -w));
+    // The two runs' twists at each period boundary, compared (scaled: (v, v, v / rho) is v_ref).
+    std::vector<Vec3> ends[2];
     for (const auto* p : {&a, &b}) {
+        for (const auto& s : p->path)
+            if (std::abs(std::remainder(s.t, sc.plate.T)) < 1e-12) ends[p == &b].push_back(s.qd);
         auto o = c.data(p == &a ? "fig3a.dat" : "fig3b.dat");
         for (const auto& s : p->path) o << s.qd[0] << ' ' << s.qd[1] << ' ' << s.qd[2] << ' ' << s.t << '\n';
         auto m = c.data(p == &a ? "fig3a_T.dat" : "fig3b_T.dat");
         for (const auto& s : p->path)
             if (std::abs(std::remainder(s.t, sc.plate.T)) < 1e-12) m << s.qd[0] << ' ' << s.qd[1] << ' ' << s.qd[2] << '\n';
     }
+    if (ends[0].empty() || ends[1].empty()) throw std::runtime_error("Fig. 3: no period boundary recorded");
+    const std::size_t last = std::min(ends[0].size(), ends[1].size()) - 1;
+    auto gap = [&](std::size_t k) {
+        const Vec3 d = ends[0][k] - ends[1][k];
+        return std::sqrt(d.head<2>().squaredNorm() + std::pow(sc.part.rho() * d[2], 2)) / v;
+    };
     c.html << "<h2>5. Observation 1 (Fig. 3)</h2>\n<p>Scene <code>fig3_random</code> at (0.01, −0.01, 0.5): two initial "
               "twists, ten periods of the reduced U-dynamics; open circles every T.</p>\n";
     c.plot("fig3",
@@ -318,7 +335,7 @@ void section_fig3(Ctx& c, const fs::path& src) {
            "splot 'data/fig3a.dat' u 1:2:3 w l lc rgb '#c03030' t 'start 1', 'data/fig3b.dat' u 1:2:3 w l lc rgb '#3050c0' t "
            "'start 2', "
            "'data/fig3a_T.dat' w p pt 6 lc rgb '#c03030' notitle, 'data/fig3b_T.dat' w p pt 6 lc rgb '#3050c0' notitle\n",
-           "Two initial twists converging to one limit cycle (twist space).");
+           fig3_caption(static_cast<int>(std::min(ends[0].size(), ends[1].size())) - 1, gap(0), gap(last)));
 }
 
 }   // namespace plate::report

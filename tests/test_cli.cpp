@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <tuple>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -61,6 +64,26 @@ std::string fig4_with(const std::string& from, const std::string& to) {
     const auto p = s.find(from);
     REQUIRE(p != std::string::npos);
     return s.replace(p, from.size(), to);
+}
+
+// The report's verdicts marked FAIL that are not expected, each with the text before it. Expected:
+// the derivation's three printed equations that differ from the derived ones (tests/test_symbolic.cpp
+// says why: (28) prints R1 for R1^T; Appendix A's A is block upper triangular, not diagonal; (38)'s
+// first row reads J R R2^T). Nothing else in the report may say FAIL.
+std::vector<std::string> unexpected_fails(const std::string& html) {
+    const std::string expected_rows[] = {"<tr><td>(28)</td>", "<tr><td>Appendix A (block diagonal)</td>", "<tr><td>(38)</td>"};
+    const std::string differs = "class=\"fail\">differs<";
+    std::vector<std::string> out;
+    for (std::size_t p = 0; (p = html.find("class=\"fail\"", p)) != std::string::npos; ++p) {
+        const std::size_t row = html.rfind("<tr>", p);
+        const bool same_row = row != std::string::npos && html.find("</tr>", row) > p;
+        bool expected = false;
+        for (const std::string& e : expected_rows)
+            expected =
+                expected || (same_row && html.compare(row, e.size(), e) == 0 && html.compare(p, differs.size(), differs) == 0);
+        if (!expected) out.push_back(html.substr(p < 300 ? 0 : p - 300, std::min<std::size_t>(p, 300) + 60));
+    }
+    return out;
 }
 
 }   // namespace
@@ -367,6 +390,22 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
     const std::size_t stopped = html.find("FAIL: the run from rest stopped");
     INFO((stopped == std::string::npos ? std::string() : html.substr(stopped, 200)));
     CHECK(stopped == std::string::npos);
+    // Every verdict marked FAIL is one this test expects, with its reason; any other fails it.
+    const std::vector<std::string> unexpected = unexpected_fails(html);
+    for (const std::string& u : unexpected) INFO("unexpected FAIL: " << u);
+    CHECK(unexpected.empty());
+}
+
+TEST_CASE("the report test's reading of verdicts: every FAIL it does not expect is named", "[cli][report]") {
+    const std::string row = "<tr><td>(38)</td><td><span class=\"fail\">differs</span></td></tr>";
+    CHECK(unexpected_fails(row).empty());
+    CHECK(unexpected_fails("<p>ok: <span class=\"pass\">pass</span></p>").empty());
+    const std::string theorem = "<tr><td>thin (Theorem 1)</td><td>Theorem 1: <span class=\"fail\">FAIL</span></td></tr>";
+    REQUIRE(unexpected_fails(theorem).size() == 1);
+    CHECK(unexpected_fails(theorem)[0].find("thin (Theorem 1)") != std::string::npos);
+    // An equation that agreed until now, marked "differs": not expected.
+    CHECK(unexpected_fails("<tr><td>(27)</td><td><span class=\"fail\">differs</span></td></tr>").size() == 1);
+    CHECK(unexpected_fails(row + "<p><span class=\"fail\">FAIL: the run from rest stopped</span></p>").size() == 1);
 }
 
 TEST_CASE("plate report --sections computes only the named sections and says which were left out", "[cli][report]") {
