@@ -109,6 +109,80 @@ TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     CHECK(nlohmann::json::parse(p.out)["twist"].size() == 2);
 }
 
+TEST_CASE("the README's quick start: every figure it quotes is what the program computes", "[cli][readme]") {
+    // README.md, "Quick start": the twist, fixed points and trajectory it prints and the sentences on
+    // them, each to the digits it quotes (the printed JSON to 1e-6 relative: the run on this machine
+    // agrees to the last digit).
+    auto near = [](double x, double quoted, double tol) { return std::abs(x - quoted) <= tol; };
+    const auto tw = nlohmann::json::parse(run("twist " + kScenes + "fig4.json --at 0.03 -0.02 1.0").out);
+    const auto t = tw["twist"].get<std::vector<double>>();
+    CHECK(near(t[0], -0.043589894576272895, 1e-6 * 0.0436));
+    CHECK(near(t[1], 0.01706607231446182, 1e-6 * 0.0436));
+    CHECK(near(t[2], -0.06612697320366145, 1e-6 * 0.0661));
+    CHECK(near(std::hypot(t[0], t[1]), 0.047, 0.0005));   // "drifts at 4.7 cm/s"
+    CHECK(near(t[2], -0.066, 0.0005));                    // "turns at -0.066 rad/s"
+    CHECK(tw["mode_sequence"].size() == 1);               // "sliding all period"
+    CHECK(tw["mode_sequence"][0]["mode"] == "slide");
+    const auto hy = nlohmann::json::parse(run("twist " + kScenes + "heave_yaw.json --at 0 0.02 0").out);
+    CHECK(hy["mode_sequence"][0]["mode"] == "stuck");
+    CHECK(hy["mode_sequence"][1]["mode"] == "pivot2");
+    const double quoted_stick[] = {0.7469875608540951, 0.781697642554991, 0.7837744722911135};
+    for (int i = 0; i < 3; ++i) CHECK(near(hy["stick_fraction"][i].get<double>(), quoted_stick[i], 1e-6));
+    // fig4's fixed points: stable at the centre at theta = 0 and pi (eigenvalues -1.60, -0.80, -0.22 1/s),
+    // saddles in between.
+    const auto fp = nlohmann::json::parse(run("fixed-points " + kScenes + "fig4.json").out);
+    CHECK(fp["summary"] == "4 fixed points found");
+    int stable = 0, saddles = 0;
+    for (const auto& p : fp["points"]) {
+        const auto at = p["at"].get<std::vector<double>>();
+        CHECK(std::hypot(at[0], at[1]) < 1e-6);
+        if (p["stability"] == "stable") {
+            ++stable;
+            CHECK((near(at[2], 0, 0.005) || near(at[2], 3.1416, 0.005)));
+            const double quoted[] = {-1.60, -0.80, -0.22};
+            for (int i = 0; i < 3; ++i) CHECK(near(p["eigenvalues"][i][0].get<double>(), quoted[i], 0.005));
+        } else {
+            saddles += p["stability"] == "saddle" && (near(at[2], 1.65, 0.005) || near(at[2], -1.49, 0.005));
+        }
+    }
+    CHECK(stable == 2);
+    CHECK(saddles == 2);
+    // (The Python example prints the first: stable [-2.06e-07 5.08e-07 -1.80e-03].)
+    const auto first = fp["points"][0]["at"].get<std::vector<double>>();
+    CHECK(fp["points"][0]["stability"] == "stable");
+    CHECK(near(first[0], -2.06e-7, 0.005e-7));
+    CHECK(near(first[1], 5.08e-7, 0.005e-7));
+    CHECK(near(first[2], -1.80e-3, 0.005e-3));
+    // fig1: lines of fixed points, stable along (0, s_y, 0) and (0, s_y, pi), saddles at theta = +-pi/2.
+    const auto f1 = nlohmann::json::parse(run("fixed-points " + kScenes + "fig1.json").out);
+    int along_y = 0;
+    for (const auto& l : f1["lines"]) {
+        const double th = l["from"][2].get<double>(), a = std::remainder(th, 3.141592653589793);
+        const bool stable_line = l["stability"] == "stable";
+        CHECK(near(l["direction"][1].get<double>(), 1, 1e-6));   // along s_y
+        CHECK(near(l["from"][0].get<double>(), 0, 1e-6));
+        CHECK((stable_line ? near(a, 0, 1e-3) : near(std::abs(a), 1.5708, 1e-3)));
+        ++along_y;
+    }
+    CHECK(along_y == 4);
+    // From (4 cm, -4 cm, 1 rad), 20 s of full dynamics: within about a millimetre of the centre, at
+    // theta = -0.033 rad.
+    const fs::path csv = tmpdir() / "readme_fig4.csv";
+    REQUIRE(run("simulate " + kScenes + "fig4.json --dynamics full --from 0.04 -0.04 1.0 --time 20 --out " + csv.string()).code ==
+            0);
+    std::istringstream rows(slurp(csv));
+    std::string line, last;
+    while (std::getline(rows, line))
+        if (!line.empty()) last = line;
+    std::vector<double> v;
+    std::istringstream cells(last);
+    for (std::string cell; std::getline(cells, cell, ',') && v.size() < 4;) v.push_back(std::stod(cell));
+    REQUIRE(v.size() == 4);
+    CHECK(v[0] == 20);
+    CHECK(std::hypot(v[1], v[2]) < 1e-3);
+    CHECK(near(v[3], -0.033, 0.0005));
+}
+
 TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header", "[cli]") {
     const fs::path out = tmpdir() / "field.csv";
     Run r = run("field " + kScenes + "fig4.json --grid 2 --format csv --out " + out.string());
@@ -127,6 +201,28 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     r = run("fixed-points " + kScenes + "fig1_point.json --grid 5");
     REQUIRE(r.code == 0);
     CHECK(nlohmann::json::parse(r.out)["lines"].size() == 1);
+}
+
+TEST_CASE("heave_yaw's fields stick everywhere, all period long at 42 of 343 and 9 of 49 (the guide's numbers)", "[cli][stick]") {
+    // docs/guide.md (Scenes) states these counts: every configuration sticks during its cycle, and at
+    // 42 of the part's 343 and 9 of the point part's 49 it is stuck all period (twist exactly zero).
+    for (const auto& [name, points, all_period] :
+         {std::tuple<const char*, int, int>{"heave_yaw", 343, 42}, std::tuple<const char*, int, int>{"heave_yaw_point", 49, 9}}) {
+        INFO(name);
+        const Run r = run("field " + kScenes + name + ".json --threads 2");
+        REQUIRE(r.code == 0);
+        const auto j = nlohmann::json::parse(r.out)["points"];
+        CHECK(static_cast<int>(j.size()) == points);
+        int sticks = 0, stuck = 0;
+        for (const auto& p : j) {
+            const auto f = p["stick_fraction"].get<std::vector<double>>();
+            const auto t = p["twist"].get<std::vector<double>>();
+            sticks += *std::max_element(f.begin(), f.end()) > 0;
+            stuck += p["converged"].get<bool>() && std::all_of(t.begin(), t.end(), [](double x) { return x == 0; });
+        }
+        CHECK(sticks == points);
+        CHECK(stuck == all_period);
+    }
 }
 
 TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twist reports its stick fractions", "[cli][stick]") {
