@@ -5,9 +5,9 @@
 #include "theorem1.hpp"
 
 #include <chrono>
-#include <functional>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
