@@ -226,8 +226,8 @@ void proofs_limit_surfaces(Ctx& c, const ReportOptions& opt, int n_surf) {
            << "</td><td>" << fmt(ls.outside_margin, 2) << "</td><td>" << verdict(ls.passed())
            << "</td></tr></table>\n<p>Maximum work and (40) hold by construction: for any wrench of "
               "the form −Σ c<sub>i</sub> G<sub>i</sub> v<sub>i</sub>/|v<sub>i</sub>| with c<sub>i</sub> ≥ 0 (Cauchy-Schwarz), so "
-              "a kernel fed a wrong μ or lever arm passes them. What can fail: strict convexity (it fails as contacts "
-              "approach collinear, below), and each part's friction set built independently (every "
+              "a kernel fed a wrong μ or lever arm passes them. What can fail: strict convexity (collinear contacts fail it: "
+              "the surface gets a vertex, below), and each part's friction set built independently (every "
               "force of magnitude ≤ μ<sub>i</sub>N<sub>i</sub> at each contact, N from the part's statics, each disk's rim "
               "sampled at 720 points): the kernel's wrench for ξ must be the set's support point in −ξ and inside the set "
               "(margins ≥ −1e-12 pass; a wrong μ or lever arm "
