@@ -1,7 +1,8 @@
 // plate: the command-line program (apps/main.cpp runs it). See `plate --help`.
 // Exit codes: 0 success; 2 bad input (usage, scene file); 3 a simulation left the model's
 // assumptions (contact lost, sticking, step collapse) -- its output up to that time is kept;
-// 4 a design that failed verification (nothing written); 1 any other failure.
+// 4 a design that failed verification (nothing written); 5 a verdict of plate proofs failed (its
+// JSON written); 1 any other failure.
 // The commands are in apps/commands/ (one file each), their shared options in apps/options.hpp.
 #include "cli.hpp"
 
@@ -27,7 +28,7 @@ const char* kFooter =
     "\n"
     "SCENE is a JSON scene file (see scenes/). Units are SI. Exit codes: 0 ok, 2 bad input,\n"
     "3 a simulation left the model (a normal force reached zero: the part would fly), 4 a design that\n"
-    "failed its verification, 1 other failure.\n";
+    "failed its verification, 5 a check of plate proofs that failed, 1 other failure.\n";
 
 // The commands, in the order `plate --help` lists them: run() adds each to the command line and runs
 // the one given. Adding a command: its file apps/commands/NAME.cpp (an Args struct over Options,

@@ -57,7 +57,7 @@ ContractionCase contraction_case(const Scene& sc, const Vec3& q0, const Vec3& xi
     sys(y, dydt, t);
     out.V0 = V(y);
     out.V_periods.push_back(out.V0);
-    double worst = 0;
+    double worst = -HUGE_VAL;
     const double eps_slip = 1e-6 * v;
     // Until |xi_rel| has fallen by 1e6 (V by 1e12), at most `periods` periods.
     for (int k = 1; k <= periods && out.V_periods.back() > 1e-12 * out.V0; ++k) {
@@ -93,7 +93,7 @@ ContractionCase contraction_case(const Scene& sc, const Vec3& q0, const Vec3& xi
             for (int i = 0; i < 3; ++i) rel += std::pow((y1[3 + i] - y1[i]) * scale[i] * S[i], 2);
             const double delta = rtol * (v + xmax);
             const double bound = std::sqrt(rel) * 2 * std::sqrt(3.0) * delta + 6 * delta * delta;
-            if (Vn > Vo) worst = std::max(worst, (Vn - Vo) / bound);
+            worst = std::max(worst, (Vn - Vo) / bound);
             y = y1;
             dydt = dydt1;
             t = tt;
@@ -236,6 +236,8 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
     return t;
 }
 
+bool unique_cycle(int reached, int starts, double spread) { return starts > 0 && reached == starts && spread < 1e-6; }
+
 ContractionCase contraction_random_case(const ContractionOptions& opt, int k) {
     const std::uint64_t seed = opt.seed + static_cast<std::uint64_t>(k);
     RandomSceneOptions ro;
@@ -268,7 +270,7 @@ ContractionCase contraction_random_case(const ContractionOptions& opt, int k) {
     // cycle is reached) says nothing about the cycle: it is replaced by another, up to 3x.
     c.unique = true;
     const Vec3 scale(v, v, w);
-    int reached = 0;
+    int& reached = c.starts_reached;
     for (int k = 0; k < 3 * opt.starts && reached < opt.starts; ++k) {
         const LimitCycleSummary o = limit_cycle(sc, q0, lo, twist());
         if (!o.converged) {
@@ -283,8 +285,7 @@ ContractionCase contraction_random_case(const ContractionOptions& opt, int k) {
         ++reached;
         c.cycle_spread = std::max(c.cycle_spread, ((o.qd_start - lc.qd_start).array() / scale.array()).abs().maxCoeff());
     }
-    c.unique = c.unique && reached > 0;
-    c.unique = c.unique && c.cycle_spread < 1e-6;
+    c.unique = c.unique && unique_cycle(reached, opt.starts, c.cycle_spread);
     return c;
 }
 
@@ -324,7 +325,10 @@ ContractionSummary summarize_contraction(const ContractionOptions& opt, std::vec
             s.converged += c.converged;
             s.unique += c.unique;
             s.floquet_below_one += c.spectral_radius < 1;
-            if (c.worst_increase > s.worst_increase) {
+            s.worst_V_end = std::max(s.worst_V_end, c.V0 > 0 ? c.V_end / c.V0 : 0.0);
+            s.max_cycle_spread = std::max(s.max_cycle_spread, c.cycle_spread);
+            s.starts_left_model += c.starts_left_model;
+            if (s.valid == 1 || c.worst_increase > s.worst_increase) {
                 s.worst_increase = c.worst_increase;
                 s.worst_seed = c.seed;
             }
@@ -365,7 +369,7 @@ LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int 
         r.set_checked = true;
         for (int i = 0; i < directions; ++i) {
             hs[i] = set->support_sampled(-xi[i], kAngles);
-            r.support_violation = std::max(r.support_violation, (hs[i] - (-xi[i]).dot(w[i])) / scale);
+            r.support_margin = std::min(r.support_margin, ((-xi[i]).dot(w[i]) - hs[i]) / scale);
         }
     }
     const double outer = 1 / std::cos(kPi / kAngles);
@@ -373,12 +377,12 @@ LimitSurfaceResult check_limit_surface(const WrenchMap& wmap, double scale, int 
         for (int j = 0; j < directions; ++j) {
             if (i == j) continue;
             ++r.pairs;
-            r.max_work_violation = std::max(r.max_work_violation, (xi[i].dot(w[i]) - xi[i].dot(w[j])) / scale);
-            if (set) r.outside_violation = std::max(r.outside_violation, ((-xi[i]).dot(w[j]) - hs[i] * outer) / scale);
+            r.max_work_margin = std::min(r.max_work_margin, (xi[i].dot(w[j]) - xi[i].dot(w[i])) / scale);
+            if (set) r.outside_margin = std::min(r.outside_margin, (hs[i] * outer - (-xi[i]).dot(w[j])) / scale);
             if ((xi[i] - xi[j]).norm() > separation)
                 r.min_strict_margin = std::min(r.min_strict_margin, (xi[i].dot(w[j]) - xi[i].dot(w[i])) / scale);
             if (j > i) {
-                r.monotonicity_violation = std::max(r.monotonicity_violation, (xi[i] - xi[j]).dot(w[i] - w[j]) / scale);
+                r.monotonicity_margin = std::min(r.monotonicity_margin, -(xi[i] - xi[j]).dot(w[i] - w[j]) / scale);
                 if ((xi[i] - xi[j]).norm() > separation)
                     r.min_separation = std::min(r.min_separation, (w[i] - w[j]).norm() / scale);
             }
@@ -408,6 +412,7 @@ LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const D
     LimitSurfaceCampaign c;
     c.parts = parts;
     c.min_separation = c.min_strict_margin = parts > 0 ? 1e300 : 0;
+    c.max_work_margin = c.monotonicity_margin = c.support_margin = c.outside_margin = parts > 0 ? 1e300 : 0;
     Rng r(seed + 7);
     for (int k = 0; k < parts; ++k) {
         const Scene sc = random_scene(seed + 90'000'000 + static_cast<std::uint64_t>(k), RandomSceneOptions{true});
@@ -420,11 +425,11 @@ LimitSurfaceCampaign check_limit_surfaces(int parts, std::uint64_t seed, const D
         const LimitSurfaceResult lr = check_limit_surface(w, scale, 300, 0.2, &set);
         c.convex += lr.convex_and_normal();
         c.on_set += lr.on_friction_set();
-        c.worst_support = std::max(c.worst_support, lr.support_violation);
-        c.worst_outside = std::max(c.worst_outside, lr.outside_violation);
+        c.support_margin = std::min(c.support_margin, lr.support_margin);
+        c.outside_margin = std::min(c.outside_margin, lr.outside_margin);
         c.strict += lr.strictly_convex();
-        c.worst_max_work = std::max(c.worst_max_work, lr.max_work_violation);
-        c.worst_monotonicity = std::max(c.worst_monotonicity, lr.monotonicity_violation);
+        c.max_work_margin = std::min(c.max_work_margin, lr.max_work_margin);
+        c.monotonicity_margin = std::min(c.monotonicity_margin, lr.monotonicity_margin);
         c.min_separation = std::min(c.min_separation, lr.min_separation);
         c.min_strict_margin = std::min(c.min_strict_margin, lr.min_strict_margin);
     }

@@ -150,6 +150,43 @@ std::string scene_heading(const std::string& title, const std::string& scene_nam
     return "<h3>" + esc(title) + " (<code>" + esc(scene_name) + "</code>, <code>scenes/" + esc(file) + "</code>)</h3>";
 }
 
+std::string contraction_caption(int shown, double worst_factor) {
+    std::ostringstream o;
+    o.precision(3);
+    if (shown <= 0) return "No thin case stayed in the model: none shown.";
+    if (worst_factor < 1)
+        o << "The " << shown << " thin parts shown contract geometrically: |ξ_rel| falls each period to at most " << worst_factor
+          << " of its value.";
+    else
+        o << "The " << shown << " thin parts shown do not all contract geometrically: in one period |ξ_rel| grew to "
+          << worst_factor << " of its value.";
+    return o.str();
+}
+
+std::string fig3_caption(int periods, double gap_start, double gap_end) {
+    std::ostringstream o;
+    o.precision(2);
+    o << "Two initial twists " << gap_start << " v_ref apart; after " << periods << " periods their twists at the period "
+      << "boundary are " << gap_end << " v_ref apart: ";
+    if (gap_end <= 1e-2 * gap_start)
+        o << "converging to one limit cycle (twist space).";
+    else
+        o << "not shown converging to one limit cycle in these periods (the gap shrank less than 100x).";
+    return o.str();
+}
+
+std::string design_runs_caption(int reached, int runs, double distance, bool verified, const std::string& failure) {
+    std::ostringstream o;
+    o.precision(3);
+    o << "The designed velocity field (arrows, scaled) and the verification's full-dynamics runs from random starts: " << reached
+      << " of " << runs << " end within " << distance * 1e3 << " mm of the target";
+    if (verified && reached == runs && runs > 0)
+        o << ", converging on the target.";
+    else
+        o << ": not all converge on the target" << (verified ? "." : "; the design failed verification: " + esc(failure) + ".");
+    return o.str();
+}
+
 std::string observation1_sentence(int valid, int converged, int unique, int attracting) {
     if (valid <= 0) return "No thick case stayed in the model, so this campaign says nothing on Observation 1.";
     if (converged == valid && unique == valid && attracting == valid)

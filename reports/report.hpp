@@ -41,6 +41,17 @@ std::string observation1_sentence(int valid, int converged, int unique, int attr
 // a vertex" only when each tenth of e/L multiplies cond(A) and divides the gap by at least 5.
 std::string collinear_sentence(const std::vector<double>& conds, const std::vector<double>& gaps, double singular);
 
+// Captions that state a result, each from what the run measured (the opposite said when it is not so).
+// Fig. V: `worst_factor`, the largest per-period factor of |xi_rel| over the `shown` thin cases (up to
+// rounding): "contract geometrically" only when it is below 1.
+std::string contraction_caption(int shown, double worst_factor);
+// Fig. 3: the two runs' twists at the period boundaries, their gap / v_ref at the start and after the
+// last period: "converging to one limit cycle" only when the gap shrank 100x or more.
+std::string fig3_caption(int periods, double gap_start, double gap_end);
+// The designed sink's runs: `reached` of `runs` verification runs ended within `distance` of the
+// target; "converging on the target" only when all did and the design was verified.
+std::string design_runs_caption(int reached, int runs, double distance, bool verified, const std::string& failure);
+
 // The heading of a field's section: the figure's title and the scene's own name (from its file,
 // user text: escaped for HTML, as everything a user supplies that reaches the page).
 std::string scene_heading(const std::string& title, const std::string& scene_name, const std::string& file);

@@ -129,6 +129,8 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                 o2 << tt << ' ' << pdd.transpose() << ' ' << wd.transpose() << '\n';
             }
         }
+        int reached = 0;   // the verification's own test (design.cpp): no early stop, within its distance
+        for (const DesignStartRun& r : d.runs) reached += r.stop.empty() && r.end_distance <= o.verify_distance;
         GridSpec g;
         g.nx = g.ny = 11;
         g.nth = 1;
@@ -171,8 +173,7 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                    "_runs.dat' u 1:2 w l lc rgb '#3050c0' t 'full dynamics, random starts', "
                    "'data/" +
                    n + "_target.dat' u 1:2 w p pt 7 ps 2 lc rgb '#c02020' t 'target'\n",
-               "The designed velocity field (arrows, scaled) and the full-dynamics runs of the verification converging "
-               "on the target.",
+               design_runs_caption(reached, static_cast<int>(d.runs.size()), o.verify_distance, d.verified, d.failure),
                "800,640");
     }
 }

@@ -355,13 +355,27 @@ void thin_part(Derivation& d, const Frames& F) {
     const ex fz = col(S.pdd[0], S.pdd[1], S.pdd[2]).add(cross(wd1, s0)).add(ez.mul_scalar(S.g)).mul_scalar(S.m)(2, 0);
     const matrix rp = col(JRw(0, 0), JRw(1, 0), fz);
     const bool matrix_ok = is_zero(sub(d.M38, Mp)), rhs_ok = is_zero(sub(d.r38_U, rp));
-    // The printed right-hand side is not well formed (see the reason), so it cannot agree.
-    add_finding(d, "(38)", false,
-                "[c_y; -c_x; 1 1 1] n = [e_x^T J R R2^T w1'; e_y^T J R2^T w1'; e_z^T m(p'' + w1'^ s0 + g e_z^T)]",
-                "[c_y; -c_x; 1 1 1] n = [e_x^T J R2^T w1'; e_y^T J R2^T w1'; m e_z^T (p'' + w1'^ s0 + g e_z)]",
-                std::string(matrix_ok && rhs_ok ? "the derived system equals the corrected form" : "[DERIVED DIFFERS]") +
-                    ": the printed third row adds g e_z^T (a row) to column vectors, it is g e_z; the first "
-                    "row's 'J R R2^T' is J R2^T");
+    // The printed form, read as written where it is well formed: row 1's J R R2^T w1' with the paper's
+    // R = R1 R2 is J R1 w1', and R1 = I in the U-dynamics; row 3's g e_z^T (a row added to columns) is
+    // read as g e_z, its only well-formed reading. Compared row by row with the derived system.
+    const matrix JR1w = Jt.mul(wd1);
+    const matrix printed = col(JR1w(0, 0), JRw(1, 0), fz);
+    std::string rows_differ;
+    for (int i = 0; i < 3; ++i)
+        if (!(d.r38_U(i, 0) - printed(i, 0)).expand().is_zero())
+            rows_differ += (rows_differ.empty() ? "" : ", ") + std::to_string(i + 1);
+    const bool row1_differs = !(d.r38_U(0, 0) - printed(0, 0)).expand().is_zero();
+    add_finding(
+        d, "(38)", matrix_ok && rows_differ.empty(),
+        "[c_y; -c_x; 1 1 1] n = [e_x^T J R R2^T w1'; e_y^T J R2^T w1'; e_z^T m(p'' + w1'^ s0 + g e_z^T)]",
+        "[c_y; -c_x; 1 1 1] n = [e_x^T J R2^T w1'; e_y^T J R2^T w1'; m e_z^T (p'' + w1'^ s0 + g e_z)]",
+        std::string(matrix_ok && rhs_ok ? "the derived system equals the corrected form" : "[DERIVED DIFFERS]") +
+            "; the printed form, with R = R1 R2 (R1 = I in the U-dynamics) and g e_z^T read as g e_z, differs in "
+            "right-hand-side rows: " +
+            (rows_differ.empty() ? "none" : rows_differ) + (matrix_ok ? "" : "; and in the matrix") +
+            (row1_differs
+                 ? " (row 1's J R R2^T w1' is J w1': the plate's angular acceleration not turned into the part's frame by R2^T)"
+                 : ""));
     {
         // (37) as printed: rows [-m 0 0 d_x], [0 -m 0 d_y], [0 0 0 1 1 1], [0 0 0 c_y], [0 0 0 -c_x],
         // [0 0 -J_zz h_z]; h_i,z is not spelled out in the paper, so row 6 is compared up to it.

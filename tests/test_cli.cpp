@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <tuple>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -63,6 +66,26 @@ std::string fig4_with(const std::string& from, const std::string& to) {
     return s.replace(p, from.size(), to);
 }
 
+// The report's verdicts marked FAIL that are not expected, each with the text before it. Expected:
+// the derivation's three printed equations that differ from the derived ones (tests/test_symbolic.cpp
+// says why: (28) prints R1 for R1^T; Appendix A's A is block upper triangular, not diagonal; (38)'s
+// first row reads J R R2^T). Nothing else in the report may say FAIL.
+std::vector<std::string> unexpected_fails(const std::string& html) {
+    const std::string expected_rows[] = {"<tr><td>(28)</td>", "<tr><td>Appendix A (block diagonal)</td>", "<tr><td>(38)</td>"};
+    const std::string differs = "class=\"fail\">differs<";
+    std::vector<std::string> out;
+    for (std::size_t p = 0; (p = html.find("class=\"fail\"", p)) != std::string::npos; ++p) {
+        const std::size_t row = html.rfind("<tr>", p);
+        const bool same_row = row != std::string::npos && html.find("</tr>", row) > p;
+        bool expected = false;
+        for (const std::string& e : expected_rows)
+            expected =
+                expected || (same_row && html.compare(row, e.size(), e) == 0 && html.compare(p, differs.size(), differs) == 0);
+        if (!expected) out.push_back(html.substr(p < 300 ? 0 : p - 300, std::min<std::size_t>(p, 300) + 60));
+    }
+    return out;
+}
+
 }   // namespace
 
 TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
@@ -76,11 +99,88 @@ TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     CHECK(j["stick_fraction"] == nlohmann::json::array({0.0, 0.0, 0.0}));   // fig4 never sticks
     CHECK(j["mode_sequence"].size() == 1);
     CHECK(j["mode_sequence"][0]["mode"] == "slide");
-    CHECK(j["periods"].get<int>() > 1);
+    // An attracting cycle, reached to the cycle tolerance (--tol 1e-7 of v_ref; measured: contraction
+    // 0.57 per period, residual 2.6e-11): an expanding map or an unconverged cycle fails these.
+    CHECK(j["contraction_per_period"].get<double>() < 1);
+    CHECK(j["residual"].get<double>() < 1e-7);
     CHECK(j["min_normal_force"].get<double>() > 0);
     const Run p = run("twist " + kScenes + "fig1_point.json --at 0.02 0.01");
     REQUIRE(p.code == 0);
     CHECK(nlohmann::json::parse(p.out)["twist"].size() == 2);
+}
+
+TEST_CASE("the README's quick start: every figure it quotes is what the program computes", "[cli][readme]") {
+    // README.md, "Quick start": the twist, fixed points and trajectory it prints and the sentences on
+    // them, each to the digits it quotes (the printed JSON to 1e-6 relative: the run on this machine
+    // agrees to the last digit).
+    auto near = [](double x, double quoted, double tol) { return std::abs(x - quoted) <= tol; };
+    const auto tw = nlohmann::json::parse(run("twist " + kScenes + "fig4.json --at 0.03 -0.02 1.0").out);
+    const auto t = tw["twist"].get<std::vector<double>>();
+    CHECK(near(t[0], -0.043589894576272895, 1e-6 * 0.0436));
+    CHECK(near(t[1], 0.01706607231446182, 1e-6 * 0.0436));
+    CHECK(near(t[2], -0.06612697320366145, 1e-6 * 0.0661));
+    CHECK(near(std::hypot(t[0], t[1]), 0.047, 0.0005));   // "drifts at 4.7 cm/s"
+    CHECK(near(t[2], -0.066, 0.0005));                    // "turns at -0.066 rad/s"
+    CHECK(tw["mode_sequence"].size() == 1);               // "sliding all period"
+    CHECK(tw["mode_sequence"][0]["mode"] == "slide");
+    const auto hy = nlohmann::json::parse(run("twist " + kScenes + "heave_yaw.json --at 0 0.02 0").out);
+    CHECK(hy["mode_sequence"][0]["mode"] == "stuck");
+    CHECK(hy["mode_sequence"][1]["mode"] == "pivot2");
+    const double quoted_stick[] = {0.7469875608540951, 0.781697642554991, 0.7837744722911135};
+    for (int i = 0; i < 3; ++i) CHECK(near(hy["stick_fraction"][i].get<double>(), quoted_stick[i], 1e-6));
+    // fig4's fixed points: stable at the centre at theta = 0 and pi (eigenvalues -1.60, -0.80, -0.22 1/s),
+    // saddles in between.
+    const auto fp = nlohmann::json::parse(run("fixed-points " + kScenes + "fig4.json").out);
+    CHECK(fp["summary"] == "4 fixed points found");
+    int stable = 0, saddles = 0;
+    for (const auto& p : fp["points"]) {
+        const auto at = p["at"].get<std::vector<double>>();
+        CHECK(std::hypot(at[0], at[1]) < 1e-6);
+        if (p["stability"] == "stable") {
+            ++stable;
+            CHECK((near(at[2], 0, 0.005) || near(at[2], 3.1416, 0.005)));
+            const double quoted[] = {-1.60, -0.80, -0.22};
+            for (int i = 0; i < 3; ++i) CHECK(near(p["eigenvalues"][i][0].get<double>(), quoted[i], 0.005));
+        } else {
+            saddles += p["stability"] == "saddle" && (near(at[2], 1.65, 0.005) || near(at[2], -1.49, 0.005));
+        }
+    }
+    CHECK(stable == 2);
+    CHECK(saddles == 2);
+    // (The Python example prints the first: stable [-2.06e-07 5.08e-07 -1.80e-03].)
+    const auto first = fp["points"][0]["at"].get<std::vector<double>>();
+    CHECK(fp["points"][0]["stability"] == "stable");
+    CHECK(near(first[0], -2.06e-7, 0.005e-7));
+    CHECK(near(first[1], 5.08e-7, 0.005e-7));
+    CHECK(near(first[2], -1.80e-3, 0.005e-3));
+    // fig1: lines of fixed points, stable along (0, s_y, 0) and (0, s_y, pi), saddles at theta = +-pi/2.
+    const auto f1 = nlohmann::json::parse(run("fixed-points " + kScenes + "fig1.json").out);
+    int along_y = 0;
+    for (const auto& l : f1["lines"]) {
+        const double th = l["from"][2].get<double>(), a = std::remainder(th, 3.141592653589793);
+        const bool stable_line = l["stability"] == "stable";
+        CHECK(near(l["direction"][1].get<double>(), 1, 1e-6));   // along s_y
+        CHECK(near(l["from"][0].get<double>(), 0, 1e-6));
+        CHECK((stable_line ? near(a, 0, 1e-3) : near(std::abs(a), 1.5708, 1e-3)));
+        ++along_y;
+    }
+    CHECK(along_y == 4);
+    // From (4 cm, -4 cm, 1 rad), 20 s of full dynamics: within about a millimetre of the centre, at
+    // theta = -0.033 rad.
+    const fs::path csv = tmpdir() / "readme_fig4.csv";
+    REQUIRE(run("simulate " + kScenes + "fig4.json --dynamics full --from 0.04 -0.04 1.0 --time 20 --out " + csv.string()).code ==
+            0);
+    std::istringstream rows(slurp(csv));
+    std::string line, last;
+    while (std::getline(rows, line))
+        if (!line.empty()) last = line;
+    std::vector<double> v;
+    std::istringstream cells(last);
+    for (std::string cell; std::getline(cells, cell, ',') && v.size() < 4;) v.push_back(std::stod(cell));
+    REQUIRE(v.size() == 4);
+    CHECK(v[0] == 20);
+    CHECK(std::hypot(v[1], v[2]) < 1e-3);
+    CHECK(near(v[3], -0.033, 0.0005));
 }
 
 TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header", "[cli]") {
@@ -101,6 +201,28 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     r = run("fixed-points " + kScenes + "fig1_point.json --grid 5");
     REQUIRE(r.code == 0);
     CHECK(nlohmann::json::parse(r.out)["lines"].size() == 1);
+}
+
+TEST_CASE("heave_yaw's fields stick everywhere, all period long at 42 of 343 and 9 of 49 (the guide's numbers)", "[cli][stick]") {
+    // docs/guide.md (Scenes) states these counts: every configuration sticks during its cycle, and at
+    // 42 of the part's 343 and 9 of the point part's 49 it is stuck all period (twist exactly zero).
+    for (const auto& [name, points, all_period] :
+         {std::tuple<const char*, int, int>{"heave_yaw", 343, 42}, std::tuple<const char*, int, int>{"heave_yaw_point", 49, 9}}) {
+        INFO(name);
+        const Run r = run("field " + kScenes + name + ".json --threads 2");
+        REQUIRE(r.code == 0);
+        const auto j = nlohmann::json::parse(r.out)["points"];
+        CHECK(static_cast<int>(j.size()) == points);
+        int sticks = 0, stuck = 0;
+        for (const auto& p : j) {
+            const auto f = p["stick_fraction"].get<std::vector<double>>();
+            const auto t = p["twist"].get<std::vector<double>>();
+            sticks += *std::max_element(f.begin(), f.end()) > 0;
+            stuck += p["converged"].get<bool>() && std::all_of(t.begin(), t.end(), [](double x) { return x == 0; });
+        }
+        CHECK(sticks == points);
+        CHECK(stuck == all_period);
+    }
 }
 
 TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twist reports its stick fractions", "[cli][stick]") {
@@ -166,12 +288,23 @@ TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the t
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    for (const char* c :
-         {"", "twist ", "field ", "fixed-points ", "simulate ", "random-scene ", "bench ", "design ", "proofs ", "report "}) {
-        const Run r = run(std::string(c) + "--help");
+    const std::string commands[] = {"twist", "field",  "fixed-points", "simulate", "random-scene",
+                                    "bench", "design", "proofs",       "report",   "sweep"};
+    const Run top = run("--help");
+    CHECK(top.code == 0);
+    // The program's help names every exit code a command can return.
+    for (const char* code : {"0 ok", "2 bad input", "3 a simulation left the model", "4 a design", "5 a check of plate proofs"})
+        CHECK(top.out.find(code) != std::string::npos);
+    for (const std::string& c : commands) {
+        INFO(c);
+        CHECK(top.out.find("\n  " + c + " ") != std::string::npos);   // listed among the commands
+        const Run r = run(c + " --help");
         CHECK(r.code == 0);
-        CHECK(r.out.find("usage") != std::string::npos);
+        CHECK(r.out.find("usage: plate " + c + " ") != std::string::npos);   // its own help, not another's
     }
+    // The commands with a verdict of their own say which exit code it sets.
+    CHECK(run("design --help").out.find("exit 4") != std::string::npos);
+    CHECK(run("proofs --help").out.find("exit code 5 when a verdict fails") != std::string::npos);
 }
 
 TEST_CASE("bad input: exit code 2, the file and the field named, no output file", "[cli][input]") {
@@ -269,10 +402,28 @@ TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]"
     const Run r = run("proofs --thin 6 --thick 3 --surfaces 3 --seed 100");
     REQUIRE(r.code == 0);
     const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["passed"] == true);
+    CHECK(j["failed"].empty());
     CHECK(j["thin"]["cases"] == 6);
     CHECK(j["thin"]["passed"] == true);
+    CHECK(j["thin"]["dynamics_tie"]["samples"] == 60);
+    // Signed margins (measured for these seeds: -7e-4, 4e-10): V fell at every step, the cycles coincide.
+    CHECK(j["thin"]["worst_increase_over_bound"].get<double>() < 0);
+    CHECK(j["thin"]["max_cycle_spread_over_v_ref"].get<double>() < 1e-8);
+    // Thick parts are beyond the theorem: observations, no verdict, and no tie (it solves thin statics).
     CHECK(j["thick"]["cases"] == 3);
-    CHECK(j["limit_surfaces"]["convex_and_normal"] == 3);
+    CHECK_FALSE(j["thick"].contains("passed"));
+    CHECK_FALSE(j["thick"].contains("dynamics_tie"));
+    CHECK(j["thick"]["observation"].get<std::string>().rfind("beyond Theorem 1", 0) == 0);
+    // The checks that hold by construction apart, with their margins (measured 2e-3, 4e-3 of sum mu N).
+    const auto& ls = j["limit_surfaces"];
+    CHECK(ls["holds_by_construction"]["convex_and_normal"] == 3);
+    CHECK(ls["holds_by_construction"]["max_work_margin"].get<double>() > 0);
+    CHECK(ls["holds_by_construction"]["monotonicity_margin"].get<double>() > 0);
+    CHECK_FALSE(ls.contains("convex_and_normal"));
+    CHECK(ls["on_friction_set"] == 3);
+    CHECK(ls["support_margin"].get<double>() > 0);
+    CHECK(ls["passed"] == true);
     // The conditioning the help promises: cond(A) grows like L/e toward collinear contacts (each tenth
     // of e at least 5x), and A is singular at e = 0 (smallest singular value at rounding).
     const auto& c = j["conditioning_of_A"];
@@ -282,6 +433,35 @@ TEST_CASE("plate proofs writes the campaign's verdicts as JSON", "[cli][proofs]"
         CHECK(c[i]["max_condition"].get<double>() > 5 * c[i - 1]["max_condition"].get<double>());
     }
     CHECK(c[4]["min_singular_over_max"].get<double>() < 1e-12);
+}
+
+TEST_CASE("plate proofs exits 5 when a verdict fails, its JSON written and the failed checks named", "[cli][proofs]") {
+    const fs::path out = tmpdir() / "proofs-wrong.json";
+    // Friction that pushes: the relative twist grows, Theorem 1's contraction fails; the limit surfaces
+    // (which never integrate) pass.
+    const Run push =
+        run("proofs --thin 4 --thick 0 --surfaces 2 --seed 100 --wrong-model pushing-friction --out " + out.string());
+    CHECK(push.code == 5);
+    CHECK(push.err.find("plate proofs: failed: [\"thin\"]") != std::string::npos);
+    REQUIRE(fs::exists(out));
+    const auto j = nlohmann::json::parse(slurp(out));
+    CHECK(j["passed"] == false);
+    CHECK(j["failed"] == nlohmann::json::array({"thin"}));
+    CHECK(j["wrong_model"] == "pushing-friction");
+    CHECK(j["thin"]["passed"] == false);
+    CHECK(j["thin"]["worst_increase_over_bound"].get<double>() > 1);   // signed: V rose past its error bound
+    CHECK(j["limit_surfaces"]["passed"] == true);
+    // Contact 3's mu 1 % off in the dynamics under test: both ties fail.
+    const Run mu3 = run("proofs --thin 2 --thick 0 --surfaces 2 --seed 100 --wrong-model mu3");
+    CHECK(mu3.code == 5);
+    const auto k = nlohmann::json::parse(mu3.out);
+    CHECK(k["failed"] == nlohmann::json::array({"thin", "limit_surfaces"}));
+    CHECK(k["limit_surfaces"]["dynamics_tie"]["failure"].get<std::string>().rfind("wrench", 0) == 0);
+    // A campaign that checks nothing has no verdict to fail; an unknown wrong model is a usage error.
+    CHECK(run("proofs --thin 0 --thick 0 --surfaces 0").code == 0);
+    const Run bad = run("proofs --thin 1 --thick 0 --surfaces 0 --wrong-model gravity");
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--wrong-model") != std::string::npos);
 }
 
 TEST_CASE("plate report writes index.html whose every figure exists", "[cli][report]") {
@@ -306,6 +486,22 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
     const std::size_t stopped = html.find("FAIL: the run from rest stopped");
     INFO((stopped == std::string::npos ? std::string() : html.substr(stopped, 200)));
     CHECK(stopped == std::string::npos);
+    // Every verdict marked FAIL is one this test expects, with its reason; any other fails it.
+    const std::vector<std::string> unexpected = unexpected_fails(html);
+    for (const std::string& u : unexpected) INFO("unexpected FAIL: " << u);
+    CHECK(unexpected.empty());
+}
+
+TEST_CASE("the report test's reading of verdicts: every FAIL it does not expect is named", "[cli][report]") {
+    const std::string row = "<tr><td>(38)</td><td><span class=\"fail\">differs</span></td></tr>";
+    CHECK(unexpected_fails(row).empty());
+    CHECK(unexpected_fails("<p>ok: <span class=\"pass\">pass</span></p>").empty());
+    const std::string theorem = "<tr><td>thin (Theorem 1)</td><td>Theorem 1: <span class=\"fail\">FAIL</span></td></tr>";
+    REQUIRE(unexpected_fails(theorem).size() == 1);
+    CHECK(unexpected_fails(theorem)[0].find("thin (Theorem 1)") != std::string::npos);
+    // An equation that agreed until now, marked "differs": not expected.
+    CHECK(unexpected_fails("<tr><td>(27)</td><td><span class=\"fail\">differs</span></td></tr>").size() == 1);
+    CHECK(unexpected_fails(row + "<p><span class=\"fail\">FAIL: the run from rest stopped</span></p>").size() == 1);
 }
 
 TEST_CASE("plate report --sections computes only the named sections and says which were left out", "[cli][report]") {

@@ -28,6 +28,24 @@ TEST_CASE("Theorem 1: the relative twist of thin parts contracts (V never rises 
     CHECK(s.tie.passed());
     CHECK(s.passed());
     CHECK(s.counterexamples.empty());
+    // Signed margins: V fell at every accepted step of every case, so the worst change of V over its
+    // error bound is below 0 (measured -7e-4 for these seeds: the closest step, near convergence); the
+    // other checks' margins as measured: V_end / V0 9e-13 (<= 1e-12), cycle spread 4e-10 (< 1e-6).
+    CHECK(s.worst_increase < 0);
+    CHECK(s.worst_V_end <= 1e-12);
+    CHECK(s.max_cycle_spread < 1e-8);
+    for (const auto& c : s.details) {   // each uniqueness verdict rests on all four further starts
+        INFO("seed " << c.seed);
+        CHECK(c.starts_reached == o.starts);
+    }
+}
+
+TEST_CASE("Observation 1's uniqueness needs every further start to reach the same cycle", "[proofs][contraction]") {
+    CHECK(unique_cycle(4, 4, 1e-9));
+    CHECK_FALSE(unique_cycle(1, 4, 0));      // one start reached the cycle, three left the model: no evidence
+    CHECK_FALSE(unique_cycle(3, 4, 1e-9));   // one short
+    CHECK_FALSE(unique_cycle(4, 4, 2e-6));   // a start reached another cycle
+    CHECK_FALSE(unique_cycle(0, 0, 0));
 }
 
 TEST_CASE("beyond Theorem 1: thick parts, seeded search for counter-examples", "[proofs][contraction][thick]") {
@@ -55,6 +73,7 @@ TEST_CASE("the contraction check catches an expanding map (negative friction)", 
     CHECK(s.monotone < s.valid);
     CHECK(s.worst_increase > 1e3);
     CHECK_FALSE(s.passed());
+    CHECK_FALSE(s.counterexamples.empty());
 }
 
 TEST_CASE("limit surface of a thin part: convex, twist normal to it, (40) holds, no vertices", "[proofs][limit_surface]") {
@@ -63,9 +82,13 @@ TEST_CASE("limit surface of a thin part: convex, twist normal to it, (40) holds,
         double scale = 0;
         const WrenchMap w = thin_wrench_map(sc, Vec3(0.01, -0.01, 0.5), 0.01, &scale);
         const LimitSurfaceResult r = check_limit_surface(w, scale, 300);
-        INFO("seed " << seed << ": max-work violation " << r.max_work_violation << ", (40) " << r.monotonicity_violation
-                     << ", separation " << r.min_separation);
+        INFO("seed " << seed << ": max-work margin " << r.max_work_margin << ", (40) " << r.monotonicity_margin << ", separation "
+                     << r.min_separation);
         CHECK(r.convex_and_normal());
+        // Signed margins: held with room at the closest pair of the 300 directions (measured 2e-3 and
+        // 4e-3 of sum mu N for random thin parts; neighbouring directions are ~0.2 apart).
+        CHECK(r.max_work_margin > 0);
+        CHECK(r.monotonicity_margin > 0);
         CHECK(r.strictly_convex());   // no flat faces, no vertices
         CHECK(r.min_separation > 1e-3);
     }
@@ -77,7 +100,8 @@ TEST_CASE("the limit-surface check catches a non-convex surface (the wrench's si
     const WrenchMap w = thin_wrench_map(sc, Vec3::Zero(), 0.0, &scale);
     const LimitSurfaceResult r = check_limit_surface([&](const Vec3& xi) { return Vec3(-w(xi)); }, scale, 200);
     CHECK_FALSE(r.convex_and_normal());
-    CHECK(r.max_work_violation > 0.1);
+    CHECK(r.max_work_margin < -0.1);   // signed: violated by more than a tenth of sum mu N
+    CHECK(r.monotonicity_margin < -0.1);
 }
 
 TEST_CASE("as contacts approach collinear the limit surface gets a vertex and A becomes singular",
@@ -207,10 +231,17 @@ TEST_CASE("the limit-surface check against the independent friction set catches 
     const Vec3 q0(0.01, -0.01, 0.5);
     const double t = 0.01;
     const FrictionSet set = thin_friction_set(sc, q0, t);
-    double scale = 0;
-    const LimitSurfaceResult good = check_limit_surface(thin_wrench_map(sc, q0, t, &scale), scale, 300, 0.2, &set);
+    double scale = 0;   // set by thin_wrench_map before it is used (not in one call: argument order)
+    const WrenchMap kernel_of_part = thin_wrench_map(sc, q0, t, &scale);
+    const LimitSurfaceResult good = check_limit_surface(kernel_of_part, scale, 300, 0.2, &set);
     CHECK(good.on_friction_set());
     CHECK(good.convex_and_normal());
+    // Signed: the sampled support function h_s underestimates h by at most h (1 - cos(pi/720)) ~ 1e-5 h,
+    // so the kernel's support point clears it by a little (measured 6e-9 of sum mu N), and every wrench
+    // lies inside the outer bound h_s / cos(pi/720) with room (measured 2e-3).
+    CHECK(good.support_margin > 0);
+    CHECK(good.support_margin < 1e-4);
+    CHECK(good.outside_margin > 0);
     // The generated kernel, fed from the set with one input edited.
     auto kernel = [&](std::function<void(gen::WrenchInput&)> edit) -> WrenchMap {
         gen::WrenchInput in =
@@ -232,7 +263,7 @@ TEST_CASE("the limit-surface check against the independent friction set catches 
     for (const auto& [what, edit] : wrong) {
         INFO(what);
         const LimitSurfaceResult r = check_limit_surface(kernel(edit), scale, 300, 0.2, &set);
-        INFO("support " << r.support_violation << ", outside " << r.outside_violation);
+        INFO("support " << r.support_margin << ", outside " << r.outside_margin);
         CHECK(r.convex_and_normal());       // the old checks pass it ...
         CHECK_FALSE(r.on_friction_set());   // ... the friction set does not
     }

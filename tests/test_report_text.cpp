@@ -55,5 +55,39 @@ TEST_CASE("write_report rejects an unknown section before it touches the report'
     o.sections = {"fig3", "figure4"};
     CHECK_THROWS_AS(plate::report::write_report(o), std::invalid_argument);
     CHECK_FALSE(fs::exists(dir));
-    CHECK(plate::report::report_section_names().size() == 8);
+    // Every section the report writes is accepted by name, and a wrong name is answered with all of them,
+    // in the report's order (what `plate report --help` lists).
+    CHECK_NOTHROW(plate::report::check_sections(plate::report::report_section_names()));
+    std::string message;
+    try {
+        plate::report::check_sections({"figure4"});
+    } catch (const std::invalid_argument& e) {
+        message = e.what();
+    }
+    CHECK(message == "'figure4' is not a section (derivation, kernels, proofs, fig3, fields, design, orient, fixed-point)");
+}
+
+TEST_CASE("report: the captions that state a result follow this run's measurements", "[report][text]") {
+    using namespace plate::report;
+    // Fig. V: as measured by the quick report, |xi_rel| falls to at most 0.71 per period.
+    CHECK(contraction_caption(5, 0.71).find("contract geometrically") != std::string::npos);
+    const std::string grew = contraction_caption(5, 1.02);
+    CHECK(grew.find("do not all contract geometrically") != std::string::npos);
+    CHECK(grew.find("1.02") != std::string::npos);
+    CHECK(contraction_caption(0, 0).find("none shown") != std::string::npos);
+    // Fig. 3: as measured, the two starts 2.7 v_ref apart end 5.4e-13 apart after ten periods.
+    const std::string met = fig3_caption(10, 2.7, 5.4e-13);
+    CHECK(met.find("converging to one limit cycle") != std::string::npos);
+    CHECK(met.find("10 periods") != std::string::npos);
+    const std::string apart = fig3_caption(10, 2.7, 0.5);   // two cycles, or not yet converged
+    CHECK(apart.find("not shown converging") != std::string::npos);
+    // A design's runs: all within the distance and verified, or said otherwise with the failure.
+    CHECK(design_runs_caption(6, 6, 0.005, true, "").find("6 of 6 end within 5 mm of the target, converging on the target") !=
+          std::string::npos);
+    const std::string failed = design_runs_caption(5, 6, 0.005, false, "a full-dynamics run ended 0.05 m from the <target>");
+    CHECK(failed.find("converging on the target") == std::string::npos);
+    CHECK(failed.find("5 of 6") != std::string::npos);
+    CHECK(failed.find("the design failed verification: a full-dynamics run ended 0.05 m from the &lt;target&gt;") !=
+          std::string::npos);
+    CHECK(design_runs_caption(6, 6, 0.005, false, "the hold").find("converging on the target") == std::string::npos);
 }

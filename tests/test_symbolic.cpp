@@ -88,10 +88,13 @@ TEST_CASE("derivation against the printed equations", "[symbolic][paper]") {
     CHECK_FALSE(f28.agrees);
     CHECK(f28.derived.find("R1^T w1") != std::string::npos);
     CHECK(f28.reason.find("FAILED") == std::string::npos);
-    // (38): typo g e_z^T; the derived system equals the corrected form.
+    // (38): compared like the others, the printed form read with R = R1 R2 (R1 = I in the U-dynamics):
+    // its first row, J R R2^T w1' = J w1', differs from the derived J R2^T w1' (they agree only at
+    // theta = 0); rows 2 and 3 agree; the derived system equals the corrected form.
     const Finding& f38 = finding("(38)");
     CHECK_FALSE(f38.agrees);
     CHECK(f38.reason.rfind("the derived system equals the corrected form", 0) == 0);
+    CHECK(f38.reason.find("differs in right-hand-side rows: 1 (") != std::string::npos);
 }
 
 TEST_CASE("omega3' about z: theta'' plus the plate's angular acceleration along the part's normal", "[symbolic]") {
