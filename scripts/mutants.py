@@ -36,6 +36,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -168,15 +169,19 @@ def sync(src_dir):
     return changed
 
 
+LOG_LOCK = threading.Lock()
+
+
 def run(cmd, log, cwd=None, env=None, timeout=None):
-    with open(log, "a") as f:
-        f.write("$ " + " ".join(cmd) + "\n")
-        f.flush()
-        try:
-            return subprocess.run(cmd, cwd=cwd, env=env, stdout=f, stderr=subprocess.STDOUT, timeout=timeout).returncode
-        except subprocess.TimeoutExpired:
-            f.write(f"(timed out after {timeout} s)\n")
-            return None
+    """CMD's exit code (None: timed out); its output appended to LOG in one piece (tests run side by side)."""
+    try:
+        r = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout)
+        rc, out = r.returncode, r.stdout
+    except subprocess.TimeoutExpired as e:
+        rc, out = None, (e.stdout or b"") + f"(timed out after {timeout} s)\n".encode()
+    with LOG_LOCK, open(log, "ab") as f:
+        f.write(("$ " + " ".join(cmd) + "\n").encode() + out + f"(exit {rc})\n".encode())
+    return rc
 
 
 class Scratch:
