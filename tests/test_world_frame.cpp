@@ -13,6 +13,7 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <vector>
 
@@ -105,8 +106,27 @@ int world_rhs(double t, const double y[], double dy[], void* params) {
     return GSL_SUCCESS;
 }
 
-// The point part's plate-frame (s, s') at t = 0, dt, ..., n dt from Newton's law in W (GSL's rk8pd,
-// absolute and relative tolerance 1e-13 on r in m, r' in m/s and R1).
+// A world-frame system from state y at t = 0 to n dt by GSL's rk8pd (absolute and relative tolerance
+// 1e-13), and at each of 0, dt, ..., n dt the plate-frame (q, q') that `plate_frame` reads from the
+// state and the plate's p, p', omega1 then.
+template <class PlateFrame>
+std::vector<std::pair<Vec3, Vec3>> in_world(const PlateMotion& u, gsl_odeiv2_system sys, double* y, double dt, int n,
+                                            PlateFrame&& plate_frame) {
+    gsl_odeiv2_driver* drv = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-5, 1e-13, 1e-13);
+    std::vector<std::pair<Vec3, Vec3>> out;
+    double t = 0;
+    for (int k = 0; k <= n; ++k) {
+        if (k > 0) REQUIRE(gsl_odeiv2_driver_apply(drv, &t, k * dt, y) == GSL_SUCCESS);
+        Vec3 p, phi, pd, w;
+        u.displacement(t, p, phi);
+        u.velocity(t, pd, w);
+        out.push_back(plate_frame(y, p, pd, w));
+    }
+    gsl_odeiv2_driver_free(drv);
+    return out;
+}
+
+// The point part's plate-frame (s, s') at t = 0, dt, ..., n dt from Newton's law in W (in_world).
 std::vector<std::pair<Vec3, Vec3>> world_point(const Scene& sc, const Vec2& s0, const Vec2& sd0, double dt, int n) {
     WorldPoint P{sc.plate, sc.g, sc.part.friction().kinetic(0)};
     Vec3 p, phi, pd, w;
@@ -117,20 +137,12 @@ std::vector<std::pair<Vec3, Vec3>> world_point(const Scene& sc, const Vec2& s0, 
     const Vec3 r = p + d, rd = pd + w.cross(d) + R * Vec3(sd0.x(), sd0.y(), 0);
     double y[15] = {r[0], r[1], r[2], rd[0], rd[1], rd[2]};
     Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(y + 6) = R;
-    gsl_odeiv2_system sys{world_rhs, nullptr, 15, &P};
-    gsl_odeiv2_driver* drv = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-5, 1e-13, 1e-13);
-    std::vector<std::pair<Vec3, Vec3>> out;
-    double t = 0;
-    for (int k = 0; k <= n; ++k) {
-        if (k > 0) REQUIRE(gsl_odeiv2_driver_apply(drv, &t, k * dt, y) == GSL_SUCCESS);
-        sc.plate.displacement(t, p, phi);
-        sc.plate.velocity(t, pd, w);
-        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Rt(y + 6);
-        const Vec3 dk = Vec3(y[0], y[1], y[2]) - p, ddk = Vec3(y[3], y[4], y[5]) - pd;
-        out.emplace_back(Rt.transpose() * dk, Rt.transpose() * (ddk - w.cross(dk)));
-    }
-    gsl_odeiv2_driver_free(drv);
-    return out;
+    return in_world(sc.plate, {world_rhs, nullptr, 15, &P}, y, dt, n,
+                    [](const double* z, const Vec3& pk, const Vec3& pdk, const Vec3& wk) {
+                        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Rt(z + 6);
+                        const Vec3 dk = Vec3(z[0], z[1], z[2]) - pk, ddk = Vec3(z[3], z[4], z[5]) - pdk;
+                        return std::make_pair(Vec3(Rt.transpose() * dk), Vec3(Rt.transpose() * (ddk - wk.cross(dk))));
+                    });
 }
 
 
@@ -192,7 +204,7 @@ int rigid_rhs(double t, const double y[], double dy[], void* params) {
     return GSL_SUCCESS;
 }
 
-// The rigid part's plate-frame (q, q') at t = 0, dt, ..., n dt from Newton-Euler in W (rk8pd, 1e-13).
+// The rigid part's plate-frame (q, q') at t = 0, dt, ..., n dt from Newton-Euler in W (in_world).
 std::vector<std::pair<Vec3, Vec3>> world_rigid(const Scene& sc, const Vec3& q0, const Vec3& qd0, double dt, int n) {
     using RowMat = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
     WorldRigid P{sc};
@@ -206,23 +218,15 @@ std::vector<std::pair<Vec3, Vec3>> world_rigid(const Scene& sc, const Vec3& q0, 
     Eigen::Map<RowMat>(y + 6) = Rp;
     for (int i = 0; i < 3; ++i) y[15 + i] = wp[i];
     Eigen::Map<RowMat>(y + 18) = R1;
-    gsl_odeiv2_system sys{rigid_rhs, nullptr, 27, &P};
-    gsl_odeiv2_driver* drv = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-5, 1e-13, 1e-13);
-    std::vector<std::pair<Vec3, Vec3>> out;
-    double t = 0;
-    for (int k = 0; k <= n; ++k) {
-        if (k > 0) REQUIRE(gsl_odeiv2_driver_apply(drv, &t, k * dt, y) == GSL_SUCCESS);
-        sc.plate.displacement(t, p, phi);
-        sc.plate.velocity(t, pd, w);
-        const Eigen::Map<const RowMat> Rpk(y + 6), R1k(y + 18);
-        const Mat3 rel = R1k.transpose() * Rpk;   // R_z(theta) while the part lies flat
-        const Vec3 dk = Vec3(y[0], y[1], y[2]) - p, ddk = Vec3(y[3], y[4], y[5]) - pd - w.cross(dk);
-        const Vec3 s = R1k.transpose() * dk, sd = R1k.transpose() * ddk;
-        const Vec3 wrel = R1k.transpose() * (Vec3(y[15], y[16], y[17]) - w);
-        out.emplace_back(Vec3(s.x(), s.y(), std::atan2(rel(1, 0), rel(0, 0))), Vec3(sd.x(), sd.y(), wrel.z()));
-    }
-    gsl_odeiv2_driver_free(drv);
-    return out;
+    return in_world(
+        sc.plate, {rigid_rhs, nullptr, 27, &P}, y, dt, n, [](const double* z, const Vec3& pk, const Vec3& pdk, const Vec3& wk) {
+            const Eigen::Map<const RowMat> Rpk(z + 6), R1k(z + 18);
+            const Mat3 rel = R1k.transpose() * Rpk;   // R_z(theta) while the part lies flat
+            const Vec3 dk = Vec3(z[0], z[1], z[2]) - pk, ddk = Vec3(z[3], z[4], z[5]) - pdk - wk.cross(dk);
+            const Vec3 s = R1k.transpose() * dk, sd = R1k.transpose() * ddk;
+            const Vec3 wrel = R1k.transpose() * (Vec3(z[15], z[16], z[17]) - wk);
+            return std::make_pair(Vec3(s.x(), s.y(), std::atan2(rel(1, 0), rel(0, 0))), Vec3(sd.x(), sd.y(), wrel.z()));
+        });
 }
 
 }   // namespace
