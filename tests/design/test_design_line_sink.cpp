@@ -8,15 +8,30 @@
 using namespace plate;
 using namespace design_tests;
 
-TEST_CASE("line sink: every start ends on the line asked and stays where it arrives", "[design][line]") {
-    const Scene part = scene("fig1_point");
+namespace {
+
+// The line through (0.01, -0.02) at 0.6 rad, for fig1_point, under 15 m/s^2 and 100 rad/s^2.
+DesignTarget line_target() {
     DesignTarget t;
     t.kind = DesignTargetKind::LineSink;
     t.at = Vec2(0.01, -0.02);
     t.theta = 0.6;
+    return t;
+}
+
+DesignOptions line_options() {
     DesignOptions o = searched(2, 60, 6, 2);
     o.lin_limit = 15;
     o.ang_limit = 100;
+    return o;
+}
+
+}   // namespace
+
+TEST_CASE("line sink: every start ends on the line asked and stays where it arrives", "[design][line]") {
+    const Scene part = scene("fig1_point");
+    const DesignTarget t = line_target();
+    DesignOptions o = line_options();
     const DesignSummary s = design(part, t, o);
     INFO(s.failure);
     REQUIRE(s.verified);
@@ -56,13 +71,8 @@ TEST_CASE("line sink: runs that end farther from the line than the verification 
     // 1.13 mm). Asked for 0.2 mm, the verification must fail on the end distance -- and the worst run
     // stays within ten times that distance, so an allowance ten times too wide would pass it.
     const Scene part = scene("fig1_point");
-    DesignTarget t;
-    t.kind = DesignTargetKind::LineSink;
-    t.at = Vec2(0.01, -0.02);
-    t.theta = 0.6;
-    DesignOptions o = searched(2, 60, 6, 2);
-    o.lin_limit = 15;
-    o.ang_limit = 100;
+    const DesignTarget t = line_target();
+    DesignOptions o = line_options();
     o.verify_distance = 2e-4;
     const DesignSummary s = design(part, t, o);
     INFO(s.failure);
