@@ -17,10 +17,36 @@ namespace {
 
 Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
 
-// Drift bound over 2 s: 0.1 mm and 1 mrad. The spheres sink ~mg/k into the plate in the engines'
-// soft contacts (microns) and the contact solve leaves a residual slip velocity of the solver's
-// tolerance; a creep of 50 um/s (what a pyramid or a lost friction row gives) is 1 mm in 2 s.
-constexpr double kDrift = 1e-4, kTurn = 1e-3, kDuration = 2;
+// Each engine's bounds, about three times what it measured (Bullet 3.24 double, ODE 0.16, MuJoCo 2.2.2
+// with peers.cpp's settings; 1e-13 where it measured rounding, 0 or ~1e-16), or the physical bound
+// where that is tighter (marked). Over 2 s at rest, rocking and carried: a creep of 50 um/s (what a
+// pyramid or a lost friction row gives) is 1 mm in 2 s.
+struct Bounds {
+    double rest_xy, rest_th;          // at rest [m, rad]
+    double rock_xy, rock_th;          // on the slowly rocking plate
+    double carried_xy, carried_th;    // on the uniformly translating plate
+    double drag_x, drag_y, drag_th;   // the 1-D Coulomb drag: s_x off the 1-D law's, s_y, theta [m, m, rad]
+    double follow;                    // fig4's second: off plate's end [m]
+    double turn_lo, turn_hi;          // and its turn, relative to plate's
+};
+
+Bounds bounds(const std::string& engine) {
+    // Measured: at rest 1.5e-8 m, 9.1e-8 rad; rocking 1.8e-5 m, 2.5e-4 rad; carried 2.1e-8 m, 2.0e-8
+    // rad; drag 3.1e-5 m off, 3.7e-8 m, 2.3e-7 rad; follow 1.9e-4 m, turn 1.08.
+    if (engine.rfind("Bullet", 0) == 0) return {5e-8, 3e-7, 6e-5, 8e-4, 6e-8, 6e-8, 1e-4, 1.2e-7, 7e-7, 6e-4, 0.75, 1.25};
+    // Measured: at rest 8.8e-16 m, 0 rad; rocking 4.2e-5 m, 4.8e-4 rad (bounds 0.1 mm and 1 mrad, the creep's);
+    // carried 2.9e-13 m, 5.6e-17 rad; drag 7.7e-6 m off, 1.3e-14 m, 7.0e-12 rad; follow 1.5e-4 m, turn
+    // 0.981.
+    if (engine.rfind("ODE", 0) == 0) return {1e-13, 1e-13, 1e-4, 1e-3, 9e-13, 1e-13, 2.5e-5, 1e-13, 2.1e-11, 4.5e-4, 0.94, 1.06};
+    // Measured: at rest 7.1e-10 m, 5.6e-16 rad; rocking 3.1e-5 m, 6.5e-6 rad; carried 7.1e-10 m, 1.1e-16
+    // rad; drag 1.3e-3 m off (its soft friction: below), 3.3e-5 m, 2.7e-3 rad; follow 5.7e-4 m (bound
+    // 8e-4, 2 % of the distance), turn 0.61 (bound 0.5 to 1.5).
+    if (engine.rfind("MuJoCo", 0) == 0) return {2.1e-9, 1e-13, 1e-4, 2e-5, 2.1e-9, 1e-13, -1, 1e-4, 8e-3, 8e-4, 0.5, 1.5};
+    FAIL("no bounds measured for " << engine);
+    return {};
+}
+
+constexpr double kDuration = 2;
 
 void require_engines() { REQUIRE(!peers::engines().empty()); }
 
@@ -36,9 +62,10 @@ TEST_CASE("peers: on a plate at rest every engine keeps the part at rest", "[pee
         INFO(r.engine << ": " << r.failure);
         REQUIRE(r.failure.empty());
         REQUIRE(r.q.size() == 21u);
+        const Bounds b = bounds(r.engine);
         for (const Vec3& q : r.q) {
-            CHECK((q.head<2>() - q0.head<2>()).norm() < kDrift);
-            CHECK(std::abs(q[2] - q0[2]) < kTurn);
+            CHECK((q.head<2>() - q0.head<2>()).norm() < b.rest_xy);
+            CHECK(std::abs(q[2] - q0[2]) < b.rest_th);
         }
     }
 }
@@ -59,9 +86,10 @@ TEST_CASE("peers: on a slowly rocking plate every engine keeps the part stuck", 
         const peers::PeerRun r = e.run(sc, q0, kDuration, 0.1, o);
         INFO(r.engine << ": " << r.failure);
         REQUIRE(r.failure.empty());
+        const Bounds b = bounds(r.engine);
         for (const Vec3& q : r.q) {
-            CHECK((q.head<2>() - q0.head<2>()).norm() < kDrift);
-            CHECK(std::abs(q[2] - q0[2]) < kTurn);
+            CHECK((q.head<2>() - q0.head<2>()).norm() < b.rock_xy);
+            CHECK(std::abs(q[2] - q0[2]) < b.rock_th);
         }
     }
 }
@@ -70,11 +98,10 @@ TEST_CASE("peers: on a slowly rocking plate every engine keeps the part stuck", 
 // slips along x with the same velocity, the normal forces' centre stays on the slip's line through the
 // centre of mass, so theta stays 0 and u = s_x' obeys u' = -p_x'' - mu g sgn u, held where u = 0 and
 // |p_x''| <= mu g. Integrated here on its own (fixed steps of 2e-7 s, the exact plate velocity):
-// s_x(0.5 s) from 0.04 at rest. Bullet and ODE within a fifth of the 2.3 mm travelled (measured 1-3e-5 m
-// off). MuJoCo's soft friction lets the part travel 1.4-1.6 times as far whatever its settings (contact
-// time constant 2e-4 to 1e-3 s, impratio 1 or 100: measured), an error of the engine the study
-// reports: within the travel itself. A driver with friction mu^2 ends near 0.009 m, one without
-// friction at -0.04 m: far outside either bound.
+// s_x(0.5 s) from 0.04 at rest. Bullet and ODE within three times what they measured (bounds()): 3.1e-5
+// and 7.7e-6 m off the 2.3 mm travelled. MuJoCo's soft friction lets the part travel 1.4-1.6 times as far whatever its settings
+// (contact time constant 2e-4 to 1e-3 s, impratio 1 or 100: measured), an error of the engine the study reports: within the
+// travel itself. A driver with friction mu^2 ends near 0.009 m, one without friction at -0.04 m: far outside either bound.
 TEST_CASE("peers: a plate translating harmonically in x drags the part as the 1-D Coulomb law says", "[peers]") {
     require_engines();
     Scene sc = scene("fig4");
@@ -106,10 +133,10 @@ TEST_CASE("peers: a plate translating harmonically in x drags the part as the 1-
         INFO(r.engine << ": " << r.failure << "; s_x " << r.q.back()[0] << ", the 1-D law's " << s << ", theta "
                       << r.q.back()[2]);
         REQUIRE(r.failure.empty());
-        const bool soft = r.engine.rfind("MuJoCo", 0) == 0;
-        CHECK(std::abs(r.q.back()[0] - s) < (soft ? 1.0 : 0.2) * travel);
-        CHECK(std::abs(r.q.back()[1]) < 0.2 * travel);
-        CHECK(std::abs(r.q.back()[2]) < 0.05);
+        const Bounds b = bounds(r.engine);
+        CHECK(std::abs(r.q.back()[0] - s) < (b.drag_x < 0 ? travel : b.drag_x));   // (MuJoCo: within the travel)
+        CHECK(std::abs(r.q.back()[1]) < b.drag_y);
+        CHECK(std::abs(r.q.back()[2]) < b.drag_th);
     }
 }
 
@@ -124,9 +151,10 @@ TEST_CASE("peers: on a plate translating uniformly every engine carries the part
         const peers::PeerRun r = e.run(sc, q0, kDuration, 0.1, o);
         INFO(r.engine << ": " << r.failure);
         REQUIRE(r.failure.empty());
+        const Bounds b = bounds(r.engine);
         for (const Vec3& q : r.q) {
-            CHECK((q.head<2>() - q0.head<2>()).norm() < kDrift);
-            CHECK(std::abs(q[2] - q0[2]) < kTurn);
+            CHECK((q.head<2>() - q0.head<2>()).norm() < b.carried_xy);
+            CHECK(std::abs(q[2] - q0[2]) < b.carried_th);
         }
     }
 }
@@ -134,11 +162,12 @@ TEST_CASE("peers: on a plate translating uniformly every engine carries the part
 namespace {
 
 // And they are engines of the same model: fig4's part under fig4's plate for one second from rest
-// (plate's full dynamics: it moves 4.6 cm and turns -0.063 rad) ends within 1 mm of plate's position
-// (2 % of the distance; measured at dt 1e-4: Bullet 0.19 mm, ODE 0.15 mm, MuJoCo 0.57 mm) and turns
-// by 0.5 to 1.5 times plate's angle (measured 1.08, 0.98, 0.61). With the engines' friction pyramids
-// (boxes) Bullet and ODE turn it the wrong way (-2.0) and MuJoCo 1.8 times too far, 1.6 mm off: the
-// test below fails for all three. A plate driven with the wrong velocity or rotation also misses.
+// (plate's full dynamics: it moves 4.0 cm and turns -0.063 rad) ends near plate's position and turns by
+// about plate's angle, each engine within its bounds() (measured at dt 1e-4: Bullet 0.19 mm, ODE 0.15 mm,
+// MuJoCo 0.57 mm off; turns 1.08, 0.98, 0.61 times plate's). With the engines' friction pyramids (boxes)
+// Bullet and ODE turn it the wrong way (-2.0) and MuJoCo 1.8 times too far, 1.6 mm off: the test below
+// fails for all three even at the loose bounds it keeps (2 % of the distance, 0.5 to 1.5 times the turn). A plate driven with the
+// wrong velocity or rotation also misses.
 void require_follows_plate(bool pyramid) {
     const Scene sc = scene("fig4");
     const Vec3 q0(0.04, -0.04, 1.0);
@@ -158,10 +187,11 @@ void require_follows_plate(bool pyramid) {
         INFO(r.engine << ": " << r.settings << " " << r.failure << "; end " << r.q.back().transpose() << ", plate's "
                       << end.transpose());
         REQUIRE(r.failure.empty());
-        CHECK((r.q.back().head<2>() - end.head<2>()).norm() < 0.02 * moved);
+        const Bounds b = pyramid ? Bounds{0, 0, 0, 0, 0, 0, 0, 0, 0, 0.02 * moved, 0.5, 1.5} : bounds(r.engine);
+        CHECK((r.q.back().head<2>() - end.head<2>()).norm() < b.follow);
         const double t = r.q.back()[2] - q0[2];
-        CHECK(t / turned > 0.5);
-        CHECK(t / turned < 1.5);
+        CHECK(t / turned > b.turn_lo);
+        CHECK(t / turned < b.turn_hi);
     }
 }
 

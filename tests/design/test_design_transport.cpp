@@ -93,3 +93,30 @@ TEST_CASE("transport of a rigid part with one friction coefficient: the point pa
     CHECK(s.transport_turn < 1e-9);
     for (const DesignStartRun& r : s.runs) CHECK(std::abs(r.end[2] - r.theta) < 1e-6);   // never turned
 }
+
+TEST_CASE("transport: runs that end farther than the verification distance from where the target velocity takes them fail",
+          "[design]") {
+    // A plate that only translates gives the part the same displacement every period once its cycle is
+    // reached, so over a run's second half (a whole number of periods) it moves by the field's mean
+    // velocity times that time: a run ends |v_mean - v_target| (t - from) from where the target velocity
+    // takes it (1.16e-6 m for this design, its velocity 1.06e-6 m/s off; each run within 1.3e-3 of that,
+    // relative, measured: the cycle's own noise; bound 4e-3). The verification distance does not enter
+    // the search, so asked for half the worst run's distance the same design must fail on it -- within
+    // ten times that distance, so an allowance ten times too wide would pass it.
+    const Scene part = scene("fig1_point");
+    const DesignTarget t = transport(Vec2(0.02, 0.01));
+    DesignOptions o = searched(8, 200, 6);
+    o.lin_limit = 15;
+    const DesignSummary first = verified_transport(part, t.velocity, o);
+    const double off = (first.transport_mean - t.velocity).norm();
+    REQUIRE(first.runs.size() == 6u);
+    for (const DesignStartRun& r : first.runs) CHECK(r.end_distance == Approx(off * (r.seconds - r.from)).epsilon(4e-3));
+    o.verify_distance = 0.5 * first.worst_end_distance;
+    const DesignSummary s = design(part, t, o);
+    INFO(s.failure);
+    CHECK(s.scene.plate.harmonics.size() == first.scene.plate.harmonics.size());
+    CHECK(s.worst_end_distance == first.worst_end_distance);
+    CHECK_FALSE(s.verified);
+    CHECK(s.failure.find("a full-dynamics run ended") == 0);
+    CHECK(s.failure.find("from where the target velocity takes it") != std::string::npos);
+}
