@@ -28,5 +28,8 @@ echo "== side by side with Bullet, ODE and MuJoCo (the engines found; a few minu
 /usr/bin/python3 bench/peers/study.py --out "$out/report"
 echo "== campaigns' scaling study (threads and MPI ranks; about a minute)" >&2
 /usr/bin/python3 bench/scaling.py --out "$out/report"
+echo "== the mutation catalogue (one-line physics bugs the tests must catch; about half an hour)" >&2
+# (a surviving mutation is shown in the report's "Mutation score" section; the job goes on)
+scripts/mutants.py --report "$out/report" || echo "mutants: not every mutation was killed: see the report" >&2
 scripts/check-report.sh "$out/report" --screenshot "$out/report/screenshot.png"
 echo "results in $out/ (open $out/report/index.html)" >&2

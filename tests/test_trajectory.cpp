@@ -453,3 +453,30 @@ TEST_CASE("stroboscopic averaging: fig4's 20 s from rest at a fraction of the co
     REQUIRE(still.samples.size() == 3u);
     CHECK((still.samples[2].q[2] - still.samples[1].q[2]) / 50 == Approx(cone).epsilon(0.02));
 }
+
+TEST_CASE("a point part on a plate that heaves and twists about z follows the field's integral curve", "[trajectory][point]") {
+    // heave_yaw_point: the plate's twist about z pushes the part along the tangent to its circle about
+    // the origin (the Euler force -m w1' x s of (33)), the heave modulates the friction that resists
+    // it, and the field drives the part about the origin. The U-dynamics from rest (their own kernels,
+    // b~ (33) and the point part's solve) must follow the integral curve of the field, which is
+    // computed from the reduced U-dynamics' cycles (the reduced kernels, (35)): two generations of the
+    // same terms, and a wrong sign in either sends the curves apart at O(1).
+    const Scene sc = scene("heave_yaw_point");
+    const double dur = 20, dt = 1;
+    for (const Vec3& q0 : {Vec3(0.05, 0.04, 0), Vec3(-0.03, 0.06, 0)}) {
+        const Trajectory u = simulate(sc, Dynamics::U, q0, Vec3::Zero(), dur, dt);
+        const Trajectory curve = field_curve(sc, q0, dur, dt);
+        REQUIRE(u.stop.reason == StopReason::None);
+        REQUIRE(curve.stop.reason == StopReason::None);
+        REQUIRE(u.samples.size() == curve.samples.size());
+        const Vec2 moved = curve.samples.back().q.head<2>() - q0.head<2>();
+        double worst = 0;
+        for (std::size_t i = 1; i < u.samples.size(); ++i)
+            worst = std::max(worst, (u.samples[i].q - curve.samples[i].q).head<2>().norm());
+        INFO("start " << q0.transpose() << ": moved " << moved.norm() << " m, worst distance from the curve " << worst << " m");
+        // Measured: it moves 13.6 and 18.9 mm (0.21 and 0.28 of its distance from the origin), and stays
+        // within 0.11 and 0.14 mm (0.85 and 0.76 % of that) of the curve; bounds at about 3x.
+        CHECK(moved.norm() > 0.15 * q0.head<2>().norm());
+        CHECK(worst < 0.025 * moved.norm());
+    }
+}
