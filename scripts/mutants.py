@@ -179,13 +179,14 @@ LOG_LOCK = threading.Lock()
 
 def run(cmd, log, cwd=None, env=None, timeout=None):
     """CMD's exit code (None: timed out); its output appended to LOG in one piece (tests run side by side)."""
+    t0 = time.monotonic()
     try:
         r = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout)
         rc, out = r.returncode, r.stdout
     except subprocess.TimeoutExpired as e:
         rc, out = None, (e.stdout or b"") + f"(timed out after {timeout} s)\n".encode()
     with LOG_LOCK, open(log, "ab") as f:
-        f.write(("$ " + " ".join(cmd) + "\n").encode() + out + f"(exit {rc})\n".encode())
+        f.write(("$ " + " ".join(cmd) + "\n").encode() + out + f"(exit {rc}, {time.monotonic() - t0:.1f} s)\n".encode())
     return rc
 
 
