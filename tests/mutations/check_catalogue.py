@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The mutation catalogue still applies to this tree and names tests this build has (scripts/mutants.py
 --check); and the check can fail: doctored copies of the catalogue (a line the code no longer has, a
-line found twice, a test that does not exist, a field missing, an entry that changes nothing) are each
+line found twice, a test that does not exist, a tag alternative that lists no case, a field missing, an entry that changes nothing) are each
 refused with exit 2 and the entry and field named.
 
     check_catalogue.py SOURCE_DIR BUILD_DIR
@@ -40,6 +40,8 @@ with tempfile.TemporaryDirectory() as tmp:
     doctored("twice", lambda m: (m.pop("anchor", None), m.update(file="tests/mutations/catalogue.json", find='"id"')),
              f"({first}): field 'find': found")
     doctored("no-test", lambda m: m["tests"].append("a test nobody wrote"), f"mutation {first}: field 'tests': no test")
+    doctored("tag-alternative-empty", lambda m: m["tests"].append("[field],[no such tag]"),
+             f"mutation {first}: field 'tests': no test '[field],[no such tag]'")
     doctored("no-meaning", lambda m: m.pop("meaning"), f"({first}): field 'meaning' missing")
     doctored("no-change", lambda m: m.update(replace=m["find"]), f"({first}): field 'replace' equals 'find'")
 sys.exit(1 if failures else 0)
