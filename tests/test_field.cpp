@@ -529,3 +529,26 @@ TEST_CASE("exact_text reads back to the same double, nan and infinities included
     CHECK_THROWS_AS(exact_value("0.1x"), std::invalid_argument);
     CHECK_THROWS_AS(exact_value(""), std::invalid_argument);
 }
+
+// Differences of field_curve's ends at steps h, h/2, h/4 shrink by 2^p for a method of order p:
+// 16 for classical RK4. From (0.04, -0.04, 1) over 4 s (fig4's part reaches the centre, fig1_point's
+// slides 4 cm) at h = 0.25, 0.125, 0.0625 s the ratio d(h, h/2) / d(h/2, h/4) was 20.2 (fig4) and 18.8
+// (fig1_point), still above 16 (the next term); at h/8 fig4's difference falls to the cycles' noise
+// (1.6e-9 m). Between 8 (third order) and 32 (fifth): 12 to 32.
+TEST_CASE("field_curve is fourth order: its ends at steps h to h/4 differ by ratios near 16", "[field][trajectory]") {
+    for (const char* name : {"fig4", "fig1_point"}) {
+        const Scene sc = scene(name);
+        const Vec3 q0(0.04, -0.04, sc.part.point ? 0.0 : 1.0);
+        const double dur = 4;
+        std::vector<Vec3> ends;
+        for (double h : {0.25, 0.125, 0.0625}) {
+            const Trajectory c = field_curve(sc, q0, dur, dur, {}, h);
+            REQUIRE(c.stop.reason == StopReason::None);
+            ends.push_back(c.samples.back().q);
+        }
+        const double d1 = (ends[0] - ends[1]).norm(), d2 = (ends[1] - ends[2]).norm();
+        INFO(name << ": differences " << d1 << ", " << d2 << " m");
+        CHECK(d1 / d2 > 12);
+        CHECK(d1 / d2 < 32);
+    }
+}

@@ -492,3 +492,42 @@ TEST_CASE("a stalled Anderson iteration hands over to plain periods: fig6's stic
     // Within tol plus the integrator's noise on the twist (~60 rtol, measured on fig6).
     CHECK((lc.twist - r.twist).cwiseQuotient(S).cwiseAbs().maxCoeff() < o.tol + 60 * o.integration.rtol);
 }
+
+// Plain periods report error_estimate = r c / (1 - c), the distance of the last period's end P(x_k)
+// to the cycle, and stop when it is below tol. Against a reference cycle (Newton shooting at tol
+// 1e-12, rtol 1e-10) at (0.03, -0.02, 0.7) and tol 1e-6 the end's actual distance over the estimate
+// was measured 1.012 (fig4, c 0.54), 1.004 (fig5, c 0.61), 1.090 (fig6, c 0.26); allow 0.8 to 1.3.
+// (An estimate r c / (1 + c) would put the ratio near (1 + c) / (1 - c): 1.7 to 4.2.)
+TEST_CASE("period by period: the error estimate is the distance of the last period end to the cycle on fig4 fig5 fig6",
+          "[limit_cycle][methods]") {
+    for (const char* name : {"fig4", "fig5", "fig6"}) {
+        const Scene sc = scene(name);
+        const Vec3 q(0.03, -0.02, 0.7);
+        LimitCycleOptions ro;
+        ro.tol = 1e-9;
+        ro.integration.rtol = 1e-10;
+        ro.solver = CycleSolver::Anderson;
+        const LimitCycleSummary warm = limit_cycle(sc, q, ro);
+        ro.tol = 1e-12;
+        ro.solver = CycleSolver::Shooting;
+        const LimitCycleSummary ref = limit_cycle(sc, q, ro, warm.qd_start);
+        LimitCycleOptions o;
+        o.tol = 1e-6;
+        o.solver = CycleSolver::PeriodByPeriod;
+        const LimitCycleSummary a = limit_cycle(sc, q, o);
+        INFO(name << "\n" << a.report() << ref.report());
+        REQUIRE(ref.converged);
+        REQUIRE(a.converged);
+        REQUIRE(a.restarts == 0);
+        // Plain periods integrate at one tolerance (limit_cycle): the end at the same.
+        IntegrationOptions io = o.integration;
+        io.large_slip_factor = 1;
+        Vec3 end;
+        REQUIRE(period_map(sc, q, a.qd_start, end, io));
+        const double v = sc.v_ref(), w = v / sc.part.rho();
+        const double dist = ((end - ref.qd_start).array() / Vec3(v, v, w).array()).abs().maxCoeff();
+        INFO("end's distance " << dist << ", estimate " << a.error_estimate);
+        CHECK(dist / a.error_estimate > 0.8);
+        CHECK(dist / a.error_estimate < 1.3);
+    }
+}
