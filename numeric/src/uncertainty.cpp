@@ -71,7 +71,7 @@ std::uint64_t mix64(std::uint64_t z) {
 // The perturbations of one draw, each from its own stream keyed by (seed, index, what, attempt): a
 // draw depends on nothing but these, and a spread added to one quantity leaves the others' draws as
 // they were.
-enum class Stream : std::uint64_t { friction = 1, mass, inertia, contacts, com, tracking, unmodelled, period };
+enum class Stream : std::uint64_t { friction = 1, mass, inertia, contacts, com, amplitude, phase, unmodelled, period };
 
 Rng stream(const UncertaintySpec& spec, std::uint64_t index, Stream what, int attempt) {
     std::uint64_t k = mix64(spec.seed + 0x9E3779B97F4A7C15ull);
@@ -135,15 +135,15 @@ Scene draw_once(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t
             c += Vec3(ex - dx, ey - dy, 0);
         }
     }
-    Rng rt = stream(spec, index, Stream::tracking, attempt);
+    Rng ra = stream(spec, index, Stream::amplitude, attempt), rp = stream(spec, index, Stream::phase, attempt);
     for (auto& h : s.plate.harmonics) {
-        h.amp *= 1 + sample(spec.amplitude, rt);
-        h.phase += sample(spec.phase, rt);
+        h.amp *= 1 + sample(spec.amplitude, ra);
+        h.phase += sample(spec.phase, rp);
     }
     Rng ru = stream(spec, index, Stream::unmodelled, attempt);
     add_unmodelled(nominal.plate, spec, ru, s.plate);
-    Rng rp = stream(spec, index, Stream::period, attempt);
-    s.plate.T *= 1 + sample(spec.period, rp);
+    Rng rT = stream(spec, index, Stream::period, attempt);
+    s.plate.T *= 1 + sample(spec.period, rT);
     s.name = nominal.name + "~" + std::to_string(index);
     return s;
 }
