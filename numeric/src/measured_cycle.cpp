@@ -2,9 +2,10 @@
 
 #include "plate/scene_io.hpp"
 
+#include "input_reader.hpp"
+
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 
 namespace plate {
@@ -26,12 +27,7 @@ std::vector<std::string> split(const std::string& line) {
     return cells;
 }
 
-std::string fmt(double x) {
-    std::ostringstream s;
-    s.precision(6);
-    s << x;
-    return s.str();
-}
+using detail::Reader;
 
 struct Rows {
     std::vector<double> t;
@@ -99,8 +95,8 @@ MeasuredCycle parse_measured_cycle(const std::string& text, const std::string& s
     if (!(dt > 0)) fail(rows.line[1], "t [s]: expected increasing times");
     for (int k = 0; k < M; ++k)
         if (std::abs(rows.t[k] - (t0 + k * dt)) > 1e-6 * dt)
-            fail(rows.line[k], "t [s]: expected uniformly spaced samples, t0 + k dt with dt = " + fmt(dt) + " s; got " +
-                                   fmt(rows.t[k]) + " s at sample " + std::to_string(k));
+            fail(rows.line[k], "t [s]: expected uniformly spaced samples, t0 + k dt with dt = " + Reader::fmt(dt) + " s; got " +
+                                   Reader::fmt(rows.t[k]) + " s at sample " + std::to_string(k));
 
     MeasuredCycle out;
     out.samples = M;
@@ -140,24 +136,21 @@ MeasuredCycle parse_measured_cycle(const std::string& text, const std::string& s
         out.residual_rms[a] = std::sqrt(std::max(0.0, ms[a] - kept_power[a]));
         const std::string axis = axis_name(static_cast<Axis>(a));
         if (std::abs(mean[a]) > kMeasuredMeanWarn * out.rms[a])
-            out.warnings.push_back(source + ": " + axis + ": the mean " + fmt(mean[a]) + " is " +
-                                   (out.rms[a] > 0 ? fmt(std::abs(mean[a]) / out.rms[a]) + " of the RMS " + fmt(out.rms[a])
-                                                   : std::string("nonzero on a constant signal")) +
+            out.warnings.push_back(source + ": " + axis + ": the mean " + Reader::fmt(mean[a]) + " is " +
+                                   (out.rms[a] > 0
+                                        ? Reader::fmt(std::abs(mean[a]) / out.rms[a]) + " of the RMS " + Reader::fmt(out.rms[a])
+                                        : std::string("nonzero on a constant signal")) +
                                    " and was removed: a periodic plate's acceleration has zero mean (an "
                                    "accelerometer offset, gravity left in z, a record that is not one period?)");
         if (out.residual_rms[a] > kMeasuredMeanWarn * out.rms[a] && out.residual_rms[a] > kMeasuredDropRelative * peak[a])
             out.warnings.push_back(source + ": " + axis + ": harmonics 1 to " + std::to_string(max_n) + " leave an RMS of " +
-                                   fmt(out.residual_rms[a]) + " of " + fmt(out.rms[a]) + " out");
+                                   Reader::fmt(out.residual_rms[a]) + " of " + Reader::fmt(out.rms[a]) + " out");
     }
     return out;
 }
 
 MeasuredCycle read_measured_cycle(const std::string& path, int max_n) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path + ": cannot open measured cycle");
-    std::stringstream buf;
-    buf << in.rdbuf();
-    return parse_measured_cycle(buf.str(), path, max_n);
+    return parse_measured_cycle(detail::read_input_file(path, "measured cycle"), path, max_n);
 }
 
 Scene with_measured_plate(const Scene& scene, const MeasuredCycle& cycle) {

@@ -3,11 +3,12 @@
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
 
+#include "input_reader.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <complex>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -17,49 +18,26 @@ namespace {
 
 using nlohmann::json;
 
-std::string fmt(double x) {
-    std::ostringstream s;
-    s.precision(6);
-    s << x;
-    return s.str();
+using detail::Reader;
+
+// A spread's object {"spread": s, "distribution": "normal" | "uniform"}; absent: no spread.
+Spread read_spread(const Reader& r, const json& doc, const std::string& field) {
+    Spread s;
+    if (!doc.contains(field)) return s;
+    const json& v = doc[field];
+    r.only_keys(v, field, {"spread", "distribution"}, {"spread"});
+    s.spread = r.number(v["spread"], field + ".spread");
+    if (v.contains("distribution")) {
+        const json& d = v["distribution"];
+        if (d == "normal")
+            s.distribution = Distribution::normal;
+        else if (d == "uniform")
+            s.distribution = Distribution::uniform;
+        else
+            r.fail(field + ".distribution", "expected \"normal\" or \"uniform\"");
+    }
+    return s;
 }
-
-struct SpecReader {
-    std::string source;
-
-    [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-        throw InputError(source + ": " + field + ": " + what);
-    }
-    void only_keys(const json& obj, const std::string& field, const std::set<std::string>& allowed) const {
-        if (!obj.is_object()) fail(field, "expected an object");
-        for (auto it = obj.begin(); it != obj.end(); ++it)
-            if (!allowed.count(it.key())) fail(field.empty() ? it.key() : field + "." + it.key(), "unknown field");
-    }
-    double number(const json& v, const std::string& field) const {
-        if (!v.is_number()) fail(field, "expected a number, got " + std::string(v.type_name()));
-        const double x = v.get<double>();
-        if (!std::isfinite(x)) fail(field, "expected a finite number");
-        return x;
-    }
-    Spread spread(const json& doc, const std::string& field) const {
-        Spread s;
-        if (!doc.contains(field)) return s;
-        const json& v = doc[field];
-        only_keys(v, field, {"spread", "distribution"});
-        if (!v.contains("spread")) fail(field + ".spread", "missing required field");
-        s.spread = number(v["spread"], field + ".spread");
-        if (v.contains("distribution")) {
-            const json& d = v["distribution"];
-            if (d == "normal")
-                s.distribution = Distribution::normal;
-            else if (d == "uniform")
-                s.distribution = Distribution::uniform;
-            else
-                fail(field + ".distribution", "expected \"normal\" or \"uniform\"");
-        }
-        return s;
-    }
-};
 
 // splitmix64's finaliser: a bijection of 64-bit words that mixes every input bit into every output bit.
 std::uint64_t mix64(std::uint64_t z) {
@@ -161,7 +139,7 @@ Vec6 axis_rms(const PlateMotion& plate) {
 }
 
 UncertaintySpec parse_uncertainty(const std::string& text, const std::string& source) {
-    SpecReader r{source};
+    Reader r{source};
     json doc;
     try {
         doc = json::parse(text);
@@ -169,26 +147,24 @@ UncertaintySpec parse_uncertainty(const std::string& text, const std::string& so
         throw InputError(source + ": malformed JSON: " + e.what());
     }
     r.only_keys(
-        doc, "(top level)",
-        {"seed", "friction", "mass", "inertia", "contacts_mm", "com_offset_mm", "amplitude", "phase", "unmodelled", "period"});
+        doc, "",
+        {"seed", "friction", "mass", "inertia", "contacts_mm", "com_offset_mm", "amplitude", "phase", "unmodelled", "period"},
+        {"seed"});
     UncertaintySpec s;
     s.source = source;
-    if (!doc.contains("seed")) r.fail("seed", "missing required field");
     if (!doc["seed"].is_number_unsigned()) r.fail("seed", "expected a whole number from 0 to 2^64 - 1");
     s.seed = doc["seed"].get<std::uint64_t>();
-    s.friction = r.spread(doc, "friction");
-    s.mass = r.spread(doc, "mass");
-    s.inertia = r.spread(doc, "inertia");
-    s.contacts_mm = r.spread(doc, "contacts_mm");
-    s.com_offset_mm = r.spread(doc, "com_offset_mm");
-    s.amplitude = r.spread(doc, "amplitude");
-    s.phase = r.spread(doc, "phase");
-    s.period = r.spread(doc, "period");
+    s.friction = read_spread(r, doc, "friction");
+    s.mass = read_spread(r, doc, "mass");
+    s.inertia = read_spread(r, doc, "inertia");
+    s.contacts_mm = read_spread(r, doc, "contacts_mm");
+    s.com_offset_mm = read_spread(r, doc, "com_offset_mm");
+    s.amplitude = read_spread(r, doc, "amplitude");
+    s.phase = read_spread(r, doc, "phase");
+    s.period = read_spread(r, doc, "period");
     if (doc.contains("unmodelled")) {
         const json& u = doc["unmodelled"];
-        r.only_keys(u, "unmodelled", {"up_to", "rms_fraction"});
-        for (const char* k : {"up_to", "rms_fraction"})
-            if (!u.contains(k)) r.fail(std::string("unmodelled.") + k, "missing required field");
+        r.only_keys(u, "unmodelled", {"up_to", "rms_fraction"}, {"up_to", "rms_fraction"});
         if (!u["up_to"].is_number_integer() || u["up_to"].get<long>() < 1 || u["up_to"].get<long>() > 1000)
             r.fail("unmodelled.up_to", "expected a whole number from 1 to 1000 (the highest harmonic added)");
         s.unmodelled_up_to = u["up_to"].get<int>();
@@ -199,10 +175,11 @@ UncertaintySpec parse_uncertainty(const std::string& text, const std::string& so
 }
 
 void validate_uncertainty(const UncertaintySpec& s) {
-    SpecReader r{s.source.empty() ? std::string("(uncertainty)") : s.source};
+    Reader r{s.source.empty() ? std::string("(uncertainty)") : s.source};
     auto check = [&](const Spread& sp, const char* field, double max, const char* unit) {
         if (!(std::isfinite(sp.spread) && sp.spread >= 0 && sp.spread <= max))
-            r.fail(std::string(field) + ".spread", "expected a number from 0 to " + fmt(max) + unit + ", got " + fmt(sp.spread));
+            r.fail(std::string(field) + ".spread",
+                   "expected a number from 0 to " + Reader::fmt(max) + unit + ", got " + Reader::fmt(sp.spread));
     };
     check(s.friction, "friction", kMaxRelativeSpread, " (relative)");
     check(s.mass, "mass", kMaxRelativeSpread, " (relative)");
@@ -216,15 +193,11 @@ void validate_uncertainty(const UncertaintySpec& s) {
         r.fail("unmodelled.up_to", "expected a whole number from 1 to 1000 (the highest harmonic added)");
     if (!(std::isfinite(s.unmodelled_rms_fraction) && s.unmodelled_rms_fraction >= 0 && s.unmodelled_rms_fraction <= 1))
         r.fail("unmodelled.rms_fraction",
-               "expected a number from 0 to 1 (of the commanded signal's RMS), got " + fmt(s.unmodelled_rms_fraction));
+               "expected a number from 0 to 1 (of the commanded signal's RMS), got " + Reader::fmt(s.unmodelled_rms_fraction));
 }
 
 UncertaintySpec load_uncertainty(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path + ": cannot open uncertainty spec");
-    std::stringstream buf;
-    buf << in.rdbuf();
-    return parse_uncertainty(buf.str(), path);
+    return parse_uncertainty(detail::read_input_file(path, "uncertainty spec"), path);
 }
 
 Scene draw(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index) {
