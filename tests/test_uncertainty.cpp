@@ -394,3 +394,24 @@ TEST_CASE("a scene built from a measured cycle has the nominal scene's twist", "
         CHECK(std::abs(a.twist[2] - b.twist[2]) * rho <= 1e-7 * v);
     }
 }
+
+TEST_CASE("a point part's draws perturb its one friction coefficient and its mass, nothing of a rigid part's", "[uncertainty]") {
+    const Scene point = load_scene(kDir + "fig1_point.json");
+    UncertaintySpec s = load_uncertainty(kDir + "uncertainty/ppod.json");
+    s.mass = {0.02, Distribution::normal};
+    s.inertia = {0.05, Distribution::normal};
+    s.contacts_mm = {0.3, Distribution::normal};
+    s.com_offset_mm = {0.4, Distribution::normal};
+    int differ = 0;
+    for (int i = 0; i < 50; ++i) {
+        const Scene d = draw(point, s, i);
+        CHECK_NOTHROW(validate_scene(d));
+        CHECK(d.part.point);
+        CHECK(d.part.mu == Vec3::Constant(d.part.mu[0]));   // one contact: every accessor sees one coefficient
+        CHECK(std::abs(d.part.mu[0] / point.part.mu[0] - 1) <= 0.1);
+        CHECK(d.part.J == point.part.J);
+        for (int c = 0; c < 3; ++c) CHECK(d.part.c[c] == point.part.c[c]);
+        differ += d.part.m != point.part.m;
+    }
+    CHECK(differ == 50);
+}
