@@ -104,6 +104,17 @@ std::map<std::string, std::vector<double>> quantities(const Scene& s, std::size_
     return q;
 }
 
+// The shipped PPOD spec with a spread on every other quantity too.
+UncertaintySpec every_spread() {
+    UncertaintySpec s = load_uncertainty(kDir + "uncertainty/ppod.json");
+    s.mass = {0.02, Distribution::normal};
+    s.inertia = {0.05, Distribution::normal};
+    s.contacts_mm = {0.3, Distribution::normal};
+    s.com_offset_mm = {0.4, Distribution::normal};
+    s.period = {0.01, Distribution::normal};
+    return s;
+}
+
 }   // namespace
 
 TEST_CASE("the shipped uncertainty spec states the issue's PPOD numbers", "[uncertainty]") {
@@ -165,6 +176,8 @@ TEST_CASE("a bad measured cycle is refused with the file, the line and the colum
     check_refused(parse, header + "0,1,0,0,0,0,0\n0,0,1,0,0,0,0\n0,-1,0,0,0,0,0\n", "bad.csv:3:1", "increasing");
     check_refused([](const std::string& t) { parse_measured_cycle(t, "bad.csv", 2); }, header + rows, "bad.csv",
                   "4 samples resolve harmonics up to n = 1 only");
+    check_refused([](const std::string& t) { parse_measured_cycle(t, "bad.csv", 0); }, header + rows, "bad.csv",
+                  "harmonics: expected a whole number from 1 to 1000");
     check_refused([](const std::string& p) { read_measured_cycle(p, 1); }, "/nonexistent/cycle.csv", "/nonexistent/cycle.csv",
                   "cannot open");
 }
@@ -181,12 +194,7 @@ TEST_CASE("draws are a function of the seed and the index only", "[uncertainty]"
     other.seed = spec.seed + 1;
     for (std::uint64_t i = 0; i < 20; ++i) CHECK(scene_to_json(draw(fig4, other, i)).dump() != forward[i]);
     // A spread taken away leaves every other quantity's draws as they were (each has its own stream).
-    UncertaintySpec full = spec;
-    full.mass = {0.02, Distribution::normal};
-    full.inertia = {0.05, Distribution::normal};
-    full.contacts_mm = {0.3, Distribution::normal};
-    full.com_offset_mm = {0.4, Distribution::normal};
-    full.period = {0.01, Distribution::normal};
+    const UncertaintySpec full = every_spread();
     const std::pair<const char*, std::function<void(UncertaintySpec&)>> without[] = {
         {"friction", [](UncertaintySpec& u) { u.friction = {}; }},
         {"mass", [](UncertaintySpec& u) { u.mass = {}; }},
@@ -397,11 +405,7 @@ TEST_CASE("a scene built from a measured cycle has the nominal scene's twist", "
 
 TEST_CASE("a point part's draws perturb its one friction coefficient and its mass, nothing of a rigid part's", "[uncertainty]") {
     const Scene point = load_scene(kDir + "fig1_point.json");
-    UncertaintySpec s = load_uncertainty(kDir + "uncertainty/ppod.json");
-    s.mass = {0.02, Distribution::normal};
-    s.inertia = {0.05, Distribution::normal};
-    s.contacts_mm = {0.3, Distribution::normal};
-    s.com_offset_mm = {0.4, Distribution::normal};
+    const UncertaintySpec s = every_spread();
     int differ = 0;
     for (int i = 0; i < 50; ++i) {
         const Scene d = draw(point, s, i);

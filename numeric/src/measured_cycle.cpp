@@ -86,7 +86,8 @@ MeasuredCycle parse_measured_cycle(const std::string& text, const std::string& s
     auto fail = [&](int line, const std::string& what) {
         throw InputError(source + (line > 0 ? ":" + std::to_string(line) + ":1" : std::string()) + ": " + what);
     };
-    if (max_n < 1) fail(0, "harmonics: expected at least 1, got " + std::to_string(max_n));
+    if (max_n < 1 || max_n > 1000)
+        fail(0, "harmonics: expected a whole number from 1 to 1000 (a scene's range), got " + std::to_string(max_n));
     if (M < 2 * max_n + 1)
         fail(0, std::to_string(M) + " samples resolve harmonics up to n = " + std::to_string((M - 1) / 2) +
                     " only (below the Nyquist frequency), " + std::to_string(max_n) + " asked for");
