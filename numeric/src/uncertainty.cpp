@@ -132,7 +132,8 @@ double Spread::standard_deviation() const { return distribution == Distribution:
 
 Vec6 axis_rms(const PlateMotion& plate) {
     std::map<std::pair<int, int>, std::complex<double>> phasor;   // (axis, n) -> amp e^{i phase}
-    for (const auto& h : plate.harmonics) phasor[{static_cast<int>(h.axis), h.n}] += std::polar(h.amp, h.phase);
+    for (const auto& h : plate.harmonics)                         // (std::polar wants amp >= 0; a scene's may be negative)
+        phasor[{static_cast<int>(h.axis), h.n}] += h.amp * std::complex<double>(std::cos(h.phase), std::sin(h.phase));
     Vec6 ms = Vec6::Zero();
     for (const auto& [key, z] : phasor) ms[key.first] += std::norm(z) / 2;
     return ms.cwiseSqrt();
