@@ -35,8 +35,9 @@ NUMERIC_LEVELS = [
     ("needs nothing of plate", ["include/plate/tasks.hpp", "src/tasks.cpp", "src/stepper.hpp", "src/events.hpp",
                                 "src/lsan_suppressions.cpp"]),
     ("model", ["include/plate/model.hpp", "src/model.cpp", "src/so3.hpp", "include/plate/scene_io.hpp",
-               "src/scene_io.cpp", "include/plate/random_scene.hpp", "src/random_scene.cpp",
-               "include/plate/friction.hpp"]),   # friction's accessors are the part's (Part::friction)
+               "src/scene_io.cpp", "src/input_reader.hpp", "include/plate/random_scene.hpp", "src/random_scene.cpp",
+               "include/plate/friction.hpp", "include/plate/uncertainty.hpp", "src/uncertainty.cpp",
+               "include/plate/measured_cycle.hpp", "src/measured_cycle.cpp"]),   # friction's accessors are the part's (Part::friction)
     ("dynamics/friction", ["generated/plate_kernels.hpp", "include/plate/dynamics.hpp", "src/dynamics.cpp",
                            "src/friction.cpp",   # the gauge and the laws, over the generated kernels
                            "src/workspace.hpp"]),   # the kernels' scratch and the engine's private state
