@@ -86,3 +86,56 @@ TEST_CASE("a sink judged against a target 10 mm off it: every run and the hold e
     CHECK(std::abs(c.worst_end_distance - p.norm()) < 1e-5);
     CHECK(c.held.end_distance == p.norm());   // (the hold is the run that gave p)
 }
+
+TEST_CASE(
+    "a rigid part's sink at a saddle: the position's field vanishes at the target but repels along one axis, not attracting",
+    "[design][verify][rigid]") {
+    // fig4's own plate motion has odd harmonics only (n = 1 on x, y, rx, ry): the field is odd about
+    // the centre, so the centre is a fixed point at every orientation, and there it attracts
+    // (eigenvalues measured -1.60 and -0.80 1/s at theta 0, 0.7, 1.5). With the x harmonic negated
+    // the centre stays a fixed point (still odd) but one eigenvalue changes sign: +1.60 and -0.80
+    // 1/s measured, a saddle. verify_rigid_sink, at the centre for three orientations (no runs and
+    // no hold: only the pull is judged), must hold the first and call the second not attracting.
+    DesignOptions o;
+    o.verify_starts = 0;
+    o.hold = 0;
+    Field f;
+    f.grid.nx = f.grid.ny = 1;
+    f.grid.nth = 3;
+    f.points.assign(f.grid.size(), FieldPoint{});
+    auto verdict = [&](const Scene& sc) {
+        DesignSummary sum;
+        sum.scene = sc;
+        std::atomic<long> cycles{0};
+        return design_detail::verify_rigid_sink(sum, f, DesignTarget{}, o, cycles, design_detail::Clock::now());
+    };
+
+    const Scene sink = scene("fig4");
+    const DesignSummary a = verdict(sink);
+    INFO(a.failure);
+    CHECK(a.unique);
+    REQUIRE(a.pulls.size() == 3u);
+    for (const DesignSummary::OrientationPull& p : a.pulls) {
+        INFO("theta " << p.theta << ": eigenvalues " << p.eigenvalues.transpose());
+        CHECK(p.zero.norm() < 1e-4);   // (the fixed point at the centre, to the cycles' noise)
+        CHECK(std::max(p.eigenvalues[0].real(), p.eigenvalues[1].real()) < -0.5);
+    }
+    CHECK(a.failure.find("not attracting") == std::string::npos);
+
+    Scene saddle = sink;
+    for (Harmonic& h : saddle.plate.harmonics)
+        if (h.axis == Axis::x) h.amp = -h.amp;
+    const DesignSummary b = verdict(saddle);
+    INFO(b.failure);
+    CHECK_FALSE(b.verified);
+    CHECK_FALSE(b.unique);
+    REQUIRE(b.pulls.size() == 3u);
+    for (const DesignSummary::OrientationPull& p : b.pulls) {
+        INFO("theta " << p.theta << ": eigenvalues " << p.eigenvalues.transpose());
+        CHECK(p.zero.norm() < 1e-4);
+        CHECK(std::max(p.eigenvalues[0].real(), p.eigenvalues[1].real()) > 0.5);
+        CHECK(std::min(p.eigenvalues[0].real(), p.eigenvalues[1].real()) < -0.5);
+    }
+    CHECK(b.failure.find("at orientation 0.000000 rad the position's field vanishes") == 0);
+    CHECK(b.failure.find(", not attracting") != std::string::npos);
+}
