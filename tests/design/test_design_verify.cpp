@@ -139,3 +139,41 @@ TEST_CASE(
     CHECK(b.failure.find("at orientation 0.000000 rad the position's field vanishes") == 0);
     CHECK(b.failure.find(", not attracting") != std::string::npos);
 }
+
+TEST_CASE("an orient design judged against THETA + 0.1 rad: every run ends 0.1 rad off it, twice the 0.05 rad allowed",
+          "[design][verify][orient]") {
+    // foot.json turned to THETA = 2 (as in the orient test): every verification run ends at THETA
+    // within 0.01 rad (each runs 1.5 times the turn's time to within 0.01 rad, plus 2 s; measured at
+    // most 6.3e-3 rad off). The same runs (the design's starts and durations)
+    // judged by orient's end distance against THETA + 0.1 rad end 0.1 rad off, and verify_distance
+    // stands for 0.05 rad: each run at 2 verify_distance (to the turn's error), the worst beyond
+    // verify_distance; against THETA itself, within it.
+    const Scene foot = scene("foot");
+    DesignTarget t;
+    t.kind = DesignTargetKind::Orient;
+    t.theta = 2.0;
+    const DesignOptions o = searched(2, 80, 8, 2);
+    const DesignSummary s = design(foot, t, o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    REQUIRE(s.runs.size() == 8u);
+    const double off = t.theta + 0.1;
+    DesignSummary j;
+    j.scene = s.scene;
+    std::size_t k = 0;
+    const int stopped = design_detail::verification_runs(
+        j, o, [&](const DesignStartRun&) { return s.runs[k++].seconds; },
+        [&](const DesignStartRun&, const Vec3& end) { return design_detail::orient_end_distance(end, off, o); });
+    CHECK(stopped == 0);
+    REQUIRE(j.runs.size() == 8u);
+    for (std::size_t i = 0; i < j.runs.size(); ++i) {
+        const DesignStartRun& r = j.runs[i];
+        INFO("run " << i << " ended at theta " << r.end[2] << ", judged " << r.end_distance << " m");
+        CHECK((r.end - s.runs[i].end).norm() == 0.0);   // (the design's own run, to the bit)
+        CHECK(std::abs(wrap_angle(r.end[2] - t.theta)) < 0.01);
+        CHECK(std::abs(r.end_distance - 2 * o.verify_distance) < 0.01 / 0.05 * o.verify_distance);
+        CHECK(design_detail::orient_end_distance(r.end, t.theta, o) <= o.verify_distance);
+    }
+    CHECK(j.worst_end_distance > o.verify_distance);
+    CHECK(s.worst_end_distance <= o.verify_distance);
+}
