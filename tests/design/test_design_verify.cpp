@@ -1,5 +1,6 @@
 // A design's verdict (design/src/verify.cpp: sink_verdict, hold_failure) on full dynamics that end off
-// the target: the verification must fail on the runs' end distance and on the hold, and say which.
+// the target: the verification must fail on the runs' end distance and on the hold, and say which; a
+// rigid sink's pull at a saddle (sink.cpp) and an orient run's end off THETA (orient.cpp) must fail too.
 #include "../../design/src/internal.hpp"
 #include "design_test_helpers.hpp"
 
