@@ -270,6 +270,13 @@ bool position_pull(const Scene& sc, const Vec2& s, double theta, const LimitCycl
 // hold_failure's verdict) and the flight margin; then the summary's end.
 DesignSummary& last_checks(DesignSummary& sum, const DesignOptions& opt, const std::string& unheld,
                            const std::atomic<long>& cycles, Clock::time_point t0);
+// An orient run's end judged against `theta` (orient.cpp): its orientation's distance from theta on
+// the scale of verify_distance, which stands for 0.05 rad.
+double orient_end_distance(const Vec3& end, double theta, const DesignOptions& opt);
+// A rigid part's sink verified (sink.cpp): at the target, for each of `field`'s orientations, the
+// position's field vanishes there and attracts (both eigenvalues' real parts negative); then sink_verdict.
+DesignSummary& verify_rigid_sink(DesignSummary& sum, const Field& field, const DesignTarget& target, const DesignOptions& opt,
+                                 std::atomic<long>& cycles, Clock::time_point t0);
 // A sink's verdict, shared: full-dynamics runs from random starts and from the target (the hold), then
 // the first check that fails (verify.cpp).
 DesignSummary& sink_verdict(DesignSummary& sum, const Field& settle, const DesignTarget& target, const DesignOptions& opt,

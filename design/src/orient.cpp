@@ -115,6 +115,10 @@ double turn_time(const std::vector<double>& w, double theta0, double theta_s, do
     return std::min(t, cap);
 }
 
+double orient_end_distance(const Vec3& end, double theta, const DesignOptions& opt) {
+    return std::abs(wrap_angle(end[2] - theta)) * opt.verify_distance / 0.05;
+}
+
 DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target, const DesignOptions& opt, double T) {
     const auto t0 = Clock::now();
     DesignSummary sum;
@@ -227,9 +231,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     sum.transport_tolerance = 2 * cycle_noise(opt.cycle);
     const int stopped = verification_runs(
         sum, opt, [&](const DesignStartRun& r) { return 1.5 * turn_time(w, r.theta, zf.theta, 0.01, 200) + 2; },
-        [&](const DesignStartRun&, const Vec3& end) {
-            return std::abs(wrap_angle(end[2] - target.theta)) * opt.verify_distance / 0.05;
-        });
+        [&](const DesignStartRun&, const Vec3& end) { return orient_end_distance(end, target.theta, opt); });
     int reached = 0;
     for (const DesignStartRun& r : sum.runs) reached += r.stop.empty() && r.end_distance <= opt.verify_distance;
     sum.basin_share = sum.runs.empty() ? 0.0 : static_cast<double>(reached) / sum.runs.size();

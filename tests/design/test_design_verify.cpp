@@ -1,5 +1,6 @@
 // A design's verdict (design/src/verify.cpp: sink_verdict, hold_failure) on full dynamics that end off
-// the target: the verification must fail on the runs' end distance and on the hold, and say which.
+// the target: the verification must fail on the runs' end distance and on the hold, and say which; a
+// rigid sink's pull at a saddle (sink.cpp) and an orient run's end off THETA (orient.cpp) must fail too.
 #include "../../design/src/internal.hpp"
 #include "design_test_helpers.hpp"
 
@@ -85,4 +86,95 @@ TEST_CASE("a sink judged against a target 10 mm off it: every run and the hold e
     CHECK(c.verified);
     CHECK(std::abs(c.worst_end_distance - p.norm()) < 1e-5);
     CHECK(c.held.end_distance == p.norm());   // (the hold is the run that gave p)
+}
+
+TEST_CASE(
+    "a rigid part's sink at a saddle: the position's field vanishes at the target but repels along one axis, not attracting",
+    "[design][verify][rigid]") {
+    // fig4's own plate motion has odd harmonics only (n = 1 on x, y, rx, ry): the field is odd about
+    // the centre, so the centre is a fixed point at every orientation, and there it attracts
+    // (eigenvalues measured -1.60 and -0.80 1/s at theta 0, 0.7, 1.5). With the x harmonic negated
+    // the centre stays a fixed point (still odd) but one eigenvalue changes sign: +1.60 and -0.80
+    // 1/s measured, a saddle. verify_rigid_sink, at the centre for three orientations (no runs and
+    // no hold: only the pull is judged), must hold the first and call the second not attracting.
+    DesignOptions o;
+    o.verify_starts = 0;
+    o.hold = 0;
+    Field f;
+    f.grid.nx = f.grid.ny = 1;
+    f.grid.nth = 3;
+    f.points.assign(f.grid.size(), FieldPoint{});
+    auto verdict = [&](const Scene& sc) {
+        DesignSummary sum;
+        sum.scene = sc;
+        std::atomic<long> cycles{0};
+        return design_detail::verify_rigid_sink(sum, f, DesignTarget{}, o, cycles, design_detail::Clock::now());
+    };
+
+    const Scene sink = scene("fig4");
+    const DesignSummary a = verdict(sink);
+    INFO(a.failure);
+    CHECK(a.unique);
+    REQUIRE(a.pulls.size() == 3u);
+    for (const DesignSummary::OrientationPull& p : a.pulls) {
+        INFO("theta " << p.theta << ": eigenvalues " << p.eigenvalues.transpose());
+        CHECK(p.zero.norm() < 1e-4);   // (the fixed point at the centre, to the cycles' noise)
+        CHECK(std::max(p.eigenvalues[0].real(), p.eigenvalues[1].real()) < -0.5);
+    }
+    CHECK(a.failure.find("not attracting") == std::string::npos);
+
+    Scene saddle = sink;
+    for (Harmonic& h : saddle.plate.harmonics)
+        if (h.axis == Axis::x) h.amp = -h.amp;
+    const DesignSummary b = verdict(saddle);
+    INFO(b.failure);
+    CHECK_FALSE(b.verified);
+    CHECK_FALSE(b.unique);
+    REQUIRE(b.pulls.size() == 3u);
+    for (const DesignSummary::OrientationPull& p : b.pulls) {
+        INFO("theta " << p.theta << ": eigenvalues " << p.eigenvalues.transpose());
+        CHECK(p.zero.norm() < 1e-4);
+        CHECK(std::max(p.eigenvalues[0].real(), p.eigenvalues[1].real()) > 0.5);
+        CHECK(std::min(p.eigenvalues[0].real(), p.eigenvalues[1].real()) < -0.5);
+    }
+    CHECK(b.failure.find("at orientation 0.000000 rad the position's field vanishes") == 0);
+    CHECK(b.failure.find(", not attracting") != std::string::npos);
+}
+
+TEST_CASE("an orient design judged against THETA + 0.1 rad: every run ends 0.1 rad off it, twice the 0.05 rad allowed",
+          "[design][verify][orient]") {
+    // foot.json turned to THETA = 2 (as in the orient test): every verification run ends at THETA
+    // within 0.01 rad (each runs 1.5 times the turn's time to within 0.01 rad, plus 2 s; measured at
+    // most 6.3e-3 rad off). The same runs (the design's starts and durations)
+    // judged by orient's end distance against THETA + 0.1 rad end 0.1 rad off, and verify_distance
+    // stands for 0.05 rad: each run at 2 verify_distance (to the turn's error), the worst beyond
+    // verify_distance; against THETA itself, within it.
+    const Scene foot = scene("foot");
+    DesignTarget t;
+    t.kind = DesignTargetKind::Orient;
+    t.theta = 2.0;
+    const DesignOptions o = searched(2, 80, 8, 2);
+    const DesignSummary s = design(foot, t, o);
+    INFO(s.failure);
+    REQUIRE(s.verified);
+    REQUIRE(s.runs.size() == 8u);
+    const double off = t.theta + 0.1;
+    DesignSummary j;
+    j.scene = s.scene;
+    std::size_t k = 0;
+    const int stopped = design_detail::verification_runs(
+        j, o, [&](const DesignStartRun&) { return s.runs[k++].seconds; },
+        [&](const DesignStartRun&, const Vec3& end) { return design_detail::orient_end_distance(end, off, o); });
+    CHECK(stopped == 0);
+    REQUIRE(j.runs.size() == 8u);
+    for (std::size_t i = 0; i < j.runs.size(); ++i) {
+        const DesignStartRun& r = j.runs[i];
+        INFO("run " << i << " ended at theta " << r.end[2] << ", judged " << r.end_distance << " m");
+        CHECK((r.end - s.runs[i].end).norm() == 0.0);   // (the design's own run, to the bit)
+        CHECK(std::abs(wrap_angle(r.end[2] - t.theta)) < 0.01);
+        CHECK(std::abs(r.end_distance - 2 * o.verify_distance) < 0.01 / 0.05 * o.verify_distance);
+        CHECK(design_detail::orient_end_distance(r.end, t.theta, o) <= o.verify_distance);
+    }
+    CHECK(j.worst_end_distance > o.verify_distance);
+    CHECK(s.worst_end_distance <= o.verify_distance);
 }
