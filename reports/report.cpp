@@ -65,46 +65,34 @@ void write_report(const ReportOptions& opt) {
          << "</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
     html << "</table>\n" << c.html.str();
-    // The speed-accuracy study (plate bench) keeps its section between the markers.
-    html << kSpeedBegin;
-    const fs::path speed = c.dir / "data" / "speed_section.html";
-    if (fs::exists(speed))
-        html << std::ifstream(speed).rdbuf();
-    else
-        html << "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " << esc(opt.out)
-             << "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n";
-    html << kSpeedEnd << "\n";
-    // The peer engines' study (bench/peers/study.py) keeps its section between these.
-    html << kPeersBegin;
-    const fs::path peers = c.dir / "data" / "peers_section.html";
-    if (fs::exists(peers))
-        html << std::ifstream(peers).rdbuf();
-    else
-        html << "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet: <code>bench/peers/study.py --out "
-             << esc(opt.out)
-             << "</code> writes this section (the same questions to the engines found at build time and to plate, "
-                "error against CPU time).</p>\n";
-    html << kPeersEnd << "\n";
-    // The campaigns' scaling study (bench/scaling.py) keeps its section between these.
-    html << kCampaignsBegin;
-    const fs::path campaigns = c.dir / "data" / "campaigns_section.html";
-    if (fs::exists(campaigns))
-        html << std::ifstream(campaigns).rdbuf();
-    else
-        html << "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " << esc(opt.out)
-             << "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
-                "load balance, the cost of a 1 000-core campaign).</p>\n";
-    html << kCampaignsEnd << "\n";
-    // The mutation catalogue's score (scripts/mutants.py --report) keeps its section between these.
-    html << kMutationsBegin;
-    const fs::path mutations = c.dir / "data" / "mutations_section.html";
-    if (fs::exists(mutations))
-        html << std::ifstream(mutations).rdbuf();
-    else
-        html << "<h2>Mutation score</h2><p>Not run yet: <code>scripts/mutants.py --report " << esc(opt.out)
-             << "</code> writes this section (one-line physics bugs from tests/mutations/catalogue.json, each applied to a "
-                "scratch copy, and the tests that caught it).</p>\n";
-    html << kMutationsEnd << "\n" << kPageCheck << "</body></html>\n";
+    // The studies run apart from the report keep their sections between their markers: DIR/data/NAME_section.html
+    // where the study has run, else a stub that says which command writes it.
+    const std::string out = esc(opt.out);
+    auto study = [&](const char* begin, const char* end, const char* name, const std::string& stub) {
+        const fs::path file = c.dir / "data" / (std::string(name) + "_section.html");
+        html << begin;
+        if (fs::exists(file))
+            html << std::ifstream(file).rdbuf();
+        else
+            html << stub;
+        html << end << "\n";
+    };
+    study(kSpeedBegin, kSpeedEnd, "speed",   // plate bench
+          "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " + out +
+              "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n");
+    study(kPeersBegin, kPeersEnd, "peers",   // bench/peers/study.py
+          "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet: <code>bench/peers/study.py --out " + out +
+              "</code> writes this section (the same questions to the engines found at build time and to plate, "
+              "error against CPU time).</p>\n");
+    study(kCampaignsBegin, kCampaignsEnd, "campaigns",   // bench/scaling.py
+          "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " + out +
+              "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
+              "load balance, the cost of a 1 000-core campaign).</p>\n");
+    study(kMutationsBegin, kMutationsEnd, "mutations",   // scripts/mutants.py --report
+          "<h2>Mutation score</h2><p>Not run yet: <code>scripts/mutants.py --report " + out +
+              "</code> writes this section (one-line physics bugs from tests/mutations/catalogue.json, each applied to a "
+              "scratch copy, and the tests that caught it).</p>\n");
+    html << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });
 }
 
