@@ -135,6 +135,16 @@ void Workspace::prepare(const Scene& sc) {
 
 namespace {
 
+// The plate's inputs of the kernels: u(t) = (p'', omega1') in the plate frame.
+inline void set_plate_accelerations(const PlateState& ps, gen::KernelInput& in) {
+    in.pddx = ps.pdd.x();
+    in.pddy = ps.pdd.y();
+    in.pddz = ps.pdd.z();
+    in.wdx = ps.wd.x();
+    in.wdy = ps.wd.y();
+    in.wdz = ps.wd.z();
+}
+
 // Configuration inputs of the kernels: s, and cos/sin theta with R2 c_i (cached: constant in the
 // reduced U-dynamics).
 inline void set_configuration(const Part& P, const Vec3& q, Workspace& ws) {
@@ -221,12 +231,7 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
     }
     // The staged kernels read only the slip directions and u(t): those fields are written here.
     gen::KernelInput& k = ks.staged;
-    k.pddx = ps.pdd.x();
-    k.pddy = ps.pdd.y();
-    k.pddz = ps.pdd.z();
-    k.wdx = ps.wd.x();
-    k.wdy = ps.wd.y();
-    k.wdz = ps.wd.z();
+    set_plate_accelerations(ps, k);
     double ux[3], uy[3];
     double dq[18];   // d q''_r / d u_j, row-major (3 x 6; point part 2 x 2)
     if (P.point) {
@@ -329,12 +334,7 @@ void accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& q
             in.u3y = uy[2];
         }
     }
-    in.pddx = ps.pdd.x();
-    in.pddy = ps.pdd.y();
-    in.pddz = ps.pdd.z();
-    in.wdx = ps.wd.x();
-    in.wdy = ps.wd.y();
-    in.wdz = ps.wd.z();
+    set_plate_accelerations(ps, in);
     double b[6];
     if (ks.thin && level != Dynamics::Full) {   // the thin part's specialised kernel does it all
         double n[3], qdd[3];

@@ -40,6 +40,15 @@ inline DesignTarget fig4_fixed_point() {
     return t;
 }
 
+// foot.json turned to THETA = 2 by a plate that only translates (the orient tests' design).
+inline DesignTarget foot_orient_target() {
+    DesignTarget t;
+    t.kind = DesignTargetKind::Orient;
+    t.theta = 2.0;
+    return t;
+}
+inline DesignOptions foot_orient_options() { return searched(2, 80, 8, 2); }
+
 inline DesignTarget transport(const Vec2& velocity) {
     DesignTarget t;
     t.kind = DesignTargetKind::Transport;

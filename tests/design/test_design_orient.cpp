@@ -55,10 +55,8 @@ TEST_CASE(
 TEST_CASE("orient: a part with a rubber foot is turned to THETA from anywhere, by a plate that only translates",
           "[design][orient]") {
     const Scene foot = scene("foot");
-    DesignTarget t;
-    t.kind = DesignTargetKind::Orient;
-    t.theta = 2.0;
-    DesignOptions o = searched(2, 80, 8, 2);
+    const DesignTarget t = foot_orient_target();
+    DesignOptions o = foot_orient_options();
     const DesignSummary s = design(foot, t, o);
     INFO(s.failure);
     REQUIRE(s.verified);

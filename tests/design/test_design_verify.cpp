@@ -150,10 +150,8 @@ TEST_CASE("an orient design judged against THETA + 0.1 rad: every run ends 0.1 r
     // stands for 0.05 rad: each run at 2 verify_distance (to the turn's error), the worst beyond
     // verify_distance; against THETA itself, within it.
     const Scene foot = scene("foot");
-    DesignTarget t;
-    t.kind = DesignTargetKind::Orient;
-    t.theta = 2.0;
-    const DesignOptions o = searched(2, 80, 8, 2);
+    const DesignTarget t = foot_orient_target();
+    const DesignOptions o = foot_orient_options();
     const DesignSummary s = design(foot, t, o);
     INFO(s.failure);
     REQUIRE(s.verified);
