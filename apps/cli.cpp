@@ -46,6 +46,7 @@ constexpr AddCommand kCommands[] = {
     add_bench,          // plate bench
     add_design,         // plate design
     add_sweep,          // plate sweep
+    add_robustness,     // plate robustness
 };
 
 }   // namespace

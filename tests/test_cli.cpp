@@ -2,6 +2,8 @@
 // message naming the file and field, and no output file.
 #include <nlohmann/json.hpp>
 
+#include "cli_run.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -16,48 +18,7 @@
 #include <tuple>
 #include <vector>
 
-namespace fs = std::filesystem;
-
 namespace {
-
-struct Run {
-    int code;
-    std::string out, err;
-};
-
-// A folder of this test process's own, removed when the process ends (ctest runs each test case
-// as a process: without it, every run left one behind in /tmp).
-struct OwnTmpDir {
-    fs::path p;
-    ~OwnTmpDir() {
-        std::error_code ec;
-        fs::remove_all(p, ec);
-    }
-};
-fs::path tmpdir() {
-    static const OwnTmpDir d{[] {
-        fs::path p = fs::temp_directory_path() / ("plate_cli_" + std::to_string(::getpid()));
-        fs::create_directories(p);
-        return p;
-    }()};
-    return d.p;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-Run run(const std::string& args) {
-    const fs::path o = tmpdir() / "stdout", e = tmpdir() / "stderr";
-    const std::string cmd = std::string(PLATE_EXE) + " " + args + " > " + o.string() + " 2> " + e.string();
-    const int st = std::system(cmd.c_str());
-    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(o), slurp(e)};
-}
-
-const std::string kScenes = PLATE_SOURCE_DIR "/scenes/";
 
 std::string fig4_with(const std::string& from, const std::string& to) {
     std::string s = slurp(kScenes + "fig4.json");
@@ -288,8 +249,8 @@ TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the t
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    const std::string commands[] = {"twist", "field",  "fixed-points", "simulate", "random-scene",
-                                    "bench", "design", "proofs",       "report",   "sweep"};
+    const std::string commands[] = {"twist",  "field",  "fixed-points", "simulate", "random-scene", "bench",
+                                    "design", "proofs", "report",       "sweep",    "robustness"};
     const Run top = run("--help");
     CHECK(top.code == 0);
     // The program's help names every exit code a command can return.

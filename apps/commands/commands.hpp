@@ -39,5 +39,6 @@ Command add_report(CLI::App& app);         // report.cpp
 Command add_bench(CLI::App& app);          // bench.cpp
 Command add_design(CLI::App& app);         // design.cpp
 Command add_sweep(CLI::App& app);          // sweep.cpp
+Command add_robustness(CLI::App& app);     // robustness.cpp
 
 }   // namespace plate::cli

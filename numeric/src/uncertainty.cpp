@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace plate {
 namespace {
@@ -69,61 +70,80 @@ double sample(const Spread& s, Rng& r) {
     return s.distribution == Distribution::uniform ? r.uniform(-s.spread, s.spread) : s.spread * standard_normal(r);
 }
 
-// The unmodelled harmonics of one draw (UncertaintySpec::unmodelled_up_to).
-void add_unmodelled(const PlateMotion& nominal, const UncertaintySpec& spec, Rng& r, PlateMotion& out) {
-    if (spec.unmodelled_up_to < 1 || spec.unmodelled_rms_fraction <= 0) return;
+// The unmodelled harmonics a spec adds to `nominal`: on each axis with a commanded signal, every n up to
+// spec.unmodelled_up_to that the axis does not command (UncertaintySpec::unmodelled_up_to), with the
+// standard deviation of each of their two coefficients (UncertainParameter).
+struct Unmodelled {
+    int axis = 0, n = 0;
+    double sd = 0;
+};
+std::vector<Unmodelled> unmodelled_of(const PlateMotion& nominal, const UncertaintySpec& spec) {
+    std::vector<Unmodelled> out;
+    if (spec.unmodelled_up_to < 1 || spec.unmodelled_rms_fraction <= 0) return out;
     const Vec6 rms = axis_rms(nominal);
     for (int a = 0; a < 6; ++a) {
         if (rms[a] <= 0) continue;
         std::set<int> commanded;
         for (const auto& h : nominal.harmonics)
             if (static_cast<int>(h.axis) == a) commanded.insert(h.n);
-        std::vector<Harmonic> added;
-        double power = 0;   // mean square of the added harmonics before scaling
-        for (int n = 1; n <= spec.unmodelled_up_to; ++n) {
-            if (commanded.count(n)) continue;
-            const double amp = standard_normal(r), phase = r.uniform(0, 2 * kPi);
-            added.push_back(Harmonic{static_cast<Axis>(a), n, amp, phase});
-            power += amp * amp / 2;
-        }
-        if (power <= 0) continue;
-        const double scale = spec.unmodelled_rms_fraction * rms[a] / std::sqrt(power);
-        for (auto& h : added) {
-            h.amp *= scale;
-            out.harmonics.push_back(h);
-        }
+        const std::size_t first = out.size();
+        for (int n = 1; n <= spec.unmodelled_up_to; ++n)
+            if (!commanded.count(n)) out.push_back(Unmodelled{a, n, 0});
+        const double K = static_cast<double>(out.size() - first);
+        for (std::size_t k = first; k < out.size(); ++k) out[k].sd = spec.unmodelled_rms_fraction * rms[a] / std::sqrt(K);
     }
+    return out;
 }
 
-Scene draw_once(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index, int attempt) {
-    Scene s = nominal;
-    Part& p = s.part;
+// The deviations p of one attempt at draw `index` (the layout of uncertain_parameters). Unmodelled
+// harmonics: per axis, random amplitudes (normal) and phases (uniform), scaled so that their sum's RMS
+// is exactly the spec's fraction of the axis's; p holds each one's (cos, sin) coefficients.
+std::vector<double> deviations(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index, int attempt) {
+    const Part& part = nominal.part;
+    std::vector<double> p;
     Rng rf = stream(spec, index, Stream::friction, attempt);
-    for (int i = 0; i < p.contacts(); ++i) p.mu[i] *= 1 + sample(spec.friction, rf);
-    if (p.point) p.mu.tail<2>().setConstant(p.mu[0]);
+    for (int i = 0; i < part.contacts(); ++i) p.push_back(sample(spec.friction, rf));
     Rng rm = stream(spec, index, Stream::mass, attempt);
-    p.m *= 1 + sample(spec.mass, rm);
-    if (!p.point) {
+    p.push_back(sample(spec.mass, rm));
+    if (!part.point) {
         Rng ri = stream(spec, index, Stream::inertia, attempt);
-        p.J *= 1 + sample(spec.inertia, ri);
+        p.push_back(sample(spec.inertia, ri));
         Rng rc = stream(spec, index, Stream::contacts, attempt), rd = stream(spec, index, Stream::com, attempt);
         const double dx = 1e-3 * sample(spec.com_offset_mm, rd), dy = 1e-3 * sample(spec.com_offset_mm, rd);
-        for (auto& c : p.c) {
+        for (int i = 0; i < 3; ++i) {
             const double ex = 1e-3 * sample(spec.contacts_mm, rc), ey = 1e-3 * sample(spec.contacts_mm, rc);
-            c += Vec3(ex - dx, ey - dy, 0);
+            p.push_back(ex);
+            p.push_back(ey);
         }
+        p.push_back(dx);
+        p.push_back(dy);
     }
+    const std::size_t H = nominal.plate.harmonics.size();
     Rng ra = stream(spec, index, Stream::amplitude, attempt), rp = stream(spec, index, Stream::phase, attempt);
-    for (auto& h : s.plate.harmonics) {
-        h.amp *= 1 + sample(spec.amplitude, ra);
-        h.phase += sample(spec.phase, rp);
-    }
+    for (std::size_t h = 0; h < H; ++h) p.push_back(sample(spec.amplitude, ra));
+    for (std::size_t h = 0; h < H; ++h) p.push_back(sample(spec.phase, rp));
     Rng ru = stream(spec, index, Stream::unmodelled, attempt);
-    add_unmodelled(nominal.plate, spec, ru, s.plate);
+    const std::vector<Unmodelled> added = unmodelled_of(nominal.plate, spec);
+    for (std::size_t k = 0; k < added.size();) {   // one axis's harmonics at a time
+        std::size_t end = k;
+        double power = 0;   // their mean square before scaling
+        std::vector<std::pair<double, double>> amp_phase;
+        for (; end < added.size() && added[end].axis == added[k].axis; ++end) {
+            const double amp = standard_normal(ru), phase = ru.uniform(0, 2 * kPi);
+            amp_phase.emplace_back(amp, phase);
+            power += amp * amp / 2;
+        }
+        // The scale f RMS_a / sqrt(power), with sd = f RMS_a / sqrt(K_a).
+        const double scale = added[k].sd * std::sqrt(static_cast<double>(end - k) / power);
+        for (const auto& [amp, phase] : amp_phase) {   // amp sin(x + phase) = amp sin(phase) cos x + amp cos(phase) sin x
+            p.push_back(scale * amp * std::sin(phase));
+            p.push_back(scale * amp * std::cos(phase));
+        }
+        k = end;
+    }
     Rng rT = stream(spec, index, Stream::period, attempt);
-    s.plate.T *= 1 + sample(spec.period, rT);
-    s.name = nominal.name + "~" + std::to_string(index);
-    return s;
+    p.push_back(sample(spec.period, rT));
+    return p;
 }
 
 }   // namespace
@@ -197,18 +217,85 @@ void validate_uncertainty(const UncertaintySpec& s) {
                "expected a number from 0 to 1 (of the commanded signal's RMS), got " + Reader::fmt(s.unmodelled_rms_fraction));
 }
 
+std::vector<UncertainParameter> uncertain_parameters(const Scene& nominal, const UncertaintySpec& spec) {
+    static const char* axis_name[6] = {"x", "y", "z", "rx", "ry", "rz"};
+    static const char* axis_unit[6] = {"m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2"};
+    const Part& part = nominal.part;
+    std::vector<UncertainParameter> out;
+    auto add = [&](const std::string& name, const char* unit, double sd) { out.push_back(UncertainParameter{name, unit, sd}); };
+    for (int i = 0; i < part.contacts(); ++i)
+        add("friction[" + std::to_string(i) + "]", "relative", spec.friction.standard_deviation());
+    add("mass", "relative", spec.mass.standard_deviation());
+    if (!part.point) {
+        add("inertia", "relative", spec.inertia.standard_deviation());
+        for (int i = 0; i < 3; ++i)
+            for (const char* c : {".x", ".y"})
+                add("contact[" + std::to_string(i) + "]" + c, "m", 1e-3 * spec.contacts_mm.standard_deviation());
+        add("com.x", "m", 1e-3 * spec.com_offset_mm.standard_deviation());
+        add("com.y", "m", 1e-3 * spec.com_offset_mm.standard_deviation());
+    }
+    auto harmonic = [&](const Harmonic& h) {
+        return std::string("[") + axis_name[static_cast<int>(h.axis)] + ",n=" + std::to_string(h.n) + "]";
+    };
+    for (const auto& h : nominal.plate.harmonics) add("amp" + harmonic(h), "relative", spec.amplitude.standard_deviation());
+    for (const auto& h : nominal.plate.harmonics) add("phase" + harmonic(h), "rad", spec.phase.standard_deviation());
+    for (const auto& u : unmodelled_of(nominal.plate, spec)) {
+        const std::string at = std::string("unmodelled[") + axis_name[u.axis] + ",n=" + std::to_string(u.n) + "]";
+        add(at + ".cos", axis_unit[u.axis], u.sd);
+        add(at + ".sin", axis_unit[u.axis], u.sd);
+    }
+    add("period", "relative", spec.period.standard_deviation());
+    return out;
+}
+
+Scene perturbed(const Scene& nominal, const UncertaintySpec& spec, const std::vector<double>& p) {
+    const std::vector<Unmodelled> added = unmodelled_of(nominal.plate, spec);
+    const std::size_t H = nominal.plate.harmonics.size(), rigid = nominal.part.point ? 0 : 9;
+    const std::size_t want = nominal.part.contacts() + 1 + rigid + 2 * H + 2 * added.size() + 1;
+    if (p.size() != want)
+        throw std::invalid_argument("perturbed: " + std::to_string(p.size()) + " deviations for a layout of " +
+                                    std::to_string(want) + " (uncertain_parameters)");
+    Scene s = nominal;
+    Part& part = s.part;
+    std::size_t k = 0;
+    for (int i = 0; i < part.contacts(); ++i) part.mu[i] *= 1 + p[k++];
+    if (part.point) part.mu.tail<2>().setConstant(part.mu[0]);
+    part.m *= 1 + p[k++];
+    if (!part.point) {
+        part.J *= 1 + p[k++];
+        const Vec3 com(p[k + 6], p[k + 7], 0);
+        for (auto& c : part.c) {
+            c += Vec3(p[k], p[k + 1], 0) - com;
+            k += 2;
+        }
+        k += 2;
+    }
+    for (auto& h : s.plate.harmonics) h.amp *= 1 + p[k++];
+    for (auto& h : s.plate.harmonics) h.phase += p[k++];
+    for (const auto& u : added) {
+        const double c = p[k++], sn = p[k++];   // c cos(n w t) + sn sin(n w t) = amp sin(n w t + phase)
+        if (c != 0 || sn != 0)
+            s.plate.harmonics.push_back(Harmonic{static_cast<Axis>(u.axis), u.n, std::hypot(c, sn), std::atan2(c, sn)});
+    }
+    s.plate.T *= 1 + p[k++];
+    return s;
+}
+
 UncertaintySpec load_uncertainty(const std::string& path) {
     return parse_uncertainty(detail::read_input_file(path, "uncertainty spec"), path);
 }
 
-Scene draw(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index) {
+Draw draw_with_deviations(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index) {
     validate_uncertainty(spec);
     std::string last;
     for (int attempt = 0; attempt < kMaxRedraws; ++attempt) {
-        Scene s = draw_once(nominal, spec, index, attempt);
+        Draw d;
+        d.p = deviations(nominal, spec, index, attempt);
+        d.scene = perturbed(nominal, spec, d.p);
+        d.scene.name = nominal.name + "~" + std::to_string(index);
         try {
-            validate_scene(s);
-            return s;
+            validate_scene(d.scene);
+            return d;
         } catch (const InputError& e) {
             last = e.what();
         }
@@ -216,6 +303,10 @@ Scene draw(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t inde
     throw InputError((spec.source.empty() ? std::string("(uncertainty)") : spec.source) + ": draw " + std::to_string(index) +
                      " of " + (nominal.source.empty() ? nominal.name : nominal.source) + " gave no valid scene in " +
                      std::to_string(kMaxRedraws) + " tries (the spreads are too wide for this part); the last: " + last);
+}
+
+Scene draw(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index) {
+    return draw_with_deviations(nominal, spec, index).scene;
 }
 
 }   // namespace plate

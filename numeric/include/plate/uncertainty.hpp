@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace plate {
 
@@ -66,6 +67,38 @@ void validate_uncertainty(const UncertaintySpec& spec);                         
 // fails validate_scene (negative friction, a part that tips, ...) is redrawn from the next stream of
 // the same (seed, index). Named "<name>~<index>".
 Scene draw(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index);
+
+// THE SPEC AS PARAMETERS. A draw is the nominal scene moved by a vector p of independent scalar
+// deviations, one per entry of uncertain_parameters (in its order): the linearisation the fixed
+// points' sensitivities use (robustness.hpp) and the draws apply the same p through perturbed().
+//   friction[i]        mu_i (1 + p), relative (a point part: one, for its one coefficient)
+//   mass, inertia      m (1 + p), J (1 + p), relative (inertia: rigid parts)
+//   contact[i].x/.y    c_i + p, m (rigid parts)
+//   com.x/.y           every c_i - p, m: the centre of mass moved by p (rigid parts)
+//   amp[h], phase[h]   harmonic h of the nominal plate (its order): amp (1 + p), phase + p [rad]
+//   unmodelled[a,n].cos/.sin   an added harmonic p_c cos(n w t) + p_s sin(n w t) on axis a, in the
+//                      axis's unit: every n <= up_to that a commanded axis a does not command
+//   period             T (1 + p), relative
+// standard_deviation is p's over draws: a Spread's, and for an unmodelled coefficient
+// f RMS_a / sqrt(K_a) (K_a harmonics added on axis a at RMS fraction f: each harmonic's random
+// amplitude and uniform phase give E[p_c^2] = E[p_s^2] = E[amp^2] / 2 = f^2 RMS_a^2 / K_a). Every
+// entry is listed, a zero spread's too (standard deviation 0).
+struct UncertainParameter {
+    std::string name;                // as above, e.g. "friction[2]", "amp[rx,n=1]", "unmodelled[z,n=4].sin"
+    const char* unit = "";           // "relative", "m", "rad", "m/s^2" or "rad/s^2"
+    double standard_deviation = 0;   // of p over draws, in its unit
+};
+std::vector<UncertainParameter> uncertain_parameters(const Scene& nominal, const UncertaintySpec& spec);
+// The nominal scene with deviations p applied (p.size() == uncertain_parameters(...).size(); zero: the
+// nominal). Not validated: a large p may give no valid scene (draw() redraws such p).
+Scene perturbed(const Scene& nominal, const UncertaintySpec& spec, const std::vector<double>& p);
+
+// Draw number `index` with its deviations p (draw(nominal, spec, index) == perturbed(nominal, spec, p)).
+struct Draw {
+    Scene scene;
+    std::vector<double> p;
+};
+Draw draw_with_deviations(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t index);
 
 // The RMS over a period of each axis of u(t) (x y z in m/s^2, rx ry rz in rad/s^2): harmonics of one
 // axis and one n add as phasors.
