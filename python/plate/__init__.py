@@ -10,6 +10,7 @@ program, from Python::
     fp = plate.fixed_points(f)                             # fp.points: stable, unstable, saddle
     tr = plate.simulate(scene, start=(0.03, -0.02, 1.0), time=5.0, dynamics="full")
     d = plate.design(plate.load_scene("scenes/fig1_point.json"), sink=(0.02, -0.01))   # d.scene, d.verified
+    r = plate.robustness(d.scene, "scenes/uncertainty/ppod.json", draws=50)          # r.outcomes, r.radius95
 
 Results carry numpy arrays and ``summary``, the command line's JSON as a dict.  Errors raise
 ``plate.InputError`` (a ValueError; bad scenes, with the file and field named as the command line
@@ -17,16 +18,15 @@ names them), ValueError (bad options) or RuntimeError.  The GIL is released whil
 """
 import json as _json
 
-from ._plate import (Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Scene, Stop,
+from ._plate import (Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Robustness, Scene, Stop,
                      Trajectory, coning_rate, design, field, fixed_points, load_scene, orientation_harmonics, parse_scene,
-                     simulate, twist)
+                     robustness, simulate, twist, uncertain_parameters)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
-__all__ = ["Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Scene", "Stop",
-           "Trajectory", "coning_rate", "design", "field", "fixed_points", "load_scene", "orientation_harmonics", "parse_scene",
-           "scene_from_dict",
-           "scene_to_dict", "simulate", "twist"]
+__all__ = ["Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Robustness", "Scene",
+           "Stop", "Trajectory", "coning_rate", "design", "field", "fixed_points", "load_scene", "orientation_harmonics",
+           "parse_scene", "robustness", "scene_from_dict", "scene_to_dict", "simulate", "twist", "uncertain_parameters"]
 
 
 def scene_from_dict(d, source="<dict>"):

@@ -31,6 +31,7 @@ void bind_field(py::module_& m);          // field.cpp:    Field, field
 void bind_fixed_points(py::module_& m);   // field.cpp:    FixedPoint, FixedLine, FixedPoints, fixed_points
 void bind_design(py::module_& m);         // design.cpp:   Design, design, orientation_harmonics, coning_rate
 void bind_simulate(py::module_& m);       // simulate.cpp: Trajectory, simulate
+void bind_robustness(py::module_& m);     // robustness.cpp: Robustness, robustness, uncertain_parameters
 
 // --- conversions (conversions.cpp) ---------------------------------------------------------------
 

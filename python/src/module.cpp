@@ -33,4 +33,5 @@ PYBIND11_MODULE(_plate, m) {
     bind_fixed_points(m);
     bind_design(m);
     bind_simulate(m);
+    bind_robustness(m);
 }

@@ -240,3 +240,29 @@ def test_the_gil_is_released_while_a_field_is_computed():
     counted = state["end"][1] - state["start"][1]
     assert seconds > 20 * interval, "the field must outlast many switch intervals for this test to mean anything"
     assert counted > 4 * interval * rate, (counted, interval * rate)
+
+
+@pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
+def test_robustness_is_the_command_lines_and_takes_a_spec_as_a_file_or_a_dict(tmp_path):
+    scene, spec = scene_path("designs/fig4_fixed_point"), os.path.join(SOURCE, "scenes", "uncertainty", "ppod.json")
+    out = tmp_path / "rob.json"
+    cli = subprocess.run([EXE, "robustness", scene, "--uncertainty", spec, "--draws", "4", "--starts", "1",
+                          "--full-draws", "0", "--out", str(out)], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    with open(spec) as f:
+        spec_dict = json.load(f)
+    for given in (spec, spec_dict):
+        r = plate.robustness(plate.load_scene(scene), given, draws=4, starts=1, full_draws=0)
+        got, want = r.summary, json.loads(out.read_text())
+        for d in (got, want):
+            d.pop("seconds")
+            d["sensitivity"].pop("seconds")
+            d.pop("uncertainty")          # (the source: the path, or "<dict>")
+        assert got == want
+        assert sorted(r.outcomes) == sorted(want["outcomes"])
+        assert r.fixed_points.shape == (4, 3) and r.deviations.shape[0] == 4
+        assert r.deviations.shape[1] == len(plate.uncertain_parameters(plate.load_scene(scene), given))
+    bad = dict(spec_dict, friction={"spread": 0.9})
+    with pytest.raises(plate.InputError) as err:
+        plate.robustness(plate.load_scene(scene), bad, draws=1)
+    assert "friction.spread" in str(err.value)
