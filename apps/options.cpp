@@ -1,6 +1,8 @@
 // The shared layer of the plate command line: see options.hpp.
 #include "options.hpp"
 
+#include "plate/measured_cycle.hpp"
+
 #include "plate/output.hpp"
 
 #include <CLI/CLI.hpp>
@@ -194,6 +196,30 @@ Scene scene_arg(const std::string& file, Io& cio) {
     if (cio.farm->root())
         for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
     return sc;
+}
+
+void add_measured_options(Options& p, MeasuredArgs& m) {
+    p.text("--measured", m.file, "CYCLE.csv", "the plate motion from one measured period (t,x,y,z,rx,ry,rz; with --harmonics)");
+    p.whole("--harmonics", m.harmonics, 1, 10'000, "the measured cycle's harmonics kept, 1..N");
+}
+
+Scene measured_arg(const Options& a, const MeasuredArgs& m, Scene sc, Io& cio) {
+    if (a.has("--measured") != a.has("--harmonics")) throw UsageError("--measured FILE and --harmonics N go together");
+    if (!a.has("--measured")) return sc;
+    std::string text;
+    const bool root = !cio.farm || cio.farm->root();
+    if (root) {
+        std::ifstream in(m.file, std::ios::binary);
+        std::stringstream buf;
+        buf << in.rdbuf();
+        text = in ? "S" + buf.str() : "E";
+    }
+    if (cio.farm && cio.farm->ranks() > 1) cio.farm->broadcast(text);
+    if (text.empty() || text[0] != 'S') throw InputError(m.file + ": cannot open measured cycle");
+    const MeasuredCycle cycle = parse_measured_cycle(text.substr(1), m.file, m.harmonics);
+    if (root)
+        for (const std::string& w : cycle.warnings) cio.err << "warning: " << m.file << ": " << w << "\n";
+    return with_measured_plate(sc, cycle);
 }
 
 Vec3 config_arg(const Options& a, const std::string& k, const std::vector<double>& v, const Scene& sc, bool required) {

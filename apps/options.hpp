@@ -137,6 +137,18 @@ private:
 // the same error, and only rank 0 prints warnings.
 Scene scene_arg(const std::string& file, Io& cio);
 
+// A measured cycle in place of the scene's plate motion (issue 51; measured_cycle.hpp): --measured
+// CYCLE.csv --harmonics N, both or neither.
+struct MeasuredArgs {
+    std::string file;
+    int harmonics = 0;
+};
+// Declares --measured and --harmonics on a command.
+void add_measured_options(Options& p, MeasuredArgs& m);
+// `sc` with its plate motion replaced by the measured cycle's harmonics 1..N when --measured is given
+// (its warnings to err; read as the scene is under mpirun, by rank 0 and sent to every rank); else sc.
+Scene measured_arg(const Options& a, const MeasuredArgs& m, Scene sc, Io& cio);
+
 // --NAME's numbers (`v`, given or not, option k of `a`): 3 for a rigid part, 2 for a point part; zero
 // when not given and not required.
 Vec3 config_arg(const Options& a, const std::string& k, const std::vector<double>& v, const Scene& sc, bool required);

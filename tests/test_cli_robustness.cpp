@@ -2,11 +2,17 @@
 // one thread or two), and bad input refused with exit code 2, the file or option named, no output.
 #include "cli_run.hpp"
 
+#include "plate/scene_io.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <array>
+#include <cmath>
+#include <sstream>
 #include <string>
+#include <vector>
 
 TEST_CASE("plate robustness writes outcome shares, the spread and the sensitivities as JSON", "[cli][robustness]") {
     const std::string scene = kScenes + "designs/fig4_fixed_point.json", spec = kScenes + "uncertainty/ppod.json";
@@ -64,5 +70,69 @@ TEST_CASE("plate robustness: bad input exits 2 naming the file or option, and wr
         CHECK(r.code == 2);
         CHECK(r.err.find(expect) != std::string::npos);
         CHECK_FALSE(fs::exists(out));
+    }
+}
+
+namespace {
+
+// One period of `sc`'s plate acceleration sampled at M points, in the measured-cycle CSV form
+// (columns permuted by `order`: the identity writes x y z rx ry rz in place).
+std::string measured_csv(const plate::Scene& sc, int M, const std::array<int, 6>& order = {0, 1, 2, 3, 4, 5}) {
+    std::ostringstream o;
+    o.precision(17);
+    o << "t [s],x [m/s^2],y [m/s^2],z [m/s^2],rx [rad/s^2],ry [rad/s^2],rz [rad/s^2]\n";
+    for (int k = 0; k < M; ++k) {
+        const double t = sc.plate.T * k / M;
+        plate::Vec3 a, w;
+        sc.plate.acceleration(t, a, w);
+        const double u[6] = {a[0], a[1], a[2], w[0], w[1], w[2]};
+        o << t;
+        for (int c : order) o << ',' << u[c];
+        o << '\n';
+    }
+    return o.str();
+}
+
+}   // namespace
+
+TEST_CASE("--measured: a recorded cycle of a scene's own plate gives its twist; a mislabelled one does not", "[cli][measured]") {
+    const std::string fig4 = kScenes + "fig4.json";
+    const plate::Scene sc = plate::load_scene(fig4);
+    const fs::path good = tmpdir() / "fig4_cycle.csv", swapped = tmpdir() / "fig4_xy_swapped.csv";
+    std::ofstream(good) << measured_csv(sc, 64);
+    std::ofstream(swapped) << measured_csv(sc, 64, {1, 0, 2, 3, 4, 5});
+    auto twist = [](const Run& r) {
+        INFO(r.err);
+        REQUIRE(r.code == 0);
+        const auto j = nlohmann::json::parse(r.out)["twist"];
+        return std::vector<double>{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+    };
+    const std::string at = " --at 0.01 -0.02 0.5";
+    const auto nominal = twist(run("twist " + fig4 + at));
+    // fig4 commands n = 1 only; harmonics 1..3 from 64 samples recover it to rounding (the DFT's
+    // test: 1e-15), and the cycle converges to the same twist within its tolerance (1e-7 v_ref).
+    const auto measured = twist(run("twist " + fig4 + at + " --measured " + good.string() + " --harmonics 3"));
+    for (int c = 0; c < 3; ++c) CHECK(measured[c] == Approx(nominal[c]).margin(1e-6));
+    const auto wrong = twist(run("twist " + fig4 + at + " --measured " + swapped.string() + " --harmonics 3"));
+    CHECK(std::abs(wrong[0] - nominal[0]) + std::abs(wrong[1] - nominal[1]) > 1e-3);
+    // Every command that takes a scene takes the cycle, and refuses it alone or broken, exit 2.
+    const fs::path broken = tmpdir() / "broken_cycle.csv";
+    std::string text = measured_csv(sc, 64);
+    const std::size_t row2 = text.find('\n', text.find('\n') + 1) + 1;   // the second sample's row: line 3
+    text.replace(row2, 1, "x");
+    std::ofstream(broken) << text;
+    const std::pair<std::string, std::string> cases[] = {
+        {"twist " + fig4 + at + " --measured " + good.string(), "--measured FILE and --harmonics N go together"},
+        {"field " + fig4 + " --grid 2 --harmonics 3", "--measured FILE and --harmonics N go together"},
+        {"fixed-points " + fig4 + " --grid 2 --measured /nonexistent.csv --harmonics 3", "/nonexistent.csv: cannot open"},
+        {"simulate " + fig4 + " --dynamics u --from 0 0 0 --time 0.1 --measured " + broken.string() + " --harmonics 3",
+         broken.string() + ":3:1"},
+        {"twist " + fig4 + at + " --measured " + good.string() + " --harmonics 32", "64 samples resolve harmonics up to n = 31"},
+    };
+    for (const auto& [args, expect] : cases) {
+        const Run r = run(args);
+        INFO(args << "\n" << r.err);
+        CHECK(r.code == 2);
+        CHECK(r.err.find(expect) != std::string::npos);
     }
 }

@@ -12,6 +12,7 @@ struct FieldArgs : Options {
     std::string scene, format = "json", out = "-";
     GridArgs grid;
     CycleArgs cycle;
+    MeasuredArgs measured;
     long max_work = 2'000'000'000L;
     explicit FieldArgs(CLI::App& app)
         : Options(app, "field", "asymptotic twist field on a grid over (s_x, s_y, theta), JSON or CSV",
@@ -27,12 +28,13 @@ struct FieldArgs : Options {
         text("--out", out, "FILE", "the output file (default: standard output)");
         whole("--max-work", max_work, 1000, kMaxWorkLimit, "work budget of the field, right-hand sides");
         add_cycle_options(*this, cycle);
+        add_measured_options(*this, measured);
     }
 };
 
 int cmd_field(const FieldArgs& a, Io& cio) {
     launched_farm(cio, a.grid.threads);
-    const Scene sc = scene_arg(a.scene, cio);
+    const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
     const GridSpec g = grid_opts(a, a.grid);
     const std::string format = a.format;
     if (format != "json" && format != "csv") throw UsageError("--format: expected json or csv");

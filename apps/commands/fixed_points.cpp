@@ -13,6 +13,7 @@ struct FixedPointsArgs : Options {
     std::string scene, out = "-";
     GridArgs grid;
     CycleArgs cycle;
+    MeasuredArgs measured;
     long max_work = 2'000'000'000L;
     explicit FixedPointsArgs(CLI::App& app)
         : Options(app, "fixed-points", "zeros of the field, refined and classified (stable, unstable, saddle; lines)",
@@ -25,12 +26,13 @@ struct FixedPointsArgs : Options {
         text("--out", out, "FILE", "the output file (default: standard output)");
         whole("--max-work", max_work, 1000, kMaxWorkLimit, "work budget of the field, right-hand sides");
         add_cycle_options(*this, cycle);
+        add_measured_options(*this, measured);
     }
 };
 
 int cmd_fixed_points(const FixedPointsArgs& a, Io& cio) {
     launched_farm(cio, a.grid.threads);
-    const Scene sc = scene_arg(a.scene, cio);
+    const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
     const LimitCycleOptions cycle = cycle_opts(a, a.cycle);
     const GridSpec g = grid_opts(a, a.grid);
     const Field f = bounded_field(sc, g, cycle, a.grid.threads, a.max_work, cio);

@@ -3,7 +3,6 @@
 #include "commands.hpp"
 
 #include "plate/farm.hpp"
-#include "plate/measured_cycle.hpp"
 #include "plate/output.hpp"
 #include "plate/robustness.hpp"
 
@@ -15,12 +14,12 @@ namespace plate::cli {
 namespace {
 
 struct RobustnessArgs : Options {
-    std::string scene, spec, out = "-", measured;
+    std::string scene, spec, out = "-";
     std::vector<double> target;
     GridArgs grid;
     CycleArgs cycle;
     RobustnessOptions o;
-    int harmonics = 0;
+    MeasuredArgs measured;
     explicit RobustnessArgs(CLI::App& app)
         : Options(app, "robustness",
                   "outcome probabilities, fixed-point spread and sensitivities of a plate motion under an uncertainty spec",
@@ -46,8 +45,7 @@ struct RobustnessArgs : Options {
         number("--horizon", o.horizon, "the longest arrival followed [s]");
         number("--curve-step", o.curve_step, "RK4 step of the field's integral curves [s]");
         whole("--full-draws", o.full_draws, 0, 1'000'000, "draws also run in full dynamics from the starts");
-        text("--measured", measured, "CYCLE.csv", "the plate motion from a measured cycle (with --harmonics)");
-        whole("--harmonics", harmonics, 1, 10'000, "the measured cycle's harmonics kept");
+        add_measured_options(*this, measured);
         text("--out", out, "FILE", "the output file (default: standard output)");
         add_grid_options(*this, grid);
         add_cycle_options(*this, cycle);
@@ -57,13 +55,7 @@ struct RobustnessArgs : Options {
 int cmd_robustness(const RobustnessArgs& a, Io& cio) {
     launched_farm(cio, a.grid.threads);
     if (!a.has("--uncertainty")) throw UsageError("missing --uncertainty SPEC.json");
-    if (a.has("--measured") != a.has("--harmonics")) throw UsageError("--measured FILE and --harmonics N go together");
-    Scene sc = scene_arg(a.scene, cio);
-    if (a.has("--measured")) {
-        const MeasuredCycle m = read_measured_cycle(a.measured, a.harmonics);
-        for (const std::string& w : m.warnings) cio.err << "warning: " << a.measured << ": " << w << "\n";
-        sc = with_measured_plate(sc, m);
-    }
+    const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
     const UncertaintySpec spec = load_uncertainty(a.spec);
     RobustnessOptions o = a.o;
     if (!(o.horizon > 0)) throw UsageError("--horizon: expected a positive number of seconds");

@@ -27,6 +27,7 @@ struct SimulateArgs : Options {
     std::string max_periods;   // (accepted as always, any value: no simulation reads it)
     long max_steps = 0;
     bool verify = false;
+    MeasuredArgs measured;
     explicit SimulateArgs(CLI::App& app)
         : Options(app, "simulate", "U-dynamics, full-dynamics or field-integral-curve trajectory, CSV",
                   "Trajectory from configuration --from with part twist --twist relative to the plate\n"
@@ -58,6 +59,7 @@ struct SimulateArgs : Options {
         number("--tol", tol, "limit-cycle tolerance of the field curve");
         text("--max-periods", max_periods, "N", "(not used by simulate)");
         number("--model-tol", model_tol, "auto: the error allowed");
+        add_measured_options(*this, measured);
         flag("--verify", verify, "auto: also run the full model and report the measured error");
         whole("--max-steps", max_steps, 1, 1'000'000'000'000L, "work budget, integrator steps", "2e7, field 1e4");
     }
@@ -97,7 +99,7 @@ void check_simulate_work(const Scene& sc_run, const std::string& dyn, const Vec3
 }
 
 int cmd_simulate(const SimulateArgs& a, Io& cio) {
-    const Scene sc = scene_arg(a.scene, cio);
+    const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
     std::string dyn = a.dynamics;
     if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "averaged" && dyn != "auto")
         throw UsageError("--dynamics: expected full, u, field, averaged or auto");

@@ -14,6 +14,7 @@ struct TwistArgs : Options {
     std::string scene;
     std::vector<double> at, from;
     CycleArgs cycle;
+    MeasuredArgs measured;
     explicit TwistArgs(CLI::App& app)
         : Options(app, "twist", "asymptotic twist (36) at one configuration, as JSON",
                   "Asymptotic twist (36) of the reduced U-dynamics limit cycle at (SX, SY, THETA), starting\n"
@@ -25,11 +26,12 @@ struct TwistArgs : Options {
         numbers("--at", at, 2, 3, "SX SY THETA", "the configuration (point parts: SX SY); required");
         numbers("--from", from, 2, 3, "VX VY OMEGA", "the part's twist relative to the plate at the start");
         add_cycle_options(*this, cycle);
+        add_measured_options(*this, measured);
     }
 };
 
 int cmd_twist(const TwistArgs& a, Io& cio) {
-    const Scene sc = scene_arg(a.scene, cio);
+    const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
     const Vec3 q = config_arg(a, "--at", a.at, sc, true);
     const Vec3 qd = config_arg(a, "--from", a.from, sc, false);
     const LimitCycleSummary lc = limit_cycle(sc, q, cycle_opts(a, a.cycle), qd);
