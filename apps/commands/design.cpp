@@ -23,7 +23,10 @@ struct DesignArgs : Options {
     double period = 0, hold = DesignOptions{}.hold, max_coning = DesignOptions{}.max_coning;
     std::uint64_t seed = 1;
     int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations, harmonics = 0;
-    std::string axes;
+    std::string axes, robust;
+    double arrive = DesignOptions{}.arrive, robust_radius = DesignOptions{}.robust_radius,
+           robust_share = DesignOptions{}.robust_share;
+    int robust_draws = DesignOptions{}.robust_draws;
     explicit DesignArgs(CLI::App& app)
         : Options(app, "design",
                   "the plate motion that sends a part where wanted: a sink, fixed point, orientation or transport, verified",
@@ -48,7 +51,13 @@ struct DesignArgs : Options {
                   "phase, turns the field about the plate's centre, so it limits the coning). --axes and --harmonics\n"
                   "narrow each target's motion family (sinks x, y, rx, ry at n = 1, 3; line sinks y, rx at n = 1;\n"
                   "transport and orienters x, y, z at n = 1, 2; rigid fixed points all six at n = 1, 2): the other\n"
-                  "harmonics stay zero. Writes the designed\n"
+                  "harmonics stay zero. --robust SPEC (sinks and fixed points): the design must hold on the plates\n"
+                  "the uncertainty spec draws -- a point part's sink is searched with its fixed point's first-order 95 %\n"
+                  "radius within --robust-radius (default 0.002 m); every robust design is then verified on\n"
+                  "--robust-draws fresh draws (default 200; plate robustness): the target unique and reached from every\n"
+                  "start within --arrive seconds (default 60) on at least --robust-share of them (default 0.95), their\n"
+                  "95 % radius within --robust-radius, and full dynamics on the nominal plate and 10 drawn ones arriving.\n"
+                  "Writes the designed\n"
                   "scene to --out and a JSON summary to stdout; exit 4 (and no scene) if the design fails verification.\n") {
         scene_file(scene, "PART_SCENE");
         words("--target", target, 1, 8, "KIND ...", design_target_usage() + "; required");
@@ -63,6 +72,11 @@ struct DesignArgs : Options {
         number("--max-coning", max_coning, "a sink's largest coning rate [rad/s] (negative: from the hold)", "from the hold");
         text("--axes", axes, "x,y,z,rx,ry,rz", "the axes the motion may use (default: the target's own)");
         whole("--harmonics", harmonics, 1, 64, "the highest harmonic n the motion may use (default: the target's own)");
+        text("--robust", robust, "SPEC.json", "design for the plates this uncertainty spec draws (sinks, fixed points)");
+        number("--arrive", arrive, "robust: every start reaches the target within this [s]");
+        number("--robust-radius", robust_radius, "robust: the fixed point's 95 % radius over the draws [m]");
+        number("--robust-share", robust_share, "robust: the share of draws that must succeed");
+        whole("--robust-draws", robust_draws, 1, 100000, "robust: the verification's draws");
     }
 };
 
@@ -87,7 +101,8 @@ void judge_options(const DesignOptions& o) {
     } catch (const std::invalid_argument& e) {
         std::string m = e.what();
         const std::pair<const char*, const char*> flags[] = {
-            {"local_evaluations:", "evaluations:"}, {"max_harmonic:", "harmonics:"}, {"max_coning:", "max-coning:"}};
+            {"local_evaluations:", "evaluations:"}, {"max_harmonic:", "harmonics:"},    {"max_coning:", "max-coning:"},
+            {"robust_radius:", "robust-radius:"},   {"robust_share:", "robust-share:"}, {"robust_draws:", "robust-draws:"}};
         for (const auto& [name, flag] : flags)
             if (m.rfind(name, 0) == 0) m = flag + m.substr(std::string(name).size());
         throw UsageError("--" + m);
@@ -109,6 +124,12 @@ DesignOptions design_options(const DesignArgs& a) {
     o.starts = a.starts;
     o.local_evaluations = a.evaluations;
     if (a.has("--harmonics")) o.max_harmonic = a.harmonics;
+    if (a.has("--robust")) o.robust = load_uncertainty(a.robust);
+    o.arrive = a.arrive;
+    o.robust_radius = a.robust_radius;
+    o.robust_share = a.robust_share;
+    o.robust_draws = a.robust_draws;
+    o.robust_full_draws = std::min(o.robust_full_draws, o.robust_draws);
     if (a.has("--axes")) {
         std::istringstream in(a.axes);
         std::string name;

@@ -146,6 +146,13 @@ void validate_design_options(const DesignOptions& o) {
     require(o.starts >= 0, "starts: expected >= 0 (0: the target's default)");
     require(o.local_evaluations >= 1, "local_evaluations: expected >= 1");
     require(o.max_harmonic >= 0, "max_harmonic: expected >= 0 (0: the target's own)");
+    if (o.robust) validate_uncertainty(*o.robust);
+    require(o.robust_radius > 0 && o.robust_radius <= 0.05, "robust_radius: expected 0 to 0.05 m");
+    require(o.robust_angle > 0 && o.robust_angle <= kPi, "robust_angle: expected 0 to pi rad");
+    require(o.robust_share > 0 && o.robust_share <= 1, "robust_share: expected a share in (0, 1]");
+    require(o.robust_draws >= 1 && o.robust_draws <= 100000, "robust_draws: expected 1 to 100000");
+    require(o.robust_full_draws >= 0 && o.robust_full_draws <= o.robust_draws, "robust_full_draws: expected 0 to robust_draws");
+    require(o.arrive > 0 && o.arrive <= 3600, "arrive: expected 0 to 3600 s");
 }
 
 void validate_design_target(const DesignTarget& target, const Scene& part_scene, const DesignOptions& opt) {
@@ -159,6 +166,14 @@ void validate_design_target(const DesignTarget& target, const Scene& part_scene,
             throw std::invalid_argument("a " + r->name + " target is built for " + (rigid ? "point" : "rigid") + " parts only");
         return;
     }
+    if (opt.robust && target.kind != DesignTargetKind::Sink && target.kind != DesignTargetKind::FixedPoint)
+        throw std::invalid_argument(
+            "robust: designed for sinks and fixed points only (the outcomes of plate robustness are "
+            "about a fixed point)");
+    if (opt.robust && rigid && target.kind == DesignTargetKind::Sink)
+        throw std::invalid_argument(
+            "robust: a rigid part's sink leaves its orientation free, so it has no fixed point to "
+            "follow over the draws; design a fixed point");
     if (target.kind == DesignTargetKind::Transport) {
         if (!(target.velocity.norm() > 0)) throw std::invalid_argument("a transport target needs a velocity");
         if (target.omega != 0)

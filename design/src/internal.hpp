@@ -241,6 +241,20 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
     return std::isfinite(best_f[best]) ? best_p[best] : std::vector<double>{};
 }
 
+// --- robust designs (robust.cpp) ------------------------------------------------------------------
+
+// The search holds the first-order radius to this fraction of robust_radius: the verification's 95 %
+// radius is an order statistic of its draws, 5 % uncertain at 200 (docs/decisions/uncertainty.md).
+constexpr double kRobustRadiusMargin = 0.85;
+
+// The first-order 95 % radius under `spec` of the fixed point at `at` of final_scene (its plate the
+// final, shifted motion, as the draws perturb it); infinite where a cycle failed. Counts its cycles.
+double first_order_radius95(const Scene& final_scene, const UncertaintySpec& spec, const Vec2& at, const LimitCycleOptions& lo,
+                            std::atomic<long>& cycles);
+// The verification on the spec's draws (DesignOptions::robust): sum.robustness, a note, and on failure
+// verified false with the reason.
+void verify_robust(DesignSummary& sum, const DesignTarget& target, const DesignOptions& opt);
+
 // --- verification (verify.cpp) -------------------------------------------------------------------
 
 constexpr const char* kNoFeasibleMotion = "no motion within the limits keeps the part on the plate over the region";
@@ -467,7 +481,16 @@ struct SinkProblem : Problem<SinkProblem> {
             // the zero's distance from THETA, in 0.01 rad (capped: a motion whose cycles fail scores 1e3, worse)
             turn = std::min(50.0, std::abs(w[1]) / std::max(slope, 1e-3) / 0.01);
         }
-        return -rate + 10 * outward + 10 * std::max(0.0, offset / 0.001 - 1) + 10 * std::max(0.0, turn - 1);
+        // Robust (a point part's sink): the first-order spread of the final motion's fixed point.
+        double spread = 0;
+        if (opt.robust && part.part.point && !orient) {
+            Scene fin = part;
+            fin.plate = combined(shift_motion(sink_motion(p, T), D));
+            spread = std::min(50.0, std::max(0.0, first_order_radius95(fin, *opt.robust, D, opt.cycle, *cycles) /
+                                                          (kRobustRadiusMargin * opt.robust_radius) -
+                                                      1));
+        }
+        return -rate + 10 * outward + 10 * std::max(0.0, offset / 0.001 - 1) + 10 * std::max(0.0, turn - 1) + 10 * spread;
     }
 };
 

@@ -91,6 +91,8 @@ DesignSummary design_sink(const Scene& part_scene, const DesignTarget& target, c
     sum.scene.plate = combined(shift_motion(sink_motion(best, T), target.at));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
     sum.coning = coning_rate(sum.scene.plate);
+    if (opt.robust && part_scene.part.point)
+        sum.predicted_radius95 = first_order_radius95(sum.scene, *opt.robust, target.at, opt.cycle, cycles);
 
     // --- verification: the field's fixed points on the grid (a rigid part: where its position's
     // field vanishes near the target, at each of the grid's orientations), then full dynamics from

@@ -111,6 +111,20 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     j["limit_cycles"] = d.cycles;
     j["seconds"] = d.seconds;
     j["notes"] = d.notes;
+    if (opt.robust) {   // (the Monte Carlo's JSON as plate robustness writes it, without its per-draw rows)
+        nlohmann::json r = {
+            {"spec", opt.robust->source}, {"radius_m", opt.robust_radius}, {"share", opt.robust_share}, {"arrive_s", opt.arrive}};
+        if (d.predicted_radius95 > 0) r["search_first_order_radius95_mm"] = 1e3 * d.predicted_radius95;
+        if (d.robustness) {
+            RobustnessOptions ro;
+            ro.horizon = opt.arrive;
+            ro.arrive_distance = opt.verify_distance;
+            nlohmann::json mc = robustness_json(*d.robustness, ro, *opt.robust);
+            mc.erase("per_draw");
+            r["monte_carlo"] = mc;
+        }
+        j["robust"] = r;
+    }
     return j;
 }
 

@@ -339,7 +339,8 @@ Share wilson(int k, int n) {
     const double z = 1.959963984540054, p = static_cast<double>(k) / n, z2n = z * z / n;
     const double centre = (p + z2n / 2) / (1 + z2n);
     const double half = z * std::sqrt(p * (1 - p) / n + z2n / (4 * n)) / (1 + z2n);
-    return {p, std::max(0.0, centre - half), std::min(1.0, centre + half)};
+    // (At k = 0 the lower end is 0 exactly, at k = n the upper is 1: written so, not left to rounding.)
+    return {p, k == 0 ? 0.0 : centre - half, k == n ? 1.0 : centre + half};
 }
 
 }   // namespace plate

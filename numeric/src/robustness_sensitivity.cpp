@@ -19,15 +19,17 @@ Vec3 twist(const Scene& sc, const Vec3& q, const LimitCycleOptions& lo, const Ve
 }   // namespace
 
 void fixed_point_sensitivities(const Scene& nominal, const UncertaintySpec& spec, const Vec3& q_star,
-                               const LimitCycleOptions& cycle, RobustnessSummary& out) {
+                               const LimitCycleOptions& cycle, RobustnessSummary& out, const SensitivityOptions& so) {
     const auto t0 = std::chrono::steady_clock::now();
     const bool point = nominal.part.point;
     const int dim = point ? 2 : 3;
     // The derivatives need a field far less noisy than their differences: the refinement's accuracy
     // (FixedPointOptions), cycles to 1e-8 v_ref and steps to 1e-9.
     LimitCycleOptions lo = cycle;
-    lo.tol = std::min(lo.tol, 1e-8);
-    lo.integration.rtol = std::min(lo.integration.rtol, 1e-9);
+    if (so.refine) {
+        lo.tol = std::min(lo.tol, 1e-8);
+        lo.integration.rtol = std::min(lo.integration.rtol, 1e-9);
+    }
     const double rho = point ? 1 : nominal.part.rho();
     // Differences of 1e-4 m in position and 1e-4 / rho rad in theta: a hundredth of the field's
     // variation length (a centimetre) and a few hundred times the field's noise relative to them.
@@ -47,7 +49,7 @@ void fixed_point_sensitivities(const Scene& nominal, const UncertaintySpec& spec
     };
     // Two Newton steps put q* on the tighter field's zero (the grid's refinement stopped at 1e-6 v_ref).
     Eigen::Matrix3d J = jacobian(q);
-    for (int it = 0; it < 2; ++it) {
+    for (int it = 0; it < (so.refine ? 2 : 0); ++it) {
         Vec3 f = twist(nominal, q, lo, warm);
         if (point) f[2] = 0;
         q -= J.lu().solve(f);

@@ -21,6 +21,7 @@
 
 #include "plate/design_target.hpp"
 #include "plate/field.hpp"
+#include "plate/robustness.hpp"
 
 #include <cstdint>
 #include <string>
@@ -144,6 +145,25 @@ struct DesignOptions {
     // narrow (a target whose family is left with nothing to move fails cleanly, naming why).
     std::vector<Axis> axes;
     int max_harmonic = 0;
+    // ROBUST DESIGN (issue 51): with `robust`, the design must hold on the plates the spec draws, not only
+    // on the nominal one (sinks and fixed points: DesignTargetKind::Sink and FixedPoint).
+    //  - A point part's sink: the search also keeps the fixed point's first-order 95 % radius under the
+    //    spec (robustness.hpp's sensitivities at the target, on the final motion) within 0.85 of
+    //    robust_radius (a penalty, like the region's edge: 10 per radius over; the margin is for the
+    //    verification's Monte Carlo, whose 95 % radius is an order statistic).
+    //  - Verification adds `robust_draws` draws of the spec (plate robustness, seed spec.seed: draws the
+    //    search never saw): the share with the target's fixed point unique and stable must reach
+    //    robust_share and the draws' 95 % radius must be within robust_radius (a rigid part's angle within
+    //    robust_angle); the field's integral curves from the robustness starts, on every draw, and the full
+    //    dynamics from them on the first robust_full_draws draws, must come within verify_distance (and
+    //    0.05 rad) of the target within `arrive` seconds.
+    std::optional<UncertaintySpec> robust;
+    double robust_radius = 0.002;   // [m]
+    double robust_angle = 0.05;     // [rad]
+    double robust_share = 0.95;
+    int robust_draws = 200;
+    int robust_full_draws = 10;
+    double arrive = 60;   // [s]
     static LimitCycleOptions cycle_defaults() {
         LimitCycleOptions o;
         o.tol = 1e-6;
@@ -229,6 +249,10 @@ struct DesignSummary {
     double transport_spread = 0;      // [m/s]
     double transport_tolerance = 0;   // accepted |mean - target| [m/s]
     double seconds = 0;
+    // Robust designs (DesignOptions::robust): the search's first-order 95 % radius at the design found
+    // [m], and the verification's Monte Carlo over the spec.
+    double predicted_radius95 = 0;
+    std::optional<RobustnessSummary> robustness;
     std::vector<std::string> notes;   // the symmetries used, and what they imply
 };
 

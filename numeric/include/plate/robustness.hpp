@@ -54,7 +54,7 @@ struct RobustnessOptions {
     double arrive_distance = 0.005;   // arrival: within this of the target [m]
     double arrive_angle = 0.05;       // and this in theta [rad]
     double horizon = 60;              // the longest arrival followed [s] (later: not arrived)
-    double curve_step = 0.5;         // RK4 step of the field's integral curves [s] (the arrival times' resolution)
+    double curve_step = 0.5;          // RK4 step of the field's integral curves [s] (the arrival times' resolution)
     int full_draws = 4;               // draws (the first ones) also run in full dynamics from the starts
     bool sensitivities = true;
     int threads = 0;    // draws in parallel (0: all cores)
@@ -111,10 +111,17 @@ struct RobustnessSummary {
 // the nominal has no stable fixed point or several).
 RobustnessSummary robustness(const Scene& nominal, const UncertaintySpec& spec, const RobustnessOptions& opt = {});
 
-// The sensitivities alone, at a fixed point q* of the nominal (refined here first); fills `out`'s
-// first-order fields.
+// How the sensitivities are computed. `refine`: the cycles tightened to 1e-8 v_ref (steps 1e-9) and q*
+// moved onto that field's zero by two Newton steps first -- what plate robustness does; without it the
+// cycles are `cycle`'s and q* is taken as given (a design's search, where q* is a zero by symmetry and
+// a hundred such evaluations must be cheap).
+struct SensitivityOptions {
+    bool refine = true;
+};
+
+// The sensitivities alone, at a fixed point q* of the nominal; fills `out`'s first-order fields.
 void fixed_point_sensitivities(const Scene& nominal, const UncertaintySpec& spec, const Vec3& q_star,
-                               const LimitCycleOptions& cycle, RobustnessSummary& out);
+                               const LimitCycleOptions& cycle, RobustnessSummary& out, const SensitivityOptions& so = {});
 
 // The radius r holding probability `level` of a centred 2-D normal distribution of covariance C
 // (P(|x| <= r) = level), by a one-dimensional integral; exact for a degenerate C too.
