@@ -63,6 +63,17 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// The generated friction_support's s and t alone: inlined (flatten) with its gradient and Hessian
+// written to scratch nobody reads, which the compiler then drops -- the same arithmetic for s and t,
+// about a tenth of the kernel's (its 632 temporaries are mostly the gradient's and Hessian's).
+#if defined(__GNUC__)
+__attribute__((flatten))
+#endif
+void support_terms(const gen::WrenchInput& in, double* s, double* t) {
+    double g[9], H[18];
+    gen::friction_support(in, s, t, g, H);
+}
+
 // A rigid part's gauge problem in the scaled coordinates of the Appendix: w = (F, tau / rho),
 // R_i = r_i / rho, cap_i = mu_si N_i the disks' radii; a twist d = (d_x, d_y, rho d_theta) moves
 // contact i with G_i^T d, a force f at contact i exerts the wrench G_i f.
@@ -104,8 +115,12 @@ struct GaugeProblem {
         win.xith = d.z();
         gen::friction_support(win, sp, term, gr, he);
     }
+    // P(d) alone (the line searches' and the pattern search's probes): support_terms.
     double h_at(const Vec3& d) {
-        support(d);
+        win.vx = d.x();
+        win.vy = d.y();
+        win.xith = d.z();
+        support_terms(win, sp, term);
         double h = 0;
         for (int i = 0; i < 3; ++i)
             if (sp[i] > 0) h += term[i];
