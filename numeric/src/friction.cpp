@@ -64,8 +64,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // The generated friction_support's s and t alone: inlined (flatten) with its gradient and Hessian
-// written to scratch nobody reads, which the compiler then drops -- the same arithmetic for s and t,
-// about a tenth of the kernel's (its 632 temporaries are mostly the gradient's and Hessian's).
+// written to scratch nobody reads, which the compiler then drops -- the same arithmetic for s and t
+// without the derivatives, most of the kernel. (docs/decisions.md, Mode evaluations without a cosine
+// per call)
 #if defined(__GNUC__)
 __attribute__((flatten))
 #endif
