@@ -1,6 +1,7 @@
 // Benchmark: stick-slip (issue 14). Not a test: nothing here passes or fails.
 //   (1) fields in one run: fig6 (78 of 343 configurations stick), heave_yaw (every configuration
 //       sticks) and the never-sticking fig4, wall time on 1 and all threads;
+//   (1d) plate's side of the peers study's question (d): fig6's sticking configurations from rest;
 //   (2) at equal accuracy, the event-driven engine against the regularised-friction method
 //       (f = -mu N v / sqrt(|v|^2 + eps^2) integrated by GSL's bsimp, the stiff method that works
 //       for it, see README): on a sample of fig6's sticking configurations, each method's error against
@@ -16,8 +17,11 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace plate;
@@ -26,6 +30,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double thread_cpu_seconds() {   // (the peers study's clock: this thread's CPU time)
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
 
 Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
 
@@ -141,6 +150,54 @@ void fig6_costs() {
     }
 }
 
+// (1d) plate's side of the peers study's question (d) (bench/peers/study.cpp): fig6's sticking
+// configurations (stick fraction > 0 in the field at tol 1e-10, rtol 1e-11), each cycle from rest on
+// one thread at the study's settings; its ratio is an engine's CPU time over the cheapest of these
+// at least as accurate as the engine.
+void peers_sticking() {
+    std::printf(
+        "\n(1d) fig6's sticking configurations, each cycle from rest (the peers study's question (d)): thread CPU\n"
+        "     time, best of three, right-hand sides, periods and the largest twist error against the tight field\n");
+    const Scene sc = scene("fig6");
+    FieldOptions tight;
+    tight.cycle.tol = 1e-10;
+    tight.cycle.integration.rtol = 1e-11;
+    const Field ref = compute_field(sc, GridSpec{}, tight);
+    std::vector<int> idx;
+    for (int i = 0; i < static_cast<int>(ref.points.size()); ++i) {
+        const FieldPoint& p = ref.points[i];
+        if (p.converged && *std::max_element(p.stick_fraction.begin(), p.stick_fraction.end()) > 0) idx.push_back(i);
+    }
+    for (const auto& [tol, rtol] :
+         std::vector<std::pair<double, double>>{{1e-2, 1e-4}, {1e-4, 1e-5}, {1e-6, 1e-7}, {1e-7, 1e-8}}) {
+        LimitCycleOptions o;
+        o.tol = tol;
+        o.integration.rtol = rtol;
+        double best = 1e300, err = 0;
+        long rhs = 0;
+        int periods = 0, converged = 0;
+        for (int run = 0; run < 3; ++run) {
+            err = 0;
+            rhs = 0;
+            periods = 0;
+            converged = 0;
+            const double t0 = thread_cpu_seconds();
+            for (int i : idx) {
+                const LimitCycleSummary lc = limit_cycle(sc, ref.points[i].q, o);
+                err = std::max(err, lc.converged ? distance(sc, lc.twist, ref.points[i].twist) : INFINITY);
+                rhs += lc.stats.rhs_evals;
+                periods += lc.periods;
+                converged += lc.converged;
+            }
+            best = std::min(best, thread_cpu_seconds() - t0);
+        }
+        std::printf(
+            "  tol %.0e, rtol %.0e: %zu configurations, %.4f s CPU (%.3f ms each), %ld right-hand sides, %.2f periods each, "
+            "%d converged, largest error %.1e\n",
+            tol, rtol, idx.size(), best, 1e3 * best / idx.size(), rhs, double(periods) / idx.size(), converged, err);
+    }
+}
+
 // (2) the engine against the regularised-friction method at equal accuracy.
 void against_regularised() {
     std::printf(
@@ -239,6 +296,7 @@ int main() {
 
     fields_timing();
     fig6_costs();
+    peers_sticking();
     against_regularised();
     return 0;
 }

@@ -57,14 +57,21 @@ void slip_velocities(const Part& part, const Vec3& q, const Vec3& qd, std::array
 }
 
 Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps) {
+    return detail::rhs_b(sc, level, q, qd, ps, std::cos(q[2]), std::sin(q[2]));
+}
+
+namespace detail {
+Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, double ct, double st) {
     const Part& P = sc.part;
+    Mat3 R2;   // rot_z(q[2])
+    R2 << ct, -st, 0, st, ct, 0, 0, 0, 1;
     const Vec3 s(q[0], q[1], P.s_z());
     const Vec3 ez = Vec3::UnitZ();
     Vec6 b;
     if (level != Dynamics::Full) {
         // (33), (34)
         b.head<3>() = P.m * (ps.pdd + ps.wd.cross(s) + sc.g * ez);
-        b.tail<3>() = P.point ? Vec3::Zero() : Vec3(P.J * (rot_z(q[2]).transpose() * ps.wd));
+        b.tail<3>() = P.point ? Vec3::Zero() : Vec3(P.J * (R2.transpose() * ps.wd));
         return b;
     }
     // (19): f_dagger = m R1^T (p'' + w1^ w1^ R1 s + w1'^ R1 s + 2 w1^ R1 s' + g e_z)
@@ -78,13 +85,14 @@ Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const
         return b;
     }
     // (30) with (28) corrected: d/dt(R2^T R1^T w1) = -R2^T w2^ R1^T w1 + R2^T R1^T w1'.
-    const Mat3 R2t = rot_z(q[2]).transpose();
+    const Mat3 R2t = R2.transpose();
     const Vec3 w2(0, 0, qd[2]);
     const Vec3 R1tw1 = R1.transpose() * ps.w1;
     const Vec3 w3 = w2 + R2t * R1tw1;   // (27)
     b.tail<3>() = P.J * (-(R2t * w2.cross(R1tw1)) + R2t * (R1.transpose() * ps.wd)) + w3.cross(P.J * w3);
     return b;
 }
+}   // namespace detail
 
 Workspace::Workspace() = default;
 Workspace::Workspace(const Workspace& o) = default;

@@ -13,6 +13,23 @@ inline Vec2 horizontal_offset(const Part& P, double theta, int i) {
     const double c = std::cos(theta), s = std::sin(theta);
     return Vec2(c * P.c[i].x() - s * P.c[i].y(), s * P.c[i].x() + c * P.c[i].y());   // r_i = R2 c_i
 }
+// r_i from the workspace's cache where it holds theta (detail::cos_sin), else computed.
+inline Vec2 horizontal_offset(const Part& P, const Workspace& ws, double theta, int i) {
+    return theta == detail::kernels(ws).theta ? ws.r[i] : horizontal_offset(P, theta, i);
+}
+// The contacts' slips, r_i from the cache where it holds theta.
+inline void slip_velocities_cached(const Part& P, const Workspace& ws, const Vec3& q, const Vec3& qd, std::array<Vec2, 3>& v) {
+    if (!P.point && q[2] == detail::kernels(ws).theta)
+        slip_velocities_at(P, ws.r, qd, v);
+    else
+        slip_velocities(P, q, qd, v);
+}
+inline Vec6 rhs_b_cached(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                         const Workspace& ws) {
+    double c, s;
+    detail::cos_sin(ws, q[2], c, s);
+    return detail::rhs_b(sc, level, q, qd, ps, c, s);
+}
 inline double kappa(Dynamics level) { return level == Dynamics::ReducedU ? 0.0 : 1.0; }
 
 // The generated kernels' inputs for the current configuration and twist (ws prepared).
@@ -37,7 +54,7 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
                  const std::array<Vec2, 3>& u, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
     const Part& P = sc.part;
-    const Vec6 b = rhs_b(sc, level, q, qd, ps);
+    const Vec6 b = rhs_b_cached(sc, level, q, qd, ps, ws);
     gen::KernelInput in = mode_input(q, qd, ws);
     in.u1x = u[0].x();
     in.u1y = u[0].y();
@@ -77,7 +94,7 @@ void pivot_solve(const Scene& sc, Dynamics level, int k, const Vec3& q, const Ve
 // q'' = 0: the needed friction total and moment, and the normal forces (generated stuck_solve).
 void stuck_solve(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
     const Part& P = sc.part;
-    const Vec6 b = rhs_b(sc, level, q, qd, ps);
+    const Vec6 b = rhs_b_cached(sc, level, q, qd, ps, ws);
     ws.b = b;
     ws.qdd.setZero();
     if (P.point) {   // one contact: N = b_z, F = b_xy (point_solve with s'' = 0)
@@ -126,7 +143,7 @@ void set_twist_hints(const Part& P, double theta, const Vec3& xi, Workspace& ws)
     detail::StickSlipState& ss = detail::stick_slip(ws);
     const double rho = P.rho();
     for (int i = 0; i < P.contacts(); ++i) {
-        const Vec2 r = horizontal_offset(P, theta, i);
+        const Vec2 r = horizontal_offset(P, ws, theta, i);
         const Vec2 v(xi[0] - xi[2] / rho * r.y(), xi[1] + xi[2] / rho * r.x());
         ss.hint[i] = v.norm() > 0 ? Vec2(v / v.norm()) : Vec2::Zero();
     }
@@ -303,18 +320,18 @@ void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Ve
             return;
         case ModeKind::Stuck:
             ++ws.evals;
-            slip_velocities(P, q, qd, ws.slip);
+            slip_velocities_cached(P, ws, q, qd, ws.slip);
             stuck_solve(sc, level, q, qd, ps, ws);
             return;
         case ModeKind::Pivot: {
             ++ws.evals;
-            slip_velocities(P, q, qd, ws.slip);
+            slip_velocities_cached(P, ws, q, qd, ws.slip);
             // The sliding contacts move on circles about c_k: v_j = theta' e_z x (r_j - r_k), whose
             // direction is the mode's sense times e_z x (r_j - r_k) (exact even at theta' = 0).
             std::array<Vec2, 3> u = zeros<Vec2>();
-            const Vec2 rk = horizontal_offset(P, q[2], mode.k);
+            const Vec2 rk = horizontal_offset(P, ws, q[2], mode.k);
             for (int j = 0; j < 3; ++j)
-                if (j != mode.k) u[j] = mode.sense * perp(horizontal_offset(P, q[2], j) - rk).normalized();
+                if (j != mode.k) u[j] = mode.sense * perp(horizontal_offset(P, ws, q[2], j) - rk).normalized();
             pivot_solve(sc, level, mode.k, q, qd, ps, u, ws);
             return;
         }

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 
 namespace plate::detail {
@@ -85,5 +86,22 @@ inline KernelScratch& kernels(Workspace& ws) { return ws.internals().kernels; }
 inline const KernelScratch& kernels(const Workspace& ws) { return ws.internals().kernels; }
 inline StickSlipState& stick_slip(Workspace& ws) { return ws.internals().stick_slip; }
 inline const StickSlipState& stick_slip(const Workspace& ws) { return ws.internals().stick_slip; }
+
+// cos and sin of theta from the configuration's cache (KernelScratch::theta: set_configuration in
+// dynamics.cpp, with r_i = R2 c_i in Workspace::r) where it holds this theta, else computed: the same
+// values, without a cosine and sine per evaluation in the modes' right-hand sides (modes.cpp).
+inline void cos_sin(const Workspace& ws, double theta, double& c, double& s) {
+    const KernelScratch& ks = kernels(ws);
+    if (theta == ks.theta) {
+        c = ks.in.ct;
+        s = ks.in.st;
+    } else {
+        c = std::cos(theta);
+        s = std::sin(theta);
+    }
+}
+
+// rhs_b (dynamics.hpp) with R2's cosine and sine given (cos_sin).
+Vec6 rhs_b(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, double ct, double st);
 
 }   // namespace plate::detail
