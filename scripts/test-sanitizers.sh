@@ -21,7 +21,7 @@ export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 # The union of the tags (a case with two of them, like the Fig. 6 field's, is listed once). Fig. 6's
 # pivoting cycles against the regularised reference (50 s under ASan) is left out: it runs the stiff
 # reference solver over cycles that the Fig. 6 field test takes the engine through here anyway.
-tags="[stick]~*pivoting cycles agree with the regularised*,[proofs],[kernels],[limit_cycle],[auto],[field],[sweep]"
+tags="[stick]~*pivoting cycles agree with the regularised*,[proofs],[kernels],[limit_cycle],[auto],[field],[sweep],[robustness]"
 work=build-asan/sanitizer-runs
 rm -rf "$work"; mkdir -p "$work"
 # (Catch2 2's listing exits with the number of cases it listed: its status says nothing. An alternative
