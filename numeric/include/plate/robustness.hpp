@@ -49,7 +49,7 @@ struct RobustnessOptions {
     GridSpec grid;                    // the field of every draw (default 7^3 over [-0.05, 0.05]^2 m)
     FixedPointOptions fixed;          // its cycles (fixed.cycle) and the refinement
     double match_distance = 0.01;     // a stable fixed point this near the target is the target's [m]
-    double match_angle = 0.3;         // and this near in theta [rad]
+    double match_angle = 0.5;         // and this near in theta [rad] (a half-turn twin is pi away)
     int starts = 8;                   // seeded starts, uniform over the grid's square and the full turn
     double arrive_distance = 0.005;   // arrival: within this of the target [m]
     double arrive_angle = 0.05;       // and this in theta [rad]
