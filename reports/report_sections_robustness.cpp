@@ -95,8 +95,7 @@ void outcome_figure(Ctx& c, const std::string& n, const RobustnessSummary& s) {
         for (int k = 0; k < kOutcomes; ++k) {
             const Share w = wilson(s.counts[k], draws);
             c.html << "<tr><td>" << outcome_name(static_cast<Outcome>(k)) << "</td><td>" << s.counts[k] << "</td><td>"
-                   << fmt(w.value, 3) << "</td><td>" << fmt(w.low < 1e-12 ? 0 : w.low, 3) << " – " << fmt(w.high, 3)
-                   << "</td></tr>\n";   // (a bound of 0 by the formula is 1e-18 in floating point)
+                   << fmt(w.value, 3) << "</td><td>" << fmt(w.low, 3) << " – " << fmt(w.high, 3) << "</td></tr>\n";
             d << k << " \"" << outcome_name(static_cast<Outcome>(k)) << "\" " << w.value << ' ' << w.low << ' ' << w.high << '\n';
         }
     }
