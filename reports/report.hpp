@@ -3,6 +3,8 @@
 // its seed, the machine and how long each part took.
 #pragma once
 
+#include "plate/model.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -21,7 +23,7 @@ struct ReportOptions {
 };
 
 // The report's sections, in page order: derivation, kernels, proofs, fig3, fields, design, orient,
-// fixed-point.
+// fixed-point, robustness.
 const std::vector<std::string>& report_section_names();
 // Throws std::invalid_argument ("'NAME' is not a section (derivation, kernels, ...)") for the first
 // name in `sections` that is not one of them.
@@ -55,6 +57,26 @@ std::string design_runs_caption(int reached, int runs, double distance, bool ver
 // The heading of a field's section: the figure's title and the scene's own name (from its file,
 // user text: escaped for HTML, as everything a user supplies that reaches the page).
 std::string scene_heading(const std::string& title, const std::string& scene_name, const std::string& file);
+
+// The robustness section's first-order ellipse: a centred 2-D normal distribution of covariance C
+// holds probability `level` inside {x : x^T C^-1 x <= k^2}, k = normal_ellipse_factor(level) =
+// sqrt(-2 ln(1 - level)) (2.4477 at 0.95: the chi-square quantile with 2 degrees of freedom); the
+// ellipse's semi-axes are k sqrt(eigenvalue) along C's eigenvectors. `points` + 1 points on it (the
+// last the first again); a degenerate C gives a segment.
+double normal_ellipse_factor(double level);
+std::vector<Vec2> covariance_ellipse(const Eigen::Matrix2d& C, double level = 0.95, int points = 96);
+
+// The robustness section's sentence on where the response is linear, from the Monte Carlo 95 % radius
+// and angle against the first-order ones (within 30 %: linear there) and the draws' linear-prediction
+// errors (RobustnessSummary's linear_error_*, nonlinear_draws).
+struct LinearityFigures {
+    bool rigid = false;
+    int matched = 0, nonlinear = 0;
+    double error_median = 0, error_max = 0;
+    double radius_mc = 0, radius_first = 0;   // [m]
+    double angle_mc = 0, angle_first = 0;     // [rad]
+};
+std::string linearity_sentence(const LinearityFigures& f);
 
 // The speed-accuracy study (`plate bench`): writes its charts into DIR and its section into
 // DIR/index.html (between the report's markers; a page of its own if there is no report yet).

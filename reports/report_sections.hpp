@@ -3,6 +3,7 @@
 //   report_sections_proofs.cpp  derivation, kernels, proofs, fig3
 //   report_sections_fields.cpp  fields (with stick-slip against the regularised-friction limit)
 //   report_sections_design.cpp  design, orient, fixed-point
+//   report_sections_robustness.cpp  robustness (the shipped designs under the PPOD spec)
 #pragma once
 
 #include "report.hpp"
@@ -21,5 +22,6 @@ void section_fields(html::Ctx& c, const std::filesystem::path& src, const Report
 void section_design(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_orient(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_fixed_point(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
+void section_robustness(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 
 }   // namespace plate::report

@@ -442,6 +442,14 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
     CHECK(images >= 15);
     for (const char* s : {"Symbolic derivation", "(28)", "Theorem 1", "Limit surfaces", "Fig. 3", "Fig. 4", "Seed 1"})
         CHECK(html.find(s) != std::string::npos);
+    // The robustness section: every shipped design (scenes/designs/*.json) with its outcomes, scatter against
+    // the first-order ellipse (a rigid part's x-theta too) and arrival times; sensitivities and the spread.
+    for (const char* s : {"<h2>Robustness", "40 draws in this quick run", "robustness_fig4_fixed_point_outcomes.svg",
+                          "robustness_fig4_fixed_point_scatter_xy.svg", "robustness_fig4_fixed_point_scatter_xtheta.svg",
+                          "robustness_fig4_fixed_point_arrival.svg", "robustness_point_sink_scatter_xy.svg",
+                          "robustness_point_sink_arrival.svg", "share of the position variance", "95 % radius [mm]"})
+        CHECK(html.find(s) != std::string::npos);
+    CHECK(html.find("robustness_point_sink_scatter_xtheta") == std::string::npos);   // (a point part has no theta)
     // Every paper figure's run from rest reached its full duration (a run that stops, as all of them
     // did when sticking stopped the program, is marked FAIL by the report and draws a dot).
     const std::size_t stopped = html.find("FAIL: the run from rest stopped");
@@ -475,9 +483,10 @@ TEST_CASE("plate report --sections computes only the named sections and says whi
     CHECK(html.find("fig3.svg") != std::string::npos);
     // Each left-out section's heading is absent (not computed, not only not named).
     for (const char* h : {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields",
-                          "<h2>Inverse design", "Orienting a part", "Fixing a rigid part"})
+                          "<h2>Inverse design", "Orienting a part", "Fixing a rigid part", "<h2>Robustness"})
         CHECK(html.find(h) == std::string::npos);
-    CHECK(html.find("Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point.") !=
+    CHECK(html.find(
+              "Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point, robustness.") !=
           std::string::npos);
     fs::remove_all(dir);
     r = run("report --quick --sections fig3 figure4 --out " + dir.string());

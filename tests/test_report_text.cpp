@@ -4,8 +4,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
 
 using plate::report::observation1_sentence;
 
@@ -64,7 +67,8 @@ TEST_CASE("write_report rejects an unknown section before it touches the report'
     } catch (const std::invalid_argument& e) {
         message = e.what();
     }
-    CHECK(message == "'figure4' is not a section (derivation, kernels, proofs, fig3, fields, design, orient, fixed-point)");
+    CHECK(message ==
+          "'figure4' is not a section (derivation, kernels, proofs, fig3, fields, design, orient, fixed-point, robustness)");
 }
 
 TEST_CASE("report: the captions that state a result follow this run's measurements", "[report][text]") {
@@ -90,4 +94,61 @@ TEST_CASE("report: the captions that state a result follow this run's measuremen
     CHECK(failed.find("the design failed verification: a full-dynamics run ended 0.05 m from the &lt;target&gt;") !=
           std::string::npos);
     CHECK(design_runs_caption(6, 6, 0.005, false, "the hold").find("converging on the target") == std::string::npos);
+}
+
+TEST_CASE("report: the robustness section's 95 % ellipse is the predicted covariance's", "[report][text]") {
+    using plate::report::covariance_ellipse;
+    using plate::report::normal_ellipse_factor;
+    // Closed form: a 2-D standard normal's squared radius is chi-square with 2 degrees of freedom,
+    // P(|z| <= k) = 1 - exp(-k^2 / 2), so 95 % is held within k = sqrt(-2 ln 0.05) = 2.4477468306808.
+    CHECK(normal_ellipse_factor(0.95) == Approx(2.4477468306808).epsilon(1e-12));
+    CHECK(1 - std::exp(-normal_ellipse_factor(0.95) * normal_ellipse_factor(0.95) / 2) == Approx(0.95).epsilon(1e-12));
+    // Covariance diag(a^2, b^2): semi-axes 2.4477 a along x and 2.4477 b along y (the extremes of the
+    // points; 96 points include the axes' ends).
+    const double a = 2e-3, b = 5e-4;
+    const std::vector<plate::Vec2> e = covariance_ellipse(Eigen::Vector2d(a * a, b * b).asDiagonal().toDenseMatrix());
+    double xmax = 0, ymax = 0;
+    for (const plate::Vec2& p : e) {
+        xmax = std::max(xmax, std::abs(p.x()));
+        ymax = std::max(ymax, std::abs(p.y()));
+    }
+    CHECK(xmax == Approx(2.4477468306808 * a).epsilon(1e-12));
+    CHECK(ymax == Approx(2.4477468306808 * b).epsilon(1e-12));
+    CHECK((e.front() - e.back()).norm() < 1e-15);   // closed
+    // A correlated covariance: every point on x^T C^-1 x = k^2 (round-off: 1e-15 measured, 1e-12 allowed).
+    Eigen::Matrix2d C;
+    C << 4e-6, -1.5e-6, -1.5e-6, 1e-6;
+    for (const plate::Vec2& p : covariance_ellipse(C))
+        CHECK(p.dot(C.inverse() * p) == Approx(2.4477468306808 * 2.4477468306808).epsilon(1e-12));
+}
+
+TEST_CASE("report: the robustness sentence says where the response is linear from the run's figures", "[report][text]") {
+    using namespace plate::report;
+    // As docs/decisions/uncertainty.md measured fig4's design (200 draws): radius 3.28 mm against 3.22 mm
+    // first order, angle 0.247 rad against 0.368 rad; median 16 %, 33 of 168 draws over 30 %.
+    LinearityFigures f;
+    f.rigid = true;
+    f.matched = 168;
+    f.nonlinear = 33;
+    f.error_median = 0.16;
+    f.error_max = 2.1;
+    f.radius_mc = 3.28e-3;
+    f.radius_first = 3.22e-3;
+    f.angle_mc = 0.247;
+    f.angle_first = 0.368;
+    const std::string fig4 = linearity_sentence(f);
+    CHECK(fig4.find("linear in position, not in angle") != std::string::npos);
+    CHECK(fig4.find("3.22 mm against 3.28 mm") != std::string::npos);
+    CHECK(fig4.find("0.368 rad against 0.247 rad") != std::string::npos);
+    CHECK(fig4.find("33 of 168 matched draws are more than 30 % off") != std::string::npos);
+    CHECK(fig4.find("median draw's fixed point is 16 %") != std::string::npos);
+    f.angle_first = 0.26;
+    CHECK(linearity_sentence(f).find("linear in position and in angle") != std::string::npos);
+    f.radius_first = 1e-3;   // first order a third of the Monte Carlo radius
+    CHECK(linearity_sentence(f).find("linear in angle, not in position") != std::string::npos);
+    f.rigid = false;
+    CHECK(linearity_sentence(f).find("not linear in position") != std::string::npos);
+    CHECK(linearity_sentence(f).find("angle") == std::string::npos);   // (a point part has none)
+    f.matched = 0;
+    CHECK(linearity_sentence(f).find("nothing to compare") != std::string::npos);
 }
