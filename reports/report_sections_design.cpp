@@ -48,9 +48,10 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     }
     c.html << "<h2>Inverse design</h2>\n<p>Plate motions designed by <code>design()</code> (NLopt COBYLA from " << o.starts
            << " seeded feasible starts, " << o.local_evaluations << " evaluations each) so that " << esc(part.name)
-           << "'s point part has its unique stable fixed point at the target, within amplitude limits of " << fmt(o.lin_limit, 3)
-           << " m/s² and " << fmt(o.ang_limit, 3) << " rad/s² per harmonic and keeping g + a<sub>z</sub> ≥ "
-           << fmt(o.flight_margin, 3) << " g over the plate; each verified on a " << o.verify_grid << "×" << o.verify_grid
+           << "'s point part has its unique stable fixed point at the target, within peak limits of " << fmt(o.lin_limit, 3)
+           << " m/s² and " << fmt(o.ang_limit, 3)
+           << " rad/s² (each axis' summed signal over the period) and keeping g + a<sub>z</sub> ≥ " << fmt(o.flight_margin, 3)
+           << " g over the plate; each verified on a " << o.verify_grid << "×" << o.verify_grid
            << " grid (one stable fixed point within " << fmt(1e3 * o.fixed_point_tolerance, 3) << " mm) and by "
            << o.verify_starts << " full-dynamics runs from seeded random starts (ending within "
            << fmt(1e3 * o.verify_distance, 3) << " mm), and by a part released at rest at the target still within that "
