@@ -18,13 +18,13 @@ names them), ValueError (bad options) or RuntimeError.  The GIL is released whil
 import json as _json
 
 from ._plate import (Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Scene, Stop,
-                     Trajectory, coning_rate, design, field, fixed_points, load_scene, orientation_harmonics, parse_scene,
+                     Trajectory, axis_peaks, coning_rate, design, field, fixed_points, load_scene, orientation_harmonics, parse_scene,
                      simulate, twist)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
 __all__ = ["Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Scene", "Stop",
-           "Trajectory", "coning_rate", "design", "field", "fixed_points", "load_scene", "orientation_harmonics", "parse_scene",
+           "Trajectory", "axis_peaks", "coning_rate", "design", "field", "fixed_points", "load_scene", "orientation_harmonics", "parse_scene",
            "scene_from_dict",
            "scene_to_dict", "simulate", "twist"]
 
