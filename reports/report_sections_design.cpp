@@ -19,11 +19,16 @@ using namespace html;
 // Inverse design (design.hpp): point-part sinks designed, verified, and shown -- the signal, the field
 // with its fixed point, and full-dynamics runs from the verification's random starts.
 // A design table row's first cells: the target, the verdict (with why it failed), unique, the rate,
-// evaluations and cycles.
+// evaluations, cycles and the designed signal's peaks (the axes that move).
 std::string design_cells(const std::string& target, const DesignSummary& d) {
+    std::string peaks;
+    for (int a = 0; a < 6; ++a)
+        if (d.peaks[a] > 0)
+            peaks += (peaks.empty() ? "" : ", ") + std::string(axis_name(static_cast<Axis>(a))) + " " + fmt(d.peaks[a], 3) +
+                     (a < 3 ? " m/s²" : " rad/s²");
     return "<tr><td>" + target + "</td><td>" + verdict(d.verified) + (d.verified ? "" : " " + esc(d.failure)) + "</td><td>" +
            (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) + "</td><td>" + std::to_string(d.evaluations) + "</td><td>" +
-           std::to_string(d.cycles) + "</td>";
+           std::to_string(d.cycles) + "</td><td>" + peaks + "</td>";
 }
 
 // The cell of the part released at the target: how far it is after the hold, marked beyond `allowed`,
@@ -48,9 +53,10 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     }
     c.html << "<h2>Inverse design</h2>\n<p>Plate motions designed by <code>design()</code> (NLopt COBYLA from " << o.starts
            << " seeded feasible starts, " << o.local_evaluations << " evaluations each) so that " << esc(part.name)
-           << "'s point part has its unique stable fixed point at the target, within amplitude limits of " << fmt(o.lin_limit, 3)
-           << " m/s² and " << fmt(o.ang_limit, 3) << " rad/s² per harmonic and keeping g + a<sub>z</sub> ≥ "
-           << fmt(o.flight_margin, 3) << " g over the plate; each verified on a " << o.verify_grid << "×" << o.verify_grid
+           << "'s point part has its unique stable fixed point at the target, within peak limits of " << fmt(o.lin_limit, 3)
+           << " m/s² and " << fmt(o.ang_limit, 3)
+           << " rad/s² (each axis' summed signal over the period) and keeping g + a<sub>z</sub> ≥ " << fmt(o.flight_margin, 3)
+           << " g over the plate; each verified on a " << o.verify_grid << "×" << o.verify_grid
            << " grid (one stable fixed point within " << fmt(1e3 * o.fixed_point_tolerance, 3) << " mm) and by "
            << o.verify_starts << " full-dynamics runs from seeded random starts (ending within "
            << fmt(1e3 * o.verify_distance, 3) << " mm), and by a part released at rest at the target still within that "
@@ -64,7 +70,7 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
               "verified at each of the grid's orientations, by runs from random positions and orientations, and "
               "held; the part may turn on at the sink).</p>\n"
               "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
-              "<th>cycles</th><th>worst end distance [mm]</th><th>seconds</th>"
+              "<th>cycles</th><th>peaks over the period</th><th>worst end distance [mm]</th><th>seconds</th>"
               "<th>coning [rad/s]</th><th>from the target, after the hold [mm]</th></tr>\n";
     DesignSummary first;
     Vec2 first_at = Vec2::Zero();
@@ -213,7 +219,8 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
            << d.starts << " starts, " << o.local_evaluations << " evaluations each), turned onto θ, verified on a ring of "
            << d.ring_theta.size() << " orientations and by " << d.runs.size() << " full-dynamics runs from random starts.</p>\n"
            << "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
-              "<th>cycles</th><th>worst end angle [rad]</th><th>travel at θ [m/s]</th><th>seconds</th></tr>\n"
+              "<th>cycles</th><th>peaks over the period</th><th>worst end angle [rad]</th><th>travel at θ "
+              "[m/s]</th><th>seconds</th></tr>\n"
            << design_cells("orient " + fmt(t.theta, 3), d) << "<td>" << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3)
            << "</td><td>" << fmt(d.transport_mean.norm(), 3) << "</td><td>" << fmt(d.seconds, 3) << "</td></tr>\n</table>\n";
     if (d.ring_theta.empty()) return;
@@ -282,7 +289,8 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
            << " evaluations each. What the design reports about how it got there:</p>\n<ul>\n";
     for (const std::string& n : d.notes) c.html << "<li>" << esc(n) << "</li>\n";
     c.html << "</ul>\n<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
-              "<th>cycles</th><th>target's share of the runs</th><th>other stable fixed points (share)</th><th>seconds</th>"
+              "<th>cycles</th><th>peaks over the period</th><th>target's share of the runs</th><th>other stable fixed points "
+              "(share)</th><th>seconds</th>"
               "<th>from the target, after the hold [mm]</th></tr>\n"
            << design_cells("fixed point (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ", " + fmt(t.theta, 3) + ")", d)
            << "<td>" << fmt(d.basin_share, 3) << "</td><td>";

@@ -42,7 +42,10 @@ struct DesignArgs : Options {
                   "  line-sink X Y PHI point part: every start ends on the line through (X, Y) along PHI [rad]\n"
                   "  transport VX VY   a uniform velocity (VX, VY) [m/s] over the plate (a rigid part: one friction\n"
                   "                    coefficient; OMEGA, a turn, is refused: see the README)\n"
-                  "--limits LIN ANG: the largest amplitude of each harmonic (default 20 m/s^2, 150 rad/s^2); g plus the\n"
+                  "--limits LIN ANG: the peak over the period of each axis' summed signal |u_a(t)|, what actuators\n"
+                  "saturate on: LIN for x, y, z [m/s^2], ANG for rx, ry, rz [rad/s^2] (default 20, 150), on the motion\n"
+                  "as designed (shifted, turned, rz added; the summary's \"peaks\"); not each harmonic's amplitude,\n"
+                  "which may exceed it where the others flatten the crest. g plus the\n"
                   "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
                   "seeded feasible motions (default 4 for sinks and line sinks, 16 otherwise),\n"
                   "--evaluations each (default 400). Verification: the field's fixed points on a 7x7 grid and full\n"
@@ -62,7 +65,8 @@ struct DesignArgs : Options {
         scene_file(scene, "PART_SCENE");
         words("--target", target, 1, 8, "KIND ...", design_target_usage() + "; required");
         text("--out", out, "SCENE.json", "the designed scene; required");
-        numbers("--limits", limits, 2, 2, "LIN ANG", "the largest harmonic amplitudes (default 20 m/s^2, 150 rad/s^2)");
+        numbers("--limits", limits, 2, 2, "LIN ANG",
+                "each axis' peak acceleration over the period, linear and angular (default 20 m/s^2, 150 rad/s^2)");
         number("--period", period, "the plate's period [s]", "the part scene's");
         whole("--seed", seed, 0, 1L << 40, "the seed");
         whole("--threads", threads, 0, 256, "threads (0: all cores)");

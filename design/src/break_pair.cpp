@@ -169,9 +169,9 @@ struct PairBreaker {
     // The motion with fixed point q, placed as place_and_verify_rigid will place it: within the limits,
     // the flight margin, and the coning and tilt-drift limits.
     bool fits(const PlateMotion& u, const Vec3& q) const {
-        double con[6 * 3 + 4];
-        placed_constraints(placed_motion(u, q, target.at, target.theta), opt, part_scene, 3, 1.0, con);
-        return *std::max_element(con, con + 6 * 3 + 4) <= 0;
+        double con[kPlacedConstraints];
+        placed_constraints(placed_motion(u, q, target.at, target.theta), opt, part_scene, 1.0, con);
+        return *std::max_element(con, con + kPlacedConstraints) <= 0;
     }
     // A ring of n values of theta' with exactly one stable zero: its fixed point by Newton from q (not
     // finite: the middle of the zero's cell at the centre), stable and within `reach` of the centre
@@ -235,16 +235,23 @@ std::string describe(const Candidate& c) {
 // The grid of rz's settings (amplitude at n = 1, its sense, amplitude at n = 2, its phase) screened on
 // the pair's motion. The placement turns the motion by THETA less the orientation found, and a pair
 // searched at the flight margin turned that far tilts its corners beyond it (fig4: 0.04-0.09 g over):
-// the sink's harmonics scaled down until some settings fit. The candidates ranked by the slowest
-// start's passage (the runs' length and the design's real speed), ties by the grid's order (tasks
-// finish in any order).
+// the sink's harmonics scaled down until some settings fit. rz's two harmonics share its peak limit: a
+// setting whose rz peaks beyond `room` is scaled down onto it (its ratio and phases kept). The
+// candidates ranked by the slowest start's passage (the runs' length and the design's real speed), ties
+// by the grid's order (tasks finish in any order).
 std::vector<Candidate> PairBreaker::screen_grid(const PlateMotion& aligned0, int& tried) const {
     std::vector<Candidate> found;
     std::vector<std::array<double, 4>> grid;   // (rz amplitude at n = 1, its sense, at n = 2, its phase)
     for (double a1 : {2.0 / 3, 1.0})
         for (double s1 : {1.0, -1.0})
             for (double a2 : {0.4, 0.5, 0.6, 0.7, 0.8, 1.0})
-                for (int k = 0; k < 24; ++k) grid.push_back({a1 * room, s1, a2 * room, -kPi + k * kPi / 12});
+                for (int k = 0; k < 24; ++k) {
+                    std::array<double, 4> g{a1 * room, s1, a2 * room, -kPi + k * kPi / 12};
+                    PlateMotion rz = with_rz(PlateMotion{aligned0.T, {}}, g);
+                    const double over = axis_peaks(rz)[5] / room;
+                    if (over > 1) g[0] /= over, g[2] /= over;
+                    grid.push_back(g);
+                }
     for (double scale : {1.0, 0.95, 0.9, 0.85, 0.8}) {
         PlateMotion base = aligned0;
         for (Harmonic& hm : base.harmonics) hm.amp *= scale;

@@ -80,6 +80,7 @@ DesignSummary design(const Scene& part_scene, const DesignTarget& target, const 
     for (const auto& [kind, designer] : kDesigners)
         if (kind == target.kind) sum = designer(part_scene, target, o, T);
     if (sum.starts == 0) sum.starts = o.starts;   // (set where a search ran its own number of starts)
+    judge_peaks(sum, o);                          // (the limits bound the motion returned, whatever built it)
     if (o.robust && sum.verified) verify_robust(sum, target, o);
     return sum;
 }

@@ -44,9 +44,17 @@ std::array<Vec2, 8> region_edge(double R);
 double cycle_noise(const LimitCycleOptions& o);
 // The option's task runner, else its threads.
 TaskRunner runner(const DesignOptions& opt);
-// c_k <= 0 for each axis' harmonics n = 1..n_max of `fin` within `room` times the axis' limit (6 n_max
-// entries, axis-major), then c <= 0 for no flight over the region; returns the entries written.
-int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room, double* c);
+// c_a <= 0 for each axis' peak of `fin` (axis_peaks) within `room` times the axis' limit (6 entries),
+// then c <= 0 for no flight over the region; returns the entries written (kPeakConstraints).
+constexpr int kPeakConstraints = 7;
+int peak_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c);
+
+// --- peaks (peaks.cpp) ---------------------------------------------------------------------------------
+// The largest |f| of the real trigonometric polynomial f(theta) = F_0 + 2 Re sum_{k >= 1} F_k e^{i k theta}
+// (F[0] real), to roundoff (peaks.cpp says how).
+double trig_peak(const std::vector<std::complex<double>>& F);
+// max over t of |(u_x(t), u_y(t))|: the largest peak of x (or y) over every turn of the motion about z.
+double horizontal_peak(const PlateMotion& u);
 
 // A search problem's bookkeeping. Derived (CRTP) supplies kParams, kConstraints, limit(i) (the
 // bound of parameter i), constraints(p, c) (c_k <= 0 when feasible) and evaluate(p).
@@ -99,7 +107,10 @@ struct Problem {
 
 // The multi-start search: from opt.starts seeded feasible random points (start 0: the problem's guess
 // if it has a feasible one; else each parameter uniform in +-limit/sqrt 2, the box shrinking after
-// every 100 infeasible tries, up to 1000), NLopt COBYLA with the constraints, opt.local_evaluations each,
+// every 100 infeasible tries, up to 1000), NLopt COBYLA with the constraints within the box +-limit
+// (a search range: a coefficient within the peak limits may reach 4 / pi of them, and a box that wide
+// made fig4's half-turn pair search fail; docs/decisions/design-and-tools.md, "Peak limits"),
+// opt.local_evaluations each,
 // starts in parallel; make(k) builds start k's problem. Returns the best feasible point over the
 // starts (empty if none) and adds the evaluations to `evaluations`.
 template <class P, class Make>
@@ -263,6 +274,8 @@ Field verification_field(const Scene& sc, const DesignOptions& opt);
 // What the grid's fixed-point search could not look at (empty: it searched every cell); a fixed point is
 // called unique only where this is empty.
 std::string unsearched(const FixedPoints& f);
+// The designed motion's peaks (sum.peaks) judged against the limits: a verified design beyond one fails.
+void judge_peaks(DesignSummary& sum, const DesignOptions& opt);
 // The hold's verdict (empty: held, or no hold asked): released at the target, the part ended beyond
 // verify_distance (`unit` names the distance) or left the model.
 std::string hold_failure(const DesignSummary& sum, const DesignOptions& opt, const std::string& unit);
@@ -408,17 +421,18 @@ struct SinkProblem : Problem<SinkProblem> {
     }
     static constexpr int kParams = 16;
     static constexpr const char* kFamily = "x, y, rx, ry at n = 1, 3";
-    static constexpr int kConstraints = 21;   // eighteen amplitudes (n = 1..3), the flight margin, coning both ways
+    static constexpr int kConstraints = kPeakConstraints + 2;   // six peaks, the flight margin, coning both ways
     double limit(int i) const { return i < 8 ? opt.lin_limit : opt.ang_limit; }
     bool is_free(int i) const { return free({Axis::x, Axis::y, Axis::rx, Axis::ry}, {1, 3}, i); }   // (sink_motion's layout)
 
-    // Constraints c_k <= 0 on the final (shifted) motion: each harmonic's amplitude within its
-    // limit, no flight under the part over the region, and no more coning than the hold allows.
+    // Constraints c_k <= 0 on the final (shifted) motion: each axis' peak within its limit (the shift
+    // adds -alpha x D to x and y), no flight under the part over the region, and no more coning than
+    // the hold allows.
     void constraints(const std::vector<double>& p, double* c) const {
         const PlateMotion fin = shift_motion(sink_motion(p, T), D);
         // (orient: 3 % of each limit and 0.02 g of the flight margin kept in hand for the placement's
         // small turn and shift onto the fixed point found)
-        const int k = amplitude_constraints(fin, opt, part, 3, orient ? 0.97 : 1.0, c);
+        const int k = peak_constraints(fin, opt, part, orient ? 0.97 : 1.0, c);
         if (orient) c[k - 1] += 0.02;
         const double psi = coning_rate(fin);
         const double cone = !std::isfinite(cone_limit) ? 0.0
@@ -518,13 +532,13 @@ DesignSummary design_rigid(const Scene& part_scene, const DesignTarget& target, 
 // The translating plate's motion (x, y, z at n = 1, 2; transport.cpp), which the weathervane shares.
 inline const std::vector<Axis> kTranslationAxes = {Axis::x, Axis::y, Axis::z};
 PlateMotion transport_motion(const std::vector<double>& p, double T);
-void translation_constraints(const std::vector<double>& p, const DesignOptions& opt, double g, double T, double* c);
 
 // What the rigid fixed point (rigid_fixed_point.cpp) and its broken pair (break_pair.cpp) share.
-// Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
-// `room`, no flight, no coning beyond kConingLimit either way and no tilt drift beyond kTiltDriftLimit
-// (6 n_max + 4 entries).
-void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room, double* c);
+// Constraints c_k <= 0 on a motion as placed: each axis' peak within its limit times `room`, no
+// flight, no coning beyond kConingLimit either way and no tilt drift beyond kTiltDriftLimit
+// (kPlacedConstraints entries).
+constexpr int kPlacedConstraints = kPeakConstraints + 3;
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c);
 // The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started
 // from the cycle at q. False if a cycle did not converge.
 bool twist_and_jacobian(const Scene& sc, const Vec3& q, const LimitCycleOptions& cyc, Vec3& xi, Mat3& J,

@@ -23,13 +23,13 @@ struct LineSinkProblem : Problem<LineSinkProblem> {
     double reach = 0;
     static constexpr int kParams = 4;
     static constexpr const char* kFamily = "y, rx at n = 1";
-    static constexpr int kConstraints = 7;   // six amplitudes, the flight margin
+    static constexpr int kConstraints = kPeakConstraints;   // six peaks, the flight margin
     double limit(int i) const { return i < 2 ? opt.lin_limit : opt.ang_limit; }
     bool is_free(int i) const { return free({Axis::y, Axis::rx}, {1}, i); }
     PlateMotion placed(const std::vector<double>& p) const {
         return shift_motion(rotate_motion(line_motion(p, T), target.theta), target.at);
     }
-    void constraints(const std::vector<double>& p, double* c) const { amplitude_constraints(placed(p), opt, part, 1, 1.0, c); }
+    void constraints(const std::vector<double>& p, double* c) const { peak_constraints(placed(p), opt, part, 1.0, c); }
     // The convergence rate onto the line, -dv_y/dy at y = 0 (v_y is odd: v_y(h) / h), and how much of
     // the region the field does not pull towards the line (four distances out to its reach).
     double evaluate(const std::vector<double>& p, double* rate_out = nullptr) {

@@ -59,28 +59,21 @@ RingZeros ring_zeros(const std::vector<double>& th, const std::vector<double>& w
     return z;
 }
 
-// The largest amplitude a turned pair of x, y phasors (X, Y) reaches over every turn: the square root
-// of the largest eigenvalue of their Gram matrix. The design is turned onto THETA afterwards, so the
-// limits must hold at every turn.
-double turned_amplitude(double xc, double xs, double yc, double ys) {
-    const double xx = xc * xc + xs * xs, yy = yc * yc + ys * ys, xy = xc * yc + xs * ys;
-    return std::sqrt(0.5 * (xx + yy) + std::hypot(0.5 * (xx - yy), xy));
-}
-
 struct OrientProblem : Problem<OrientProblem> {
     using Problem::Problem;
     static constexpr int kParams = 12;   // transport_motion's layout: x, y, z; n = 1, 2; cos, sin
     static constexpr const char* kFamily = "x, y, z at n = 1, 2";
-    static constexpr int kConstraints = 5;   // x-y at any turn (n = 1, 2), z (n = 1, 2), the flight margin
+    static constexpr int kConstraints = 3;   // x and y's peaks at any turn, z's, the flight margin
     double limit(int) const { return opt.lin_limit; }
     bool is_free(int i) const { return free(kTranslationAxes, {1, 2}, i); }
+    // The design is turned onto THETA afterwards, so x's and y's peak limits must hold at every turn:
+    // max_t |(u_x, u_y)| (horizontal_peak) within the limit.
     void constraints(const std::vector<double>& p, double* c) const {
         const double L = std::max(opt.lin_limit, 1e-12);
-        for (int h = 0; h < 2; ++h) {
-            c[h] = (turned_amplitude(p[2 * h], p[2 * h + 1], p[4 + 2 * h], p[4 + 2 * h + 1]) - opt.lin_limit) / L;
-            c[2 + h] = (std::hypot(p[8 + 2 * h], p[8 + 2 * h + 1]) - opt.lin_limit) / L;
-        }
-        c[4] = opt.flight_margin - vertical_margin(transport_motion(p, T), part.g, opt.region);
+        const PlateMotion u = transport_motion(p, T);
+        c[0] = (horizontal_peak(u) - opt.lin_limit) / L;
+        c[1] = (axis_peaks(u)[2] - opt.lin_limit) / L;
+        c[2] = opt.flight_margin - vertical_margin(u, part.g, opt.region);
     }
     // One stable orientation on the ring: minus its rate [1/s]; else the number of stable ones less
     // one, or 1 for none (a part that does not turn).
@@ -190,7 +183,7 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     double c[OrientProblem::kConstraints];
     OrientProblem(part_scene, opt, T, &cycles).constraints(params_from(sum.scene.plate, kTranslationAxes, {1, 2}), c);
     if (*std::max_element(c, c + OrientProblem::kConstraints) > 1e-9) {
-        sum.failure = "the turned motion exceeds the amplitude limits or the flight margin";
+        sum.failure = "the turned motion exceeds the peak limits or the flight margin";
         return finished(sum, cycles, t0);
     }
 

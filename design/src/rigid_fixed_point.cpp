@@ -12,11 +12,11 @@ namespace plate::design_detail {
 const std::vector<Axis> kRigidAxes = {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz};
 PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion_from(p, kRigidAxes, {1, 2}, T); }
 
-// Constraints c_k <= 0 on a motion as placed: each (axis, n <= n_max) amplitude within its limit times
-// `room`, no flight under the part's contacts over the region, no coning beyond kConingLimit either
-// way and no tilt drift beyond kTiltDriftLimit (6 n_max + 4 entries).
-void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room, double* c) {
-    const int k = amplitude_constraints(fin, opt, part, n_max, room, c);
+// Constraints c_k <= 0 on a motion as placed: each axis' peak within its limit times `room`, no flight
+// under the part's contacts over the region, no coning beyond kConingLimit either way and no tilt drift
+// beyond kTiltDriftLimit (kPlacedConstraints entries).
+void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
+    const int k = peak_constraints(fin, opt, part, room, c);
     const double cone = coning_rate(fin) / kConingLimit;
     c[k] = cone - 1;
     c[k + 1] = -cone - 1;
@@ -51,15 +51,15 @@ struct RigidProblem : Problem<RigidProblem> {
     DesignTarget target;
     static constexpr int kParams = 24;
     static constexpr const char* kFamily = "x, y, z, rx, ry, rz at n = 1, 2";
-    static constexpr int kConstraints = 16;   // twelve amplitudes, the flight margin, coning both ways, tilt drift
+    static constexpr int kConstraints = kPlacedConstraints;   // six peaks, the flight margin, coning both ways, tilt drift
     // The search keeps 3% of each limit in hand for the final placement's correction (shifting by the
     // found fixed point's offset, a few mm, adds alpha x offset to the linear amplitudes).
     static constexpr double kRoom = 0.97;
     double limit(int i) const { return i < 12 ? opt.lin_limit : opt.ang_limit; }
     bool is_free(int i) const { return free(kRigidAxes, {1, 2}, i); }
     void constraints(const std::vector<double>& p, double* c) const {
-        placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt, part, 2,
-                           kRoom, c);
+        placed_constraints(combined(shift_motion(rotate_motion(rigid_motion(p, T), target.theta), target.at)), opt, part, kRoom,
+                           c);
     }
     // -rate at the centre, plus how far the centre is from being the fixed point (the Newton step
     // J^-1 xi there, over 1 cm / 0.1 rad), plus how much the region's edge (8 points, theta = 0) and
@@ -273,12 +273,10 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     const Vec2 s_turned = Eigen::Rotation2Dd(target.theta - theta_offset - q[2]) * Vec2(q.head<2>());
     sum.scene.plate = placed_motion(centred.plate, q, at, target.theta, theta_offset);
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
-    int n_max = 1;
-    for (const Harmonic& h : sum.scene.plate.harmonics) n_max = std::max(n_max, h.n);
-    std::vector<double> c(6 * n_max + 4);
-    placed_constraints(sum.scene.plate, opt, sum.scene, n_max, 1.0, c.data());
-    if (*std::max_element(c.begin(), c.end()) > 1e-9) {
-        sum.failure = "the placed motion exceeds the amplitude limits, the flight margin or the coning (or tilt drift) limit";
+    double c[kPlacedConstraints];
+    placed_constraints(sum.scene.plate, opt, sum.scene, 1.0, c);
+    if (*std::max_element(c, c + kPlacedConstraints) > 1e-9) {
+        sum.failure = "the placed motion exceeds the peak limits, the flight margin or the coning (or tilt drift) limit";
         return finished(sum, cycles, t0);
     }
     const Vec3 goal(at.x(), at.y(), wrap_angle(target.theta));

@@ -87,21 +87,16 @@ double cycle_noise(const LimitCycleOptions& o) { return o.tol + 60 * o.integrati
 // The option's task runner, else its threads.
 TaskRunner runner(const DesignOptions& opt) { return opt.tasks ? opt.tasks : thread_tasks(opt.threads); }
 
-// c_k <= 0 for each axis' harmonics n = 1..n_max of `fin` within `room` times the axis' limit (6 n_max
-// entries, axis-major), then c <= 0 for no flight over the region; returns the entries written.
-int amplitude_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, int n_max, double room,
-                          double* c) {
-    const auto ph = phasors(fin);
-    int k = 0;
-    for (int axis = 0; axis < 6; ++axis)
-        for (int n = 1; n <= n_max; ++n) {
-            const auto it = ph.find({axis, n});
-            const double amp = it == ph.end() ? 0.0 : std::abs(it->second);
-            const double lim = axis < 3 ? opt.lin_limit : opt.ang_limit;
-            c[k++] = (amp - room * lim) / std::max(lim, 1e-12);
-        }
-    c[k++] = opt.flight_margin - vertical_margin(fin, part.g, flight_region(part, opt));
-    return k;
+// c_a <= 0 for each axis' peak of `fin` (axis_peaks) within `room` times the axis' limit (6 entries),
+// then c <= 0 for no flight over the region; returns the entries written (kPeakConstraints).
+int peak_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
+    const Vec6 peak = axis_peaks(fin);
+    for (int axis = 0; axis < 6; ++axis) {
+        const double lim = axis < 3 ? opt.lin_limit : opt.ang_limit;
+        c[axis] = (peak[axis] - room * lim) / std::max(lim, 1e-12);
+    }
+    c[6] = opt.flight_margin - vertical_margin(fin, part.g, flight_region(part, opt));
+    return kPeakConstraints;
 }
 
 

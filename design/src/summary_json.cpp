@@ -105,7 +105,10 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     }
     j["coning_rate"] = d.coning;
     j["min_vertical_acceleration_margin_over_g"] = d.min_vertical_margin;
-    j["limits"] = {opt.lin_limit, opt.ang_limit};
+    j["limits"] = {opt.lin_limit, opt.ang_limit};   // (peaks: linear [m/s^2], angular [rad/s^2])
+    // The designed signal's peak per axis over the period (axis_peaks): what the limits bound.
+    j["peaks"] = {{"x_m_per_s2", d.peaks[0]},    {"y_m_per_s2", d.peaks[1]},    {"z_m_per_s2", d.peaks[2]},
+                  {"rx_rad_per_s2", d.peaks[3]}, {"ry_rad_per_s2", d.peaks[4]}, {"rz_rad_per_s2", d.peaks[5]}};
     j["starts"] = d.starts;
     j["evaluations"] = d.evaluations;
     j["limit_cycles"] = d.cycles;

@@ -7,22 +7,18 @@ namespace plate::design_detail {
 // translates). The field is uniform; its value at the centre is driven onto the target.
 PlateMotion transport_motion(const std::vector<double>& p, double T) { return motion_from(p, kTranslationAxes, {1, 2}, T); }
 
-// c_k <= 0: each of transport_motion's six harmonics within the linear limit, and no flight.
-void translation_constraints(const std::vector<double>& p, const DesignOptions& opt, double g, double T, double* c) {
-    for (int k = 0; k < 6; ++k) c[k] = (std::hypot(p[2 * k], p[2 * k + 1]) - opt.lin_limit) / std::max(opt.lin_limit, 1e-12);
-    c[6] = opt.flight_margin - vertical_margin(transport_motion(p, T), g, opt.region);
-}
-
 struct TransportProblem : Problem<TransportProblem> {
     TransportProblem(const Scene& part_, const Vec2& v_, const DesignOptions& opt_, double T_, std::atomic<long>* cycles_)
         : Problem(part_, opt_, T_, cycles_), target(v_) {}
     Vec2 target;
     static constexpr int kParams = 12;
     static constexpr const char* kFamily = "x, y, z at n = 1, 2";
-    static constexpr int kConstraints = 7;   // six harmonic amplitudes, the flight margin
+    static constexpr int kConstraints = kPeakConstraints;   // x, y, z's peaks (the others' zero), the flight margin
     double limit(int) const { return opt.lin_limit; }
     bool is_free(int i) const { return free(kTranslationAxes, {1, 2}, i); }
-    void constraints(const std::vector<double>& p, double* c) const { translation_constraints(p, opt, part.g, T, c); }
+    void constraints(const std::vector<double>& p, double* c) const {
+        peak_constraints(transport_motion(p, T), opt, part, 1.0, c);
+    }
     double evaluate(const std::vector<double>& p) {
         ++evaluations;
         Scene sc = part;

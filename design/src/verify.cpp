@@ -111,6 +111,24 @@ bool position_pull(const Scene& sc, const Vec2& s, double theta, const LimitCycl
 }
 
 
+// The designed motion's peaks against the limits, for every target (design() judges what each designer
+// returns, a registered kind's too): sum.peaks set, and a verified design with an axis' peak beyond its
+// limit (by more than 1e-9 relative: the searches' constraints hold to roundoff) fails, naming the axis.
+void judge_peaks(DesignSummary& sum, const DesignOptions& opt) {
+    sum.peaks = axis_peaks(sum.scene.plate);
+    for (int a = 0; a < 6 && sum.verified; ++a) {
+        const double lim = a < 3 ? opt.lin_limit : opt.ang_limit;
+        if (sum.peaks[a] <= lim * (1 + 1e-9)) continue;
+        std::ostringstream why;
+        why.precision(4);
+        const char* unit = a < 3 ? " m/s^2" : " rad/s^2";
+        why << "the designed motion's peak on " << axis_name(static_cast<Axis>(a)) << " is " << sum.peaks[a] << unit
+            << ", above the limit " << lim << unit << " (the peak of the axis' summed signal over the period)";
+        sum.verified = false;
+        sum.failure = why.str();
+    }
+}
+
 // The checks every sink and fixed point ends with, where nothing before failed: the hold (`unheld`:
 // hold_failure's verdict) and the flight margin; then the summary's end.
 DesignSummary& last_checks(DesignSummary& sum, const DesignOptions& opt, const std::string& unheld,

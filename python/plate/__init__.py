@@ -19,14 +19,15 @@ names them), ValueError (bad options) or RuntimeError.  The GIL is released whil
 import json as _json
 
 from ._plate import (Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Robustness, Scene, Stop,
-                     Trajectory, coning_rate, design, field, fixed_points, load_scene, orientation_harmonics, parse_scene,
-                     robustness, simulate, twist, uncertain_parameters)
+                     Trajectory, axis_peaks, coning_rate, design, field, fixed_points, load_scene, orientation_harmonics,
+                     parse_scene, robustness, simulate, twist, uncertain_parameters)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
 __all__ = ["Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Robustness", "Scene",
-           "Stop", "Trajectory", "coning_rate", "design", "field", "fixed_points", "load_scene", "orientation_harmonics",
-           "parse_scene", "robustness", "scene_from_dict", "scene_to_dict", "simulate", "twist", "uncertain_parameters"]
+           "Stop", "Trajectory", "axis_peaks", "coning_rate", "design", "field", "fixed_points", "load_scene",
+           "orientation_harmonics", "parse_scene", "robustness", "scene_from_dict", "scene_to_dict", "simulate", "twist",
+           "uncertain_parameters"]
 
 
 def scene_from_dict(d, source="<dict>"):

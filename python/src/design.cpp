@@ -1,5 +1,5 @@
-// plate.design (a plate motion for a target, verified: plate.Design), plate.orientation_harmonics and
-// plate.coning_rate.
+// plate.design (a plate motion for a target, verified: plate.Design), plate.orientation_harmonics,
+// plate.coning_rate and plate.axis_peaks.
 #include "bindings.hpp"
 
 #include <array>
@@ -113,6 +113,9 @@ void bind_design(py::module_& m) {
             "held", [](const DesignSummary& s) { return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance); },
             "sinks and fixed points: (seconds, end, distance) of the part released at rest at the target")
         .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)")
+        .def_readonly("peaks", &DesignSummary::peaks,
+                      "the designed motion's peak per axis over the period, x y z [m/s^2], rx ry rz [rad/s^2] "
+                      "(plate.axis_peaks): what lin_limit and ang_limit bound")
         .def_property_readonly(
             "pulls",
             [](const DesignSummary& s) {
@@ -162,7 +165,9 @@ void bind_design(py::module_& m) {
         py::arg("starts") = 0, py::arg("local_evaluations") = 400, py::arg("verify_starts") = 20, py::arg("threads") = 0,
         py::arg("hold") = 120.0, py::arg("max_coning") = -1.0, py::arg("axes") = std::vector<std::string>{},
         py::arg("max_harmonic") = 0, py::arg("target") = py::none(),
-        "Designs a plate motion within the amplitude limits and without flight, and verifies it (grid and\n"
+        "Designs a plate motion within the peak limits (lin_limit [m/s^2] for x, y, z and ang_limit [rad/s^2]\n"
+        "for rx, ry, rz bound the peak over the period of each axis' summed signal; `peaks`) and without\n"
+        "flight, and verifies it (grid and\n"
         "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
         "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
         "sink=(x, y) for a rigid part: its position ends at\n"
@@ -201,6 +206,10 @@ void bind_design(py::module_& m) {
         "coning_rate", [](const Scene& sc) { return coning_rate(sc.plate); }, py::arg("scene"),
         "The plate's steady yaw drift from rx and ry out of phase [rad/s], which the asymptotic field does\n"
         "not see and the full dynamics does: sum_n Im(A_rx,n conj A_ry,n) / (2 (n w)^3).");
+    m.def(
+        "axis_peaks", [](const Scene& sc) { return axis_peaks(sc.plate); }, py::arg("scene"),
+        "The peak over the period of each axis' summed plate acceleration |u_a(t)|, x y z [m/s^2], rx ry rz\n"
+        "[rad/s^2]: what actuators saturate on, and what plate.design's limits bound.");
 }
 
 }   // namespace plate::python

@@ -128,9 +128,11 @@ TEST_CASE("the half-turn pair broken by rz about its centre: fig4's fixed point 
     // 0.5 mm), and theta' there. Every fixed point of the field is a zero of that theta' on the branch of
     // s* followed; the position is a stable node there (its 2x2 Jacobian: positive determinant, negative
     // trace), so one branch. A stable fixed point is a zero theta' falls through: exactly one, within a
-    // ring step of THETA, and every other well of theta' above zero by half lift_wells's 0.003 rad/s
-    // margin (its linearisation was measured 3e-4 off: -0.0016 against -0.0013). Without lift_wells:
-    // two falls, the second near -2.49, THETA + pi + 0.15 wrapped.
+    // ring step of THETA, and every other well of theta' above zero. (Under per-harmonic limits
+    // lift_wells raised them to its 0.003 rad/s margin, and this asked for half of it; under the peak
+    // limits rz has 145 rad/s^2 of peak where it had 177, and the lifted motion, placed at its own fixed
+    // point 4 mm off, flies by 0.009 g: not applied, the shallowest other well measured 3.2e-5 rad/s.)
+    // Without lift_wells (per-harmonic limits): two falls, the second near -2.49, THETA + pi + 0.15.
     {
         const int n = 96;
         std::vector<double> w(n);
@@ -169,7 +171,7 @@ TEST_CASE("the half-turn pair broken by rz about its centre: fig4's fixed point 
             if (!target_well[k] && w[k] <= w[(k + n - 1) % n] && w[k] < w[(k + 1) % n])
                 lowest_other = std::min(lowest_other, w[k]);
         INFO("the shallowest other well " << lowest_other << " rad/s");
-        CHECK(lowest_other >= 0.0015);
+        CHECK(lowest_other > 0);
     }
     // The pairing is broken: the motion has rz at n = 1 (a half turn keeps rz, half a period reverses it)
     // and no tilt drift (rz at n = 1 along the tilts, which were made parallel): without that the plate's

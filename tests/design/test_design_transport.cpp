@@ -19,10 +19,8 @@ TEST_CASE("transport: a translating plate carries a point part at the target vel
     CHECK((s.transport_mean - t.velocity).norm() <= 0.02 * t.velocity.norm());
     // Uniform by construction: what remains is the cycles' tolerance (1e-6 v_ref).
     CHECK(s.transport_spread < 1e-5 * s.scene.v_ref());
-    for (const Harmonic& h : s.scene.plate.harmonics) {
-        CHECK(static_cast<int>(h.axis) < 3);   // it only translates
-        CHECK(std::abs(h.amp) <= o.lin_limit * (1 + 1e-9));
-    }
+    for (const Harmonic& h : s.scene.plate.harmonics) CHECK(static_cast<int>(h.axis) < 3);   // it only translates
+    check_peaks(s, o);                                                                       // (x, y, z's summed signals)
     CHECK(s.min_vertical_margin >= o.flight_margin - 1e-9);
     // An independent look, not the design's own cycle: a plate that only translates makes the full
     // dynamics the U-dynamics and the field uniform, so once the transient is over the part moves by
@@ -99,8 +97,9 @@ TEST_CASE("transport: runs that end farther than the verification distance from 
     // A plate that only translates gives the part the same displacement every period once its cycle is
     // reached, so over a run's second half (a whole number of periods) it moves by the field's mean
     // velocity times that time: a run ends |v_mean - v_target| (t - from) from where the target velocity
-    // takes it (1.16e-6 m for this design, its velocity 1.06e-6 m/s off; each run within 1.3e-3 of that,
-    // relative, measured: the cycle's own noise; bound 4e-3). The verification distance does not enter
+    // takes it, up to the error of the field's mean velocity, the cycles' own (absolute: 1.5e-9 m measured
+    // on the design under per-harmonic limits, 1.16e-6 m off; 3.5e-9 m on the one under peak limits,
+    // 2.96e-7 m off, which lands closer to the target; bound 1e-8 m). The verification distance does not enter
     // the search, so asked for half the worst run's distance the same design must fail on it -- within
     // ten times that distance, so an allowance ten times too wide would pass it.
     const Scene part = scene("fig1_point");
@@ -110,7 +109,7 @@ TEST_CASE("transport: runs that end farther than the verification distance from 
     const DesignSummary first = verified_transport(part, t.velocity, o);
     const double off = (first.transport_mean - t.velocity).norm();
     REQUIRE(first.runs.size() == 6u);
-    for (const DesignStartRun& r : first.runs) CHECK(r.end_distance == Approx(off * (r.seconds - r.from)).epsilon(4e-3));
+    for (const DesignStartRun& r : first.runs) CHECK(r.end_distance == Approx(off * (r.seconds - r.from)).margin(1e-8));
     o.verify_distance = 0.5 * first.worst_end_distance;
     const DesignSummary s = design(part, t, o);
     INFO(s.failure);

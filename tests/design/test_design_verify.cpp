@@ -80,11 +80,12 @@ TEST_CASE("a sink judged against a target 10 mm off it: every run and the hold e
     CHECK(std::abs(h.held.end_distance - expected) < 3e-10);   // (measured 9.5e-11 m)
 
     // And against the centre the same verdict passes: it is the distance that fails it. (Runs that
-    // arrive stop early, at another phase of the period: measured 2.7e-6 m from |p|.)
+    // arrive stop early, at another phase of the period, off |p| by the part's swing within it: measured
+    // 2.7e-6 m on the design under per-harmonic limits, 1.6e-5 m on the one under peak limits.)
     const DesignSummary c = judged(s, DesignTarget{}, o);
     INFO(c.failure);
     CHECK(c.verified);
-    CHECK(std::abs(c.worst_end_distance - p.norm()) < 1e-5);
+    CHECK(std::abs(c.worst_end_distance - p.norm()) < 5e-5);
     CHECK(c.held.end_distance == p.norm());   // (the hold is the run that gave p)
 }
 

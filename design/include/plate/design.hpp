@@ -87,9 +87,25 @@ struct OrientationHarmonics {
 OrientationHarmonics harmonics_of(const std::vector<double>& theta_dot);
 OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n = 12);
 
+// PEAKS. What an actuator saturates on: per axis a, the peak over the period of |u_a(t)|, the axis'
+// harmonics summed (x, y, z in m/s^2; rx, ry, rz in rad/s^2; entries of one (axis, n) add as phasors,
+// a negative amp is a half-period phase). Not the sum of the amplitudes: a third harmonic a sixth of
+// the first flattens its crest (sin t + sin(3 t) / 6 peaks at sqrt(3) / 2), in the wrong phase it
+// sharpens it (sin t - sin(3 t) / 3 = (4 / 3) sin^3 t). Exact to roundoff: the extrema are the zeros of
+// the derivative, a trigonometric polynomial's, found as a companion matrix's eigenvalues and polished
+// by Newton steps (peaks.cpp; tests/design/test_design_peaks.cpp: within 1e-12 of closed forms).
+Vec6 axis_peaks(const PlateMotion& u);
+
 struct DesignOptions {
-    double lin_limit = 20;    // largest amplitude of a linear-acceleration harmonic [m/s^2]
-    double ang_limit = 150;   // of an angular-acceleration harmonic [rad/s^2]
+    // The limits: every designed motion keeps each axis' peak (axis_peaks) within them -- a constraint
+    // of every search, on the motion as finally placed (turned, shifted, rz added), and checked again
+    // by design() on the motion it returns (a design beyond them fails verification). A harmonic's
+    // amplitude is not limited by itself: it may exceed the peak where others flatten its crest, by at
+    // most 4 / pi (a coefficient is an average of u cos(n w t) over the period). The searches' box for
+    // each cosine or sine coefficient stays +-limit: a search range, not the limit (it leaves out the
+    // motions with a coefficient between 1 and 4 / pi of the limit; docs/decisions: why not wider).
+    double lin_limit = 20;    // the peak of each linear axis' acceleration, x, y, z [m/s^2]
+    double ang_limit = 150;   // the peak of each angular axis' acceleration, rx, ry, rz [rad/s^2]
     double period = 0;        // plate period T [s]; 0: the part scene's
     double region = 0.05;     // the plate region |s_x|, |s_y| <= region [m]
     // No flight: g + the vertical acceleration of every plate point in the region (for a rigid part
@@ -226,6 +242,7 @@ struct DesignSummary {
     // DesignOptions::hold seconds of full dynamics and how far that is (measured as end_distance).
     DesignStartRun held;
     double coning = 0;                // the design's coning rate psi' [rad/s] (coning_rate)
+    Vec6 peaks = Vec6::Zero();        // the designed motion's axis_peaks [m/s^2 x y z, rad/s^2 rx ry rz]
     double min_vertical_margin = 0;   // min over the period and the flight check's square of (g + a_z) / g
     // A rigid part's sink (position only: the part may turn as it pleases): at the target, per
     // orientation of the verification grid, where the position's velocity field vanishes and its
