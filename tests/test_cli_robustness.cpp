@@ -95,7 +95,8 @@ std::string measured_csv(const plate::Scene& sc, int M, const std::array<int, 6>
 
 }   // namespace
 
-TEST_CASE("--measured: a recorded cycle of a scene's own plate gives its twist; a mislabelled one does not", "[cli][measured]") {
+TEST_CASE("plate --measured: a recorded cycle of a scene's own plate gives its twist, a mislabelled one does not",
+          "[cli][measured]") {
     const std::string fig4 = kScenes + "fig4.json";
     const plate::Scene sc = plate::load_scene(fig4);
     const fs::path good = tmpdir() / "fig4_cycle.csv", swapped = tmpdir() / "fig4_xy_swapped.csv";
