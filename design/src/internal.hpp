@@ -495,9 +495,12 @@ struct SinkProblem : Problem<SinkProblem> {
             // the zero's distance from THETA, in 0.01 rad (capped: a motion whose cycles fail scores 1e3, worse)
             turn = std::min(50.0, std::abs(w[1]) / std::max(slope, 1e-3) / 0.01);
         }
-        // Robust (a point part's sink): the first-order spread of the final motion's fixed point.
+        // Robust (a point part's sink): the first-order spread of the final motion's fixed point; a point
+        // that does not attract has no spread to speak of and takes the cap (else a repeller, whose
+        // "spread" -J^-1 dxi/dp can be small, would beat every sink).
         double spread = 0;
-        if (opt.robust && part.part.point && !orient) {
+        if (opt.robust && part.part.point && !orient && !(rate > 0)) spread = 50;
+        if (opt.robust && part.part.point && !orient && rate > 0) {
             Scene fin = part;
             fin.plate = combined(shift_motion(sink_motion(p, T), D));
             spread = std::min(50.0, std::max(0.0, first_order_radius95(fin, *opt.robust, D, opt.cycle, *cycles) /
