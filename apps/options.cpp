@@ -177,23 +177,22 @@ std::string Options::in_parentheses(const std::string& range, const std::string&
 
 // ---- the scene and a configuration -------------------------------------------------------------
 
-Scene scene_arg(const std::string& file, Io& cio) {
-    if (!cio.farm || cio.farm->ranks() == 1) {
-        Scene sc = load_scene(file);
-        for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
-        return sc;
-    }
+std::string input_text(const std::string& file, const std::string& what, Io& cio) {
     std::string text;
-    if (cio.farm->root()) {
+    if (!cio.farm || cio.farm->root()) {
         std::ifstream in(file, std::ios::binary);
         std::stringstream buf;
         buf << in.rdbuf();
         text = in ? "S" + buf.str() : "E";
     }
-    cio.farm->broadcast(text);
-    if (text.empty() || text[0] != 'S') throw InputError(file + ": cannot open scene file");
-    Scene sc = parse_scene(text.substr(1), file);
-    if (cio.farm->root())
+    if (cio.farm && cio.farm->ranks() > 1) cio.farm->broadcast(text);
+    if (text.empty() || text[0] != 'S') throw InputError(file + ": cannot open " + what);
+    return text.substr(1);
+}
+
+Scene scene_arg(const std::string& file, Io& cio) {
+    const Scene sc = parse_scene(input_text(file, "scene file", cio), file);
+    if (!cio.farm || cio.farm->root())
         for (const std::string& w : scene_warnings(sc)) cio.err << "warning: " << w << "\n";
     return sc;
 }
@@ -206,18 +205,8 @@ void add_measured_options(Options& p, MeasuredArgs& m) {
 Scene measured_arg(const Options& a, const MeasuredArgs& m, Scene sc, Io& cio) {
     if (a.has("--measured") != a.has("--harmonics")) throw UsageError("--measured FILE and --harmonics N go together");
     if (!a.has("--measured")) return sc;
-    std::string text;
-    const bool root = !cio.farm || cio.farm->root();
-    if (root) {
-        std::ifstream in(m.file, std::ios::binary);
-        std::stringstream buf;
-        buf << in.rdbuf();
-        text = in ? "S" + buf.str() : "E";
-    }
-    if (cio.farm && cio.farm->ranks() > 1) cio.farm->broadcast(text);
-    if (text.empty() || text[0] != 'S') throw InputError(m.file + ": cannot open measured cycle");
-    const MeasuredCycle cycle = parse_measured_cycle(text.substr(1), m.file, m.harmonics);
-    if (root)
+    const MeasuredCycle cycle = parse_measured_cycle(input_text(m.file, "measured cycle", cio), m.file, m.harmonics);
+    if (!cio.farm || cio.farm->root())
         for (const std::string& w : cycle.warnings) cio.err << "warning: " << m.file << ": " << w << "\n";
     return with_measured_plate(sc, cycle);
 }

@@ -131,6 +131,11 @@ private:
 
 // ---- the scene and a configuration -------------------------------------------------------------
 
+// The whole text of an input file (`what` names it in the error: "FILE: cannot open WHAT", an
+// InputError). Under mpirun (cio.farm) rank 0 reads it and sends it to every rank (the others may not
+// see the file: nodes without a shared filesystem), so every rank has the same text or the same error.
+std::string input_text(const std::string& file, const std::string& what, Io& cio);
+
 // The scene of a command; its warnings (scene_warnings: admissible, outside the intended regime) to
 // err. Under mpirun (cio.farm) rank 0 reads the file and sends its text to every rank (the others may
 // not see the file: nodes without a shared filesystem), so that every rank has the same scene or

@@ -128,7 +128,6 @@ DesignOptions design_options(const DesignArgs& a) {
     o.starts = a.starts;
     o.local_evaluations = a.evaluations;
     if (a.has("--harmonics")) o.max_harmonic = a.harmonics;
-    if (a.has("--robust")) o.robust = load_uncertainty(a.robust);
     o.arrive = a.arrive;
     o.robust_radius = a.robust_radius;
     o.robust_share = a.robust_share;
@@ -158,6 +157,7 @@ int cmd_design(const DesignArgs& a, Io& cio) {
     if (!a.has("--out")) throw UsageError("missing --out SCENE.json");
     const DesignTarget t = parse_target(a.target, part);
     DesignOptions o = design_options(a);
+    if (a.has("--robust")) o.robust = parse_uncertainty(input_text(a.robust, "uncertainty spec", cio), a.robust);
     judge_options(o);
     // Under mpirun the starts, the verification field's planes and the verification runs are shared
     // over the ranks; every rank follows the same path, rank 0 writes.

@@ -56,7 +56,7 @@ int cmd_robustness(const RobustnessArgs& a, Io& cio) {
     launched_farm(cio, a.grid.threads);
     if (!a.has("--uncertainty")) throw UsageError("missing --uncertainty SPEC.json");
     const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
-    const UncertaintySpec spec = load_uncertainty(a.spec);
+    const UncertaintySpec spec = parse_uncertainty(input_text(a.spec, "uncertainty spec", cio), a.spec);
     RobustnessOptions o = a.o;
     if (!(o.horizon > 0)) throw UsageError("--horizon: expected a positive number of seconds");
     if (!(o.curve_step > 0 && o.curve_step <= o.horizon))
@@ -73,8 +73,10 @@ int cmd_robustness(const RobustnessArgs& a, Io& cio) {
         throw UsageError(std::string(a.scene) + ": " + e.what());
     }
     if (cio.farm && !cio.farm->root()) return 0;
+    nlohmann::json j = robustness_json(s, o, spec);
+    if (cio.farm) j["mpi"] = cio.farm->describe();
     write_file_atomic(
-        a.out, [&](std::ostream& out) { out << robustness_json(s, o, spec).dump(2) << "\n"; }, cio.out);
+        a.out, [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
     const int n = static_cast<int>(s.draws.size());
     char line[200];
     std::snprintf(line, sizeof line, "plate robustness: %s: unique in %d of %d draws; 95 %% radius %.3g mm", a.scene.c_str(),

@@ -3,7 +3,7 @@
 threads and `mpirun -np 2`; a run killed mid-way (SIGKILL of the process, SIGKILL of one MPI rank,
 SIGINT of the launcher) leaves no table, and the same command resumes it to the uninterrupted table,
 skipping the finished cases and cutting a torn journal line; bad input exits 2 naming file and field.
-And `plate proofs`, `plate field`, `plate fixed-points` and `plate design` under `mpirun -np 2` give the
+And `plate proofs`, `plate field`, `plate fixed-points`, `plate design` and `plate robustness` under `mpirun -np 2` give the
 single-process output to the last digit (but wall times).
 
     check_sweep.py PLATE SOURCE_DIR WORKDIR [MPIRUN]
@@ -276,6 +276,27 @@ if MPI:
                 run_.pop("seconds")
         ok = a == b and a["verified"]
     check(ok, "plate design (sink, 4 starts) under mpirun -np 2: the same scene byte for byte, the same summary")
+    # plate robustness: the draws shared over the ranks, the same JSON but the wall times; the spec, read
+    # by rank 0 and sent, reaches a rank that cannot see it.
+    rob = ["robustness", str(source / "scenes" / "designs" / "point_sink.json"), "--uncertainty",
+           str(source / "scenes" / "uncertainty" / "ppod.json"), "--draws", "6", "--starts", "2", "--full-draws", "1"]
+    r = outputs(rob, "robustness", [((), "2"), (MPI, "1")])
+    ok = all(x[0] == 0 for x in r) and r[0][1] and r[1][1]
+    if ok:
+        a, b = (json.loads(x[1]) for x in r)
+        said = b.pop("mpi", "")
+        for o in (a, b):
+            o.pop("seconds"), o["sensitivity"].pop("seconds")
+        ok = a == b and len(a["per_draw"]) == 6 and "2 MPI ranks" in said
+    check(ok, "plate robustness (6 draws) under mpirun -np 2: the same JSON as one process, but its wall times")
+    moved = work / "spec_rank0_only.json"
+    shutil.copy(source / "scenes" / "uncertainty" / "ppod.json", moved)
+    spec_mixed = [mpirun, "-np", "1", plate, *rob[:3], str(moved), *rob[4:], "--threads", "1", "--out", str(work / "rmixed.json"),
+                  ":", "-np", "1", plate, *rob[:3], str(work / "missing_spec.json"), *rob[4:], "--threads", "1",
+                  "--out", str(work / "rmixed.json")]
+    p = subprocess.run(spec_mixed, env=env, capture_output=True, text=True, timeout=300)
+    check(p.returncode == 0 and (work / "rmixed.json").exists(),
+          f"plate robustness, rank 1 without the spec file: rank 0's spec, exit 0 ({p.returncode}: {p.stderr.strip()[:200]})")
     # The work budget means the same shared or not: heave_yaw's 5^3 field takes ~5.7e5 right-hand sides.
     for budget, expect in (("400000", 1), ("1000000", 0)):
         codes = []
