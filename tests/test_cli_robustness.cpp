@@ -137,3 +137,35 @@ TEST_CASE("plate --measured: a recorded cycle of a scene's own plate gives its t
         CHECK(r.err.find(expect) != std::string::npos);
     }
 }
+
+TEST_CASE(
+    "plate robustness --write-draws: each drawn scene, run through plate fixed-points, has the fixed point the "
+    "robustness run reported",
+    "[cli][robustness]") {
+    const std::string scene = kScenes + "designs/fig4_fixed_point.json", spec = kScenes + "uncertainty/ppod.json";
+    const fs::path dir = tmpdir() / "draws", out = tmpdir() / "rob_draws.json";
+    fs::remove_all(dir);
+    const std::string args = "robustness " + scene + " --uncertainty " + spec + " --draws 3 --starts 0 --full-draws 0 --out ";
+    const Run r = run(args + out.string() + " --write-draws " + dir.string());
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(slurp(out));
+    for (int i = 0; i < 3; ++i) {
+        const fs::path f = dir / ("draw_" + std::to_string(i) + ".json");
+        REQUIRE(fs::exists(f));
+        const Run fp = run("fixed-points " + f.string() + " --threads 2");
+        REQUIRE(fp.code == 0);
+        const auto points = nlohmann::json::parse(fp.out)["points"];
+        const auto& d = j["per_draw"][i];
+        INFO("draw " << i << ": " << d.dump());
+        if (!d.contains("fixed_point_m_m_rad")) continue;   // (no stable point at the target in this draw)
+        // The same field and refinement (the same cycle options, any threads): the same point, every digit.
+        bool found = false;
+        for (const auto& p : points) found = found || (p["stability"] == "stable" && p["at"] == d["fixed_point_m_m_rad"]);
+        CHECK(found);
+    }
+    // A folder that exists is not overwritten: exit 2 before any work.
+    const Run again = run(args + out.string() + " --write-draws " + dir.string());
+    CHECK(again.code == 2);
+    CHECK(again.err.find("exists") != std::string::npos);
+}

@@ -7,6 +7,8 @@
 #include "plate/robustness.hpp"
 
 #include <cstdio>
+#include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,7 +16,7 @@ namespace plate::cli {
 namespace {
 
 struct RobustnessArgs : Options {
-    std::string scene, spec, out = "-";
+    std::string scene, spec, out = "-", draws_dir;
     std::vector<double> target;
     GridArgs grid;
     CycleArgs cycle;
@@ -36,7 +38,8 @@ struct RobustnessArgs : Options {
                   "within 5 mm and 0.05 rad of the target (at most --horizon s), and the full dynamics' for the first\n"
                   "--full-draws draws. --measured FILE --harmonics N replaces the scene's plate motion by a measured\n"
                   "cycle (CSV: t,x,y,z,rx,ry,rz; numeric/include/plate/measured_cycle.hpp). Draws run in parallel\n"
-                  "(--threads; under mpirun over the ranks); the same seed gives the same result. JSON to stdout or --out.\n") {
+                  "(--threads; under mpirun over the ranks); the same seed gives the same result. JSON to stdout or --out;\n"
+                  "--write-draws DIR also writes each drawn scene (DIR/draw_INDEX.json), to run through any command.\n") {
         scene_file(scene);
         text("--uncertainty", spec, "SPEC.json", "the uncertainty spec; required");
         whole("--draws", o.draws, 1, 1'000'000, "draws");
@@ -47,6 +50,7 @@ struct RobustnessArgs : Options {
         whole("--full-draws", o.full_draws, 0, 1'000'000, "draws also run in full dynamics from the starts");
         add_measured_options(*this, measured);
         text("--out", out, "FILE", "the output file (default: standard output)");
+        text("--write-draws", draws_dir, "DIR", "also write each drawn scene as DIR/draw_INDEX.json (a new folder)");
         add_grid_options(*this, grid);
         add_cycle_options(*this, cycle);
     }
@@ -59,6 +63,13 @@ int cmd_robustness(const RobustnessArgs& a, Io& cio) {
     const UncertaintySpec spec = parse_uncertainty(input_text(a.spec, "uncertainty spec", cio), a.spec);
     RobustnessOptions o = a.o;
     if (!(o.horizon > 0)) throw UsageError("--horizon: expected a positive number of seconds");
+    if (a.has("--write-draws")) {   // (before the run, as rank 0 sees it: another run's draws are not overwritten)
+        std::string seen = "new";
+        std::error_code ec;
+        if ((!cio.farm || cio.farm->root()) && std::filesystem::exists(a.draws_dir, ec)) seen = "exists";
+        if (cio.farm && cio.farm->ranks() > 1) cio.farm->broadcast(seen);
+        if (seen != "new") throw UsageError("--write-draws: " + a.draws_dir + " exists (give a new folder)");
+    }
     if (!(o.curve_step > 0 && o.curve_step <= o.horizon))
         throw UsageError("--curve-step: expected a positive number of seconds, at most --horizon");
     o.fixed.cycle = cycle_opts(a, a.cycle);
@@ -73,6 +84,15 @@ int cmd_robustness(const RobustnessArgs& a, Io& cio) {
         throw UsageError(std::string(a.scene) + ": " + e.what());
     }
     if (cio.farm && !cio.farm->root()) return 0;
+    if (a.has("--write-draws")) {   // (each file written whole or not at all; a draw is a function of (seed, index))
+        std::error_code ec;
+        std::filesystem::create_directories(a.draws_dir, ec);
+        if (ec) throw std::runtime_error(a.draws_dir + ": cannot create the folder: " + ec.message());
+        for (int i = 0; i < o.draws; ++i)
+            write_file_atomic(a.draws_dir + "/draw_" + std::to_string(i) + ".json", [&](std::ostream& out) {
+                out << scene_to_json(draw(sc, spec, static_cast<std::uint64_t>(i))).dump(2) << "\n";
+            });
+    }
     nlohmann::json j = robustness_json(s, o, spec);
     if (cio.farm) j["mpi"] = cio.farm->describe();
     write_file_atomic(
