@@ -292,9 +292,7 @@ double flight_region(const Scene& part, const DesignOptions& opt);
 double pair_basin_bound(const Vec2& D, double region);
 
 // The starts a design makes when DesignOptions::starts is 0: 4 for sinks and line sinks (16 and 4
-// parameters: a point part's sink at (0.02, -0.01) under 15 / 100, seeds 1 to 6, 4 starts reach
-// 0.74-0.89 1/s in 2.7-3.7 s, 16 starts 0.77-0.94 1/s in 10-11 s, all verified; fig4's part's sink
-// there under 20 / 150, 0.96 1/s with 4 starts or 16), 16 for the rest.
+// parameters: more starts bought little there, docs/decisions/design-and-tools.md), 16 for the rest.
 int default_starts(const Scene& part_scene, const DesignTarget& target);
 
 // Designs a plate motion for the part of `part_scene` (its plate block is ignored but for its
