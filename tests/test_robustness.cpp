@@ -304,3 +304,95 @@ TEST_CASE("arrival times are where the field's integral curve enters the toleran
         CHECK(s.nominal_result.arrival[k] <= t + o.curve_step + 0.05);
     }
 }
+
+// ---- audit (issue 51): the predicted covariance against the covariance of the draws' own linear predictions
+TEST_CASE("predicted covariance and 95 % radius/angle are those of S p over the draws", "[robustness][audit]") {
+    const Scene sc = load_scene(kDir + "designs/fig4_fixed_point.json");
+    const UncertaintySpec spec = ppod(1);
+    RobustnessSummary s;
+    fixed_point_sensitivities(sc, spec, Vec3(0.02, -0.01, 0.4832), LimitCycleOptions{}, s);
+    const int N = 4000;
+    std::vector<Vec3> lin;
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < N; ++i) {
+        const Draw d = draw_with_deviations(sc, spec, static_cast<std::uint64_t>(100000 + i));
+        Vec3 l = Vec3::Zero();
+        for (std::size_t k = 0; k < d.p.size(); ++k) l += s.sensitivities[k].dq * d.p[k];
+        lin.push_back(l);
+        C += l * l.transpose() / N;
+    }
+    const Eigen::Matrix3d& P = s.predicted_covariance;
+    INFO("sample\n" << C << "\npredicted\n" << P);
+    for (int a = 0; a < 3; ++a)
+        for (int b = a; b < 3; ++b)
+            CHECK(std::abs(C(a, b) - P(a, b)) <= 4 * std::sqrt((P(a, a) * P(b, b) + P(a, b) * P(a, b)) / N));
+    int in_r = 0, in_a = 0;
+    for (const Vec3& l : lin) {
+        in_r += l.head<2>().norm() <= s.predicted_radius95;
+        in_a += std::abs(l[2]) <= s.predicted_angle95;
+    }
+    INFO("coverage radius " << double(in_r) / N << ", angle " << double(in_a) / N);
+    CHECK(std::abs(double(in_r) / N - 0.95) <= 0.015);
+    CHECK(std::abs(double(in_a) / N - 0.95) <= 0.015);
+}
+
+TEST_CASE("every attractor is counted (points, a stable line, the stuck region)", "[robustness][audit]") {
+    // plate fixed-points scenes/heave_yaw_point.json: stable points at (-0.00833, 0.04167) and (0.04167, 0.00833),
+    // one stable line, 16 stuck cells.
+    RobustnessOptions o = quick(1);
+    o.target = Vec3(-0.008333, 0.041667, 0);
+    o.sensitivities = false;
+    const RobustnessSummary s = robustness(load_scene(kDir + "heave_yaw_point.json"), spec_of(R"({"seed": 1})"), o);
+    INFO(s.nominal_result.note);
+    CHECK(s.nominal_result.outcome == Outcome::competing);
+    CHECK(s.nominal_result.attractors == 4);
+}
+
+TEST_CASE("full-dynamics arrival is the time after which the part stays within the tolerances", "[robustness][audit]") {
+    const Scene sc = load_scene(kDir + "designs/point_sink.json");
+    RobustnessOptions o = quick(1);
+    o.starts = 3;
+    o.full_draws = 1;
+    o.horizon = 30;
+    const RobustnessSummary s = robustness(sc, spec_of(R"({"seed": 4})"), o);
+    REQUIRE(s.nominal_result.arrival_full.size() == 3u);
+    for (std::size_t k = 0; k < 3; ++k) {
+        IntegrationOptions io;
+        io.rtol = o.fixed.cycle.integration.rtol;
+        const Trajectory tr = simulate(sc, Dynamics::Full, s.starts[k], Vec3::Zero(), o.horizon, sc.plate.T, io);
+        double last_out = -1;
+        for (const Sample& x : tr.samples)
+            if ((x.q - s.target).head<2>().norm() > o.arrive_distance) last_out = x.t;
+        double want = std::numeric_limits<double>::infinity();
+        for (const Sample& x : tr.samples)
+            if (x.t > last_out) {
+                want = x.t;
+                break;
+            }
+        INFO("start " << k << " want " << want << " got " << s.nominal_result.arrival_full[k]);
+        CHECK(s.nominal_result.arrival_full[k] == want);
+    }
+}
+
+TEST_CASE("a rigid part's arrival needs its orientation, not only its position", "[robustness][audit]") {
+    // fig4: stable fixed points at the centre at theta 0 and pi; curves bound for the twin pass the
+    // target's position at the wrong orientation.
+    const Scene fig4 = load_scene(kDir + "fig4.json");
+    RobustnessOptions o = quick(1);
+    o.starts = 6;
+    o.horizon = 30;
+    o.target = Vec3(0, 0, 0);
+    o.sensitivities = false;
+    const RobustnessSummary s = robustness(fig4, spec_of(R"({"seed": 1})"), o);
+    int finite = 0;
+    for (std::size_t k = 0; k < s.starts.size(); ++k) {
+        const double t = s.nominal_result.arrival[k];
+        if (!std::isfinite(t)) continue;
+        ++finite;
+        const Trajectory tr = field_curve(fig4, s.starts[k], t + 1e-9, o.curve_step, o.fixed.cycle);
+        INFO("start " << s.starts[k].transpose() << " arrival " << t << " s at " << tr.samples.back().q.transpose());
+        CHECK(std::abs(wrap_angle(tr.samples.back().q[2])) <= o.arrive_angle + 0.01);
+    }
+    INFO(finite << " finite arrivals");
+    CHECK(finite < static_cast<int>(s.starts.size()));
+}

@@ -269,7 +269,9 @@ void verify_robust(DesignSummary& sum, const DesignTarget& target, const DesignO
 // --- verification (verify.cpp) -------------------------------------------------------------------
 
 constexpr const char* kNoFeasibleMotion = "no motion within the limits keeps the part on the plate over the region";
-// The designed field on the verify_grid^2 grid over the region (a rigid part: verify_grid orientations too).
+// The verify_grid^2 grid over the region (a rigid part: verify_grid orientations too), and the designed
+// field on it.
+GridSpec verification_grid(const Scene& sc, const DesignOptions& opt);
 Field verification_field(const Scene& sc, const DesignOptions& opt);
 // What the grid's fixed-point search could not look at (empty: it searched every cell); a fixed point is
 // called unique only where this is empty.

@@ -26,7 +26,7 @@ void verify_robust(DesignSummary& sum, const DesignTarget& target, const DesignO
     RobustnessOptions ro;
     ro.draws = opt.robust_draws;
     ro.target = Vec3(target.at.x(), target.at.y(), rigid ? target.theta : 0.0);
-    ro.grid = verification_field(sum.scene, opt).grid;
+    ro.grid = verification_grid(sum.scene, opt);
     ro.fixed.cycle.max_rhs_evaluations = 2'000'000;   // (plate robustness's: the command line's cycle budget)
     ro.starts = opt.verify_starts;
     ro.arrive_distance = opt.verify_distance;

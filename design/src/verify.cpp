@@ -7,13 +7,18 @@ namespace plate::design_detail {
 // Verification, shared: the designed field on the verify_grid^2 grid over the region, and full
 // dynamics from verify_starts seeded random starts, each run for seconds(start) and measured by
 // end_distance(start, end); the worst distance and the runs that left the model are tallied.
-Field verification_field(const Scene& sc, const DesignOptions& opt) {
+GridSpec verification_grid(const Scene& sc, const DesignOptions& opt) {
     GridSpec g;
     g.nx = g.ny = opt.verify_grid;
     g.nth = 1;
     g.x0 = g.y0 = -opt.region;
     g.x1 = g.y1 = opt.region;
     if (!sc.part.point) g.nth = opt.verify_grid;   // theta: a full turn
+    return g;
+}
+
+Field verification_field(const Scene& sc, const DesignOptions& opt) {
+    const GridSpec g = verification_grid(sc, opt);
     FieldOptions fo;
     fo.threads = opt.threads;
     fo.tasks = opt.tasks;

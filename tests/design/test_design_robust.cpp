@@ -98,3 +98,17 @@ TEST_CASE("robust design is refused where it has no fixed point to follow", "[de
     o.robust_share = 1.5;
     CHECK_THROWS_WITH(design(scene("fig1_point"), sink, o), Catch::Contains("robust_share"));
 }
+
+TEST_CASE("a robust design whose starts cannot arrive in time fails on the share", "[design][robust][audit]") {
+    const Scene part = scene("fig1_point");
+    DesignTarget t;
+    t.at = Vec2(0.02, -0.01);
+    DesignOptions o = robust_options(0.01);
+    o.starts = 2;
+    o.local_evaluations = 150;
+    o.arrive = 2;
+    const DesignSummary r = design(part, t, o);
+    INFO(r.failure);
+    CHECK_FALSE(r.verified);
+    CHECK(r.failure.find("reached from every start within 2 s") != std::string::npos);
+}
