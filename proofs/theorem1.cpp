@@ -215,7 +215,7 @@ DynamicsTie check_dynamics_tie(const Scene& sc, const Vec3& q0, int samples, std
         // The limit surface (39): the generated thin_wrench with the statics' forces.
         std::array<Vec2, 3> r2;
         for (int i = 0; i < 3; ++i) r2[i] = (R2 * P.c[i]).head<2>();
-        const Vec3 w = wrench_map(wrench_input(r2, Ns, P.friction().kinetic(), rho))(Vec3(qd[0], qd[1], rho * qd[2]));
+        const Vec3 w = wrench_map(wrench_input(r2, Ns, P.friction(), rho))(Vec3(qd[0], qd[1], rho * qd[2]));
         const Vec3 W(P.m * qdd[0] + f.x(), P.m * qdd[1] + f.y(), (P.J(2, 2) * qdd[2] + tau.z()) / rho);
         const double es = (n - Ns).cwiseAbs().maxCoeff() / mg;
         const double ew = (W - w).cwiseAbs().maxCoeff() / mg;
@@ -394,7 +394,7 @@ WrenchMap thin_wrench_map(const Scene& sc, const Vec3& q0, double t, double* fri
     Workspace ws;
     accelerations(sc, Dynamics::ReducedU, q0, Vec3(0.1, 0.05, 1), plate_state(sc.plate, t, Dynamics::ReducedU), ws);
     if (friction_scale) *friction_scale = sc.part.friction().kinetic().dot(ws.n);
-    return wrench_map(wrench_input(ws.r, ws.n, sc.part.friction().kinetic(), sc.part.rho()));
+    return wrench_map(wrench_input(ws.r, ws.n, sc.part.friction(), sc.part.rho()));
 }
 
 WrenchMap wrench_map(gen::WrenchInput in) {

@@ -65,6 +65,7 @@ Symbols::Symbols()
         cx[i] = realsymbol(idx("c", i, "x"));
         cy[i] = realsymbol(idx("c", i, "y"));
         mu[i] = realsymbol(idx("mu", i));
+        mus[i] = realsymbol(idx("mus", i));
         N[i] = realsymbol(idx("N", i));
         ux[i] = realsymbol(idx("u", i, "x"));
         uy[i] = realsymbol(idx("u", i, "y"));
@@ -378,6 +379,7 @@ Derivation derive() {
     pivot_modes(d, F, kinetic);       // stick-slip modes
     stuck_mode(d, F);
     support_function(d);
+    friction_roles(d);
     u_dynamics(d, F);   // (32)-(34)
     point_part(d, F);
     thick_reduction(d);

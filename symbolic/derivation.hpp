@@ -27,8 +27,9 @@ struct Symbols {
     realsymbol Jxx, Jxy, Jxz, Jyy, Jyz, Jzz;
     std::array<realsymbol, 3> cx, cy;   // contacts c_i in S
     realsymbol cz;                      // their common z
-    std::array<realsymbol, 3> mu;
-    realsymbol ct, st, thd, thdd;   // cos theta, sin theta, theta', theta''
+    std::array<realsymbol, 3> mu;       // kinetic coefficients mu_ki: sliding contacts (17)
+    std::array<realsymbol, 3> mus;      // static coefficients mu_si: the disks of held contacts
+    realsymbol ct, st, thd, thdd;       // cos theta, sin theta, theta', theta''
     realsymbol sx, sy, sz, sxd, syd, sxdd, sydd;
     std::array<realsymbol, 3> N;
     std::array<realsymbol, 3> ux, uy;             // unit slip directions (inputs, so entries stay polynomial)

@@ -180,16 +180,53 @@ void stuck_mode(Derivation& d, const Frames& F) {
 }
 
 // Break-away from stuck: the gauge max_d (d . w) / P(d) of the needed wrench w against the
-// friction set, P(d) = sum_i mu_i N_i |G_i^T d| (the support function, Appendix B). Each term
-// with its gradient and Hessian in d = (vx, vy, xith) drives the gauge's Newton iteration.
+// friction set, P(d) = sum_i mu_si N_i |G_i^T d| (the support function, Appendix B, of the static
+// disks). Each term with its gradient and Hessian in d = (vx, vy, xith) drives the gauge's Newton
+// iteration.
 void support_function(Derivation& d) {
     const Symbols& S = d.S;
     for (int i = 0; i < 3; ++i) {
         const ex om = S.xith / S.rho;
         const ex vix = S.vx - om * S.ry[i], viy = S.vy + om * S.rx[i];
         d.support_speed[i] = sqrt(vix * vix + viy * viy);
-        d.support_term[i] = S.mu[i] * S.N[i] * d.support_speed[i];
+        d.support_term[i] = S.mus[i] * S.N[i] * d.support_speed[i];
     }
+}
+
+// Static and kinetic friction: a sliding contact's force is mu_ki N_i (17), a held contact's force
+// lies in its disk mu_si N_i. Checked exactly on the derived equations: the slide system holds every
+// mu_ki and no mu_si; pivot k's system holds the sliding contacts' mu_ki, not its own (contact k
+// enters through its unknown force f_k alone, bounded by mu_sk N_k in the hold margin) and no mu_si;
+// the stuck part's normal forces and needed wrench hold no coefficient at all (the gauge judges them
+// against the static disks); the support function holds the static coefficients only. So a contact
+// that breaks away (|f_k| = mu_sk N_k) slides on at mu_kk N_k: with mu_s > mu_k its friction drops at
+// the event, and a slip that reaches zero re-sticks where the needed force fits the static disk.
+void friction_roles(Derivation& d) {
+    const Symbols& S = d.S;
+    const auto holds = [](const matrix& M, const realsymbol& s) {
+        for (unsigned r = 0; r < M.rows(); ++r)
+            for (unsigned c = 0; c < M.cols(); ++c)
+                if (M(r, c).has(s)) return true;
+        return false;
+    };
+    bool ok = true;
+    for (int i = 0; i < 3; ++i) {
+        ok = ok && holds(d.A, S.mu[i]) && !holds(d.A, S.mus[i]);
+        ok = ok && !holds(d.stuck_solution, S.mu[i]) && !holds(d.stuck_solution, S.mus[i]);
+        ok = ok && d.support_term[i].has(S.mus[i]) && !d.support_term[i].has(S.mu[i]);
+        for (int k = 0; k < 3; ++k) {
+            const bool own = holds(d.pivot_A[k], S.mu[i]) || holds(d.pivot_c[k], S.mu[i]);
+            ok = ok && own == (i != k) && !holds(d.pivot_A[k], S.mus[i]) && !holds(d.pivot_c[k], S.mus[i]);
+        }
+    }
+    if (!ok) throw std::logic_error("a mode's equations hold the wrong friction coefficients");
+    add_finding(d, "static and kinetic friction", ok, "(not in the paper: one coefficient per contact)",
+                "slide: mu_k1..3; pivot k: mu_ki of the sliding contacts i != k, contact k's force bounded by mu_sk N_k; "
+                "stuck: no coefficient in N, F, tau_z, judged against the static disks; support function: mu_s1..3",
+                "a held contact's friction lies in its static disk |f_k| <= mu_sk N_k and a sliding one's is mu_kk N_k "
+                "(17): the static coefficients enter only the hold margins and the gauge, so a break-away drops the "
+                "contact's friction from mu_sk N_k to mu_kk N_k, and a slip re-sticks where the needed force fits the "
+                "static disk (checked exactly on the derived equations)");
 }
 
 // --- Point part -----------------------------------------------------------------------------

@@ -86,8 +86,9 @@ matrix newton_euler(const Derivation& d, const Frames& F, const std::array<matri
 void pivot_modes(Derivation& d, const Frames& F, const std::array<matrix, 3>& kinetic);   // stick-slip: pivots
 void stuck_mode(Derivation& d, const Frames& F);                                          // stick-slip: stuck
 void support_function(Derivation& d);                                                     // the friction set's support function
-void point_part(Derivation& d, const Frames& F);                                          // one contact at the centre of mass
-void thick_reduction(Derivation& d);                                                      // A z = b reduced to 3x3 in n
+void friction_roles(Derivation& d);                          // which coefficient, static or kinetic, each mode's equations hold
+void point_part(Derivation& d, const Frames& F);             // one contact at the centre of mass
+void thick_reduction(Derivation& d);                         // A z = b reduced to 3x3 in n
 void staged_reduction(Derivation& d, const Frames& F);       // the same with placeholders, for codegen
 void staged_plate_frame_b(Derivation& d, const Frames& F);   // b in plate-frame vectors, for codegen
 void thin_part(Derivation& d, const Frames& F);              // Appendix A, (37), (38)

@@ -32,8 +32,8 @@ const char* kInputFields[] = {"m",   "g",   "Jxx", "Jxy", "Jxz", "Jyy", "Jyz",  
                               "c3y", "cz",  "mu1", "mu2", "mu3", "ct",  "st",   "thd",  "sx",   "sy",  "sz",  "sxd", "syd",
                               "u1x", "u1y", "u2x", "u2y", "u3x", "u3y", "pddx", "pddy", "pddz", "wx",  "wy",  "wz",  "wdx",
                               "wdy", "wdz", "R11", "R12", "R13", "R21", "R22",  "R23",  "R31",  "R32", "R33"};
-const char* kWrenchFields[] = {"N1",  "N2",  "N3",  "r1x", "r1y", "r2x", "r2y", "r3x",
-                               "r3y", "mu1", "mu2", "mu3", "rho", "vx",  "vy",  "xith"};
+const char* kWrenchFields[] = {"N1",  "N2",  "N3",   "r1x",  "r1y",  "r2x", "r2y", "r3x", "r3y", "mu1",
+                               "mu2", "mu3", "mus1", "mus2", "mus3", "rho", "vx",  "vy",  "xith"};
 
 Inputs inputs(const std::vector<std::string>& fields, const std::string& prefix) {
     Inputs m;
@@ -584,7 +584,7 @@ void wrench_kernels(const Derivation& d, std::vector<Kernel>& kernels) {
         std::vector<std::string> wf(std::begin(kWrenchFields), std::end(kWrenchFields));
         Kernel k{
             "// Support function of the friction set (the break-away test of a stuck part): for each contact,\n"
-            "// s[i] = |G_i^T d|, the term mu_i N_i |G_i^T d|, its gradient g[3 i + j] and Hessian\n"
+            "// s[i] = |G_i^T d|, the term mu_si N_i |G_i^T d| (static coefficients), its gradient g[3 i + j] and Hessian\n"
             "// H[6 i + (xx, xy, xt, yy, yt, tt)] in d = (vx, vy, xith) (scaled twist, Appendix B).\n"
             "// Undefined where s[i] = 0 (a kink of P): the caller tests s[i] first.\n",
             "friction_support(const WrenchInput& in, double* s, double* t, double* g, double* H)",

@@ -321,15 +321,18 @@ TEST_CASE("shooting: Newton with the variational monodromy reaches the cycle in 
 namespace {
 
 // Independent stick-slip solution of a point part on a plate shaken along x by
-// a_p(t) = sum_k A_k sin(k w t + phi_k), relative velocity v (1-D, Coulomb, mu g):
-//   sliding with sign s:  v' = -a_p(t) - mu g s  =>  v(t) = -(V_p(t) - V_p(t0)) - mu g s (t - t0)
-//   stuck (v = 0) while |a_p(t)| <= mu g; breaks away with s = -sign(a_p) when |a_p| > mu g.
+// a_p(t) = sum_k A_k sin(k w t + phi_k), relative velocity v (1-D, Coulomb, kinetic mu_k g, static
+// mu_s g >= mu_k g):
+//   sliding with sign s:  v' = -a_p(t) - mu_k g s  =>  v(t) = -(V_p(t) - V_p(t0)) - mu_k g s (t - t0)
+//   stuck (v = 0) while |a_p(t)| <= mu_s g; breaks away with s = -sign(a_p) when |a_p| > mu_s g; a
+//   slide that reaches v = 0 sticks if |a_p| <= mu_s g there, else slides on the other way.
 // V_p, X_p are the plate's zero-mean velocity and position (integrals of a_p). Roots by bisection on
 // a fine grid. Returns the part's mean velocity over the period [n T, (n + 1) T] (after n periods
 // from rest) and the stuck time in that period.
 struct StickSlip1D {
     std::vector<double> A, k, phi;
-    double w, mug;
+    double w, mug;       // mu_k g
+    double hold_g = 0;   // mu_s g (0: mu_k g)
     double a(double t) const {
         double s = 0;
         for (std::size_t i = 0; i < A.size(); ++i) s += A[i] * std::sin(k[i] * w * t + phi[i]);
@@ -354,7 +357,7 @@ struct StickSlip1D {
         return 0.5 * (a + b);
     }
     void run(double T, int n, double& mean_v, double& stuck_time) const {
-        const double h = T / 20000, t_end = (n + 1) * T;
+        const double h = T / 20000, t_end = (n + 1) * T, hold = hold_g > 0 ? hold_g : mug;
         double t = 0, x = 0, x_n = 0;   // part displacement relative to the plate
         stuck_time = 0;
         bool stuck = true;
@@ -362,14 +365,14 @@ struct StickSlip1D {
         while (t < t_end) {
             if (stuck) {   // find the break-away
                 double tb = t;
-                while (tb < t_end && std::abs(a(tb)) <= mug) tb += h;
+                while (tb < t_end && std::abs(a(tb)) <= hold) tb += h;
                 if (tb >= t_end) {
                     if (t < n * T) t = n * T;
                     stuck_time += t_end - std::max(t, n * T);
                     t = t_end;
                     break;
                 }
-                if (tb > t) tb = root([&](double u) { return std::abs(a(u)) - mug; }, tb - h, tb);
+                if (tb > t) tb = root([&](double u) { return std::abs(a(u)) - hold; }, tb - h, tb);
                 if (tb > n * T) stuck_time += tb - std::max(t, n * T);
                 if (t < n * T && tb >= n * T) x_n = x;
                 t = tb;
@@ -390,7 +393,7 @@ struct StickSlip1D {
             x += dx(ts);
             t = ts;
             if (t >= t_end) break;
-            if (std::abs(a(t)) <= mug)
+            if (std::abs(a(t)) <= hold)
                 stuck = true;
             else {
                 t0 = t;
@@ -471,6 +474,44 @@ TEST_CASE("a point part shaken above mu g: stick-slip cycle against the piecewis
 // Anderson acceleration stalls where the period map's noise matches the residual it extrapolates from
 // (here a sticking cycle of fig6 at tol 1e-5, rtol 1e-6: it hovered at 2e-5 for all 400 periods and
 // reported no cycle, while plain periods converge in 13). A stall hands over to plain periods.
+
+TEST_CASE("static above kinetic friction: a point part's stick-slip cycle against the piecewise closed form",
+          "[limit_cycle][stick][static_friction]") {
+    // mu_k = 0.3, mu_s = 0.36: it breaks away at |a_p| = mu_s g, slides at mu_k g and re-sticks where
+    // |a_p| <= mu_s g (StickSlip1D with hold_g). Tolerances as in the equal-coefficient case above.
+    const double muk_g = 0.3 * 9.81, mus_g = 0.36 * 9.81;
+    for (double A2 : {0.0, 2.0}) {
+        Scene sc = shaken_point(1.5 * mus_g, A2);
+        sc.part.mu_static = Vec3::Constant(0.36);
+        const double T = sc.plate.T;
+        StickSlip1D ref{{1.5 * mus_g}, {1}, {0.0}, sc.plate.omega(), muk_g, mus_g};
+        StickSlip1D one = ref;   // the wrong model: one coefficient, mu_k, for holding too
+        one.hold_g = 0;
+        if (A2 != 0) {
+            for (StickSlip1D* r : {&ref, &one}) {
+                r->A.push_back(A2);
+                r->k.push_back(2);
+                r->phi.push_back(0.7);
+            }
+        }
+        double mean_v, stuck, mean_v1, stuck1;
+        ref.run(T, 40, mean_v, stuck);
+        one.run(T, 40, mean_v1, stuck1);
+        LimitCycleOptions o;
+        o.tol = 1e-9;
+        o.integration.rtol = 1e-10;
+        const LimitCycleSummary lc = limit_cycle(sc, Vec3::Zero(), o);
+        INFO("A2 = " << A2 << ": reference mean velocity " << mean_v << " m/s, stuck " << stuck / T
+                     << " of T (one coefficient: " << mean_v1 << " m/s, " << stuck1 / T << " of T); " << lc.report());
+        REQUIRE(lc.converged);
+        CHECK(std::abs(lc.twist[0] - mean_v) < 1e-7 * sc.v_ref());
+        CHECK(std::abs(lc.twist[1]) < 1e-12);
+        CHECK(lc.stick_fraction[0] == Approx(stuck / T).margin(1e-7));
+        // The two models differ by far more than the tolerance: the check tells them apart.
+        CHECK(std::abs(stuck - stuck1) / T > 1e-2);
+        if (A2 != 0) CHECK(std::abs(mean_v - mean_v1) > 1e-5 * sc.v_ref());
+    }
+}
 TEST_CASE("a stalled Anderson iteration hands over to plain periods: fig6's sticking cycle at tol 1e-5",
           "[limit_cycle][stickslip]") {
     const Scene sc = scene("fig6");

@@ -245,7 +245,7 @@ TEST_CASE("the limit-surface check against the independent friction set catches 
     // The generated kernel, fed from the set with one input edited.
     auto kernel = [&](std::function<void(gen::WrenchInput&)> edit) -> WrenchMap {
         gen::WrenchInput in =
-            wrench_input(set.r, set.cap.cwiseQuotient(sc.part.friction().kinetic()), sc.part.friction().kinetic(), set.rho);
+            wrench_input(set.r, set.cap.cwiseQuotient(sc.part.friction().kinetic()), sc.part.friction(), set.rho);
         edit(in);
         return wrench_map(in);
     };

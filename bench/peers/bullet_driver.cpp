@@ -32,6 +32,10 @@ PeerRun run_bullet(const Scene& sc, const Vec3& q0, double duration, double samp
         r.failure = "point parts are not modelled here (a ball would roll)";
         return r;
     }
+    if (!P.friction().single()) {
+        r.failure = "Bullet has one friction coefficient per contact: static friction above kinetic is not modelled";
+        return r;
+    }
     if (P.friction().kinetic().maxCoeff() != P.friction().kinetic().minCoeff()) {
         r.failure = "Bullet has one friction coefficient per body: contacts with different mu are not modelled";
         return r;

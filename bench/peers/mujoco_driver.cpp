@@ -37,6 +37,10 @@ PeerRun run_mujoco(const Scene& sc, const Vec3& q0, double duration, double samp
         r.failure = "point parts are not modelled here (a ball would roll)";
         return r;
     }
+    if (!P.friction().single()) {
+        r.failure = "MuJoCo has one friction coefficient per contact: static friction above kinetic is not modelled";
+        return r;
+    }
     const double dt = opt.dt, rad = opt.sphere_radius;
     const long n = whole_steps(duration, dt, r.failure), every = whole_steps(sample_dt, dt, r.failure);
     if (!r.failure.empty()) return r;

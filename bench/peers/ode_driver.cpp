@@ -80,6 +80,10 @@ PeerRun run_ode(const Scene& sc, const Vec3& q0, double duration, double sample_
         r.failure = "point parts are not modelled here (a ball would roll)";
         return r;
     }
+    if (!P.friction().single()) {
+        r.failure = "ODE has one friction coefficient per contact: static friction above kinetic is not modelled";
+        return r;
+    }
     std::call_once(ode_init, [] { dInitODE2(0); });
     const double dt = opt.dt, rad = opt.sphere_radius;
     const long n = whole_steps(duration, dt, r.failure), every = whole_steps(sample_dt, dt, r.failure);

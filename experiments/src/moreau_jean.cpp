@@ -67,6 +67,7 @@ MoreauJeanSummary moreau_jean_u(const Scene& sc, const Vec3& q0, double duration
     Vec3 v = Vec3::Zero(), w = Vec3::Zero();
     double theta = q0[2];
 
+    P.friction().require_single("Moreau-Jean (Siconos' Coulomb cone)");
     Fc3d fc(nc, opt);
     for (int i = 0; i < nc; ++i) fc.problem->mu[i] = P.friction().kinetic(i);
     Eigen::VectorXd r = Eigen::VectorXd::Zero(n), u = Eigen::VectorXd::Zero(n);   // warm start: last step's

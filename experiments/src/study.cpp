@@ -170,6 +170,7 @@ int periods_to_cycle(Method m, const OdeSystem& sys, double T, const MethodOptio
 }
 
 std::shared_ptr<ReducedW> reduced_wrapped(const Scene& sc, const Vec3& q0, FrictionLaw law, double eps) {
+    if (law != FrictionLaw::Coulomb) sc.part.friction().require_single("a regularised friction law");
     auto w = std::make_shared<ReducedW>(sc, q0);
     w->model.ws.law = law;
     w->model.ws.law_eps = eps;
@@ -281,6 +282,7 @@ RunResult trajectory_run(const Scene& sc, const Vec3& q0, double duration, doubl
         r.seconds = seconds_since(t0);
         return r;
     }
+    if (s.law != FrictionLaw::Coulomb) sc.part.friction().require_single("a regularised friction law");
     auto w = std::make_shared<Wrapped<detail::FullModel>>(sc);
     w->model.ws.law = s.law;
     w->model.ws.law_eps = s.law_eps * sc.v_ref();

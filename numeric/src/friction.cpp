@@ -5,8 +5,17 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace plate {
+
+void ContactFriction::require_single(const char* who) const {
+    if (single()) return;
+    throw std::invalid_argument(std::string(who) +
+                                " has one friction coefficient per contact, and this part's static coefficients differ "
+                                "from its kinetic ones: use the stick-slip engine (Coulomb friction)");
+}
 
 const char* friction_law_name(FrictionLaw f) {
     switch (f) {
@@ -41,7 +50,7 @@ Eigen::Matrix2d direction_derivative(FrictionLaw law, double eps, const Vec2& v)
     return (I - e * e.transpose()) / s;
 }
 
-gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho) {
+gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const ContactFriction& mu, double rho) {
     gen::WrenchInput in;
     in.N1 = n[0];
     in.N2 = n[1];
@@ -52,9 +61,12 @@ gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const
     in.r2y = r[1].y();
     in.r3x = r[2].x();
     in.r3y = r[2].y();
-    in.mu1 = mu[0];
-    in.mu2 = mu[1];
-    in.mu3 = mu[2];
+    in.mu1 = mu.kinetic(0);
+    in.mu2 = mu.kinetic(1);
+    in.mu3 = mu.kinetic(2);
+    in.mus1 = mu.static_(0);
+    in.mus2 = mu.static_(1);
+    in.mus3 = mu.static_(2);
     in.rho = rho;
     return in;
 }
@@ -105,7 +117,7 @@ struct GaugeProblem {
         const Vec3 t1 = (std::abs(a.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(a).normalized();
         B.col(0) = t1;
         B.col(1) = a.cross(t1);
-        win = wrench_input({R[0] * rg, R[1] * rg, R[2] * rg}, n.cwiseMax(0.0), P.friction().static_(), rg);
+        win = wrench_input({R[0] * rg, R[1] * rg, R[2] * rg}, n.cwiseMax(0.0), P.friction(), rg);
     }
     // The support function P(d) = sum_i mu_i N_i |G_i^T d| with its gradient and Hessian: the
     // generated friction_support (a term is left out where its contact is at rest, a kink of P,

@@ -41,6 +41,32 @@ struct Support {
     }
 };
 
+// One set of friction coefficients: a number (every contact), [mu] (a point part) or [mu1, mu2,
+// mu3] (a rigid part's contacts in order), each >= 0.
+Vec3 friction_coefficients(const Reader& r, const json& f, const std::string& field, bool point) {
+    Vec3 mu;
+    if (f.is_number()) {
+        mu.setConstant(r.number(f, field));
+    } else if (f.is_array() && f.size() == 3 && !point) {
+        mu = r.vec3(f, field);
+    } else if (f.is_array() && f.size() == 1 && point) {
+        mu.setConstant(r.number(f[0], field + "[0]"));
+    } else {
+        r.fail(field, point ? "expected one number for a point part" : "expected one number or an array of 3 numbers");
+    }
+    for (int i = 0; i < (point ? 1 : 3); ++i)
+        if (mu[i] < 0) r.fail(field, "expected friction coefficients >= 0, got " + Reader::fmt(mu[i]));
+    return mu;
+}
+
+// The part's friction as a scene file has it: the one-coefficient form while static equals kinetic
+// (so such scenes write as before), else {"static": ..., "kinetic": ...}.
+json friction_json(const Part& p, int n) {
+    const auto coefficients = [n](const Vec3& mu) { return n == 1 ? json(mu[0]) : json{mu[0], mu[1], mu[2]}; };
+    if (p.friction().single()) return coefficients(p.mu);
+    return json{{"static", coefficients(*p.mu_static)}, {"kinetic", coefficients(p.mu)}};
+}
+
 }   // namespace
 
 Scene parse_scene(const std::string& text, const std::string& source) {
@@ -84,17 +110,14 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     part.point = point;
     part.m = r.positive(p["mass"], "part.mass");
     const json& f = p["friction"];
-    if (f.is_number()) {
-        part.mu.setConstant(r.number(f, "part.friction"));
-    } else if (f.is_array() && f.size() == 3 && !point) {
-        part.mu = r.vec3(f, "part.friction");
-    } else if (f.is_array() && f.size() == 1 && point) {
-        part.mu.setConstant(r.number(f[0], "part.friction[0]"));
+    if (f.is_object()) {
+        // {"static": ..., "kinetic": ...}: each in the one-coefficient forms below.
+        r.only_keys(f, "part.friction", {"static", "kinetic"}, {"static", "kinetic"});
+        part.mu = friction_coefficients(r, f["kinetic"], "part.friction.kinetic", point);
+        part.mu_static = friction_coefficients(r, f["static"], "part.friction.static", point);
     } else {
-        r.fail("part.friction", point ? "expected one number for a point part" : "expected one number or an array of 3 numbers");
+        part.mu = friction_coefficients(r, f, "part.friction", point);
     }
-    for (int i = 0; i < part.contacts(); ++i)
-        if (part.mu[i] < 0) r.fail("part.friction", "expected friction coefficients >= 0, got " + Reader::fmt(part.mu[i]));
     if (!point) {
         const json& I = p["inertia"];
         if (!I.is_array() || I.size() != 3) r.fail("part.inertia", "expected a 3x3 array of numbers");
@@ -155,8 +178,19 @@ void validate_scene(const Scene& s) {
         r.fail("plate.period", Reader::fmt(s.plate.T) + " s is outside " + Reader::fmt(kPeriodRange[0]) + " to " +
                                    Reader::fmt(kPeriodRange[1]) + " s (100 kHz to a thousandth of a hertz): a rigid plate " +
                                    "under Coulomb friction is not a model of it");
+    const char* kinetic_field = p.mu_static ? "part.friction.kinetic" : "part.friction";
     for (int i = 0; i < p.contacts(); ++i)
-        if (!(std::isfinite(p.mu[i]) && p.mu[i] >= 0)) r.fail("part.friction", "expected finite friction coefficients >= 0");
+        if (!(std::isfinite(p.mu[i]) && p.mu[i] >= 0)) r.fail(kinetic_field, "expected finite friction coefficients >= 0");
+    if (p.mu_static) {
+        for (int i = 0; i < p.contacts(); ++i) {
+            const double ms = (*p.mu_static)[i];
+            if (!std::isfinite(ms)) r.fail("part.friction.static", "expected finite friction coefficients");
+            // A held contact that let go below the sliding force would re-stick at once: no model of it.
+            if (ms < p.mu[i])
+                r.fail("part.friction.static", "contact " + std::to_string(i + 1) + ": static coefficient " + Reader::fmt(ms) +
+                                                   " below the kinetic " + Reader::fmt(p.mu[i]) + ": expected static >= kinetic");
+        }
+    }
     if (!p.point) {
         if (!p.J.allFinite()) r.fail("part.inertia", "expected finite numbers");
         const double scale = p.J.cwiseAbs().maxCoeff();
@@ -214,10 +248,12 @@ void validate_scene(const Scene& s) {
                                        Reader::fmt(kGyrationRange) + " to " + Reader::fmt(kGyrationRange) +
                                        " is almost surely a unit error (mass in kg, inertia in kg m^2, lengths in m)");
     }
+    const Vec3 largest = p.friction().static_();   // (static >= kinetic)
     for (int i = 0; i < p.contacts(); ++i)
-        if (p.mu[i] > kMaxFriction)
-            r.fail("part.friction", "friction coefficient " + Reader::fmt(p.mu[i]) + " above " + Reader::fmt(kMaxFriction) +
-                                        ": no pair of materials grips that hard (dry contacts lie below ~2)");
+        if (largest[i] > kMaxFriction)
+            r.fail(p.mu_static ? "part.friction.static" : "part.friction",
+                   "friction coefficient " + Reader::fmt(largest[i]) + " above " + Reader::fmt(kMaxFriction) +
+                       ": no pair of materials grips that hard (dry contacts lie below ~2)");
 
     for (std::size_t k = 0; k < s.plate.harmonics.size(); ++k) {
         const auto& h = s.plate.harmonics[k];
@@ -234,9 +270,9 @@ std::vector<std::string> scene_warnings(const Scene& s) {
     const Part& p = s.part;
     const std::string src = s.source.empty() ? std::string("(scene)") : s.source;
     for (int i = 0; i < p.contacts(); ++i)
-        if (p.mu[i] > kHighFriction) {
-            w.push_back(src + ": part.friction: " + Reader::fmt(p.mu[i]) + " is above " + Reader::fmt(kHighFriction) +
-                        ", more than dry contacts usually have");
+        if (p.friction().static_(i) > kHighFriction) {
+            w.push_back(src + ": part.friction: " + Reader::fmt(p.friction().static_(i)) + " is above " +
+                        Reader::fmt(kHighFriction) + ", more than dry contacts usually have");
             break;
         }
     const Support sup(p);
@@ -293,7 +329,7 @@ nlohmann::json scene_to_json(const Scene& s) {
     json part;
     part["mass"] = s.part.m;
     if (s.part.point) {
-        part["friction"] = s.part.mu[0];
+        part["friction"] = friction_json(s.part, 1);
     } else {
         json I = json::array(), C = json::array();
         for (int i = 0; i < 3; ++i) {
@@ -302,7 +338,7 @@ nlohmann::json scene_to_json(const Scene& s) {
         }
         part["inertia"] = I;
         part["contacts"] = C;
-        part["friction"] = {s.part.mu[0], s.part.mu[1], s.part.mu[2]};
+        part["friction"] = friction_json(s.part, 3);
     }
     j["part"] = part;
     json H = json::array();

@@ -258,8 +258,13 @@ Scene perturbed(const Scene& nominal, const UncertaintySpec& spec, const std::ve
     Scene s = nominal;
     Part& part = s.part;
     std::size_t k = 0;
-    for (int i = 0; i < part.contacts(); ++i) part.mu[i] *= 1 + p[k++];
+    // A contact's static and kinetic coefficients move together (one deviation: their ratio is kept).
+    for (int i = 0; i < part.contacts(); ++i, ++k) {
+        part.mu[i] *= 1 + p[k];
+        if (part.mu_static) (*part.mu_static)[i] *= 1 + p[k];
+    }
     if (part.point) part.mu.tail<2>().setConstant(part.mu[0]);
+    if (part.point && part.mu_static) part.mu_static->tail<2>().setConstant((*part.mu_static)[0]);
     part.m *= 1 + p[k++];
     if (!part.point) {
         part.J *= 1 + p[k++];

@@ -23,24 +23,35 @@ namespace gen {
 struct WrenchInput;   // (plate_kernels.hpp, generated)
 }
 
-// The friction coefficients of a part's contacts. The part sigma (Section III-B) has one
-// coefficient per contact, mu_ki, stored as Part::mu (what a scene file's part.friction sets);
-// today it serves both a sliding contact (kinetic) and a held one (static). Every reader of a
-// coefficient asks this class which of the two it means, so that a static coefficient above the
-// kinetic one changes this class and not its readers.
+// The friction coefficients of a part's contacts. The part sigma (Section III-B) has a kinetic
+// coefficient per contact, mu_ki (Part::mu), and a static one, mu_si >= mu_ki (Part::mu_static;
+// unset: equal to the kinetic one, the paper's model). Every reader of a coefficient asks this class
+// which of the two it means:
+//   kinetic  a sliding contact's force, -mu_ki N_i v_i/|v_i| (17): the slide modes, a pivot's
+//            sliding contacts, the limit surface of a sliding part (Theorem 1)
+//   static   the disk |f_i| <= mu_si N_i of a held contact: whether a contact or the whole part
+//            holds (stick tests, the gauge) and when it breaks away (hold_margin)
+// With mu_s > mu_k a contact that breaks away at |f_i| = mu_si N_i slides on at mu_ki N_i: its
+// friction drops at the event, and it re-sticks only where the needed force fits the static disk.
 class ContactFriction {
 public:
-    explicit ContactFriction(const Part& part) : mu_(part.mu), point_(part.point) {}
+    explicit ContactFriction(const Part& part)
+        : mu_(part.mu), mus_(part.mu_static ? *part.mu_static : part.mu), point_(part.point) {}
 
     // Kinetic coefficient of contact i: a sliding contact's force is -kinetic(i) N_i v_i/|v_i| (17).
     double kinetic(int i) const { return mu_[i]; }
     // Static coefficient of contact i: a held contact's force lies in |f_i| <= static_(i) N_i.
-    double static_(int i) const { return mu_[i]; }
-    // The three, in contact order (the generated kernels' inputs mu1..mu3).
+    double static_(int i) const { return mus_[i]; }
+    // The three, in contact order (the generated kernels' inputs: mu1..mu3 kinetic, mus1..mus3 static).
     const Vec3& kinetic() const { return mu_; }
-    const Vec3& static_() const { return mu_; }
+    const Vec3& static_() const { return mus_; }
     // The largest kinetic coefficient of the part's contacts (a point part: its one).
     double largest_kinetic() const { return point_ ? mu_[0] : mu_.maxCoeff(); }
+    // Does every contact's static coefficient equal its kinetic one (one coefficient per contact)?
+    bool single() const { return mus_ == mu_; }
+    // Throws std::invalid_argument naming `who` (a method or peer engine with one coefficient per
+    // contact) unless single().
+    void require_single(const char* who) const;
 
     // Radius of contact i's friction disk at normal force N (none while N < 0).
     double disk(int i, double N) const { return static_(i) * std::max(N, 0.0); }
@@ -49,7 +60,7 @@ public:
     double hold_margin(int i, double N, const Vec2& f) const { return static_(i) * N - f.norm(); }
 
 private:
-    Vec3 mu_;
+    Vec3 mu_, mus_;
     bool point_;
 };
 
@@ -97,10 +108,11 @@ struct FrictionGauge {
 };
 FrictionGauge friction_gauge(const Part& part, double theta, const Vec3& n, const Vec2& F, double tau);
 
-// The inputs of the generated limit-surface kernels (thin_wrench, friction_support): contacts r_i
-// from the centre of mass (plate frame, horizontal), normal forces n, friction coefficients mu and
-// the radius of gyration; the twist (vx, vy, xith) is left at zero for the caller. (The caller
-// includes plate_kernels.hpp for the type.)
-gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const Vec3& mu, double rho);
+// The inputs of the generated limit-surface kernels: contacts r_i from the centre of mass (plate frame,
+// horizontal), normal forces n, the friction coefficients -- kinetic mu1..3 for a sliding part's wrench
+// (thin_wrench), static mus1..3 for the friction set's support function (friction_support) -- and the
+// radius of gyration; the twist (vx, vy, xith) is left at zero for the caller. (The caller includes
+// plate_kernels.hpp for the type.)
+gen::WrenchInput wrench_input(const std::array<Vec2, 3>& r, const Vec3& n, const ContactFriction& mu, double rho);
 
 }   // namespace plate

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,14 +31,15 @@ std::array<V, N> zeros() {
 
 class ContactFriction;   // friction.hpp
 
-// sigma = (m, J, c1, c2, c3, mu_k1, mu_k2, mu_k3).
+// sigma = (m, J, c1, c2, c3, mu_k1, mu_k2, mu_k3), and the static coefficients mu_s1..3.
 // A point part has only m and mu (one contact at the centre of mass, no rotation).
 struct Part {
     bool point = false;
     double m = 0;                            // mass [kg]
     Mat3 J = Mat3::Zero();                   // rotational inertia about s, in S [kg m^2]
     std::array<Vec3, 3> c = zeros<Vec3>();   // contacts c_i in S [m]; all share one z (flat plate)
-    Vec3 mu = Vec3::Zero();                  // friction coefficients mu_ki, as set (read them through friction())
+    Vec3 mu = Vec3::Zero();                  // kinetic friction coefficients mu_ki (read them through friction())
+    std::optional<Vec3> mu_static;           // static coefficients mu_si >= mu_ki; unset: equal to the kinetic ones
 
     int contacts() const { return point ? 1 : 3; }
     // The contacts' kinetic and static friction coefficients (friction.hpp, which defines it).

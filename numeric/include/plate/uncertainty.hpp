@@ -71,7 +71,8 @@ Scene draw(const Scene& nominal, const UncertaintySpec& spec, std::uint64_t inde
 // THE SPEC AS PARAMETERS. A draw is the nominal scene moved by a vector p of independent scalar
 // deviations, one per entry of uncertain_parameters (in its order): the linearisation the fixed
 // points' sensitivities use (robustness.hpp) and the draws apply the same p through perturbed().
-//   friction[i]        mu_i (1 + p), relative (a point part: one, for its one coefficient)
+//   friction[i]        mu_i (1 + p), relative (a point part: one, for its one coefficient); a contact's
+//                      static coefficient, if the scene has one, by the same factor
 //   mass, inertia      m (1 + p), J (1 + p), relative (inertia: rigid parts)
 //   contact[i].x/.y    c_i + p, m (rigid parts)
 //   com.x/.y           every c_i - p, m: the centre of mass moved by p (rigid parts)
