@@ -42,15 +42,13 @@ void verify_robust(DesignSummary& sum, const DesignTarget& target, const DesignO
         for (double t : d.arrival) all = all && std::isfinite(t);
         success += all;
     }
-    int full_runs = 0, full_arrived = 0;
-    for (const DrawResult* d : {&r.nominal_result}) {
-        full_runs += static_cast<int>(d->arrival_full.size());
-        for (double t : d->arrival_full) full_arrived += std::isfinite(t);
-    }
-    for (const DrawResult& d : r.draws) {
+    int full_runs = 0, full_arrived = 0;   // the nominal plate's runs and the draws'
+    const auto count_full = [&](const DrawResult& d) {
         full_runs += static_cast<int>(d.arrival_full.size());
         for (double t : d.arrival_full) full_arrived += std::isfinite(t);
-    }
+    };
+    count_full(r.nominal_result);
+    for (const DrawResult& d : r.draws) count_full(d);
     const int n = static_cast<int>(r.draws.size());
     const double share = static_cast<double>(success) / n;
     std::ostringstream why;

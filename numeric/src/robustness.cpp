@@ -16,16 +16,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity(), kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint64_t kNominal = std::numeric_limits<std::uint64_t>::max();
 
-// Within the arrival tolerances of the target (a point part: position only).
-bool arrived(const Vec3& q, const Vec3& target, bool point, const RobustnessOptions& opt) {
-    const bool near = std::hypot(q[0] - target[0], q[1] - target[1]) <= opt.arrive_distance;
-    return near && (point || std::abs(wrap_angle(q[2] - target[2])) <= opt.arrive_angle);
-}
-
-// Within a tenth of the arrival tolerances of q (a fixed point): there the field is linear about it.
-bool caught(const Vec3& q, const Vec3& at, bool point, const RobustnessOptions& opt) {
-    const bool near = std::hypot(q[0] - at[0], q[1] - at[1]) <= 0.1 * opt.arrive_distance;
-    return near && (point || std::abs(wrap_angle(q[2] - at[2])) <= 0.1 * opt.arrive_angle);
+// Within `scale` times the arrival tolerances of `at` (a point part: position only): scale 1 is an
+// arrival at the target; 0.1 is caught by a fixed point, where the field is linear about it.
+bool within(const Vec3& q, const Vec3& at, bool point, const RobustnessOptions& opt, double scale = 1) {
+    const bool near = std::hypot(q[0] - at[0], q[1] - at[1]) <= scale * opt.arrive_distance;
+    return near && (point || std::abs(wrap_angle(q[2] - at[2])) <= scale * opt.arrive_angle);
 }
 
 // The field's integral curve from q0 (classical RK4, step opt.curve_step) until it comes within the
@@ -40,9 +35,9 @@ double field_arrival(const Scene& sc, const Vec3& q0, const Vec3& target, const 
     Vec3 q = q0, warm = Vec3::Zero();
     try {
         for (double t = 0;; t += h) {
-            if (arrived(q, target, point, opt)) return t;
+            if (within(q, target, point, opt)) return t;
             for (const Vec3& e : elsewhere)
-                if (caught(q, e, point, opt)) return kInf;
+                if (within(q, e, point, opt, 0.1)) return kInf;
             if (t + h > opt.horizon * (1 + 1e-12)) return kInf;
             const Vec3 k1 = field_at(sc, q, lo, &warm);
             const Vec3 k2 = field_at(sc, q + h / 2 * k1, lo, &warm);
@@ -67,7 +62,7 @@ double full_arrival(const Scene& sc, const Vec3& q0, const Vec3& target, const R
     if (tr.stop.reason != StopReason::None) return kNaN;
     double since = kInf;
     for (const Sample& s : tr.samples) {
-        if (!arrived(s.q, target, sc.part.point, opt))
+        if (!within(s.q, target, sc.part.point, opt))
             since = kInf;
         else if (!(since < kInf))
             since = s.t;
@@ -157,7 +152,7 @@ DrawResult analyse(const Scene& sc, std::uint64_t index, const Vec3& target, con
     classify(sc, target, opt, r, stable);
     if (r.outcome == Outcome::contact_lost || r.outcome == Outcome::failed) return r;
     for (const Vec3& q : stable)
-        if (!arrived(q, target, sc.part.point, opt)) elsewhere.push_back(q);
+        if (!within(q, target, sc.part.point, opt)) elsewhere.push_back(q);
     for (const Vec3& q0 : starts) r.arrival.push_back(field_arrival(sc, q0, target, elsewhere, opt));
     if (full)
         for (const Vec3& q0 : starts) r.arrival_full.push_back(full_arrival(sc, q0, target, opt));

@@ -35,6 +35,16 @@ double first_order_radius(const DesignSummary& d) {
     return s.predicted_radius95;
 }
 
+// A lean search (2 starts, 150 local evaluations) for a point sink at (0.02, -0.01) of fig1's point
+// part, verified robustly under `o` (the two designs below that must fail verification).
+DesignSummary lean_point_sink(DesignOptions o) {
+    DesignTarget t;
+    t.at = Vec2(0.02, -0.01);
+    o.starts = 2;
+    o.local_evaluations = 150;
+    return design(scene("fig1_point"), t, o);
+}
+
 }   // namespace
 
 TEST_CASE("a robust point sink holds its fixed point within the asked radius on draws the search never saw", "[design][robust]") {
@@ -68,15 +78,9 @@ TEST_CASE("a robust point sink holds its fixed point within the asked radius on 
 }
 
 TEST_CASE("a robust design that cannot hold the asked spread fails verification, naming the spread", "[design][robust]") {
-    const Scene part = scene("fig1_point");
-    DesignTarget t;
-    t.at = Vec2(0.02, -0.01);
     // 0.3 mm: under PPOD's 3 % amplitude and 0.03 rad phase no sink of these limits is that tight (the search's
     // best first order is ~2 mm at the rates a verification needs): the Monte Carlo must refuse it.
-    DesignOptions o = robust_options(0.0003);
-    o.starts = 2;
-    o.local_evaluations = 150;
-    const DesignSummary r = design(part, t, o);
+    const DesignSummary r = lean_point_sink(robust_options(0.0003));
     INFO(r.failure);
     CHECK_FALSE(r.verified);
     CHECK(r.failure.rfind("robust: ", 0) == 0);
@@ -100,14 +104,9 @@ TEST_CASE("robust design is refused where it has no fixed point to follow", "[de
 }
 
 TEST_CASE("a robust design whose starts cannot arrive in time fails on the share", "[design][robust][audit]") {
-    const Scene part = scene("fig1_point");
-    DesignTarget t;
-    t.at = Vec2(0.02, -0.01);
     DesignOptions o = robust_options(0.01);
-    o.starts = 2;
-    o.local_evaluations = 150;
     o.arrive = 2;
-    const DesignSummary r = design(part, t, o);
+    const DesignSummary r = lean_point_sink(o);
     INFO(r.failure);
     CHECK_FALSE(r.verified);
     CHECK(r.failure.find("reached from every start within 2 s") != std::string::npos);
