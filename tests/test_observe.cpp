@@ -157,6 +157,23 @@ TEST_CASE("stroboscopic frames at phase phi are stamped (k + phi) T, and a laten
     CHECK(moved > 1e-3);   // (frames one off would differ by the motion)
 }
 
+TEST_CASE("a run that loses contact ends the track at the last frame before the stop", "[observe][schedule]") {
+    // The plate's heave at 15 m/s^2 > g: the normal force reaches zero within the first period.
+    Scene sc = scene("fig1_point");
+    sc.plate.harmonics.push_back({Axis::z, 1, 15, 0});
+    Camera cam = camera(1000, CameraFrame::plate);
+    Trajectory exact;
+    const Track tr = observe(sc, cam, Dynamics::Full, Vec3(0.01, 0, 0), Vec3::Zero(), 0.2, {}, &exact);
+    REQUIRE(exact.stop.reason == StopReason::ContactLost);
+    const double stop = exact.stop.t;
+    INFO("contact lost at " << stop << " s; " << tr.t.size() << " frames");
+    REQUIRE(stop < sc.plate.T);
+    // Every stamp k / 1000 before the stop is a frame, none at or after it (the stop's own sample is no frame).
+    CHECK(tr.t.size() == static_cast<std::size_t>(std::floor(stop * 1000)) + 1);
+    CHECK(tr.t.back() < stop);
+    CHECK(exact.samples.back().t == stop);
+}
+
 namespace {
 
 // n frames of a part at rest at q (plate frame): the exact trajectory a camera films (film()).
