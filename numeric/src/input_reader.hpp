@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -81,6 +82,21 @@ struct Reader {
         Vec3 out;
         for (int i = 0; i < 3; ++i) out[i] = number(v[i], field + "[" + std::to_string(i) + "]");
         return out;
+    }
+
+    // The JSON document of `text` ("SOURCE: malformed JSON: ..." if it is none).
+    json parse(const std::string& text) const {
+        try {
+            return json::parse(text);
+        } catch (const json::exception& e) {
+            throw InputError(source + ": malformed JSON: " + e.what());
+        }
+    }
+
+    // A seed: a whole number from 0 to 2^64 - 1.
+    std::uint64_t seed(const json& v, const std::string& field) const {
+        if (!v.is_number_unsigned()) fail(field, "expected a whole number from 0 to 2^64 - 1");
+        return v.get<std::uint64_t>();
     }
 
     static std::string fmt(double x) {

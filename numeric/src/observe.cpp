@@ -44,12 +44,7 @@ void Camera::validate() const {
 
 Camera parse_camera(const std::string& text, const std::string& source) {
     Reader r{source};
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::exception& e) {
-        throw InputError(source + ": malformed JSON: " + e.what());
-    }
+    const json doc = r.parse(text);
     r.only_keys(doc, "", {"rate_hz", "stroboscopic", "noise", "latency_s", "drop", "seed", "frame"}, {"frame"});
     Camera c;
     c.source = source;
@@ -77,10 +72,7 @@ Camera parse_camera(const std::string& text, const std::string& source) {
     }
     if (doc.contains("latency_s")) c.latency = r.number(doc["latency_s"], "latency_s");
     if (doc.contains("drop")) c.drop = r.number(doc["drop"], "drop");
-    if (doc.contains("seed")) {
-        if (!doc["seed"].is_number_unsigned()) r.fail("seed", "expected a whole number from 0 to 2^64 - 1");
-        c.seed = doc["seed"].get<std::uint64_t>();
-    }
+    if (doc.contains("seed")) c.seed = r.seed(doc["seed"], "seed");
     const json& f = doc["frame"];
     if (f == "plate")
         c.frame = CameraFrame::plate;
