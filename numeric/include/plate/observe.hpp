@@ -22,16 +22,17 @@
 // The track file (CSV), written by write_track_csv:
 //
 //   # plate track 1
-//   # scene: fig4
-//   # scene_id: 5c1f0a3e8b2d4f67
-//   # camera: {"frame":"plate","latency_s":0.0,...}
+//   # scene: "fig4"
+//   # scene_id: d8d0707459dc4bba
+//   # camera: {"drop":0.0,"frame":"plate","latency_s":0.0,"noise":{...},"seed":1,"stroboscopic":{...}}
 //   # frame: plate
 //   # part: rigid
 //   t [s],s_x [m],s_y [m],theta [rad]
-//   0.0125,0.030001,-0.019998,1.0002
+//   0.012500000000000001,0.028551897259516866,-0.020566585395640418,1.0093570203833446
 //   ...
 //
-// The first line names the format and its version; "# key: value" lines follow in this order; then
+// The first line names the format and its version; "# key: value" lines follow in this order (the
+// scene's name as a JSON string, its scene_id, the camera in its file form, its frame, the part); then
 // the column line and one row per recorded frame, t strictly increasing. A point part has no heading:
 // its part line says "point" and its columns are t [s],s_x [m],s_y [m]. t is the camera's stamp; the
 // state shown is at t - latency_s (the camera line says it).
