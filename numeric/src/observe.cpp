@@ -113,8 +113,9 @@ std::vector<double> frame_stamps(const Camera& c, double T, double duration) {
     const double per_second = c.stroboscopic() ? c.per_period / T : c.rate;
     if (duration * per_second > 1e9) throw std::invalid_argument("frame_stamps: more than 10^9 frames");
     std::vector<double> out;
-    // (from a frame or two before the latency: the first whose state time is >= 0)
-    for (long k = std::max(0L, static_cast<long>(c.latency * per_second) - 2);; ++k) {
+    // (from a frame or two before the first whose state time is >= 0: stamp k is k / per_second + offset)
+    const double offset = c.stroboscopic() ? c.phase * T : 0;
+    for (long k = std::max(0L, static_cast<long>((c.latency - offset) * per_second) - 2);; ++k) {
         const double t = stamp(k);
         if (t - c.latency > duration) break;
         if (t - c.latency >= 0) out.push_back(t);
@@ -202,9 +203,14 @@ Track film(const Scene& scene, const Camera& camera, const std::vector<double>& 
 
 Track observe(const Scene& scene, const Camera& camera, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration,
               const IntegrationOptions& opt, Trajectory* exact) {
-    camera.validate();
     const std::vector<double> stamps = frame_stamps(camera, scene.plate.T, duration);
     if (stamps.empty()) throw std::invalid_argument("observe: no frame of the camera falls within the duration");
+    return observe_at(scene, camera, level, q0, qd0, stamps, opt, exact);
+}
+
+Track observe_at(const Scene& scene, const Camera& camera, Dynamics level, const Vec3& q0, const Vec3& qd0,
+                 const std::vector<double>& stamps, const IntegrationOptions& opt, Trajectory* exact) {
+    camera.validate();
     std::vector<double> times;
     for (double t : stamps) times.push_back(t - camera.latency);
     Trajectory tr = simulate_at(scene, level, q0, qd0, times, opt);

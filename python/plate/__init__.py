@@ -23,14 +23,15 @@ import json as _json
 
 from ._plate import (Camera, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Robustness, Scene, Stop,
                      Track, Trajectory, axis_peaks, check_track_scene, coning_rate, design, field, fixed_points,
-                     frame_stamps, load_camera, load_scene, observe, orientation_harmonics, parse_camera, parse_scene,
-                     read_track_csv, robustness, scene_id, simulate, twist, uncertain_parameters, write_track_csv)
+                     frame_stamps, load_camera, load_scene, observe, observe_at, orientation_harmonics, parse_camera,
+                     parse_scene, read_track_csv, robustness, scene_id, simulate, twist, uncertain_parameters,
+                     write_track_csv)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
 __all__ = ["Camera", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Robustness",
            "Scene", "Stop", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "design", "field",
-           "fixed_points", "frame_stamps", "load_camera", "load_scene", "observe", "orientation_harmonics",
+           "fixed_points", "frame_stamps", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
            "parse_camera", "parse_scene", "read_track_csv", "robustness", "scene_from_dict", "scene_id", "scene_to_dict",
            "simulate", "twist", "uncertain_parameters", "write_track_csv"]
 

@@ -5,6 +5,7 @@
 #include "plate/observe.hpp"
 
 #include <cmath>
+#include <functional>
 
 namespace plate::python {
 
@@ -17,6 +18,30 @@ Camera camera_of(const py::object& c) {
     if (py::isinstance<py::str>(c)) return load_camera(c.cast<std::string>());
     require(py::isinstance<py::dict>(c), "camera: expected a plate.Camera, a camera file's path or a dict in its form");
     return parse_camera(py::module_::import("json").attr("dumps")(c).cast<std::string>(), "<dict>");
+}
+
+// plate.observe and plate.observe_at: the options checked, `run` (the library's observe or observe_at)
+// called without the GIL, the track returned with the run's stop as track.stop.
+using Run = std::function<Track(Dynamics, const Vec3&, const Vec3&, const IntegrationOptions&, Trajectory*)>;
+py::object run_observe(const Scene& sc, const std::vector<double>& start, const std::optional<std::vector<double>>& twist,
+                       const std::string& dynamics, double rtol, long max_steps, const Run& run) {
+    require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
+    const Vec3 q0 = config(sc, start, "start");
+    const Vec3 qd0 = twist ? config(sc, *twist, "twist") : Vec3::Zero();
+    require(rtol > 0 && rtol < 1e-2, "rtol: expected a number in (0, 1e-2)");
+    require(max_steps >= 1, "max_steps: expected >= 1");
+    IntegrationOptions io;
+    io.rtol = rtol;
+    io.max_steps = max_steps;
+    Trajectory exact;
+    Track tr;
+    {
+        py::gil_scoped_release free;
+        tr = run(dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, io, &exact);
+    }
+    py::object out = py::cast(std::move(tr));
+    out.attr("stop") = py::cast(to_py(exact.stop));
+    return out;
 }
 
 }   // namespace
@@ -78,33 +103,33 @@ void bind_observe(py::module_& m) {
         "observe",
         [](const Scene& sc, const py::object& camera, const std::vector<double>& start, double time, const std::string& dynamics,
            std::optional<std::vector<double>> twist, double rtol, long max_steps) {
-            require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
             const Camera cam = camera_of(camera);
-            const Vec3 q0 = config(sc, start, "start");
-            const Vec3 qd0 = twist ? config(sc, *twist, "twist") : Vec3::Zero();
             require(std::isfinite(time) && time > 0, "time: expected a number > 0");
-            require(rtol > 0 && rtol < 1e-2, "rtol: expected a number in (0, 1e-2)");
-            require(max_steps >= 1, "max_steps: expected >= 1");
             const double per_second = cam.stroboscopic() ? cam.per_period / sc.plate.T : cam.rate;
             require(time * per_second <= 1e7, "time: the camera would take more than 10^7 frames");
-            IntegrationOptions io;
-            io.rtol = rtol;
-            io.max_steps = max_steps;
-            Trajectory exact;
-            Track tr;
-            {
-                py::gil_scoped_release free;
-                tr = observe(sc, cam, dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, io, &exact);
-            }
-            py::object out = py::cast(std::move(tr));
-            out.attr("stop") = py::cast(to_py(exact.stop));
-            return out;
+            return run_observe(sc, start, twist, dynamics, rtol, max_steps,
+                               [&](Dynamics level, const Vec3& q0, const Vec3& qd0, const IntegrationOptions& io,
+                                   Trajectory* ex) { return observe(sc, cam, level, q0, qd0, time, io, ex); });
         },
         py::arg("scene"), py::arg("camera"), py::arg("start"), py::arg("time"), py::kw_only(), py::arg("dynamics") = "full",
         py::arg("twist") = py::none(), py::arg("rtol") = 1e-9, py::arg("max_steps") = 20'000'000L,
         "What `camera` (a plate.Camera, a camera file's path or a dict in its form) records of a simulation from\n"
         "`start` (twist `twist` relative to the plate, default at rest) for `time` seconds: ('full' or 'u' dynamics).\n"
         "A run that stops (a normal force reaches zero) ends the track there: track.stop says when and why.");
+    m.def(
+        "observe_at",
+        [](const Scene& sc, const py::object& camera, const std::vector<double>& start, const std::vector<double>& stamps,
+           const std::string& dynamics, std::optional<std::vector<double>> twist, double rtol, long max_steps) {
+            const Camera cam = camera_of(camera);
+            require(!stamps.empty() && stamps.size() <= 10'000'000u, "stamps: expected 1 to 10^7 stamps");
+            return run_observe(sc, start, twist, dynamics, rtol, max_steps,
+                               [&](Dynamics level, const Vec3& q0, const Vec3& qd0, const IntegrationOptions& io,
+                                   Trajectory* ex) { return observe_at(sc, cam, level, q0, qd0, stamps, io, ex); });
+        },
+        py::arg("scene"), py::arg("camera"), py::arg("start"), py::arg("stamps"), py::kw_only(), py::arg("dynamics") = "full",
+        py::arg("twist") = py::none(), py::arg("rtol") = 1e-9, py::arg("max_steps") = 20'000'000L,
+        "plate.observe at the given camera stamps (increasing, none before the camera's latency): e.g. a model's\n"
+        "prediction of a recorded track -- track.t, a camera without noise and drops.");
     m.def(
         "read_track_csv", &read_track_csv, py::arg("path"),
         "Reads a track file (raises plate.InputError naming the file and the line: a bad header, cell or time, too few frames).");

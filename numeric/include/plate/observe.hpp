@@ -150,6 +150,11 @@ Track film(const Scene& scene, const Camera& camera, const std::vector<double>& 
 Track observe(const Scene& scene, const Camera& camera, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration,
               const IntegrationOptions& opt = {}, Trajectory* exact = nullptr);
 
+// observe() at the given stamps (increasing, each at or after camera.latency; std::invalid_argument
+// else): e.g. a model's prediction of a recorded track -- its t, a camera without noise and drops.
+Track observe_at(const Scene& scene, const Camera& camera, Dynamics level, const Vec3& q0, const Vec3& qd0,
+                 const std::vector<double>& stamps, const IntegrationOptions& opt = {}, Trajectory* exact = nullptr);
+
 // The track file (above): numbers with 17 significant digits, which read back to the same doubles.
 void write_track_csv(std::ostream& out, const Track& track);
 // InputError naming the file and the line (and the column of a bad cell) and what was expected: a
