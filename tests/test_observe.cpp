@@ -136,7 +136,7 @@ TEST_CASE("stroboscopic frames at phase phi are stamped (k + phi) T, and a laten
 
     // Any schedule and latency: every stamp from k = 0 on whose state time lies in [0, duration], none other.
     for (const double phase : {0.0, 0.5, 0.9})
-        for (const int m : {1, 4})
+        for (const int m : {1, 4, 8})
             for (const double L : {0.0, 0.3 * T, 1.7 * T}) {
                 c.per_period = m;
                 c.phase = phase;
