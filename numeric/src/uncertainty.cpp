@@ -59,12 +59,6 @@ Rng stream(const UncertaintySpec& spec, std::uint64_t index, Stream what, int at
     return Rng(k);
 }
 
-double standard_normal(Rng& r) {
-    // Box-Muller; 1 - uniform() lies in (0, 1], so the log is finite.
-    const double u1 = 1 - r.uniform(), u2 = r.uniform();
-    return std::sqrt(-2 * std::log(u1)) * std::cos(2 * kPi * u2);
-}
-
 double sample(const Spread& s, Rng& r) {
     if (s.spread == 0) return 0;
     return s.distribution == Distribution::uniform ? r.uniform(-s.spread, s.spread) : s.spread * standard_normal(r);
@@ -161,20 +155,14 @@ Vec6 axis_rms(const PlateMotion& plate) {
 
 UncertaintySpec parse_uncertainty(const std::string& text, const std::string& source) {
     Reader r{source};
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::exception& e) {
-        throw InputError(source + ": malformed JSON: " + e.what());
-    }
+    const json doc = r.parse(text);
     r.only_keys(
         doc, "",
         {"seed", "friction", "mass", "inertia", "contacts_mm", "com_offset_mm", "amplitude", "phase", "unmodelled", "period"},
         {"seed"});
     UncertaintySpec s;
     s.source = source;
-    if (!doc["seed"].is_number_unsigned()) r.fail("seed", "expected a whole number from 0 to 2^64 - 1");
-    s.seed = doc["seed"].get<std::uint64_t>();
+    s.seed = r.seed(doc["seed"], "seed");
     s.friction = read_spread(r, doc, "friction");
     s.mass = read_spread(r, doc, "mass");
     s.inertia = read_spread(r, doc, "inertia");

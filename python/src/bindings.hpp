@@ -32,6 +32,7 @@ void bind_fixed_points(py::module_& m);   // field.cpp:    FixedPoint, FixedLine
 void bind_design(py::module_& m);         // design.cpp:   Design, design, orientation_harmonics, coning_rate
 void bind_simulate(py::module_& m);       // simulate.cpp: Trajectory, simulate
 void bind_robustness(py::module_& m);     // robustness.cpp: Robustness, robustness, uncertain_parameters
+void bind_observe(py::module_& m);        // observe.cpp:  Camera, Track, observe, read_track_csv, ...
 
 // --- conversions (conversions.cpp) ---------------------------------------------------------------
 

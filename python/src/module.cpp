@@ -34,4 +34,5 @@ PYBIND11_MODULE(_plate, m) {
     bind_design(m);
     bind_simulate(m);
     bind_robustness(m);
+    bind_observe(m);
 }
