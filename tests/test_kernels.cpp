@@ -272,15 +272,18 @@ TEST_CASE("the limit-surface kernel is the derived wrench", "[kernels][symbolic]
         double* rx[3] = {&in.r1x, &in.r2x, &in.r3x};
         double* ry[3] = {&in.r1y, &in.r2y, &in.r3y};
         double* mu[3] = {&in.mu1, &in.mu2, &in.mu3};
+        double* mus[3] = {&in.mus1, &in.mus2, &in.mus3};   // static above kinetic: the kernels must read each
         for (int i = 0; i < 3; ++i) {
             *N[i] = r.uniform(0.01, 0.2);
             *rx[i] = r.uniform(-0.05, 0.05);
             *ry[i] = r.uniform(-0.05, 0.05);
             *mu[i] = r.uniform(0.1, 0.4);
+            *mus[i] = *mu[i] * r.uniform(1.1, 1.5);
             sub[S.N[i]] = *N[i];
             sub[S.rx[i]] = *rx[i];
             sub[S.ry[i]] = *ry[i];
             sub[S.mu[i]] = *mu[i];
+            sub[S.mus[i]] = *mus[i];
         }
         in.rho = r.uniform(0.01, 0.04);
         in.vx = r.uniform(-0.3, 0.3);
@@ -302,7 +305,7 @@ TEST_CASE("the limit-surface kernel is the derived wrench", "[kernels][symbolic]
         gen::friction_support(in, sp, tm, gr, he);
         const realsymbol dv[3] = {S.vx, S.vy, S.xith};
         for (int i = 0; i < 3; ++i) {
-            const double cap = (i == 0 ? in.mu1 * in.N1 : i == 1 ? in.mu2 * in.N2 : in.mu3 * in.N3);
+            const double cap = *mus[i] * *N[i];
             CHECK(std::abs(sp[i] - ex_to<numeric>(d.support_speed[i].subs(sub).evalf()).to_double()) <= 1e-12 * sp[i]);
             CHECK(std::abs(tm[i] - ex_to<numeric>(d.support_term[i].subs(sub).evalf()).to_double()) <= 1e-12 * tm[i]);
             int h = 0;
@@ -313,9 +316,14 @@ TEST_CASE("the limit-surface kernel is the derived wrench", "[kernels][symbolic]
                     CHECK(std::abs(he[6 * i + h] - ex_to<numeric>(ga.diff(dv[b]).subs(sub).evalf()).to_double()) <=
                           1e-11 * cap * 100 / sp[i]);
             }
-            // The support function is the dissipated power, whose gradient is minus the wrench.
         }
-        for (int a = 0; a < 3; ++a) CHECK(std::abs(gr[a] + gr[3 + a] + gr[6 + a] + w[a]) <= 1e-12 * scale);
+        // The support function is the power the static disks would dissipate, whose gradient is minus the
+        // wrench with mu_si in place of mu_ki: each contact's term scaled by mu_ki / mu_si gives the wrench.
+        for (int a = 0; a < 3; ++a) {
+            double sum = 0;
+            for (int i = 0; i < 3; ++i) sum += gr[3 * i + a] * *mu[i] / *mus[i];
+            CHECK(std::abs(sum + w[a]) <= 1e-12 * scale);
+        }
         // Coulomb: each contact's force is mu_i N_i against its own slip v_i = (v_x - xi r_iy / rho, v_y +
         // xi r_ix / rho), so the wrench's power is minus the sum of mu_i N_i |v_i| (written out here).
         double dissipated = 0;
