@@ -1,14 +1,17 @@
 // plate simulate: a U-dynamics, full-dynamics, averaged or field-integral-curve trajectory, as CSV;
-// --dynamics auto picks the cheapest model predicted within --model-tol.
+// --dynamics auto picks the cheapest model predicted within --model-tol; --observe CAMERA.json writes
+// what a camera records of a full or U-dynamics run instead (observe.hpp).
 #include "commands.hpp"
 
 #include "plate/hierarchy.hpp"
+#include "plate/observe.hpp"
 #include "plate/output.hpp"
 #include "plate/simulate.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -20,7 +23,7 @@ namespace {
 constexpr double kMaxRows = 1e7;   // rows of a trajectory CSV
 
 struct SimulateArgs : Options {
-    std::string scene, dynamics, out = "-";
+    std::string scene, dynamics, out = "-", observe;
     std::vector<double> from, twist;
     double time = 0, sample = 0, model_tol = 1e-2;
     double rtol = IntegrationOptions{}.rtol, tol = LimitCycleOptions{}.tol;
@@ -47,7 +50,13 @@ struct SimulateArgs : Options {
                   "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n"
                   "--max-steps N: the work budget (integrator steps; for field, RK4 steps of the curve; default\n"
                   "2e7, field 1e4). The work is estimated up front from one plate period (or one RK4 step) and a\n"
-                  "run that would exceed the budget is refused with the estimate (exit 2); at most 10^7 rows.\n") {
+                  "run that would exceed the budget is refused with the estimate (exit 2); at most 10^7 rows.\n"
+                  "--observe CAMERA.json (full or u): --out gets the track a camera records instead of the\n"
+                  "trajectory -- frames at rate_hz or once per period at a phase (stroboscopic), with pixel noise,\n"
+                  "latency and dropped frames, in the plate's or the world's frame (the plate's own motion\n"
+                  "included): '#' header lines (format version, scene name and scene_id, camera, frame, part), then\n"
+                  "t [s],s_x [m],s_y [m],theta [rad] (point parts: no theta). t is the camera's stamp; the state\n"
+                  "shown is at t - latency_s. The camera file: docs/guide.md, Observations.\n") {
         scene_file(scene);
         text("--dynamics", dynamics, "full|u|field|averaged|auto", "the model; required");
         numbers("--from", from, 2, 3, "SX SY THETA", "the start (point parts: SX SY); required");
@@ -55,6 +64,7 @@ struct SimulateArgs : Options {
         numbers("--twist", twist, 2, 3, "VX VY OMEGA", "the part's twist relative to the plate at the start");
         number("--sample", sample, "seconds between rows", "a quarter of the plate's period");
         text("--out", out, "FILE", "the CSV file (default: standard output)");
+        text("--observe", observe, "CAMERA.json", "write the camera's track instead of the trajectory");
         number("--rtol", rtol, "integrator tolerance");
         number("--tol", tol, "limit-cycle tolerance of the field curve");
         text("--max-periods", max_periods, "N", "(not used by simulate)");
@@ -98,6 +108,48 @@ void check_simulate_work(const Scene& sc_run, const std::string& dyn, const Vec3
                          " steps: raise it with --max-steps or shorten --time");
 }
 
+// The run's end: a run cut off by the budget is no result (nothing written); else `write` to --out,
+// then exit 3 when a normal force reached zero, 1 at another stop, 0.
+int finish(const SimulateArgs& a, const StopEvent& stop, const std::function<void(std::ostream&)>& write, Io& cio) {
+    if (stop.reason == StopReason::StepLimit)   // the estimate was low: a cut-off run is not a result
+        throw std::runtime_error(a.scene + ": stopped: " + stop.describe() +
+                                 " (the up-front estimate was low: raise --max-steps); nothing written");
+    write_file_atomic(a.out, write, cio.out);
+    if (stop.reason != StopReason::None) {
+        cio.err << "plate simulate: " << a.scene << ": stopped: " << stop.describe() << std::endl;
+        return stop.reason == StopReason::ContactLost ? 3 : 1;
+    }
+    return 0;
+}
+
+// --observe: the camera's track of a full or U-dynamics run (observe()), at most kMaxRows frames, the
+// work bounded as a trajectory's with a row per frame.
+int observe_run(const SimulateArgs& a, const Scene& sc, const std::string& dyn, const Vec3& q0, const Vec3& qd0,
+                IntegrationOptions io, Io& cio) {
+    if (dyn != "full" && dyn != "u") throw UsageError("--observe goes with --dynamics full or u");
+    if (a.has("--sample")) throw UsageError("--sample goes without --observe: the camera's schedule sets the frames");
+    const Camera cam = load_camera(a.observe);
+    const double T = a.time, per_second = cam.stroboscopic() ? cam.per_period / sc.plate.T : cam.rate;
+    const double frames = std::floor(T * per_second) + 1;
+    if (frames > kMaxRows)
+        throw UsageError("the camera takes about " + fmt(frames) + " frames in --time " + fmt(T) + " s, above the limit of " +
+                         fmt(kMaxRows));
+    const std::size_t stamps = frame_stamps(cam, sc.plate.T, T).size();
+    if (stamps < static_cast<std::size_t>(kMinTrackFrames))
+        throw UsageError(a.observe + ": the camera takes " + std::to_string(stamps) + " frames in --time " + fmt(T) +
+                         " s: a track needs at least " + std::to_string(kMinTrackFrames));
+    io.max_steps = a.has("--max-steps") ? a.max_steps : io.max_steps;
+    check_simulate_work(sc, dyn, q0, qd0, T, std::min(sc.plate.T, 1 / per_second), frames, a.tol, io, io.max_steps);
+    Trajectory exact;
+    const Track tr = observe(sc, cam, dyn == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, T, io, &exact);
+    if (exact.stop.reason != StopReason::StepLimit && tr.t.size() < static_cast<std::size_t>(kMinTrackFrames))
+        throw std::runtime_error(a.scene + ": the camera recorded " + std::to_string(tr.t.size()) +
+                                 " frames (dropped or after a stop): a track needs at least " + std::to_string(kMinTrackFrames) +
+                                 "; nothing written");
+    return finish(
+        a, exact.stop, [&](std::ostream& out) { write_track_csv(out, tr); }, cio);
+}
+
 int cmd_simulate(const SimulateArgs& a, Io& cio) {
     const Scene sc = measured_arg(a, a.measured, scene_arg(a.scene, cio), cio);
     std::string dyn = a.dynamics;
@@ -138,6 +190,7 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
         throw UsageError("--verify goes with --dynamics auto");
     }
     const Scene& sc_run = used;
+    if (a.has("--observe")) return observe_run(a, sc_run, dyn, q0, qd0, io, cio);
     // Bounded work (issue 18): rows, then the steps (check_simulate_work).
     const double rows = std::ceil(T / dt) + 1;
     if (rows > kMaxRows)
@@ -168,16 +221,8 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
             cio.err << "  verify: the full model stopped: " << ref.stop.describe() << "\n";
         }
     }
-    if (tr.stop.reason == StopReason::StepLimit)   // the estimate was low: a cut-off run is not a result
-        throw std::runtime_error(a.scene + ": stopped: " + tr.stop.describe() +
-                                 " (the up-front estimate was low: raise --max-steps); nothing written");
-    write_file_atomic(
-        a.out, [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio.out);
-    if (tr.stop.reason != StopReason::None) {
-        cio.err << "plate simulate: " << a.scene << ": stopped: " << tr.stop.describe() << std::endl;
-        return tr.stop.reason == StopReason::ContactLost ? 3 : 1;
-    }
-    return 0;
+    return finish(
+        a, tr.stop, [&](std::ostream& out) { write_trajectory_csv(out, tr, sc_run.part.point); }, cio);
 }
 
 }   // namespace

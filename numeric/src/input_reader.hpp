@@ -8,10 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace plate::detail {
 
@@ -89,6 +91,30 @@ struct Reader {
     }
 };
 
+
+// A line of a CSV input without spaces, tabs and carriage returns at either end.
+inline std::string trim(const std::string& s) {
+    const auto a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
+    return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+}
+
+// The comma-separated cells of a CSV line, each trimmed (a trailing comma: a last empty cell).
+inline std::vector<std::string> split_csv(const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream in(line);
+    std::string cell;
+    while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
+    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    return cells;
+}
+
+// A CSV cell as a finite number (all of it read by strtod); false if it is empty, not a number or
+// not finite.
+inline bool finite_number(const std::string& cell, double& v) {
+    char* end = nullptr;
+    v = std::strtod(cell.c_str(), &end);
+    return !cell.empty() && *end == '\0' && std::isfinite(v);
+}
 
 // The whole text of an input file; one that cannot be opened is an InputError "PATH: cannot open WHAT".
 inline std::string read_input_file(const std::string& path, const std::string& what) {

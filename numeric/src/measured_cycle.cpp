@@ -13,21 +13,9 @@ namespace {
 
 const char* const kColumns[7] = {"t [s]", "x [m/s^2]", "y [m/s^2]", "z [m/s^2]", "rx [rad/s^2]", "ry [rad/s^2]", "rz [rad/s^2]"};
 
-std::string trim(const std::string& s) {
-    const auto a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
-    return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
-}
-
-std::vector<std::string> split(const std::string& line) {
-    std::vector<std::string> cells;
-    std::stringstream in(line);
-    std::string cell;
-    while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
-    return cells;
-}
-
 using detail::Reader;
+using detail::split_csv;
+using detail::trim;
 
 struct Rows {
     std::vector<double> t;
@@ -48,7 +36,7 @@ Rows read_rows(const std::string& text, const std::string& source) {
     for (int line = 1; std::getline(in, raw); ++line) {
         const std::string l = trim(raw);
         if (l.empty() || l[0] == '#') continue;
-        const auto cells = split(l);
+        const auto cells = split_csv(l);
         if (!have_header) {
             for (std::size_t k = 0; k < 7; ++k)
                 if (k >= cells.size() || cells[k] != kColumns[k])
@@ -62,10 +50,7 @@ Rows read_rows(const std::string& text, const std::string& source) {
         if (cells.size() != 7) fail(line, 0, "expected 7 columns (t, x, y, z, rx, ry, rz), got " + std::to_string(cells.size()));
         double v[7];
         for (int k = 0; k < 7; ++k) {
-            const char* s = cells[k].c_str();
-            char* end = nullptr;
-            v[k] = std::strtod(s, &end);
-            if (cells[k].empty() || *end != '\0' || !std::isfinite(v[k]))
+            if (!detail::finite_number(cells[k], v[k]))
                 fail(line, k + 1, std::string(kColumns[k]) + ": expected a finite number, got \"" + cells[k] + "\"");
         }
         rows.t.push_back(v[0]);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdarg>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <unistd.h>
@@ -204,6 +205,17 @@ void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_pa
         }
         out << ',' << mode_name(s.mode) << '\n';
     }
+}
+
+std::string fnv1a_hex(const std::string& text) {
+    std::uint64_t h = 1469598103934665603ULL;
+    for (unsigned char ch : text) {
+        h ^= ch;
+        h *= 1099511628211ULL;
+    }
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+    return buf;
 }
 
 bool progress_wanted() {

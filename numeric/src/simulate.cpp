@@ -95,19 +95,19 @@ double breakaway_time(const Scene& sc, const Vec3& q0, double t0, Dynamics level
 
 namespace {
 
-template <class Model>
-Trajectory run(Model& model, const Scene& sc, const typename Model::State& y0, double duration, double sample_dt,
+// Runs the engine from y0 at t = 0 and samples it at time_at(k), k = first..last (increasing, the
+// engine stepping to each exactly); k = 0 at time 0 is the start itself.
+template <class Model, class TimeAt>
+Trajectory run(Model& model, const Scene& sc, const typename Model::State& y0, long first, long last, TimeAt time_at,
                const IntegrationOptions& opt) {
     detail::Engine<Model> e(model, sc, opt);
     Trajectory tr;
     auto push = [&](double t, const typename Model::State& y, const Vec3& n) {
         tr.samples.push_back(Sample{t, model.q(y), model.qd(y), n, e.mode()});
     };
-    const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
     if (e.start(0, y0)) {
-        push(0, e.y(), e.n());
-        for (long k = 1; k <= count; ++k) {
-            if (!e.advance(std::min(k * sample_dt, duration), [](double, const auto&, const Vec3&) {})) break;
+        for (long k = first; k <= last; ++k) {
+            if (k > 0 && !e.advance(time_at(k), [](double, const auto&, const Vec3&) {})) break;
             push(e.t(), e.y(), e.n());
         }
     }
@@ -119,21 +119,42 @@ Trajectory run(Model& model, const Scene& sc, const typename Model::State& y0, d
     return tr;
 }
 
-}   // namespace
-
-Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
-                    const IntegrationOptions& opt) {
+// run() of the model of `level` started at (q0, qd0); full dynamics with the plate on its zero-mean motion.
+template <class TimeAt>
+Trajectory run_level(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3& qd0, long first, long last, TimeAt time_at,
+                     const IntegrationOptions& opt) {
     if (level == Dynamics::ReducedU)
         throw std::invalid_argument("simulate: reduced U-dynamics have no trajectory; use limit_cycle");
-    if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate: duration and sample_dt must be > 0");
     if (level == Dynamics::Full) {
         detail::FullModel m(sc);
         Vec3 p, phi;
         sc.plate.displacement(0.0, p, phi);   // R1 at the start
-        return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]}, duration, sample_dt, opt);
+        return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], phi[0], phi[1], phi[2]}, first, last, time_at, opt);
     }
     detail::UModel m(sc);
-    return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, duration, sample_dt, opt);
+    return run(m, sc, {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, first, last, time_at, opt);
+}
+
+}   // namespace
+
+Trajectory simulate(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
+                    const IntegrationOptions& opt) {
+    if (!(duration > 0 && sample_dt > 0)) throw std::invalid_argument("simulate: duration and sample_dt must be > 0");
+    const long count = static_cast<long>(std::ceil(duration / sample_dt - 1e-9));
+    return run_level(
+        sc, level, q0, qd0, 0, count, [&](long k) { return std::min(k * sample_dt, duration); }, opt);
+}
+
+Trajectory simulate_at(const Scene& sc, Dynamics level, const Vec3& q0, const Vec3& qd0, const std::vector<double>& times,
+                       const IntegrationOptions& opt) {
+    if (times.empty()) throw std::invalid_argument("simulate_at: no times");
+    for (std::size_t k = 0; k < times.size(); ++k)
+        if (!(std::isfinite(times[k]) && times[k] >= 0 && (k == 0 || times[k] > times[k - 1])))
+            throw std::invalid_argument("simulate_at: expected finite increasing times >= 0");
+    // (sample k is at times[k - first]: with times[0] = 0 the start itself is the first sample)
+    const long first = times[0] == 0 ? 0 : 1, n = static_cast<long>(times.size());
+    return run_level(
+        sc, level, q0, qd0, first, n - 1 + first, [&](long k) { return times[k - first]; }, opt);
 }
 
 namespace {

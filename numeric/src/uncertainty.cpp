@@ -59,12 +59,6 @@ Rng stream(const UncertaintySpec& spec, std::uint64_t index, Stream what, int at
     return Rng(k);
 }
 
-double standard_normal(Rng& r) {
-    // Box-Muller; 1 - uniform() lies in (0, 1], so the log is finite.
-    const double u1 = 1 - r.uniform(), u2 = r.uniform();
-    return std::sqrt(-2 * std::log(u1)) * std::cos(2 * kPi * u2);
-}
-
 double sample(const Spread& s, Rng& r) {
     if (s.spread == 0) return 0;
     return s.distribution == Distribution::uniform ? r.uniform(-s.spread, s.spread) : s.spread * standard_normal(r);

@@ -3,9 +3,10 @@
 // Running the cases, the journal and the tables: sweep.cpp.
 #include "plate/sweep.hpp"
 
+#include "plate/output.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -324,15 +325,7 @@ Campaign load_campaign(const std::string& path) {
 }
 
 std::string fingerprint(const Campaign& c) {
-    const std::string s = c.file.dump();        // (keys sorted: a canonical text)
-    std::uint64_t h = 1469598103934665603ULL;   // FNV-1a
-    for (unsigned char ch : s) {
-        h ^= ch;
-        h *= 1099511628211ULL;
-    }
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-    return buf;
+    return fnv1a_hex(c.file.dump());   // (keys sorted: a canonical text)
 }
 
 std::vector<double> case_values(const Campaign& c, int index) {

@@ -11,7 +11,7 @@ the layer of the resolved file -- its top-level folder -- is compared with the i
 sources in a top-level folder that is no layer fail too (their layer would be unknown).
 Within numeric/ the same holds between its internal levels (NUMERIC_LEVELS below, lowest first: what
 needs nothing of plate < the model < dynamics and friction < the contact modes < the engine < simulate and
-limit cycles < fields, fixed points and output < robustness): no numeric file includes a numeric header of a higher
+limit cycles < fields, fixed points and output < observations < robustness): no numeric file includes a numeric header of a higher
 level, and every numeric source has a level (a new file gets a line in NUMERIC_LEVELS).
 Exit 1 with the offending lines, also when no file at all was found to check (a wrong SOURCE_DIR).
     check_layers.py SOURCE_DIR
@@ -50,6 +50,8 @@ NUMERIC_LEVELS = [
                               "src/cycle_solvers.hpp", "src/shooting_cycle.cpp"]),
     ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp",
                             "include/plate/output.hpp", "src/output.cpp"]),
+    ("observe", ["include/plate/observe.hpp", "src/observe.cpp",   # cameras filming simulations
+                 "src/track_io.cpp"]),                             # and the track file
     ("robustness", ["include/plate/robustness.hpp", "src/robustness.cpp", "src/robustness_sensitivity.cpp",
                     "src/robustness_json.cpp"]),
 ]

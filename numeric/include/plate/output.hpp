@@ -20,6 +20,10 @@ nlohmann::json to_json(const Scene& scene, const FixedPoints& fp);
 void write_field_csv(std::ostream& out, const Field& field);
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part);
 
+// A text's FNV-1a 64-bit hash as 16 lowercase hex digits: a fingerprint of a canonical text (a
+// campaign file, a scene), the same on every platform.
+std::string fnv1a_hex(const std::string& text);
+
 // Progress on stderr for long runs: silent for the first 1.5 s, then a line at most every
 // `every` seconds, and the final count if anything was shown.
 // Progress lines go to stderr only when it is a terminal (a person watching); in pipes, logs and

@@ -5,6 +5,7 @@
 
 #include "plate/model.hpp"
 
+#include <cmath>
 #include <cstdint>
 
 namespace plate {
@@ -31,6 +32,13 @@ public:
 private:
     std::uint64_t s_;
 };
+
+// A standard normal draw from two uniforms of r (Box-Muller; 1 - uniform() lies in (0, 1], so the
+// log is finite): the same on every platform, where std::normal_distribution is the library's own.
+inline double standard_normal(Rng& r) {
+    const double u1 = 1 - r.uniform(), u2 = r.uniform();
+    return std::sqrt(-2 * std::log(u1)) * std::cos(2 * kPi * u2);
+}
 
 Scene random_scene(std::uint64_t seed, const RandomSceneOptions& opt = {});
 

@@ -103,6 +103,12 @@ double breakaway_time(const Scene& scene, const Vec3& q0, double t0, Dynamics le
 Trajectory simulate(const Scene& scene, Dynamics level, const Vec3& q0, const Vec3& qd0, double duration, double sample_dt,
                     const IntegrationOptions& opt = {});
 
+// simulate() sampled at the given times (finite, increasing, >= 0; std::invalid_argument else), the
+// engine stepping to each exactly: the states a camera's frames show (observe.hpp). A run that stops
+// ends with a sample at the stop time, as simulate()'s.
+Trajectory simulate_at(const Scene& scene, Dynamics level, const Vec3& q0, const Vec3& qd0, const std::vector<double>& times,
+                       const IntegrationOptions& opt = {});
+
 // STROBOSCOPIC AVERAGING of the full dynamics (a heterogeneous multiscale method, after Calvo,
 // Chartier, Murua and Sanz-Serna's stroboscopic averaging). Over one period the configuration q and
 // the plate's orientation phi (which drifts: coning, design.hpp) move little, while the twist
