@@ -87,6 +87,10 @@ int main(int argc, char** argv) {
             std::printf(" %s %+.4f(sd %.4f)%s", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]");
         }
         std::printf("  %s\n", s.termination.substr(0, 40).c_str());
+        if (s.reduced_chi2 > 1.5)   // (which track does not fit)
+            for (const TrackFit& f : s.tracks)
+                std::printf("      %s: %d frames, rms %.3f mm %.2f mrad, chi2 %.1f\n", f.source.c_str(), f.frames, f.rms_xy_mm,
+                            f.rms_theta_mrad, f.chi2);
         std::fflush(stdout);
         total_s += s.seconds;
         worst_s = std::max(worst_s, s.seconds);

@@ -114,6 +114,38 @@ std::vector<std::vector<double>> starts(const Layout& layout, const IdentifyOpti
     return out;
 }
 
+// Each track's start as the solver starts it: its first frame (mm, mm, rad).
+std::vector<std::vector<double>> first_frames(const std::vector<Track>& tracks, int d) {
+    std::vector<std::vector<double>> q0;
+    for (const Track& tr : tracks) {
+        const Vec3& f = tr.q.front();
+        q0.push_back({f.x() * 1e3, f.y() * 1e3, f.z()});
+        q0.back().resize(d);
+    }
+    return q0;
+}
+
+// The named parameters no track's residuals depend on at x (their Jacobian columns exactly zero: e.g.
+// a static coefficient of a part that breaks away at once and never sticks). The solver holds them:
+// Levenberg-Marquardt would only wander along them at the cost of their differences.
+std::vector<int> unseen_parameters(const std::vector<std::unique_ptr<TrackCost>>& costs, const std::vector<double>& x,
+                                   std::vector<std::vector<double>> q0, int n) {
+    std::vector<bool> seen(n, false);
+    for (std::size_t t = 0; t < costs.size(); ++t) {
+        const int m = costs[t]->num_residuals();
+        std::vector<double> r(m), j0(static_cast<std::size_t>(m) * n);
+        const double* params[2] = {x.data(), q0[t].data()};
+        double* jac[2] = {j0.data(), nullptr};
+        if (!costs[t]->Evaluate(params, r.data(), jac)) return {};
+        for (int i = 0; i < m; ++i)
+            for (int j = 0; j < n; ++j) seen[j] = seen[j] || j0[static_cast<std::size_t>(i) * n + j] != 0;
+    }
+    std::vector<int> held;
+    for (int j = 0; j < n; ++j)
+        if (!seen[j]) held.push_back(j);
+    return held;
+}
+
 }   // namespace
 }   // namespace identify_detail
 
@@ -175,20 +207,21 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     std::vector<std::vector<double>> best_q0;
     double best_cost = std::numeric_limits<double>::infinity();
     const std::vector<std::vector<double>> xs = starts(layout, o);
+    const std::vector<int> held = unseen_parameters(costs, xs[0], first_frames(tracks, d), n);
+    s.held = static_cast<int>(held.size());
     for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
         const double left = o.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (left <= 0) break;
         std::vector<double> x = xs[k];
-        std::vector<std::vector<double>> q0(nt);
+        std::vector<std::vector<double>> q0 = first_frames(tracks, d);
         ceres::Problem::Options po;
         po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
         ceres::Problem problem(po);
-        for (int t = 0; t < nt; ++t) {
-            const Vec3& f = tracks[t].q.front();
-            q0[t] = {f.x() * 1e3, f.y() * 1e3, f.z()};
-            q0[t].resize(d);
-            problem.AddResidualBlock(costs[t].get(), nullptr, x.data(), q0[t].data());
-        }
+        for (int t = 0; t < nt; ++t) problem.AddResidualBlock(costs[t].get(), nullptr, x.data(), q0[t].data());
+        if (static_cast<int>(held.size()) == n)
+            problem.SetParameterBlockConstant(x.data());
+        else if (!held.empty())
+            problem.SetManifold(x.data(), new ceres::SubsetManifold(n, held));
         for (int j = 0; j < n; ++j) {
             problem.SetParameterLowerBound(x.data(), j, layout.lower(j, o));
             problem.SetParameterUpperBound(x.data(), j, layout.upper(j, o));
@@ -200,8 +233,11 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         so.max_num_iterations = o.max_iterations;
         so.max_solver_time_in_seconds = left;
         so.num_threads = o.threads;
-        so.function_tolerance = 1e-8;
-        so.parameter_tolerance = 1e-8;
+        // Converged when an iteration changes the chi-square by under 1e-6 of itself (about 1e-6 dof,
+        // far below its sd sqrt(2 dof) at the truth) or the parameters by under 1e-6 of themselves:
+        // tighter, the search only wanders along directions the tracks hardly see.
+        so.function_tolerance = 1e-6;
+        so.parameter_tolerance = 1e-6;
         so.logging_type = ceres::SILENT;
         ceres::Solver::Summary sum;
         ceres::Solve(so, &problem, &sum);

@@ -70,6 +70,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
                  {{"method", "Ceres Levenberg-Marquardt, central differences of the simulation"},
                   {"starts_run", s.starts_run},
                   {"best_start", s.best_start},
+                  {"held_unseen", s.held},
                   {"start_chi2", s.start_costs},
                   {"iterations", s.iterations},
                   {"termination", s.termination},

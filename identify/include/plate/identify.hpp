@@ -92,6 +92,7 @@ struct IdentifySummary {
     int residuals = 0, dof = 0;   // dof: residuals - fitted parameters (the starts' included)
     double reduced_chi2 = 0;      // chi2 / dof: near 1 when the model and the noise sds are right
     int starts_run = 0, best_start = 0;
+    int held = 0;              // named parameters no residual depended on at the first start: held there
     int iterations = 0;        // of the best start
     std::string termination;   // of the best start (Ceres' termination type and message)
     bool converged = false;
