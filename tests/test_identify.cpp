@@ -139,3 +139,24 @@ TEST_CASE("plate identify refuses tracks of another scene, too few frames and un
     CHECK(contact2.err.find("mu_k2: a point part has one contact") != std::string::npos);
     CHECK_FALSE(fs::exists(out));
 }
+
+// apply_parameters, the one place a parameter reaches the part: fig4's contacts move by minus the
+// centre-of-mass offset (the centre of mass moves by +offset relative to them), a shared static
+// coefficient reaches every contact, a static below its kinetic one is refused, and a point part's one
+// coefficient fills the three slots the kernels read.
+TEST_CASE("named parameters set the part: contacts move by minus the offset, static below kinetic is refused", "[identify]") {
+    const Scene fig4 = scene("fig4");
+    const Scene s = apply_parameters(fig4, {"mu_k2", "mu_s", "com_x", "com_y"}, {0.4, 0.5, 0.002, -0.001});
+    for (int i = 0; i < 3; ++i) {
+        CHECK(s.part.c[i].x() == fig4.part.c[i].x() - 0.002);
+        CHECK(s.part.c[i].y() == fig4.part.c[i].y() + 0.001);
+        CHECK(s.part.c[i].z() == fig4.part.c[i].z());
+        CHECK(s.part.friction().static_(i) == 0.5);
+    }
+    CHECK(s.part.friction().kinetic() == Vec3(0.3, 0.4, 0.3));
+    CHECK_THROWS_AS(apply_parameters(fig4, {"mu_k1", "mu_s1"}, {0.4, 0.35}), std::invalid_argument);
+    CHECK_THROWS_AS(apply_parameters(fig4, {"mu_k", "mu_k3"}, {0.4, 0.35}), std::invalid_argument);
+    const Scene p = apply_parameters(scene("fig1_point"), {"mu_k", "mu_s"}, {0.2, 0.25});
+    CHECK(p.part.friction().kinetic() == Vec3::Constant(0.2));
+    CHECK(p.part.friction().static_() == Vec3::Constant(0.25));
+}
