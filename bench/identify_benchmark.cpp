@@ -5,7 +5,7 @@
 // values (0.3 everywhere) of mu_k1..3 and mu_s1..3 (or PARAMS). Per seed: each estimate's error, whether
 // its 95 % interval covers the truth, the reduced chi-square, seconds; then the share within +-0.01,
 // the coverage and the mean and largest seconds.
-//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS]]]]]]
+//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
     const int ntracks = argc > 4 ? std::stoi(argv[4]) : 5;
     const double duration = argc > 5 ? std::stod(argv[5]) : 10;
     const int threads = argc > 6 ? std::stoi(argv[6]) : 2;
+    const double rtol = argc > 7 ? std::stod(argv[7]) : IdentifyOptions{}.rtol;
+    const int first_seed = argc > 8 ? std::stoi(argv[8]) : 1;
     const Scene nominal = load_scene(file);
     std::vector<std::string> names;
     std::stringstream in(plist);
@@ -50,10 +52,11 @@ int main(int argc, char** argv) {
     o.params = names;
     o.threads = threads;
     o.starts = 2;
+    o.rtol = rtol;
     int within = 0, covered = 0, counted = 0, unid = 0;
     double total_s = 0, worst_s = 0;
     std::printf("seed  seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
-    for (int seed = 1; seed <= seeds; ++seed) {
+    for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
         Rng rng(1000 + seed);
         std::vector<Track> tracks;
         for (int k = 0; k < ntracks; ++k) {

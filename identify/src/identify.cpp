@@ -22,6 +22,11 @@ void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<dou
 
 namespace {
 
+// Levenberg-Marquardt's damping takes each parameter's information (the diagonal of J^T J, in noise
+// sds per internal unit, squared) as at least this: a direction the tracks barely see (a static
+// coefficient of a part that hardly sticks: 1e-2-1e2, against 1e8 for a kinetic one) is then not
+// stepped across its whole range, into a regime it does not hold (docs/decisions/identification.md).
+constexpr double kMinLmDiagonal = 1e4;
 constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // central-difference steps of a track's start
 
 // One track's residual block: parameter blocks (the named parameters, internal coordinates) and (the
@@ -230,6 +235,7 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         so.minimizer_type = ceres::TRUST_REGION;
         so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
         so.linear_solver_type = ceres::DENSE_QR;
+        so.min_lm_diagonal = kMinLmDiagonal;
         so.max_num_iterations = o.max_iterations;
         so.max_solver_time_in_seconds = left;
         so.num_threads = o.threads;
