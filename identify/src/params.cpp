@@ -116,7 +116,7 @@ double Layout::upper(int j, const IdentifyOptions& o) const {
 
 double Layout::range(int j, const IdentifyOptions& o) const { return upper(j, o) - lower(j, o); }
 
-// Friction: 1e-4 (a hundredth of the accuracy asked, far above the simulation's 1e-8 relative error);
+// Friction: 1e-4 (a hundredth of the accuracy asked, far above the simulation's relative error, rtol 1e-7);
 // centre of mass: 1e-3 mm.
 double Layout::step(int j) const { return p[j].kind == Param::ComX || p[j].kind == Param::ComY ? 1e-3 : 1e-4; }
 
