@@ -47,6 +47,7 @@ constexpr AddCommand kCommands[] = {
     add_design,         // plate design
     add_sweep,          // plate sweep
     add_robustness,     // plate robustness
+    add_identify,       // plate identify
 };
 
 }   // namespace

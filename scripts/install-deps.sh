@@ -3,7 +3,7 @@
 set -euo pipefail
 pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-dev libcln-dev
       catch2 nlohmann-json3-dev libcli11-dev gnuplot-nox libjs-katex valgrind chromium
-      python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev
+      python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev libceres-dev
       clang libclang-rt-dev   # (the sanitizer build, scripts/test-sanitizers.sh)
       clang-format            # (the format check, scripts/check-format.sh)
       ccache                  # (the mutation catalogue's scratch build reuses the build's objects)

@@ -40,5 +40,6 @@ Command add_bench(CLI::App& app);          // bench.cpp
 Command add_design(CLI::App& app);         // design.cpp
 Command add_sweep(CLI::App& app);          // sweep.cpp
 Command add_robustness(CLI::App& app);     // robustness.cpp
+Command add_identify(CLI::App& app);       // identify.cpp
 
 }   // namespace plate::cli

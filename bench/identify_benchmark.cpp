@@ -1,0 +1,105 @@
+// Benchmark: identification (issue 52, point 3) against the issue's target. Not a test: nothing here
+// passes or fails. For each seed: fig4's part (or SCENE's) at kinetic (0.25, 0.30, 0.35) and static
+// 20 % above, TRACKS tracks of DURATION s from random starts at rest, stroboscopic (phase 0.25, once a
+// period), noise 0.1 mm and 5 mrad, filmed with plate's own observe(); the fit from the scene's
+// values (0.3 everywhere) of mu_k1..3 and mu_s1..3 (or PARAMS). Per seed: each estimate's error, whether
+// its 95 % interval covers the truth, the reduced chi-square, seconds; then the share within +-0.01,
+// the coverage and the mean and largest seconds.
+//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED]]]]]]]]
+#include "plate/identify.hpp"
+#include "plate/observe.hpp"
+#include "plate/random_scene.hpp"
+#include "plate/scene_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace plate;
+
+int main(int argc, char** argv) {
+    const int seeds = argc > 1 ? std::stoi(argv[1]) : 5;
+    const std::string file = argc > 2 ? argv[2] : PLATE_SOURCE_DIR "/scenes/fig4.json";
+    const std::string plist = argc > 3 ? argv[3] : "mu_k1,mu_k2,mu_k3,mu_s1,mu_s2,mu_s3";
+    const int ntracks = argc > 4 ? std::stoi(argv[4]) : 5;
+    const double duration = argc > 5 ? std::stod(argv[5]) : 10;
+    const int threads = argc > 6 ? std::stoi(argv[6]) : 2;
+    const double rtol = argc > 7 ? std::stod(argv[7]) : IdentifyOptions{}.rtol;
+    const int first_seed = argc > 8 ? std::stoi(argv[8]) : 1;
+    const Scene nominal = load_scene(file);
+    std::vector<std::string> names;
+    std::stringstream in(plist);
+    for (std::string w; std::getline(in, w, ',');) names.push_back(w);
+    const double kin[3] = {0.25, 0.30, 0.35};
+    std::vector<double> truth;
+    for (const std::string& n : names) {
+        const int i = n.size() == 5 ? n[4] - '1' : 1;
+        if (n.rfind("mu_k", 0) == 0)
+            truth.push_back(kin[i]);
+        else if (n.rfind("mu_s", 0) == 0)
+            truth.push_back(1.2 * kin[i]);
+        else
+            truth.push_back(n == "com_x" ? 0.001 : -0.0005);
+    }
+    std::vector<std::string> truth_names = names;
+    std::vector<double> truth_values = truth;
+    // Contacts not named keep the scene's: give them the truth's too (a shared mu_k: 0.30 everywhere).
+    const Scene truth_scene = apply_parameters(nominal, truth_names, truth_values);
+    IdentifyOptions o;
+    o.params = names;
+    o.threads = threads;
+    o.starts = 2;
+    o.rtol = rtol;
+    int within = 0, covered = 0, counted = 0, unid = 0;
+    double total_s = 0, worst_s = 0;
+    std::printf("seed  seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
+    for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
+        Rng rng(1000 + seed);
+        std::vector<Track> tracks;
+        for (int k = 0; k < ntracks; ++k) {
+            const Vec3 q0(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), rng.uniform(-kPi, kPi));
+            Camera cam;
+            cam.per_period = 1;
+            cam.phase = 0.25;
+            cam.noise_xy_mm = 0.1;
+            cam.noise_theta_mrad = nominal.part.point ? 0 : 5;
+            cam.seed = 100 * seed + k;
+            Track tr = observe(truth_scene, cam, Dynamics::Full, q0, Vec3::Zero(), duration);
+            tr.scene_name = nominal.name;
+            tr.scene_id = scene_id(nominal);
+            tr.source = "seed" + std::to_string(seed) + "_track" + std::to_string(k);
+            tracks.push_back(tr);
+        }
+        const IdentifySummary s = identify(nominal, tracks, o);
+        std::printf("%4d  %7.2f  %8.3f  %5d  %5d ", seed, s.seconds, s.reduced_chi2, s.iterations, s.best_start);
+        for (std::size_t j = 0; j < names.size(); ++j) {
+            const FittedParameter& p = s.params[j];
+            const double err = p.estimate - truth[j];
+            if (!p.identifiable) {
+                ++unid;
+                std::printf(" %s %+.4f [n/i]", names[j].c_str(), err);
+                continue;
+            }
+            const bool cov = p.lo <= truth[j] && truth[j] <= p.hi;
+            within += std::abs(err) <= 0.01;
+            covered += cov;
+            ++counted;
+            std::printf(" %s %+.4f(sd %.4f)%s", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]");
+        }
+        std::printf("  %s\n", s.termination.substr(0, 40).c_str());
+        if (s.reduced_chi2 > 1.5)   // (which track does not fit)
+            for (const TrackFit& f : s.tracks)
+                std::printf("      %s: %d frames, rms %.3f mm %.2f mrad, chi2 %.1f\n", f.source.c_str(), f.frames, f.rms_xy_mm,
+                            f.rms_theta_mrad, f.chi2);
+        std::fflush(stdout);
+        total_s += s.seconds;
+        worst_s = std::max(worst_s, s.seconds);
+    }
+    std::printf(
+        "within 0.01: %d of %d; 95%% intervals covering: %d of %d (%.1f %%); not identifiable: %d; "
+        "seconds mean %.2f, largest %.2f\n",
+        within, counted, covered, counted, counted ? 100.0 * covered / counted : 0.0, unid, total_s / seeds, worst_s);
+}

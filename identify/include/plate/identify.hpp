@@ -1,0 +1,125 @@
+// Identification of a part's parameters from camera tracks (issue 52, point 3): the friction
+// coefficients and the centre-of-mass offset that make the hybrid simulation reproduce what the
+// cameras filmed, by least squares (Ceres' Levenberg-Marquardt; docs/decisions/identification.md says
+// why Ceres and how each choice below was made), with their covariance, 95 % intervals and a verdict on
+// what the tracks cannot separate.
+//
+// The parameters, by name (a comma-separated list on the command line):
+//   mu_k              every contact's kinetic coefficient, one shared value
+//   mu_k1 mu_k2 mu_k3 contact i's kinetic coefficient (rigid parts)
+//   mu_s              every contact's static coefficient, one shared value
+//   mu_s1 mu_s2 mu_s3 contact i's static coefficient (rigid parts)
+//   com_x com_y       the centre of mass's offset from the scene's, in the part frame [m]: every contact
+//                     moves by -offset (as uncertainty.cpp's "com" does; the inertia is kept, and the
+//                     camera is taken to see the centre of mass)
+// A contact's coefficient is fitted by at most one name (mu_k with mu_k2 is refused). Static >= kinetic
+// holds by construction: the solver moves a static coefficient's excess over the kinetic one(s) it
+// must exceed, bounded below by 0 (a shared mu_s over per-contact kinetic ones: its excess over their
+// largest). A static coefficient not fitted keeps the scene's value, raised to its contact's fitted
+// kinetic one where that is larger.
+//
+// The model of a track: the part starts at t = 0 (the camera's zero) at rest relative to the plate, at
+// a configuration fitted per track (nuisance parameters, started at the track's first frame), as
+// observe() films it; frames before settle_periods plate periods may be left out (default none), so
+// that a part filmed with another start twist fits once friction has damped the difference. Each kept frame gives the residuals
+// (s_x, s_y) / sd_xy and theta / sd_theta (a point part: no theta), the camera's noise sds, so that
+// the sum of squares is a chi-square at the truth.
+#pragma once
+
+#include "plate/dynamics.hpp"
+#include "plate/model.hpp"
+#include "plate/observe.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace plate {
+
+// What an identification asks: validated once, by validate() (std::invalid_argument naming the field).
+struct IdentifyOptions {
+    std::vector<std::string> params;   // the names above, each once; at least one
+    Dynamics level = Dynamics::Full;   // the model the tracks are fitted with (Full or U)
+    // Multi-start: the scene's values, then seeded draws within the bounds, until one fits as well as
+    // the noise allows (chi-square within 3 sds of its mean at the truth) or all have run.
+    int starts = 3;
+    std::uint64_t seed = 1;      // of the drawn starts
+    int max_iterations = 25;     // Levenberg-Marquardt iterations per start
+    double time_limit = 60;      // [s] over all starts; a start under way stops at it
+    double settle_periods = 0;   // frames before this many plate periods are left out
+    // The simulation's tolerance (IntegrationOptions::rtol): 1e-7 keeps fig4's kinetic estimates within
+    // their sd of those at 1e-8 at about a third of the time (docs/decisions/identification.md, Measured).
+    double rtol = 1e-7;
+    int threads = 2;                      // tracks evaluated in parallel
+    double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
+    double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
+    void validate() const;
+};
+
+// One fitted parameter, in the scene's units.
+struct FittedParameter {
+    std::string name, unit;   // unit "1" (friction) or "m"
+    double estimate = 0;
+    double sd = 0;              // from the covariance; NaN where not identifiable
+    double lo = 0, hi = 0;      // 95 %: estimate -+ 1.96 sd; NaN where not identifiable
+    bool identifiable = true;   // false: part of a combination the tracks cannot separate
+    bool at_bound = false;      // the estimate lies on a physical bound (the interval is then one-sided at best)
+};
+
+// A combination of the parameters the tracks cannot place within the physical ranges: the singular
+// vector (weights per name, unit length in range-scaled units) and its 95 % half-width in those units
+// (> 1: wider than the whole range; infinite: the tracks do not depend on it at all).
+struct Unidentifiable {
+    std::vector<std::pair<std::string, double>> combination;
+    double half_width = 0;
+};
+
+struct TrackFit {
+    std::string source;
+    int frames = 0;              // used in the fit
+    Vec3 start = Vec3::Zero();   // the fitted start configuration at t = 0 [m, m, rad]
+    double rms_xy_mm = 0;        // residual RMS of s_x and s_y [mm]
+    double rms_theta_mrad = 0;   // of theta [mrad] (0 for a point part)
+    double chi2 = 0;             // the track's sum of squared scaled residuals
+};
+
+struct IdentifySummary {
+    std::vector<FittedParameter> params;   // in the order asked
+    Eigen::MatrixXd covariance;            // of the estimates, rows and columns as params (NaN where not identifiable)
+    std::vector<Unidentifiable> unidentifiable;
+    std::vector<TrackFit> tracks;
+    double chi2 = 0;              // sum of squared scaled residuals at the estimate
+    int residuals = 0, dof = 0;   // dof: residuals - fitted parameters (the starts' included)
+    double reduced_chi2 = 0;      // chi2 / dof: near 1 when the model and the noise sds are right
+    int starts_run = 0, best_start = 0;
+    int held = 0;              // named parameters no residual depended on at the first start: held there
+    int iterations = 0;        // of the best start
+    std::string termination;   // of the best start (Ceres' termination type and message)
+    bool converged = false;
+    double seconds = 0;
+    std::vector<double> start_costs;   // each start's final chi2
+    Scene fitted;                      // the scene at the estimates
+};
+
+// InputError naming the file (and line) of a track that cannot be fitted to `scene`: from another
+// scene (check_track_scene), a rigid track for a point part or the reverse, a camera without noise
+// (the residuals' scale), fewer than kMinTrackFrames frames after settle_periods.
+void check_tracks(const Scene& scene, const std::vector<Track>& tracks, const IdentifyOptions& o);
+
+// std::invalid_argument unless every name is one of the above, given once, that the scene's part has
+// (mu_k2 for a point part, com_x for a point part: refused), no contact fitted by two names.
+void check_parameter_names(const Scene& scene, const std::vector<std::string>& names);
+
+// The scene with the named parameters at `values` (scene units; static below kinetic refused with
+// std::invalid_argument). The one place a parameter reaches the part.
+Scene apply_parameters(const Scene& scene, const std::vector<std::string>& names, const std::vector<double>& values);
+
+// The least-squares fit over the tracks. Throws as check_parameter_names, check_tracks and validate.
+IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, const IdentifyOptions& o);
+
+// The summary as the command writes it (units in the keys or beside the values).
+nlohmann::json identify_json(const IdentifySummary& s, const IdentifyOptions& o);
+
+}   // namespace plate

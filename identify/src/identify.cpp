@@ -1,0 +1,303 @@
+// The fit: one Ceres residual block per track (its frames' scaled residuals; central differences of
+// the hybrid simulation), Levenberg-Marquardt from several starts, the best kept.
+#include "internal.hpp"
+
+#include "plate/random_scene.hpp"
+#include "plate/scene_io.hpp"
+
+#include <ceres/ceres.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace plate {
+namespace identify_detail {
+
+// Covariance, intervals and identifiability at the optimum (uncertainty.cpp).
+void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
+           int starts_size, IdentifySummary& s);
+
+namespace {
+
+// Levenberg-Marquardt's damping takes each parameter's information (the diagonal of J^T J, in noise
+// sds per internal unit, squared) as at least this: a direction the tracks barely see (a static
+// coefficient of a part that hardly sticks: 1e-2-1e2, against 1e8 for a kinetic one) is then not
+// stepped across its whole range, into a regime it does not hold (docs/decisions/identification.md).
+constexpr double kMinLmDiagonal = 1e4;
+constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // central-difference steps of a track's start
+
+// One track's residual block: parameter blocks (the named parameters, internal coordinates) and (the
+// track's start: s_x, s_y [mm], theta [rad]; a point part without theta).
+class TrackCost final : public ceres::CostFunction {
+public:
+    TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o)
+        : scene_(scene), layout_(layout), track_(track), first_(first), o_(o) {
+        dim_ = track.point ? 2 : 3;
+        mutable_parameter_block_sizes()->push_back(layout.size());
+        mutable_parameter_block_sizes()->push_back(dim_);
+        set_num_residuals(dim_ * (static_cast<int>(track.t.size()) - first));
+        opt_.rtol = o.rtol;
+    }
+
+    bool residuals(const double* x, const double* q0, double* r) const {
+        const Scene s = at(scene_, layout_, std::vector<double>(x, x + layout_.size()));
+        const Vec3 q(q0[0] * 1e-3, q0[1] * 1e-3, dim_ == 3 ? q0[2] : 0.0);
+        std::vector<Vec3> pred;
+        if (!predict(s, track_, o_.level, q, opt_, pred)) return false;
+        const double sxy = track_.camera.noise_xy_mm * 1e-3, sth = track_.camera.noise_theta_mrad * 1e-3;
+        for (std::size_t k = first_; k < pred.size(); ++k) {
+            const Vec3 d = pred[k] - track_.q[k];
+            double* rk = r + dim_ * (k - first_);
+            rk[0] = d.x() / sxy;
+            rk[1] = d.y() / sxy;
+            if (dim_ == 3) rk[2] = std::remainder(d.z(), 2 * kPi) / sth;
+        }
+        return true;
+    }
+
+    bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override {
+        if (!residuals(parameters[0], parameters[1], r)) return false;
+        if (!jacobians) return true;
+        const int m = num_residuals();
+        std::vector<double> plus(m), minus(m);
+        for (int b = 0; b < 2; ++b) {
+            if (!jacobians[b]) continue;
+            const int n = b == 0 ? layout_.size() : dim_;
+            std::vector<double> x(parameters[b], parameters[b] + n);
+            for (int j = 0; j < n; ++j) {
+                const double h = b == 0 ? layout_.step(j) : (j < 2 ? kStartStepMm : kStartStepRad);
+                const double x0 = x[j];
+                // One-sided at a bound (a static excess at 0: below it the part would have static < kinetic).
+                const bool down = b != 0 || x0 - h >= layout_.lower(j, o_);
+                const bool up = b != 0 || x0 + h <= layout_.upper(j, o_);
+                const double* blocks[2] = {parameters[0], parameters[1]};
+                blocks[b] = x.data();
+                x[j] = x0 + (up ? h : 0);
+                if (up && !residuals(blocks[0], blocks[1], plus.data())) return false;
+                x[j] = x0 - (down ? h : 0);
+                if (down && !residuals(blocks[0], blocks[1], minus.data())) return false;
+                x[j] = x0;
+                const double span = (up ? h : 0) + (down ? h : 0);
+                for (int i = 0; i < m; ++i) jacobians[b][i * n + j] = ((up ? plus[i] : r[i]) - (down ? minus[i] : r[i])) / span;
+            }
+        }
+        return true;
+    }
+
+private:
+    const Scene& scene_;
+    const Layout& layout_;
+    const Track& track_;
+    int first_, dim_;
+    const IdentifyOptions& o_;
+    IntegrationOptions opt_;
+};
+
+// The starts: the scene's values (clamped into the bounds), then draws within them.
+std::vector<std::vector<double>> starts(const Layout& layout, const IdentifyOptions& o) {
+    std::vector<std::vector<double>> out;
+    std::vector<double> x0 = layout.internal(layout.scene_values());
+    for (int j = 0; j < layout.size(); ++j) x0[j] = std::min(std::max(x0[j], layout.lower(j, o)), layout.upper(j, o));
+    out.push_back(x0);
+    Rng rng(o.seed);
+    for (int k = 1; k < o.starts; ++k) {
+        std::vector<double> x(layout.size());
+        for (int j = 0; j < layout.size(); ++j) {
+            const Param::Kind kind = layout.p[j].kind;
+            if (kind == Param::Kinetic)
+                x[j] = rng.uniform(std::max(o.mu_min, 0.1), std::min(o.mu_max, 1.0));
+            else if (kind == Param::Static)
+                x[j] = rng.uniform(0, std::min(0.3, layout.upper(j, o)));
+            else
+                x[j] = rng.uniform(-0.25, 0.25) * o.com_max * 1e3;
+        }
+        out.push_back(x);
+    }
+    return out;
+}
+
+// Each track's start as the solver starts it: its first frame (mm, mm, rad).
+std::vector<std::vector<double>> first_frames(const std::vector<Track>& tracks, int d) {
+    std::vector<std::vector<double>> q0;
+    for (const Track& tr : tracks) {
+        const Vec3& f = tr.q.front();
+        q0.push_back({f.x() * 1e3, f.y() * 1e3, f.z()});
+        q0.back().resize(d);
+    }
+    return q0;
+}
+
+// The named parameters no track's residuals depend on at x (their Jacobian columns exactly zero: e.g.
+// a static coefficient of a part that breaks away at once and never sticks). The solver holds them:
+// Levenberg-Marquardt would only wander along them at the cost of their differences.
+std::vector<int> unseen_parameters(const std::vector<std::unique_ptr<TrackCost>>& costs, const std::vector<double>& x,
+                                   std::vector<std::vector<double>> q0, int n) {
+    std::vector<bool> seen(n, false);
+    for (std::size_t t = 0; t < costs.size(); ++t) {
+        const int m = costs[t]->num_residuals();
+        std::vector<double> r(m), j0(static_cast<std::size_t>(m) * n);
+        const double* params[2] = {x.data(), q0[t].data()};
+        double* jac[2] = {j0.data(), nullptr};
+        if (!costs[t]->Evaluate(params, r.data(), jac)) return {};
+        for (int i = 0; i < m; ++i)
+            for (int j = 0; j < n; ++j) seen[j] = seen[j] || j0[static_cast<std::size_t>(i) * n + j] != 0;
+    }
+    std::vector<int> held;
+    for (int j = 0; j < n; ++j)
+        if (!seen[j]) held.push_back(j);
+    return held;
+}
+
+}   // namespace
+}   // namespace identify_detail
+
+void IdentifyOptions::validate() const {
+    auto bad = [](const std::string& what) { throw std::invalid_argument("identify: " + what); };
+    if (params.empty()) bad("params: no parameter to fit");
+    if (level != Dynamics::Full && level != Dynamics::U) bad("level: full or U dynamics");
+    if (starts < 1 || starts > 1000) bad("starts: from 1 to 1000");
+    if (max_iterations < 1 || max_iterations > 10000) bad("max_iterations: from 1 to 10000");
+    if (!(time_limit > 0 && time_limit <= 1e6)) bad("time_limit: a positive number of seconds up to 1e6");
+    if (!(settle_periods >= 0 && settle_periods <= 1e6)) bad("settle_periods: from 0 to 1e6");
+    if (!(rtol > 0 && rtol <= 1e-3)) bad("rtol: in (0, 1e-3]");
+    if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
+    if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");
+    if (!(com_max > 0 && com_max <= 1)) bad("com_max: in (0, 1] m");
+}
+
+void check_tracks(const Scene& scene, const std::vector<Track>& tracks, const IdentifyOptions& o) {
+    if (tracks.empty()) throw std::invalid_argument("identify: no track");
+    for (const Track& tr : tracks) {
+        const std::string src = tr.source.empty() ? std::string("(track)") : tr.source;
+        check_track_scene(tr, scene);
+        if (tr.point != scene.part.point)
+            throw InputError(src + ": a " + (tr.point ? "point" : "rigid") + " part's track for the scene's " +
+                             (scene.part.point ? "point" : "rigid") + " part");
+        const std::string camera_line = tr.scene_id_line ? ":" + std::to_string(tr.scene_id_line + 1) : "";
+        if (!(tr.camera.noise_xy_mm > 0) || (!tr.point && !(tr.camera.noise_theta_mrad > 0)))
+            throw InputError(src + camera_line +
+                             ": the camera has no noise: identification weighs each frame by the noise's sd (give it)");
+        const int first = identify_detail::first_used_frame(tr, scene.plate.T, o.settle_periods);
+        const int used = static_cast<int>(tr.t.size()) - first;
+        if (used < kMinTrackFrames) {
+            const std::string line = tr.lines.empty() ? "" : ":" + std::to_string(tr.lines.back());
+            throw InputError(src + line + ": " + std::to_string(used) + " frames after the first " +
+                             std::to_string(o.settle_periods) + " periods (at least " + std::to_string(kMinTrackFrames) +
+                             " are needed)");
+        }
+    }
+}
+
+IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, const IdentifyOptions& o) {
+    using namespace identify_detail;
+    const auto t0 = std::chrono::steady_clock::now();
+    o.validate();
+    const Layout layout(scene, o.params);
+    check_tracks(scene, tracks, o);
+    const int n = layout.size(), nt = static_cast<int>(tracks.size()), d = scene.part.point ? 2 : 3;
+    std::vector<std::unique_ptr<TrackCost>> costs;
+    for (const Track& tr : tracks)
+        costs.push_back(std::make_unique<TrackCost>(scene, layout, tr, first_used_frame(tr, scene.plate.T, o.settle_periods), o));
+
+    IdentifySummary s;
+    // A start whose chi-square lies within 3 sds of its mean at the truth (dof + 3 sqrt(2 dof)) fits as
+    // well as the noise allows: the later starts are not run.
+    int rows = 0;
+    for (const auto& c : costs) rows += c->num_residuals();
+    const double enough = (rows - n - d * nt) + 3 * std::sqrt(2.0 * std::max(rows - n - d * nt, 1));
+    std::vector<double> best;
+    std::vector<std::vector<double>> best_q0;
+    double best_cost = std::numeric_limits<double>::infinity();
+    const std::vector<std::vector<double>> xs = starts(layout, o);
+    const std::vector<int> held = unseen_parameters(costs, xs[0], first_frames(tracks, d), n);
+    s.held = static_cast<int>(held.size());
+    for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
+        const double left = o.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (left <= 0) break;
+        std::vector<double> x = xs[k];
+        std::vector<std::vector<double>> q0 = first_frames(tracks, d);
+        ceres::Problem::Options po;
+        po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+        ceres::Problem problem(po);
+        for (int t = 0; t < nt; ++t) problem.AddResidualBlock(costs[t].get(), nullptr, x.data(), q0[t].data());
+        if (static_cast<int>(held.size()) == n)
+            problem.SetParameterBlockConstant(x.data());
+        else if (!held.empty())
+            problem.SetManifold(x.data(), new ceres::SubsetManifold(n, held));
+        for (int j = 0; j < n; ++j) {
+            problem.SetParameterLowerBound(x.data(), j, layout.lower(j, o));
+            problem.SetParameterUpperBound(x.data(), j, layout.upper(j, o));
+        }
+        ceres::Solver::Options so;
+        so.minimizer_type = ceres::TRUST_REGION;
+        so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+        so.linear_solver_type = ceres::DENSE_QR;
+        so.min_lm_diagonal = kMinLmDiagonal;
+        so.max_num_iterations = o.max_iterations;
+        so.max_solver_time_in_seconds = left;
+        so.num_threads = o.threads;
+        // Converged when an iteration changes the chi-square by under 1e-6 of itself (about 1e-6 dof,
+        // far below its sd sqrt(2 dof) at the truth) or the parameters by under 1e-6 of themselves:
+        // tighter, the search only wanders along directions the tracks hardly see.
+        so.function_tolerance = 1e-6;
+        so.parameter_tolerance = 1e-6;
+        so.logging_type = ceres::SILENT;
+        ceres::Solver::Summary sum;
+        ceres::Solve(so, &problem, &sum);
+        ++s.starts_run;
+        const double chi2 = 2 * sum.final_cost;
+        s.start_costs.push_back(chi2);
+        if (sum.IsSolutionUsable() && chi2 < best_cost) {
+            best_cost = chi2;
+            best = x;
+            best_q0 = q0;
+            s.best_start = k;
+            s.iterations = static_cast<int>(sum.iterations.size()) - 1;
+            s.termination = std::string(ceres::TerminationTypeToString(sum.termination_type)) + ": " + sum.message;
+            s.converged = sum.termination_type == ceres::CONVERGENCE;
+        }
+        if (best_cost <= enough) break;
+    }
+    if (best.empty()) throw std::runtime_error("identify: no start gave a usable fit (every simulation stopped?)");
+
+    // The whole Jacobian at the optimum (the tracks' starts beside the named parameters), and the fits.
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * nt);
+    s.chi2 = 0;
+    for (int t = 0, row = 0; t < nt; ++t) {
+        const int m = costs[t]->num_residuals();
+        std::vector<double> r(m), j0(static_cast<std::size_t>(m) * n), j1(static_cast<std::size_t>(m) * d);
+        const double* params[2] = {best.data(), best_q0[t].data()};
+        double* jac[2] = {j0.data(), j1.data()};
+        if (!costs[t]->Evaluate(params, r.data(), jac)) throw std::runtime_error("identify: the optimum's simulation stopped");
+        for (int i = 0; i < m; ++i) {
+            for (int j = 0; j < n; ++j) J(row + i, j) = j0[i * n + j];
+            for (int j = 0; j < d; ++j) J(row + i, n + d * t + j) = j1[i * d + j];
+        }
+        TrackFit f;
+        f.source = tracks[t].source;
+        f.frames = m / d;
+        f.start = Vec3(best_q0[t][0] * 1e-3, best_q0[t][1] * 1e-3, d == 3 ? best_q0[t][2] : 0.0);
+        double sxy = 0, sth = 0;
+        for (int i = 0; i < m; ++i) {
+            f.chi2 += r[i] * r[i];
+            (i % d < 2 ? sxy : sth) += r[i] * r[i];
+        }
+        f.rms_xy_mm = std::sqrt(sxy / (2.0 * f.frames)) * tracks[t].camera.noise_xy_mm;
+        f.rms_theta_mrad = d == 3 ? std::sqrt(sth / f.frames) * tracks[t].camera.noise_theta_mrad : 0.0;
+        s.chi2 += f.chi2;
+        s.tracks.push_back(f);
+        row += m;
+    }
+    s.residuals = rows;
+    s.dof = rows - (n + d * nt);
+    s.reduced_chi2 = s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
+    judge(layout, o, best, J, d * nt, s);
+    s.fitted = at(scene, layout, best);
+    s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return s;
+}
+
+}   // namespace plate

@@ -1,0 +1,55 @@
+// The identification's inner pieces, shared by its sources: the parameter layout (names <-> the
+// solver's internal coordinates) and the prediction of a track.
+#pragma once
+
+#include "plate/identify.hpp"
+#include "plate/simulate.hpp"
+
+#include <string>
+#include <vector>
+
+namespace plate::identify_detail {
+
+// One named parameter: what it sets and of which contact (-1: every contact).
+struct Param {
+    enum Kind { Kinetic, Static, ComX, ComY } kind = Kinetic;
+    int contact = -1;
+    std::string name;
+};
+
+// The named parameters of a scene in the solver's coordinates: a kinetic coefficient as itself, a
+// static one as its excess over the kinetic one(s) it must exceed (>= 0), a centre-of-mass offset in
+// millimetres (so that every coordinate is of order 0.1-10 and the difference steps below fit all).
+struct Layout {
+    std::vector<Param> p;
+    Part part;   // the scene's part (the values of what is not fitted)
+
+    Layout(const Scene& scene, const std::vector<std::string>& names);   // std::invalid_argument for a bad name
+    int size() const { return static_cast<int>(p.size()); }
+    // Scene units (friction, metres) from internal coordinates, and back.
+    std::vector<double> natural(const std::vector<double>& x) const;
+    std::vector<double> internal(const std::vector<double>& v) const;
+    // The scene's values of the named parameters (its static ones raised to the kinetic where below).
+    std::vector<double> scene_values() const;
+    // Bounds in internal coordinates, and the physical range used to judge identifiability.
+    double lower(int j, const IdentifyOptions& o) const;
+    double upper(int j, const IdentifyOptions& o) const;
+    double range(int j, const IdentifyOptions& o) const;
+    // Central-difference step in internal coordinates (docs/decisions/identification.md).
+    double step(int j) const;
+    const char* unit(int j) const { return p[j].kind == Param::ComX || p[j].kind == Param::ComY ? "m" : "1"; }
+};
+
+// The scene at internal coordinates x.
+Scene at(const Scene& scene, const Layout& layout, const std::vector<double>& x);
+
+// What the track's camera, noise- and drop-free, records of the part started at rest at q0 at t = 0
+// under `scene` at the track's own stamps (simulate_at and film, observe.hpp). False if the run stops
+// before the last stamp (contact lost: no prediction).
+bool predict(const Scene& scene, const Track& track, Dynamics level, const Vec3& q0, const IntegrationOptions& opt,
+             std::vector<Vec3>& q);
+
+// The index of the first frame at or after settle_periods periods.
+int first_used_frame(const Track& track, double T, double settle_periods);
+
+}   // namespace plate::identify_detail
