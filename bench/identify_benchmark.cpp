@@ -68,8 +68,6 @@ int main(int argc, char** argv) {
             cam.noise_theta_mrad = nominal.part.point ? 0 : 5;
             cam.seed = 100 * seed + k;
             Track tr = observe(truth_scene, cam, Dynamics::Full, q0, Vec3::Zero(), duration);
-            tr.scene_name = nominal.name;
-            tr.scene_id = scene_id(nominal);
             tr.source = "seed" + std::to_string(seed) + "_track" + std::to_string(k);
             tracks.push_back(tr);
         }

@@ -30,13 +30,11 @@ Camera strobe(double xy_mm, double theta_mrad, std::uint64_t seed) {
 }
 
 // What a camera films of the part with the named parameters at `truth`, started at rest at q0: the
-// track names the nominal scene (the one whose part is being identified; its friction is the unknown).
+// track's scene_id is the set-up's (plate motion, gravity), so it matches the nominal scene's.
 Track filmed(const Scene& nominal, const std::vector<std::string>& names, const std::vector<double>& truth, const Camera& cam,
              const Vec3& q0, double duration, Trajectory* exact = nullptr) {
     const Scene truth_scene = apply_parameters(nominal, names, truth);
     Track tr = observe(truth_scene, cam, Dynamics::Full, q0, Vec3::Zero(), duration, {}, exact);
-    tr.scene_name = nominal.name;
-    tr.scene_id = scene_id(nominal);
     tr.source = "track.csv";
     return tr;
 }

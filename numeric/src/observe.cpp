@@ -100,7 +100,11 @@ json camera_to_json(const Camera& c) {
     return j;
 }
 
-std::string scene_id(const Scene& scene) { return fnv1a_hex(scene_to_json(scene).dump()); }
+std::string scene_id(const Scene& scene) {
+    const nlohmann::json all = scene_to_json(scene);
+    const nlohmann::json setup = {{"gravity", all["gravity"]}, {"plate", all["plate"]}, {"point_part", scene.part.point}};
+    return fnv1a_hex(setup.dump());
+}
 
 std::vector<double> frame_stamps(const Camera& c, double T, double duration) {
     c.validate();

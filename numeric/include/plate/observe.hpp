@@ -23,7 +23,7 @@
 //
 //   # plate track 1
 //   # scene: "fig4"
-//   # scene_id: d8d0707459dc4bba
+//   # scene_id: fa0586ad9c2e6259
 //   # camera: {"drop":0.0,"frame":"plate","latency_s":0.0,"noise":{...},"seed":1,"stroboscopic":{...}}
 //   # frame: plate
 //   # part: rigid
@@ -86,9 +86,12 @@ Camera parse_camera(const std::string& text, const std::string& source);   // th
 // The camera in the file form (parse_camera(camera_to_json(c).dump(), ..) gives c back).
 nlohmann::json camera_to_json(const Camera& camera);
 
-// A stable fingerprint of a scene: FNV-1a 64 of scene_to_json(scene).dump() (keys sorted, numbers
-// that read back to the same doubles), as 16 lowercase hex digits. The same scene file gives the same
-// id on every run and platform; any change of the part or the plate motion (or the name) changes it.
+// A stable fingerprint of the set-up a camera films: FNV-1a 64 of the scene file's gravity and plate
+// motion and whether the part is a point (keys sorted, numbers that read back to the same doubles), as
+// 16 lowercase hex digits. Not the part's mass, inertia, contacts or friction, nor the scene's name:
+// those are what a real part leaves unknown and identification estimates, so a track filmed on the
+// real plate matches any guess of them. The same set-up gives the same id on every run and platform;
+// any change of the plate motion or gravity changes it.
 std::string scene_id(const Scene& scene);
 
 // The frames a track holds: camera stamps t and the observed (s_x, s_y, theta) -- theta 0 for a
