@@ -154,7 +154,11 @@ Scene apply_parameters(const Scene& scene, const std::vector<std::string>& names
         if (q.kind == Param::ComX) com.x() = values[j];
         if (q.kind == Param::ComY) com.y() = values[j];
     }
+    // A scene with one coefficient per contact (no static ones of its own) keeps them one: an unfitted
+    // static coefficient follows its contact's fitted kinetic one.
+    const bool one_coefficient = !scene.part.mu_static;
     for (int i = 0; i < 3; ++i) {
+        if (one_coefficient && !static_fitted[i]) mus[i] = part.mu[i];
         if (static_fitted[i] && mus[i] < part.mu[i])
             throw std::invalid_argument("apply_parameters: contact " + std::to_string(i + 1) + "'s static coefficient " +
                                         std::to_string(mus[i]) + " below its kinetic one " + std::to_string(part.mu[i]));

@@ -13,6 +13,7 @@ program, from Python::
     r = plate.robustness(d.scene, "scenes/uncertainty/ppod.json", draws=50)          # r.outcomes, r.radius95
     cam = {"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1}, "frame": "world"}
     tk = plate.observe(scene, cam, start=(0.03, -0.02, 1.0), time=5.0)   # tk.t, tk.q: what a camera records
+    est = plate.identify(scene, [tk], ["mu_k1", "mu_k2", "mu_k3"])     # est.estimates, est.intervals
     plate.write_track_csv(tk, "track.csv"); tk = plate.read_track_csv("track.csv")
 
 Results carry numpy arrays and ``summary``, the command line's JSON as a dict.  Errors raise
@@ -21,17 +22,17 @@ names them), ValueError (bad options) or RuntimeError.  The GIL is released whil
 """
 import json as _json
 
-from ._plate import (Camera, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, InputError, Robustness, Scene, Stop,
-                     Track, Trajectory, axis_peaks, check_track_scene, coning_rate, design, field, fixed_points,
-                     frame_stamps, load_camera, load_scene, observe, observe_at, orientation_harmonics, parse_camera,
-                     parse_scene, read_track_csv, robustness, scene_id, simulate, twist, uncertain_parameters,
-                     write_track_csv)
+from ._plate import (Camera, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
+                     Robustness, Scene, Stop, Track, Trajectory, axis_peaks, check_track_scene, coning_rate, design, field,
+                     fixed_points, frame_stamps, identify, load_camera, load_scene, observe, observe_at,
+                     orientation_harmonics, parse_camera, parse_scene, read_track_csv, robustness, scene_id, simulate,
+                     twist, uncertain_parameters, write_track_csv)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
-__all__ = ["Camera", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "InputError", "Robustness",
-           "Scene", "Stop", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "design", "field",
-           "fixed_points", "frame_stamps", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
+__all__ = ["Camera", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "Identification", "InputError",
+           "Robustness", "Scene", "Stop", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "design",
+           "field", "fixed_points", "frame_stamps", "identify", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
            "parse_camera", "parse_scene", "read_track_csv", "robustness", "scene_from_dict", "scene_id", "scene_to_dict",
            "simulate", "twist", "uncertain_parameters", "write_track_csv"]
 

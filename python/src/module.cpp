@@ -35,4 +35,5 @@ PYBIND11_MODULE(_plate, m) {
     bind_simulate(m);
     bind_robustness(m);
     bind_observe(m);
+    bind_identify(m);
 }

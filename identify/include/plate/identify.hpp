@@ -16,7 +16,8 @@
 // holds by construction: the solver moves a static coefficient's excess over the kinetic one(s) it
 // must exceed, bounded below by 0 (a shared mu_s over per-contact kinetic ones: its excess over their
 // largest). A static coefficient not fitted keeps the scene's value, raised to its contact's fitted
-// kinetic one where that is larger.
+// kinetic one where that is larger; in a scene with one coefficient per contact (no static ones of
+// its own: static = kinetic) it follows the fitted kinetic one.
 //
 // The model of a track: the part starts at t = 0 (the camera's zero) at rest relative to the plate, at
 // a configuration fitted per track (nuisance parameters, started at the track's first frame), as

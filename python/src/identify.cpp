@@ -1,0 +1,123 @@
+// plate.identify: a part's friction and centre-of-mass offset from camera tracks (plate.Identification),
+// identify/include/plate/identify.hpp.
+#include "bindings.hpp"
+
+#include "plate/identify.hpp"
+
+#include <cmath>
+
+namespace plate::python {
+
+namespace {
+
+struct PyIdentification {
+    IdentifySummary s;
+    IdentifyOptions o;
+};
+
+// A track from a plate.Track or a track file's path (read as the command line reads it).
+Track track_of(const py::handle& t) {
+    if (py::isinstance<Track>(t)) return t.cast<Track>();
+    require(py::isinstance<py::str>(t), "tracks: expected plate.Track objects or track files' paths");
+    return read_track_csv(t.cast<std::string>());
+}
+
+// One number per fitted parameter, in the order asked.
+py::array_t<double> per_parameter(const IdentifySummary& s, double FittedParameter::*field) {
+    std::vector<double> v;
+    for (const FittedParameter& p : s.params) v.push_back(p.*field);
+    return array(v, {static_cast<py::ssize_t>(v.size())});
+}
+
+}   // namespace
+
+void bind_identify(py::module_& m) {
+    py::class_<PyIdentification>(m, "Identification",
+                                 "A least-squares fit of a part's parameters to camera tracks (plate identify): estimates, "
+                                 "their covariance and 95 % intervals, and what the tracks cannot separate.")
+        .def_property_readonly(
+            "names",
+            [](const PyIdentification& r) {
+                std::vector<std::string> v;
+                for (const FittedParameter& p : r.s.params) v.push_back(p.name);
+                return v;
+            },
+            "the fitted parameters, in the order asked")
+        .def_property_readonly(
+            "estimates", [](const PyIdentification& r) { return per_parameter(r.s, &FittedParameter::estimate); },
+            "the estimates (friction: 1, com_x/com_y: m)")
+        .def_property_readonly(
+            "sd", [](const PyIdentification& r) { return per_parameter(r.s, &FittedParameter::sd); },
+            "standard deviations; NaN where not identifiable")
+        .def_property_readonly(
+            "intervals",
+            [](const PyIdentification& r) {
+                std::vector<double> v;
+                for (const FittedParameter& p : r.s.params) v.insert(v.end(), {p.lo, p.hi});
+                return array(v, {static_cast<py::ssize_t>(r.s.params.size()), 2});
+            },
+            "95 % intervals, shape (parameters, 2); NaN rows where not identifiable")
+        .def_property_readonly(
+            "identifiable",
+            [](const PyIdentification& r) {
+                std::vector<bool> v;
+                for (const FittedParameter& p : r.s.params) v.push_back(p.identifiable);
+                return v;
+            },
+            "per parameter: False where the tracks cannot place it within its physical range")
+        .def_property_readonly(
+            "covariance", [](const PyIdentification& r) { return Eigen::MatrixXd(r.s.covariance); },
+            "of the estimates, rows and columns as names (NaN where not identifiable)")
+        .def_property_readonly(
+            "chi2", [](const PyIdentification& r) { return r.s.chi2; }, "sum of squared noise-scaled residuals")
+        .def_property_readonly(
+            "reduced_chi2", [](const PyIdentification& r) { return r.s.reduced_chi2; },
+            "chi2 / degrees of freedom: near 1 when the model and the cameras' noise are right")
+        .def_property_readonly("converged", [](const PyIdentification& r) { return r.s.converged; })
+        .def_property_readonly(
+            "fitted", [](const PyIdentification& r) { return r.s.fitted; }, "the scene at the estimates")
+        .def_property_readonly(
+            "summary", [](const PyIdentification& r) { return json_to_python(identify_json(r.s, r.o)); },
+            "the command line's JSON (plate identify --out), as a dict")
+        .def("__repr__", [](const PyIdentification& r) {
+            std::string s = "<plate.Identification:";
+            for (const FittedParameter& p : r.s.params)
+                s += " " + p.name + " = " + std::to_string(p.estimate) +
+                     (p.identifiable ? " +- " + std::to_string(1.96 * p.sd) : " (not identifiable)");
+            return s + ">";
+        });
+    m.def(
+        "identify",
+        [](const Scene& sc, const py::list& tracks, const std::vector<std::string>& params, const std::string& dynamics,
+           int starts, std::uint64_t seed, int max_iterations, double time_limit, double settle_periods, double rtol,
+           int threads) {
+            require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
+            std::vector<Track> tr;
+            for (const py::handle& t : tracks) tr.push_back(track_of(t));
+            PyIdentification r;
+            r.o.params = params;
+            r.o.level = dynamics == "full" ? Dynamics::Full : Dynamics::U;
+            r.o.starts = starts;
+            r.o.seed = seed;
+            r.o.max_iterations = max_iterations;
+            r.o.time_limit = time_limit;
+            r.o.settle_periods = settle_periods;
+            r.o.rtol = rtol;
+            r.o.threads = threads;
+            {
+                py::gil_scoped_release free;
+                r.s = identify(sc, tr, r.o);
+            }
+            return r;
+        },
+        py::arg("scene"), py::arg("tracks"), py::arg("params"), py::kw_only(), py::arg("dynamics") = "full",
+        py::arg("starts") = IdentifyOptions{}.starts, py::arg("seed") = IdentifyOptions{}.seed,
+        py::arg("max_iterations") = IdentifyOptions{}.max_iterations, py::arg("time_limit") = IdentifyOptions{}.time_limit,
+        py::arg("settle_periods") = IdentifyOptions{}.settle_periods, py::arg("rtol") = IdentifyOptions{}.rtol,
+        py::arg("threads") = IdentifyOptions{}.threads,
+        "Fits the named parameters of `scene`'s part (mu_k, mu_k1..3, mu_s, mu_s1..3, com_x, com_y) to `tracks`\n"
+        "(plate.Track objects or track files' paths) by least squares over the hybrid simulation, as `plate identify`.\n"
+        "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.");
+}
+
+}   // namespace plate::python

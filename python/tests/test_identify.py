@@ -1,0 +1,82 @@
+"""Identification from Python: a point part's kinetic friction recovered from one filmed track within its
+interval, the command line's estimate to the bit, a static coefficient the track cannot show reported as
+such, and tracks from another set-up refused with the file and the line."""
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import plate
+
+SOURCE = os.environ.get("PLATE_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+EXE = os.environ.get("PLATE_EXE")
+CAMERA = os.path.join(SOURCE, "scenes", "cameras", "stroboscopic.json")   # one frame a period, 0.1 mm
+
+
+def point_scene(mu_k, mu_s=None, phase=0.0):
+    d = plate.scene_to_dict(plate.load_scene(os.path.join(SOURCE, "scenes", "fig1_point.json")))
+    d["part"]["friction"] = mu_k if mu_s is None else {"static": mu_s, "kinetic": mu_k}
+    d["plate"]["harmonics"][0]["phase"] = phase
+    return plate.scene_from_dict(d)
+
+
+def filmed(tmp_path, truth, name="track.csv", start=(0.01, 0.02), time=10.0):
+    tk = plate.observe(truth, CAMERA, start=start, time=time)
+    path = str(tmp_path / name)
+    plate.write_track_csv(tk, path)
+    return path
+
+
+def test_a_point_parts_kinetic_friction_from_one_track(tmp_path):
+    # fig1's point part slides all the time under fig1's plate: one 10 s track of 200 frames at 0.1 mm
+    # places mu_k to sd ~0.0014 (the helper's 20 seeds: largest error 0.0042). The nominal guess is 0.03 off.
+    path = filmed(tmp_path, point_scene(0.27))
+    r = plate.identify(point_scene(0.30), [path], ["mu_k"])
+    assert r.converged and r.names == ["mu_k"]
+    lo, hi = r.intervals[0]
+    assert abs(r.estimates[0] - 0.27) < 0.005 and lo < 0.27 < hi
+    assert 0.7 < r.reduced_chi2 < 1.3   # 199 degrees of freedom: chi2 / dof within ~3 sd of 1
+    assert r.summary["parameters"][0]["estimate"] == r.estimates[0]
+    assert r.fitted.to_dict()["part"]["friction"] == r.estimates[0]
+    # A wrong noise model fails the chi-square check above: the same track declaring 0.01 mm of noise
+    # (ten times too little) gives reduced chi2 near 100.
+    text = open(path).read()
+    assert '"xy_mm":0.1' in text
+    wrong = tmp_path / "wrong_noise.csv"
+    wrong.write_text(text.replace('"xy_mm":0.1', '"xy_mm":0.01'))
+    assert plate.identify(point_scene(0.30), [str(wrong)], ["mu_k"]).reduced_chi2 > 50
+
+
+def test_a_static_coefficient_the_track_cannot_show(tmp_path):
+    # fig1's plate started at its peak, 20 m/s^2 along x against mu_s g = 3.5 m/s^2: the part at rest breaks
+    # away at once and slides throughout (as in tests/test_identify.cpp), so mu_s is not identifiable.
+    path = filmed(tmp_path, point_scene(0.27, 0.36, np.pi / 2), start=(0.005, -0.02), time=3.0)
+    r = plate.identify(point_scene(0.30, 0.40, np.pi / 2), [path], ["mu_k", "mu_s"])
+    assert r.identifiable == [True, False]
+    assert np.isnan(r.sd[1]) and np.all(np.isnan(r.intervals[1]))
+    assert "not identifiable" in repr(r)
+
+
+def test_tracks_from_another_set_up_are_refused(tmp_path):
+    path = filmed(tmp_path, point_scene(0.27))
+    other = plate.scene_to_dict(point_scene(0.27))
+    other["plate"]["harmonics"][0]["amp"] *= 1.01
+    with pytest.raises(plate.InputError, match=r"track\.csv:3: tracks from another scene"):
+        plate.identify(plate.scene_from_dict(other), [path], ["mu_k"])
+    with pytest.raises(ValueError, match="mu_k2"):
+        plate.identify(point_scene(0.27), [path], ["mu_k2"])
+
+
+@pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
+def test_the_command_lines_estimate_to_the_bit(tmp_path):
+    path = filmed(tmp_path, point_scene(0.27))
+    scene_file = tmp_path / "nominal.json"
+    scene_file.write_text(json.dumps(plate.scene_to_dict(point_scene(0.30))))
+    out = tmp_path / "est.json"
+    cli = subprocess.run([EXE, "identify", str(scene_file), "--tracks", path, "--params", "mu_k", "--out", str(out)],
+                         capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    r = plate.identify(point_scene(0.30), [path], ["mu_k"])
+    assert json.loads(out.read_text())["parameters"][0]["estimate"] == r.estimates[0]
