@@ -7,9 +7,12 @@
 #include "plate/scene_io.hpp"
 #include "plate/suggest.hpp"
 
+#include "cli_run.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <fstream>
 
 using namespace plate;
 
@@ -137,4 +140,43 @@ TEST_CASE("the predicted sds match the spread of seeded identifications under th
         CHECK(ratio > 0.55);
         CHECK(ratio < 1.6);
     }
+}
+
+// The command: the suggested scene is written and films (plate simulate --observe), its plate motion
+// the JSON's winner's; bad input exits 2 naming the flag or the file.
+TEST_CASE("plate identify --suggest writes a scene to film, and refuses bad input naming the field", "[identify][suggest][cli]") {
+    const fs::path out = tmpdir() / "suggest.json", sc = tmpdir() / "suggested.json", cam = tmpdir() / "camera.json",
+                   quiet = tmpdir() / "quiet.json", track = tmpdir() / "track.csv";
+    std::ofstream(cam) << R"({"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1}, "seed": 1, "frame": "plate"})";
+    std::ofstream(quiet) << R"({"stroboscopic": {"phase": 0.25}, "frame": "plate"})";
+    const std::string head = "identify " + kScenes + "fig1_point.json --suggest --params mu_k --tracks-planned 1 --duration 1";
+    const Run ok = run(head + " --camera " + cam.string() + " --out " + out.string() + " --scene-out " + sc.string());
+    REQUIRE(ok.code == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(out));
+    const Scene suggested = load_scene(sc.string());
+    bool found = false;
+    for (const auto& c : j["candidates"])
+        if (c["label"] == j["best"]) {
+            found = true;
+            REQUIRE(c["harmonics"].size() == suggested.plate.harmonics.size());
+            CHECK(c["harmonics"][0]["amp"].get<double>() == suggested.plate.harmonics[0].amp);
+        }
+    CHECK(found);
+    const Run filmed = run("simulate " + sc.string() + " --dynamics full --from 0.01 -0.02 --time 0.5 --observe " + cam.string() +
+                           " --out " + track.string());
+    CHECK(filmed.code == 0);
+
+    const Run limits = run(head + " --limits 0 150 --out " + out.string());
+    CHECK(limits.code == 2);
+    CHECK(limits.err.find("--limits") != std::string::npos);
+    const Run tracks = run(head + " --tracks " + track.string() + " --out " + out.string());
+    CHECK(tracks.code == 2);
+    CHECK(tracks.err.find("--tracks-planned") != std::string::npos);
+    const Run alone = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks " + track.string() + " --camera " +
+                          cam.string() + " --out " + out.string());
+    CHECK(alone.code == 2);
+    CHECK(alone.err.find("--camera: only with --suggest") != std::string::npos);
+    const Run noiseless = run(head + " --camera " + quiet.string() + " --out " + out.string());
+    CHECK(noiseless.code == 2);
+    CHECK(noiseless.err.find(quiet.string() + ": the camera has no noise") != std::string::npos);
 }

@@ -6,10 +6,12 @@
 //
 // The candidates: horizontal drives whose horizontal peak acceleration A runs over `levels` times the
 // nominal part's mean static coefficient times g (a part at rest breaks away where A exceeds mu_s g and,
-// sliding, sticks again where the plate's acceleration is below it) in three shapes -- x alone, x with
-// its second harmonic at a third of the first (asymmetric: the part drifts, the stick and slip phases
-// differ), and the latter with a yaw (rz) component (rigid parts only: the plate turning under the
-// contacts loads each differently, so their coefficients separate). A candidate whose axis peaks
+// sliding, sticks again where the plate's acceleration is below it) in three shapes -- x with its
+// second harmonic at a third of the first (asymmetric: the part drifts along x, so a stroboscope sees
+// it move; a symmetric drive brings it back to the same place every period), the same with a y second
+// harmonic at a third, a quarter of its period later (a drift along y too: two numbers a period, two
+// combinations of the coefficients), and the first with a yaw (rz) component (rigid parts only: the
+// plate turning under the contacts loads each differently, so their coefficients separate). A candidate whose axis peaks
 // (axis_peaks) exceed the limits is reported and not weighed.
 //
 // The information of a candidate: the fit's own Jacobian (identify_detail::track_jacobian) of the
