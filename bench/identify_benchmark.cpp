@@ -7,7 +7,9 @@
 // the coverage and the mean and largest seconds. MOTION "suggest": the tracks are filmed under the
 // motion suggest_motion() proposes (its candidates printed) for the scene's part with static friction
 // 20 % above its kinetic (the user's guess: that the part has some), and the fit starts from there.
-//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION]]]]]]]]]
+// TIME_LIMIT: each identification's (IdentifyOptions::time_limit, default 60 s). START "truth": the fit
+// starts from the truth (what the tracks can tell, apart from the search), else from the scene's values.
+//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -99,6 +101,8 @@ int main(int argc, char** argv) {
     o.threads = threads;
     o.starts = 2;
     o.rtol = rtol;
+    if (argc > 10) o.time_limit = std::stod(argv[10]);
+    const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     int within = 0, covered = 0, counted = 0, unid = 0;
     double total_s = 0, worst_s = 0;
     std::printf("seed  seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
@@ -112,7 +116,7 @@ int main(int argc, char** argv) {
             tr.source = "seed" + std::to_string(seed) + "_track" + std::to_string(k);
             tracks.push_back(tr);
         }
-        const IdentifySummary s = identify(nominal, tracks, o);
+        const IdentifySummary s = identify(from_truth ? truth_scene : nominal, tracks, o);
         std::printf("%4d  %7.2f  %8.3f  %5d  %5d ", seed, s.seconds, s.reduced_chi2, s.iterations, s.best_start);
         for (std::size_t j = 0; j < names.size(); ++j) {
             const FittedParameter& p = s.params[j];

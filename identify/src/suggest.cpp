@@ -77,14 +77,6 @@ PlannedTrack plan_track(const Scene& s, const Camera& camera, const SuggestOptio
     return p;
 }
 
-Harmonic harmonic(Axis a, int n, double amp, double phase) {
-    Harmonic h;
-    h.axis = a;
-    h.n = n;
-    h.amp = amp;
-    h.phase = phase;
-    return h;
-}
 
 }   // namespace
 
@@ -113,14 +105,14 @@ std::vector<MotionCandidate> candidate_motions(const Scene& scene, const Suggest
             label << shapes[k] << " @ " << level << " mu_s g";
             c.label = label.str();
             c.motion.T = scene.plate.T;
-            c.motion.harmonics.push_back(harmonic(Axis::x, 1, 1, 0));
-            c.motion.harmonics.push_back(harmonic(Axis::x, 2, 1.0 / 3, 0));
-            if (k == 1) c.motion.harmonics.push_back(harmonic(Axis::y, 2, 1.0 / 3, kPi / 2));
+            c.motion.harmonics.push_back(Harmonic{Axis::x, 1, 1, 0});
+            c.motion.harmonics.push_back(Harmonic{Axis::x, 2, 1.0 / 3, 0});
+            if (k == 1) c.motion.harmonics.push_back(Harmonic{Axis::y, 2, 1.0 / 3, kPi / 2});
             const double A = level * a_s, scale = A / horizontal_peak(c.motion);
             for (Harmonic& h : c.motion.harmonics) h.amp *= scale;
             // yaw: the contacts' tangential acceleration from it half the drive's peak, a quarter period
             // after the drive
-            if (k == 2) c.motion.harmonics.push_back(harmonic(Axis::rz, 1, 0.5 * A / r, kPi / 2));
+            if (k == 2) c.motion.harmonics.push_back(Harmonic{Axis::rz, 1, 0.5 * A / r, kPi / 2});
             out.push_back(c);
         }
     return out;
