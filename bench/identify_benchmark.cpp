@@ -4,21 +4,67 @@
 // period), noise 0.1 mm and 5 mrad, filmed with plate's own observe(); the fit from the scene's
 // values (0.3 everywhere) of mu_k1..3 and mu_s1..3 (or PARAMS). Per seed: each estimate's error, whether
 // its 95 % interval covers the truth, the reduced chi-square, seconds; then the share within +-0.01,
-// the coverage and the mean and largest seconds.
-//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED]]]]]]]]
+// the coverage and the mean and largest seconds. MOTION "suggest": the tracks are filmed under the
+// motion suggest_motion() proposes (its candidates printed) for the scene's part with static friction
+// 20 % above its kinetic (the user's guess: that the part has some), and the fit starts from there.
+// TIME_LIMIT: each identification's (IdentifyOptions::time_limit, default 60 s). START "truth": the fit
+// starts from the truth (what the tracks can tell, apart from the search), else from the scene's values.
+//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
+#include "plate/suggest.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 using namespace plate;
+
+namespace {
+
+Camera strobe(const Scene& s, std::uint64_t seed) {
+    Camera cam;
+    cam.per_period = 1;
+    cam.phase = 0.25;
+    cam.noise_xy_mm = 0.1;
+    cam.noise_theta_mrad = s.part.point ? 0 : 5;
+    cam.seed = seed;
+    return cam;
+}
+
+// The nominal part's static friction raised 20 % above its kinetic, the suggested motion printed and
+// given to the nominal and the true scene.
+void suggested(Scene& nominal, Scene& truth, const std::vector<std::string>& names, int ntracks, double duration, int threads,
+               double rtol) {
+    const Vec3 mu = nominal.part.mu;
+    nominal.part.mu_static = Vec3(1.2 * mu);
+    SuggestOptions o;
+    o.fit.params = names;
+    o.fit.threads = threads;
+    o.fit.rtol = rtol;
+    o.tracks = ntracks;
+    o.duration = duration;
+    const SuggestSummary s = suggest_motion(nominal, strobe(nominal, 0), o);
+    std::printf("suggest: %.1f s\n", s.seconds);
+    for (const MotionCandidate& c : s.candidates) {
+        std::printf("  %-24s stick %.3f  min eigenvalue %10.4g  %5.1f s  sd", c.label.c_str(), c.stick_fraction, c.min_eigenvalue,
+                    c.seconds);
+        for (const FittedParameter& p : c.predicted) std::printf(" %.4f", p.sd);
+        std::printf("\n");
+    }
+    if (s.best < 0) throw std::runtime_error("no candidate simulated");
+    std::printf("suggested: %s\n", s.candidates[s.best].label.c_str());
+    std::fflush(stdout);
+    nominal.plate = truth.plate = s.suggested.plate;
+}
+
+}   // namespace
 
 int main(int argc, char** argv) {
     const int seeds = argc > 1 ? std::stoi(argv[1]) : 5;
@@ -29,7 +75,8 @@ int main(int argc, char** argv) {
     const int threads = argc > 6 ? std::stoi(argv[6]) : 2;
     const double rtol = argc > 7 ? std::stod(argv[7]) : IdentifyOptions{}.rtol;
     const int first_seed = argc > 8 ? std::stoi(argv[8]) : 1;
-    const Scene nominal = load_scene(file);
+    const bool suggest = argc > 9 && std::string(argv[9]) == "suggest";
+    Scene nominal = load_scene(file);
     std::vector<std::string> names;
     std::stringstream in(plist);
     for (std::string w; std::getline(in, w, ',');) names.push_back(w);
@@ -47,12 +94,15 @@ int main(int argc, char** argv) {
     std::vector<std::string> truth_names = names;
     std::vector<double> truth_values = truth;
     // Contacts not named keep the scene's: give them the truth's too (a shared mu_k: 0.30 everywhere).
-    const Scene truth_scene = apply_parameters(nominal, truth_names, truth_values);
+    Scene truth_scene = apply_parameters(nominal, truth_names, truth_values);
+    if (suggest) suggested(nominal, truth_scene, names, ntracks, duration, threads, rtol);
     IdentifyOptions o;
     o.params = names;
     o.threads = threads;
     o.starts = 2;
     o.rtol = rtol;
+    if (argc > 10) o.time_limit = std::stod(argv[10]);
+    const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     int within = 0, covered = 0, counted = 0, unid = 0;
     double total_s = 0, worst_s = 0;
     std::printf("seed  seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
@@ -61,17 +111,12 @@ int main(int argc, char** argv) {
         std::vector<Track> tracks;
         for (int k = 0; k < ntracks; ++k) {
             const Vec3 q0(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), rng.uniform(-kPi, kPi));
-            Camera cam;
-            cam.per_period = 1;
-            cam.phase = 0.25;
-            cam.noise_xy_mm = 0.1;
-            cam.noise_theta_mrad = nominal.part.point ? 0 : 5;
-            cam.seed = 100 * seed + k;
+            const Camera cam = strobe(nominal, 100 * seed + k);
             Track tr = observe(truth_scene, cam, Dynamics::Full, q0, Vec3::Zero(), duration);
             tr.source = "seed" + std::to_string(seed) + "_track" + std::to_string(k);
             tracks.push_back(tr);
         }
-        const IdentifySummary s = identify(nominal, tracks, o);
+        const IdentifySummary s = identify(from_truth ? truth_scene : nominal, tracks, o);
         std::printf("%4d  %7.2f  %8.3f  %5d  %5d ", seed, s.seconds, s.reduced_chi2, s.iterations, s.best_start);
         for (std::size_t j = 0; j < names.size(); ++j) {
             const FittedParameter& p = s.params[j];

@@ -23,3 +23,6 @@ set_tests_properties(
 set_tests_properties(
   "stick-slip: fig6's pivoting cycles agree with the regularised-friction limit to 1e-7 v_ref"
   PROPERTIES COST 12)
+set_tests_properties(
+  "the predicted sds match the spread of seeded identifications under the suggested motion"
+  PROPERTIES COST 30)

@@ -5,6 +5,8 @@
 
 #include "plate/identify.hpp"
 #include "plate/output.hpp"
+#include "plate/scene_io.hpp"
+#include "plate/suggest.hpp"
 
 #include <sstream>
 #include <stdexcept>
@@ -15,9 +17,12 @@ namespace plate::cli {
 namespace {
 
 struct IdentifyArgs : Options {
-    std::string scene, params, dynamics = "full", out = "-";
+    std::string scene, params, dynamics = "full", out = "-", camera, scene_out;
     std::vector<std::string> tracks;
+    std::vector<double> limits;
+    bool suggest = false;
     IdentifyOptions o;
+    SuggestOptions so;
     explicit IdentifyArgs(CLI::App& app)
         : Options(app, "identify", "friction coefficients and centre-of-mass offset from camera tracks, JSON",
                   "Fits the named parameters of SCENE's part (--params, comma-separated: mu_k, mu_k1..3 kinetic\n"
@@ -33,9 +38,18 @@ struct IdentifyArgs : Options {
                   "right), the solver's report, and the parameter combinations the tracks cannot place within the\n"
                   "physical ranges (friction 0.05-1.5): \"not identifiable from these tracks\", with no interval.\n"
                   "Exit 2 for a track of another scene, too few frames or a bad cell (file and line named), a name\n"
-                  "that is no parameter or one the part has not (mu_k2, com_x for a point part).\n") {
+                  "that is no parameter or one the part has not (mu_k2, com_x for a point part).\n"
+                  "--suggest: no fit; which plate motion to film so that the --params are identifiable. Candidate\n"
+                  "horizontal drives (x and its second harmonic; with a y second harmonic; with yaw for rigid parts)\n"
+                  "at 1.1-2 mu_s g of SCENE's part, within --limits LIN ANG (each axis' peak, as plate design's;\n"
+                  "default 20 150), each weighed by the information --tracks-planned K tracks of --duration S s\n"
+                  "(default 5 of 10 s, from seeded starts) filmed by --camera (default: stroboscopic at phase 0.25,\n"
+                  "0.1 mm and 5 mrad) would carry at SCENE's values; the one whose worst-determined combination is\n"
+                  "best determined wins. JSON: every candidate's motion, peaks, stick fraction, predicted sds and\n"
+                  "smallest eigenvalue, the winner; --scene-out FILE writes SCENE with the winner's plate motion\n"
+                  "(film it: plate simulate FILE ... --observe CAMERA.json). Exit 4 if no candidate could be simulated.\n") {
         scene_file(scene);
-        words("--tracks", tracks, 1, 1000, "T.csv ...", "the track files; required");
+        words("--tracks", tracks, 1, 1000, "T.csv ...", "the track files; required (but with --suggest)");
         text("--params", params, "NAMES", "the parameters, comma-separated; required");
         text("--dynamics", dynamics, "full|u", "the model fitted (default full)");
         text("--out", out, "FILE", "the output file (default: standard output)");
@@ -46,6 +60,12 @@ struct IdentifyArgs : Options {
         number("--settle", o.settle_periods, "plate periods of each track left out at its start");
         number("--rtol", o.rtol, "the simulation's tolerance");
         whole("--threads", o.threads, 1, 1024, "tracks simulated in parallel");
+        flag("--suggest", suggest, "propose the plate motion to film instead of fitting");
+        text("--camera", camera, "CAMERA.json", "--suggest: the camera that will film");
+        numbers("--limits", limits, 2, 2, "LIN ANG", "--suggest: each axis' peak [m/s^2, rad/s^2]");
+        whole("--tracks-planned", so.tracks, 1, 1000, "--suggest: tracks that will be filmed");
+        number("--duration", so.duration, "--suggest: seconds of each");
+        text("--scene-out", scene_out, "FILE", "--suggest: SCENE with the suggested plate motion");
     }
 };
 
@@ -56,8 +76,48 @@ std::vector<std::string> split_names(const std::string& s) {
     return v;
 }
 
+// The suggestion's camera: the file given, else the (stroboscopic at phase 0.25, 0.1 mm, 5 mrad).
+Camera suggest_camera(const IdentifyArgs& a, const Scene& sc) {
+    if (a.has("--camera")) return load_camera(a.camera);
+    Camera c;
+    c.per_period = 1;
+    c.phase = 0.25;
+    c.noise_xy_mm = 0.1;
+    c.noise_theta_mrad = sc.part.point ? 0 : 5;
+    c.source = "(default camera)";
+    return c;
+}
+
+int cmd_suggest(const IdentifyArgs& a, const Scene& sc, const IdentifyOptions& o, Io& cio) {
+    SuggestOptions so = a.so;
+    so.fit = o;
+    if (a.has("--limits")) {
+        so.lin_limit = a.limits[0];
+        so.ang_limit = a.limits[1];
+    }
+    try {
+        so.validate();
+    } catch (const std::invalid_argument& e) {
+        std::string m = e.what();   // "suggest: lin_limit: ..." -> "--limits: ..."
+        const std::pair<const char*, const char*> flags[] = {{"suggest: lin_limit", "--limits"},
+                                                             {"suggest: ang_limit", "--limits"},
+                                                             {"suggest: tracks", "--tracks-planned"},
+                                                             {"suggest: duration", "--duration"}};
+        for (const auto& [name, flag] : flags)
+            if (m.rfind(name, 0) == 0) m = flag + m.substr(std::string(name).size());
+        throw UsageError(m);
+    }
+    const Camera cam = suggest_camera(a, sc);
+    const SuggestSummary s = suggest_motion(sc, cam, so);
+    if (a.has("--scene-out") && s.best >= 0)
+        write_file_atomic(a.scene_out, [&](std::ostream& out) { out << scene_to_json(s.suggested).dump(2) << "\n"; });
+    write_file_atomic(
+        a.out, [&](std::ostream& out) { out << suggest_json(s, so).dump(2) << "\n"; }, cio.out);
+    return s.best >= 0 ? 0 : 4;
+}
+
 int cmd_identify(const IdentifyArgs& a, Io& cio) {
-    if (!a.has("--tracks")) throw UsageError("missing --tracks T.csv ...");
+    if (!a.suggest && !a.has("--tracks")) throw UsageError("missing --tracks T.csv ...");
     if (!a.has("--params")) throw UsageError("missing --params NAMES");
     if (a.dynamics != "full" && a.dynamics != "u") throw UsageError("--dynamics: full or u");
     const Scene sc = scene_arg(a.scene, cio);
@@ -70,6 +130,12 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
     } catch (const std::invalid_argument& e) {
         throw UsageError(std::string("--params/options: ") + e.what());
     }
+    if (a.suggest) {
+        if (a.has("--tracks")) throw UsageError("--suggest plans tracks: give --tracks-planned, not --tracks");
+        return cmd_suggest(a, sc, o, cio);
+    }
+    for (const char* f : {"--camera", "--limits", "--tracks-planned", "--duration", "--scene-out"})
+        if (a.has(f)) throw UsageError(std::string(f) + ": only with --suggest");
     std::vector<Track> tracks;
     for (const std::string& f : a.tracks) tracks.push_back(read_track_csv(f));
     check_tracks(sc, tracks, o);

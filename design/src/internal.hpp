@@ -49,12 +49,9 @@ TaskRunner runner(const DesignOptions& opt);
 constexpr int kPeakConstraints = 7;
 int peak_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c);
 
-// --- peaks (peaks.cpp) ---------------------------------------------------------------------------------
-// The largest |f| of the real trigonometric polynomial f(theta) = F_0 + 2 Re sum_{k >= 1} F_k e^{i k theta}
-// (F[0] real), to roundoff (peaks.cpp says how).
-double trig_peak(const std::vector<std::complex<double>>& F);
-// max over t of |(u_x(t), u_y(t))|: the largest peak of x (or y) over every turn of the motion about z.
-double horizontal_peak(const PlateMotion& u);
+// --- peaks (plate/peaks.hpp, numeric) ------------------------------------------------------------------
+using plate::horizontal_peak;
+using plate::trig_peak;
 
 // A search problem's bookkeeping. Derived (CRTP) supplies kParams, kConstraints, limit(i) (the
 // bound of parameter i), constraints(p, c) (c_k <= 0 when feasible) and evaluate(p).

@@ -15,11 +15,6 @@
 
 namespace plate {
 namespace identify_detail {
-
-// Covariance, intervals and identifiability at the optimum (uncertainty.cpp).
-void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
-           int starts_size, IdentifySummary& s);
-
 namespace {
 
 // Levenberg-Marquardt's damping takes each parameter's information (the diagonal of J^T J, in noise
@@ -152,6 +147,23 @@ std::vector<int> unseen_parameters(const std::vector<std::unique_ptr<TrackCost>>
 }
 
 }   // namespace
+
+bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
+                    const std::vector<double>& x, const std::vector<double>& q0, Eigen::VectorXd& r, Eigen::MatrixXd& Jx,
+                    Eigen::MatrixXd& Jq) {
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    const TrackCost cost(scene, layout, track, first, o);
+    const int m = cost.num_residuals(), n = layout.size(), d = track.point ? 2 : 3;
+    std::vector<double> rr(m), j0(static_cast<std::size_t>(m) * n), j1(static_cast<std::size_t>(m) * d);
+    const double* params[2] = {x.data(), q0.data()};
+    double* jac[2] = {j0.data(), j1.data()};
+    if (!cost.Evaluate(params, rr.data(), jac)) return false;
+    r = Eigen::Map<const Eigen::VectorXd>(rr.data(), m);
+    Jx = Eigen::Map<const RowMajor>(j0.data(), m, n);
+    Jq = Eigen::Map<const RowMajor>(j1.data(), m, d);
+    return true;
+}
+
 }   // namespace identify_detail
 
 void IdentifyOptions::validate() const {
@@ -267,15 +279,14 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * nt);
     s.chi2 = 0;
     for (int t = 0, row = 0; t < nt; ++t) {
-        const int m = costs[t]->num_residuals();
-        std::vector<double> r(m), j0(static_cast<std::size_t>(m) * n), j1(static_cast<std::size_t>(m) * d);
-        const double* params[2] = {best.data(), best_q0[t].data()};
-        double* jac[2] = {j0.data(), j1.data()};
-        if (!costs[t]->Evaluate(params, r.data(), jac)) throw std::runtime_error("identify: the optimum's simulation stopped");
-        for (int i = 0; i < m; ++i) {
-            for (int j = 0; j < n; ++j) J(row + i, j) = j0[i * n + j];
-            for (int j = 0; j < d; ++j) J(row + i, n + d * t + j) = j1[i * d + j];
-        }
+        Eigen::VectorXd r;
+        Eigen::MatrixXd Jx, Jq;
+        if (!track_jacobian(scene, layout, tracks[t], first_used_frame(tracks[t], scene.plate.T, o.settle_periods), o, best,
+                            best_q0[t], r, Jx, Jq))
+            throw std::runtime_error("identify: the optimum's simulation stopped");
+        const int m = static_cast<int>(r.size());
+        J.block(row, 0, m, n) = Jx;
+        J.block(row, n + d * t, m, d) = Jq;
         TrackFit f;
         f.source = tracks[t].source;
         f.frames = m / d;

@@ -52,4 +52,22 @@ bool predict(const Scene& scene, const Track& track, Dynamics level, const Vec3&
 // The index of the first frame at or after settle_periods periods.
 int first_used_frame(const Track& track, double T, double settle_periods);
 
+// A track's scaled residuals r (from frame `first` on) and their Jacobians by the named parameters at
+// internal coordinates x (Jx) and by the track's start q0 (mm, mm, rad; a point part without theta:
+// Jq), by the fit's own central differences (identify.cpp). False if a simulation stops.
+bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
+                    const std::vector<double>& x, const std::vector<double>& q0, Eigen::VectorXd& r, Eigen::MatrixXd& Jx,
+                    Eigen::MatrixXd& Jq);
+
+// The named parameters' Gauss-Newton information J^T J with the tracks' starts (J's last starts_size
+// columns) eliminated by the Schur complement, in range-scaled internal units (each coordinate divided
+// by its physical range): 1.96 / sqrt(an eigenvalue) is a direction's 95 % half-width as a share of
+// the ranges (judge.cpp).
+Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size);
+
+// Covariance, intervals and identifiability at internal coordinates x from the whole Jacobian J (the
+// named parameters' columns, then the starts'), into s.params, s.covariance, s.unidentifiable (judge.cpp).
+void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
+           int starts_size, IdentifySummary& s);
+
 }   // namespace plate::identify_detail

@@ -15,10 +15,8 @@ namespace plate::identify_detail {
 // direction's variance above 1 %).
 constexpr double kZ95 = 1.959963984540054, kLoading = 0.1;
 
-void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
-           int starts_size, IdentifySummary& s) {
+Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size) {
     const int n = layout.size();
-    const double nan = std::numeric_limits<double>::quiet_NaN();
     const Eigen::MatrixXd F = J.transpose() * J;
     Eigen::MatrixXd info = F.topLeftCorner(n, n);
     if (starts_size > 0) {
@@ -29,7 +27,16 @@ void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<dou
     Eigen::VectorXd range(n);
     for (int j = 0; j < n; ++j) range[j] = layout.range(j, o);
     const Eigen::MatrixXd scaled = range.asDiagonal() * info * range.asDiagonal();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (scaled + scaled.transpose()));
+    return 0.5 * (scaled + scaled.transpose());
+}
+
+void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
+           int starts_size, IdentifySummary& s) {
+    const int n = layout.size();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Eigen::VectorXd range(n);
+    for (int j = 0; j < n; ++j) range[j] = layout.range(j, o);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled_information(layout, o, J, starts_size));
     Eigen::MatrixXd pinv = Eigen::MatrixXd::Zero(n, n);
     std::vector<bool> internal_ok(n, true);
     for (int i = 0; i < n; ++i) {

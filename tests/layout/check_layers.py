@@ -37,7 +37,8 @@ NUMERIC_LEVELS = [
     ("model", ["include/plate/model.hpp", "src/model.cpp", "src/so3.hpp", "include/plate/scene_io.hpp",
                "src/scene_io.cpp", "src/input_reader.hpp", "include/plate/random_scene.hpp", "src/random_scene.cpp",
                "include/plate/friction.hpp", "include/plate/uncertainty.hpp", "src/uncertainty.cpp",
-               "include/plate/measured_cycle.hpp", "src/measured_cycle.cpp"]),   # friction's accessors are the part's (Part::friction)
+               "include/plate/measured_cycle.hpp", "src/measured_cycle.cpp",
+               "include/plate/peaks.hpp", "src/peaks.cpp"]),   # friction's accessors are the part's (Part::friction)
     ("dynamics/friction", ["generated/plate_kernels.hpp", "include/plate/dynamics.hpp", "src/dynamics.cpp",
                            "src/friction.cpp",   # the gauge and the laws, over the generated kernels
                            "src/workspace.hpp"]),   # the kernels' scratch and the engine's private state

@@ -21,6 +21,7 @@
 
 #include "plate/design_target.hpp"
 #include "plate/field.hpp"
+#include "plate/peaks.hpp"
 #include "plate/robustness.hpp"
 
 #include <cstdint>
@@ -87,14 +88,7 @@ struct OrientationHarmonics {
 OrientationHarmonics harmonics_of(const std::vector<double>& theta_dot);
 OrientationHarmonics orientation_harmonics(const Scene& scene, const Vec2& s, const LimitCycleOptions& opt, int n = 12);
 
-// PEAKS. What an actuator saturates on: per axis a, the peak over the period of |u_a(t)|, the axis'
-// harmonics summed (x, y, z in m/s^2; rx, ry, rz in rad/s^2; entries of one (axis, n) add as phasors,
-// a negative amp is a half-period phase). Not the sum of the amplitudes: a third harmonic a sixth of
-// the first flattens its crest (sin t + sin(3 t) / 6 peaks at sqrt(3) / 2), in the wrong phase it
-// sharpens it (sin t - sin(3 t) / 3 = (4 / 3) sin^3 t). Exact to roundoff: the extrema are the zeros of
-// the derivative, a trigonometric polynomial's, found as a companion matrix's eigenvalues and polished
-// by Newton steps (peaks.cpp; tests/design/test_design_peaks.cpp: within 1e-12 of closed forms).
-Vec6 axis_peaks(const PlateMotion& u);
+// PEAKS: axis_peaks (plate/peaks.hpp, numeric: identification judges its suggested motions by them too).
 
 struct DesignOptions {
     // The limits: every designed motion keeps each axis' peak (axis_peaks) within them -- a constraint

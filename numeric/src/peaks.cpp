@@ -1,10 +1,14 @@
-// The peaks of a plate motion's signals over the period (design.hpp, axis_peaks): what actuators
-// saturate on, and what DesignOptions' limits bound.
-#include "internal.hpp"
+// The peaks of a plate motion's signals over the period (peaks.hpp): what actuators saturate on, what
+// DesignOptions' limits bound and what identification's suggested motions keep within.
+#include "plate/peaks.hpp"
 
-namespace plate::design_detail {
+#include <Eigen/Eigenvalues>
 
-// (internal.hpp) The extrema of f are the zeros of f'(theta) = sum_{|k| <= M} i k F_k e^{i k theta}
+#include <cmath>
+
+namespace plate {
+
+// (peaks.hpp) The extrema of f are the zeros of f'(theta) = sum_{|k| <= M} i k F_k e^{i k theta}
 // (F_{-k} = conj F_k): z^M f'(theta) is a polynomial of degree 2 M in z = e^{i theta}, whose roots are
 // the companion matrix's eigenvalues. Each root's angle, polished by Newton steps on f', is a candidate;
 // so are 16 (M + 1) equally spaced samples (a net under the roots); the peak is the largest |f| over the
@@ -74,7 +78,7 @@ std::vector<std::complex<double>> coefficients(const PlateMotion& u, int axis) {
 }
 }   // namespace
 
-// (internal.hpp) max_t |(u_x, u_y)|: the peak of x^2 + y^2, whose coefficients are the
+// (peaks.hpp) max_t |(u_x, u_y)|: the peak of x^2 + y^2, whose coefficients are the
 // self-convolutions of x's and y's (two-sided, length 2 N + 1; the product has degree 2 N).
 double horizontal_peak(const PlateMotion& u) {
     const std::vector<std::complex<double>> X = coefficients(u, 0), Y = coefficients(u, 1);
@@ -91,13 +95,9 @@ double horizontal_peak(const PlateMotion& u) {
     return std::sqrt(trig_peak(G));
 }
 
-}   // namespace plate::design_detail
-
-namespace plate {
-
 Vec6 axis_peaks(const PlateMotion& u) {
     Vec6 p;
-    for (int a = 0; a < 6; ++a) p[a] = design_detail::trig_peak(design_detail::coefficients(u, a));
+    for (int a = 0; a < 6; ++a) p[a] = trig_peak(coefficients(u, a));
     return p;
 }
 
