@@ -2,6 +2,7 @@
 #include "plate/field.hpp"
 #include "plate/study.hpp"
 #include "plate/scene_io.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,7 +17,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 bool line_at(const FixedLine& l, double theta, double tol_x, double tol_th) {
     for (const auto& q : l.points)

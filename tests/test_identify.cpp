@@ -7,6 +7,7 @@
 #include "plate/scene_io.hpp"
 
 #include "cli_run.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -17,7 +18,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 Camera strobe(double xy_mm, double theta_mrad, std::uint64_t seed) {
     Camera c;

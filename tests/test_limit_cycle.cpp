@@ -3,6 +3,7 @@
 #include "plate/limit_cycle.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -12,7 +13,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 // Plate position (A cos wt, A sin wt, 0): p'' = -A w^2 (cos wt, sin wt) = A w^2 (sin(wt - pi/2), sin(wt + pi)).
 PlateMotion circle(double Aw2, double T) {

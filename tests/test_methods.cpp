@@ -7,6 +7,7 @@
 #include "plate/scene_io.hpp"
 #include "plate/simulate.hpp"
 #include "plate/study.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,7 +17,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(std::string(PLATE_SOURCE_DIR) + "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 // y'' = -y with y(0) = 1, y'(0) = 0: y = cos t (smooth; exact solution known).
 OdeSystem oscillator() {

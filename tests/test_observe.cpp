@@ -5,6 +5,7 @@
 #include "plate/scene_io.hpp"
 
 #include "cli_run.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -15,7 +16,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 Camera camera(double rate, CameraFrame frame) {
     Camera c;

@@ -6,6 +6,7 @@
 
 #include "plate/scene_io.hpp"
 #include "plate/simulate.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -15,7 +16,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 // Each engine's bounds, about three times what it measured (Bullet 3.24 double, ODE 0.16, MuJoCo 2.2.2
 // with peers.cpp's settings; 1e-13 where it measured rounding, 0 or ~1e-16), or the physical bound

@@ -21,6 +21,7 @@
 #include "plate/moreau_jean.hpp"
 #include "plate/scene_io.hpp"
 #include "plate/simulate.hpp"
+#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -30,7 +31,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 // Distance between two configurations in units of rho (theta scaled by rho; a point part's rho is 1 m
 // and its theta 0).

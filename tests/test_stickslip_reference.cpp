@@ -5,6 +5,7 @@
 #include "plate/field.hpp"
 #include "plate/scene_io.hpp"
 #include "plate/study.hpp"
+#include "shipped_scenes.hpp"
 
 #include <Eigen/SVD>
 #include <catch2/catch.hpp>
@@ -18,7 +19,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 double twist_distance(const Scene& sc, const Vec3& a, const Vec3& b) {
     const double v = sc.v_ref();

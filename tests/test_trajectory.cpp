@@ -2,6 +2,7 @@
 // (Section IV-C), and the full dynamics' limit as the plate's amplitude shrinks.
 #include "plate/field.hpp"
 #include "plate/scene_io.hpp"
+#include "shipped_scenes.hpp"
 
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
@@ -11,7 +12,7 @@
 using namespace plate;
 
 namespace {
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 }   // namespace
 
 TEST_CASE("full dynamics tend to U-dynamics as the plate amplitude shrinks, at rate k^-2", "[trajectory][full]") {

@@ -6,6 +6,7 @@
 // plate-frame equations (31), whose right-hand side carries those terms.
 #include "plate/scene_io.hpp"
 #include "plate/simulate.hpp"
+#include "shipped_scenes.hpp"
 
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
@@ -21,7 +22,7 @@ using namespace plate;
 
 namespace {
 
-Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 // R1 at t = 0, as the full dynamics start it: the rotation by the plate's zero-mean rotation vector.
 Mat3 start_orientation(const PlateMotion& u) {

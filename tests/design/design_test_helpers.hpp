@@ -4,6 +4,7 @@
 
 #include "plate/design.hpp"
 #include "plate/scene_io.hpp"
+#include "../shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -12,7 +13,7 @@
 namespace design_tests {
 using namespace plate;
 
-inline Scene scene(const std::string& name) { return load_scene(PLATE_SOURCE_DIR "/scenes/" + name + ".json"); }
+using plate_tests::scene;
 
 inline LimitCycleOptions tight() {
     LimitCycleOptions o;
