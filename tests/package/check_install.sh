@@ -2,7 +2,8 @@
 # The package (issue 17, point 2): install the build into a temporary prefix, move the prefix
 # elsewhere (relocatable), run the installed plate from / and check it finds its scenes beside
 # itself, then build a consumer project with find_package(plate CONFIG) against it and check it
-# computes the same twist as the installed program.
+# computes the same twist as the installed program. The licence, changelog, citation and README
+# are installed under share/doc/plate.
 # With the Python module built, the installed module is imported from / with the documented
 # PYTHONPATH=PREFIX/lib/python3/dist-packages and must give the installed program's twist.
 #   check_install.sh BUILD_DIR SOURCE_DIR [PYTHON]
@@ -16,6 +17,9 @@ cd /
 version=$("$prefix/bin/plate" --version)
 echo "$version"
 case "$version" in *"$prefix/share/plate"*) ;; *) echo "installed plate does not use its own share/plate"; exit 1;; esac
+for f in LICENSE CHANGELOG.md CITATION.cff README.md; do
+  [ -s "$prefix/share/doc/plate/$f" ] || { echo "the package lacks share/doc/plate/$f"; exit 1; }
+done
 "$prefix/bin/plate" twist "$prefix/share/plate/scenes/fig4.json" --at 0.02 0.01 0.5 > "$work/twist.json"
 cmake -S "$src/tests/package/consumer" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > /dev/null
 cmake --build "$work/consumer" > /dev/null
