@@ -102,6 +102,7 @@ int run(int argc, char** argv, std::ostream& out, std::ostream& err) {
         for (const Command& c : commands) {
             if (!c.options->given()) continue;
             c.options->reject(app.remaining(true));
+            for (const std::string& n : c.options->notices()) cio.err << "plate " << cmd << ": " << n << "\n";
             return c.run(cio);
         }
         return 0;   // (not reached: a command is required)

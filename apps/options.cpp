@@ -32,7 +32,12 @@ double parse_num(const std::string& k, const std::string& s) {
 
 long parse_whole(const std::string& k, const std::string& s, long lo, long hi) {
     char* end = nullptr;
-    const long x = std::strtol(s.c_str(), &end, 10);
+    long x = std::strtol(s.c_str(), &end, 10);
+    if (!s.empty() && (*end == 'e' || *end == 'E')) {   // 2e7: a whole number in exponent form, as the help writes budgets
+        const double d = std::strtod(s.c_str(), &end);
+        const bool whole = *end == '\0' && std::isfinite(d) && d == std::floor(d) && std::abs(d) <= 9.007199254740992e15;
+        x = whole ? static_cast<long>(d) : lo - 1;
+    }
     if (s.empty() || *end != '\0' || x < lo || x > hi)
         throw UsageError("option " + k + ": expected a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) +
                          ", got '" + s + "'");
@@ -72,12 +77,14 @@ void Options::reject(const std::vector<std::string>& leftovers) const {
         if (s.size() > 1 && s[0] == '-' && *end != '\0') throw UsageError("unknown option " + s);
     }
     if (leftovers.empty()) return;
-    throw UsageError(takes_scene_ ? "expected exactly one SCENE file" : cmd_->get_name() + " takes no SCENE argument");
+    throw UsageError(takes_scene_ ? "expected exactly one " + file_name_ + " file"
+                                  : cmd_->get_name() + " takes no SCENE argument");
 }
 
-void Options::scene_file(std::string& file, const std::string& name) {
+void Options::scene_file(std::string& file, const std::string& name, const std::string& what) {
     takes_scene_ = true;
-    cmd_->add_option(name, file, "the scene file (JSON, see scenes/)")->required()->option_text(" ");
+    file_name_ = name;
+    cmd_->add_option(name, file, what)->required()->option_text(" ");
 }
 
 void Options::number(const std::string& name, double& x, const std::string& help, const char* def) {
@@ -161,12 +168,38 @@ void Options::add(const std::string& name, const std::string& names, const std::
 
 void Options::add(const std::string& name, int max_values, const std::string& names, const std::string& help,
                   std::function<void(const std::vector<std::string>&)> store) {
+    multi_[name] = Multi{max_values, names, store};
     add_option<std::vector<std::string>>(
         cmd_, name, max_values, names, help, [this](const std::string& n) { once(n); }, std::move(store));
 }
 
+void Options::unused(const std::string& name) {
+    add(name, "X", "", [this, name](const std::string&) {
+        notices_.push_back(name + " is not used by this command (accepted for old scripts; refused from the next release)");
+    });
+    cmd_->get_option(name)->group("");
+}
+
+void Options::deprecated(const std::string& old_name, const std::string& name) {
+    const auto m = multi_.find(name);
+    if (m == multi_.end()) throw std::logic_error("deprecated(" + old_name + ", " + name + "): no such option");
+    old_names_[name] = old_name;
+    const std::string notice = old_name + " is deprecated: use " + name + " (the old spelling goes in the next release)";
+    add_option<std::vector<std::string>>(
+        cmd_, old_name, m->second.max_values, m->second.names, "",
+        [this, name, notice](const std::string&) {
+            once(name);
+            notices_.push_back(notice);
+        },
+        m->second.store);
+    cmd_->get_option(old_name)->group("");   // (hidden from the help)
+}
+
 void Options::once(const std::string& name) {
-    if (!seen_.insert(name).second) throw UsageError("option " + name + " given twice");
+    if (seen_.insert(name).second) return;
+    const auto old = old_names_.find(name);
+    throw UsageError("option " + name + " given twice" +
+                     (old == old_names_.end() ? "" : " (" + old->second + " is its old spelling)"));
 }
 
 std::string Options::in_parentheses(const std::string& range, const std::string& def) {
@@ -199,7 +232,7 @@ Scene scene_arg(const std::string& file, Io& cio) {
 
 void add_measured_options(Options& p, MeasuredArgs& m) {
     p.text("--measured", m.file, "CYCLE.csv", "the plate motion from one measured period (t,x,y,z,rx,ry,rz; with --harmonics)");
-    p.whole("--harmonics", m.harmonics, 1, 10'000, "the measured cycle's harmonics kept, 1..N");
+    p.whole("--harmonics", m.harmonics, 1, 10'000, "the measured cycle's harmonics kept, 1..N", "none: required with --measured");
 }
 
 Scene measured_arg(const Options& a, const MeasuredArgs& m, Scene sc, Io& cio) {

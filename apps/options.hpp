@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <ostream>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -48,7 +49,8 @@ struct UsageError : std::runtime_error {
 // refused with a UsageError naming k).
 double parse_num(const std::string& k, const std::string& s);
 
-// Option k's value `s` as a whole number from lo to hi, all of the text, base 10.
+// Option k's value `s` as a whole number from lo to hi, all of the text: base 10, or a whole number
+// in exponent form (2e7, as the help writes budgets).
 long parse_whole(const std::string& k, const std::string& s, long lo, long hi);
 
 // x with three significant digits, for the numbers in messages (estimates, budgets, limits).
@@ -87,7 +89,9 @@ public:
     void reject(const std::vector<std::string>& leftovers) const;
 
     // The command's positional file argument, `name` in the help (SCENE, PART_SCENE, CAMPAIGN): required.
-    void scene_file(std::string& file, const std::string& name = "SCENE");
+    // `what` says what the file is, in the help.
+    void scene_file(std::string& file, const std::string& name = "SCENE",
+                    const std::string& what = "the scene file (JSON, see scenes/)");
     // A finite number. The help shows the default: `def`, or else x's value; none if def is "".
     void number(const std::string& name, double& x, const std::string& help, const char* def = nullptr);
     // A whole number from lo to hi (int, long or std::uint64_t); the help shows the range and the
@@ -111,6 +115,15 @@ public:
     void text(const std::string& name, std::string& s, const std::string& value, const std::string& help);
     // A flag: b becomes true when given.
     void flag(const std::string& name, bool& b, const std::string& help);
+    // `old_name`, an old spelling of option `name` (declared before, as numbers or words): it does what
+    // `name` does, is left out of the help and leaves a deprecation notice (notices()). Old spellings are
+    // kept for one release (issue 54: one vocabulary). Giving both is giving `name` twice.
+    void deprecated(const std::string& old_name, const std::string& name);
+    // An option this command accepts for old scripts (one word, any value) but does not use: left out
+    // of the help, it leaves a notice that it is not used and goes in the next release.
+    void unused(const std::string& name);
+    // The deprecation notices of the old spellings and unused options given, for the error stream.
+    const std::vector<std::string>& notices() const { return notices_; }
 
 private:
     // An option taking one value, passed to `store` as parsed.
@@ -126,7 +139,17 @@ private:
 
     CLI::App* cmd_;
     std::set<std::string> seen_;
+    // Each option taking several values: its most values, its `names` and its store (for deprecated()).
+    struct Multi {
+        int max_values;
+        std::string names;
+        std::function<void(const std::vector<std::string>&)> store;
+    };
+    std::map<std::string, Multi> multi_;
+    std::map<std::string, std::string> old_names_;   // an option's deprecated spelling, for messages
+    std::vector<std::string> notices_;
     bool takes_scene_ = false;
+    std::string file_name_ = "SCENE";   // the positional file's name in the help and in messages
 };
 
 // ---- the scene and a configuration -------------------------------------------------------------

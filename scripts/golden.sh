@@ -102,11 +102,14 @@ for scene in scenes/*.json; do
     fi
     run "$s.twist.json" "$plate" twist "$scene" --at "${at[@]}"
 done
-run fig4.full.csv "$plate" simulate scenes/fig4.json --dynamics full --from 0.04 -0.04 1.0 --time 3
-run fig6.u.csv "$plate" simulate scenes/fig6.json --dynamics u --from 0.0167 0 2.693 --time 2
-run fig1.averaged.csv "$plate" simulate scenes/fig1.json --dynamics averaged --from -0.04 0.03 1.2 --time 4
-run fig1_point.field-curve.csv "$plate" simulate scenes/fig1_point.json --dynamics field --from 0.03 0.02 --time 5
-run heave_yaw.full.csv "$plate" simulate scenes/heave_yaw.json --dynamics full --from 0.02 0 0.3 --time 1
+# (the start's option: --start since issue 54, --from before; so that builds on both sides compare)
+start=--from
+[[ $("$plate" simulate --help) == *--start* ]] && start=--start
+run fig4.full.csv "$plate" simulate scenes/fig4.json --dynamics full "$start" 0.04 -0.04 1.0 --time 3
+run fig6.u.csv "$plate" simulate scenes/fig6.json --dynamics u "$start" 0.0167 0 2.693 --time 2
+run fig1.averaged.csv "$plate" simulate scenes/fig1.json --dynamics averaged "$start" -0.04 0.03 1.2 --time 4
+run fig1_point.field-curve.csv "$plate" simulate scenes/fig1_point.json --dynamics field "$start" 0.03 0.02 --time 5
+run heave_yaw.full.csv "$plate" simulate scenes/heave_yaw.json --dynamics full "$start" 0.02 0 0.3 --time 1
 for seed in 3 7; do
     run "random.$seed.json" "$plate" random-scene --seed $seed
     run "random.$seed.thin.json" "$plate" random-scene --seed $seed --thin

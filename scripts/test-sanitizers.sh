@@ -51,8 +51,8 @@ memcheck() {
   local args
   for args in "twist scenes/fig4.json --at 0.03 -0.02 1.0" "twist scenes/fig1_point.json --at 0.01 0.02" \
               "twist scenes/heave_yaw.json --at 0.01 0.02 0.5" \
-              "simulate scenes/fig6.json --dynamics full --from 0.01 0.02 0.3 --time 0.1" \
-              "simulate scenes/heave_yaw_point.json --dynamics u --from 0.01 0.02 --time 0.2" \
+              "simulate scenes/fig6.json --dynamics full --start 0.01 0.02 0.3 --time 0.1" \
+              "simulate scenes/heave_yaw_point.json --dynamics u --start 0.01 0.02 --time 0.2" \
               "field scenes/fig1_point.json --grid 3 --threads 1" "fixed-points scenes/fig4.json --grid 3 --threads 1"; do
     echo "valgrind plate $args"
     # shellcheck disable=SC2086

@@ -70,6 +70,33 @@ TEST_CASE("plate twist prints the asymptotic twist as JSON", "[cli]") {
     CHECK(nlohmann::json::parse(p.out)["twist"].size() == 2);
 }
 
+TEST_CASE(
+    "one vocabulary: --start is a configuration, --twist a twist, and --from, the old spelling of both, works with a notice",
+    "[cli][vocabulary]") {
+    // twist: the initial twist changes how many periods the cycle takes (not where it ends).
+    const std::string tw = "twist " + kScenes + "fig4.json --at 0.02 0.01 0.5";
+    const Run rest = run(tw), moving = run(tw + " --twist 0.05 0 0"), old = run(tw + " --from 0.05 0 0");
+    REQUIRE(rest.code == 0);
+    REQUIRE(moving.code == 0);
+    REQUIRE(old.code == 0);
+    CHECK(nlohmann::json::parse(moving.out)["periods"] != nlohmann::json::parse(rest.out)["periods"]);
+    CHECK(old.out == moving.out);
+    CHECK(moving.err.empty());
+    CHECK(old.err.find("--from is deprecated: use --twist") != std::string::npos);
+    // simulate: --from is the start configuration.
+    const std::string sim = "simulate " + kScenes + "fig1_point.json --dynamics u --time 0.1";
+    const Run start = run(sim + " --start 0.01 0.02"), old_start = run(sim + " --from 0.01 0.02");
+    REQUIRE(start.code == 0);
+    CHECK(old_start.out == start.out);
+    CHECK(old_start.err.find("--from is deprecated: use --start") != std::string::npos);
+    CHECK(run(sim + " --start 0.02 0.02").out != start.out);
+    // Both spellings: one option given twice.
+    const Run both = run(sim + " --start 0.01 0.02 --from 0.01 0.02");
+    CHECK(both.code == 2);
+    CHECK(both.err.find("option --start given twice (--from is its old spelling)") != std::string::npos);
+    CHECK(both.out.empty());
+}
+
 TEST_CASE("the README's quick start: every figure it quotes is what the program computes", "[cli][readme]") {
     // README.md, "Quick start": the twist, fixed points and trajectory it prints and the sentences on
     // them, each to the digits it quotes (the printed JSON to 1e-6 relative: the run on this machine
@@ -129,8 +156,9 @@ TEST_CASE("the README's quick start: every figure it quotes is what the program 
     // From (4 cm, -4 cm, 1 rad), 20 s of full dynamics: within about a millimetre of the centre, at
     // theta = -0.033 rad.
     const fs::path csv = tmpdir() / "readme_fig4.csv";
-    REQUIRE(run("simulate " + kScenes + "fig4.json --dynamics full --from 0.04 -0.04 1.0 --time 20 --out " + csv.string()).code ==
-            0);
+    REQUIRE(
+        run("simulate " + kScenes + "fig4.json --dynamics full --start 0.04 -0.04 1.0 --time 20 --out " + csv.string()).code ==
+        0);
     std::istringstream rows(slurp(csv));
     std::string line, last;
     while (std::getline(rows, line))
@@ -155,7 +183,7 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     REQUIRE(r.code == 0);
     CHECK(nlohmann::json::parse(r.out)["points"].size() == 9);
     const fs::path sim = tmpdir() / "sim.csv";
-    r = run("simulate " + kScenes + "fig4.json --dynamics full --from 0.02 0.01 0.5 --time 0.5 --out " + sim.string());
+    r = run("simulate " + kScenes + "fig4.json --dynamics full --start 0.02 0.01 0.5 --time 0.5 --out " + sim.string());
     REQUIRE(r.code == 0);
     const std::string s = slurp(sim);
     CHECK(s.rfind("t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n", 0) == 0);
@@ -189,7 +217,7 @@ TEST_CASE("heave_yaw's fields stick everywhere, all period long at 42 of 343 and
 TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twist reports its stick fractions", "[cli][stick]") {
     // Issue 14's first check: Fig. 1(a)'s run from rest used to stop at t = 0.00077 s.
     const fs::path sim = tmpdir() / "fig1.csv";
-    Run r = run("simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 20 --out " + sim.string());
+    Run r = run("simulate " + kScenes + "fig1.json --dynamics full --start -0.04 0.03 1.2 --time 20 --out " + sim.string());
     INFO(r.err);
     REQUIRE(r.code == 0);
     std::istringstream in(slurp(sim));
@@ -218,7 +246,7 @@ TEST_CASE("stick-slip in every command: fig1 from rest runs 20 s, a sticking twi
 
 TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the twist left out between macro points",
           "[cli][averaged]") {
-    const std::string args = "simulate " + kScenes + "fig4.json --from 0.04 -0.04 1.0 --time 20 --sample 5 --rtol 1e-5";
+    const std::string args = "simulate " + kScenes + "fig4.json --start 0.04 -0.04 1.0 --time 20 --sample 5 --rtol 1e-5";
     const Run avg = run(args + " --dynamics averaged"), full = run(args + " --dynamics full");
     INFO(avg.err);
     REQUIRE(avg.code == 0);
@@ -316,13 +344,13 @@ TEST_CASE("bad arguments: exit code 2 with the option named", "[cli][input]") {
         {"field " + f4 + " --grid 0", "--grid: expected a whole number"},
         {"field " + f4 + " --format xml", "--format"},
         {"field " + f4 + " --colour red", "unknown option --colour"},
-        {"simulate " + f4 + " --dynamics fast --from 0 0 0 --time 1", "--dynamics"},
-        {"simulate " + f4 + " --dynamics u --from 0 0 0 --time -1", "--time"},
+        {"simulate " + f4 + " --dynamics fast --start 0 0 0 --time 1", "--dynamics"},
+        {"simulate " + f4 + " --dynamics u --start 0 0 0 --time -1", "--time"},
         {"twist /nonexistent.json --at 0 0 0", "/nonexistent.json: cannot open"},
         {"frobnicate", "unknown command"},
         {"twist " + f4 + " --at 0 0 0 --cycle-solver secant", "--cycle-solver: unknown cycle solver 'secant'"},
         {"bench", "missing --out"},
-        {"simulate " + f4 + " --dynamics auto --from 0 0 0 --time 1 --model-tol -1", "--model-tol"},
+        {"simulate " + f4 + " --dynamics auto --start 0 0 0 --time 1 --model-tol -1", "--model-tol"},
     };
     for (const auto& [args, expect] : cases) {
         const Run r = run(args);
@@ -338,7 +366,7 @@ TEST_CASE("a simulation that leaves the model stops with exit code 3 and says wh
                                       "{\"axis\": \"x\",  \"n\": 1, \"amp\": 20,  \"phase\": 0}, "
                                       "{\"axis\": \"z\",  \"n\": 1, \"amp\": 15,  \"phase\": 0}");
     const fs::path out = tmpdir() / "bounce.csv";
-    const Run r = run("simulate " + scene.string() + " --dynamics u --from 0 0 0 --time 1 --out " + out.string());
+    const Run r = run("simulate " + scene.string() + " --dynamics u --start 0 0 0 --time 1 --out " + out.string());
     CHECK(r.code == 3);
     CHECK(r.err.find("lost") != std::string::npos);
     CHECK(fs::exists(out));   // the trajectory up to the loss of contact
@@ -348,13 +376,13 @@ TEST_CASE("plate simulate --dynamics auto states its choice, decided up front, a
     const fs::path out = tmpdir() / "auto.csv";
     const Run r =
         run("simulate " + kScenes +
-            "fig4.json --dynamics auto --model-tol 0.05 --from 0.04 -0.04 1.0 --time 0.5 --verify --out " + out.string());
+            "fig4.json --dynamics auto --model-tol 0.05 --start 0.04 -0.04 1.0 --time 0.5 --verify --out " + out.string());
     INFO(r.err);
     CHECK(r.code == 0);
     CHECK(r.err.find("auto model, decided up front (tolerance 0.05): picked") != std::string::npos);
     CHECK(r.err.find("estimates: |xi|") != std::string::npos);
     CHECK(fs::exists(out));
-    const Run bad = run("simulate " + kScenes + "fig4.json --dynamics full --from 0 0 0 --time 0.1 --verify");
+    const Run bad = run("simulate " + kScenes + "fig4.json --dynamics full --start 0 0 0 --time 0.1 --verify");
     CHECK(bad.code == 2);
     CHECK(bad.err.find("--verify goes with --dynamics auto") != std::string::npos);
 }
@@ -522,7 +550,7 @@ TEST_CASE("a command interrupted while it writes leaves no output that looks com
     const Job jobs[] = {
         {"field " + kScenes + "fig4.json --grid 3 --out " + (d / "field.json").string(), d / "field.json"},
         {"fixed-points " + kScenes + "fig4.json --grid 3 --out " + (d / "fp.json").string(), d / "fp.json"},
-        {"simulate " + kScenes + "fig1.json --dynamics full --from -0.04 0.03 1.2 --time 1 --out " + (d / "traj.csv").string(),
+        {"simulate " + kScenes + "fig1.json --dynamics full --start -0.04 0.03 1.2 --time 1 --out " + (d / "traj.csv").string(),
          d / "traj.csv"},
         {"proofs --thin 4 --thick 2 --surfaces 2 --out " + (d / "proofs.json").string(), d / "proofs.json"},
         {"random-scene --seed 3 --out " + (d / "scene.json").string(), d / "scene.json"},
@@ -588,14 +616,14 @@ TEST_CASE("bounded work: a run over its budget is refused up front with the esti
           "[cli][budget]") {
     const std::string f1 = kScenes + "fig1.json", f6 = kScenes + "fig6.json";
     // 10^6 s of fig1 is 2e7 plate periods of ~100 steps: ~2e9 steps against the default 2e7.
-    Run r = run("simulate " + f1 + " --dynamics full --from -0.04 0.03 1.2 --time 1e6 --sample 1e3");
+    Run r = run("simulate " + f1 + " --dynamics full --start -0.04 0.03 1.2 --time 1e6 --sample 1e3");
     CHECK(r.code == 2);
     CHECK(r.err.find("plate periods") != std::string::npos);
     CHECK(r.err.find("raise it with --max-steps") != std::string::npos);
     // ... and the same run with a budget that allows it is not refused up front (1 s: 20 periods).
-    CHECK(run("simulate " + f1 + " --dynamics full --from -0.04 0.03 1.2 --time 1 --max-steps 100000").code == 0);
-    CHECK(run("simulate " + f1 + " --dynamics full --from -0.04 0.03 1.2 --time 1 --max-steps 100").code == 2);
-    r = run("simulate " + f1 + " --dynamics u --from 0 0 0 --time 1 --sample 1e-8");
+    CHECK(run("simulate " + f1 + " --dynamics full --start -0.04 0.03 1.2 --time 1 --max-steps 100000").code == 0);
+    CHECK(run("simulate " + f1 + " --dynamics full --start -0.04 0.03 1.2 --time 1 --max-steps 100").code == 2);
+    r = run("simulate " + f1 + " --dynamics u --start 0 0 0 --time 1 --sample 1e-8");
     CHECK(r.code == 2);
     CHECK(r.err.find("rows, above the limit") != std::string::npos);
     r = run("field " + f6 + " --grid 201");

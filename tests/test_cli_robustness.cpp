@@ -126,7 +126,7 @@ TEST_CASE("plate --measured: a recorded cycle of a scene's own plate gives its t
         {"twist " + fig4 + at + " --measured " + good.string(), "--measured FILE and --harmonics N go together"},
         {"field " + fig4 + " --grid 2 --harmonics 3", "--measured FILE and --harmonics N go together"},
         {"fixed-points " + fig4 + " --grid 2 --measured /nonexistent.csv --harmonics 3", "/nonexistent.csv: cannot open"},
-        {"simulate " + fig4 + " --dynamics u --from 0 0 0 --time 0.1 --measured " + broken.string() + " --harmonics 3",
+        {"simulate " + fig4 + " --dynamics u --start 0 0 0 --time 0.1 --measured " + broken.string() + " --harmonics 3",
          broken.string() + ":3:1"},
         {"twist " + fig4 + at + " --measured " + good.string() + " --harmonics 32", "64 samples resolve harmonics up to n = 31"},
     };

@@ -118,7 +118,7 @@ TEST_CASE("plate identify refuses tracks of another scene, too few frames and un
           "[identify][cli]") {
     const fs::path cam = tmpdir() / "camera.json", track = tmpdir() / "track.csv", out = tmpdir() / "est.json";
     std::ofstream(cam) << R"({"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1}, "seed": 1, "frame": "plate"})";
-    const Run made = run("simulate " + kScenes + "fig1_point.json --dynamics full --from 0.01 -0.02 --time 0.5 --observe " +
+    const Run made = run("simulate " + kScenes + "fig1_point.json --dynamics full --start 0.01 -0.02 --time 0.5 --observe " +
                          cam.string() + " --out " + track.string());
     REQUIRE(made.code == 0);
     const std::string tail = " --tracks " + track.string() + " --out " + out.string();

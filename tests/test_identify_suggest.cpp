@@ -162,8 +162,8 @@ TEST_CASE("plate identify --suggest writes a scene to film, and refuses bad inpu
             CHECK(c["harmonics"][0]["amp"].get<double>() == suggested.plate.harmonics[0].amp);
         }
     CHECK(found);
-    const Run filmed = run("simulate " + sc.string() + " --dynamics full --from 0.01 -0.02 --time 0.5 --observe " + cam.string() +
-                           " --out " + track.string());
+    const Run filmed = run("simulate " + sc.string() + " --dynamics full --start 0.01 -0.02 --time 0.5 --observe " +
+                           cam.string() + " --out " + track.string());
     CHECK(filmed.code == 0);
 
     const Run limits = run(head + " --limits 0 150 --out " + out.string());

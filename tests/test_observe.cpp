@@ -451,8 +451,8 @@ TEST_CASE("plate simulate --observe writes the camera's track, and a bad camera 
     const fs::path cam = tmpdir() / "camera.json", track = tmpdir() / "track.csv";
     std::ofstream(cam) << R"({"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1, "theta_mrad": 5},
                              "latency_s": 0, "drop": 0.0, "seed": 1, "frame": "world"})";
-    const Run r = run("simulate " + kScenes + "fig4.json --dynamics full --from 0.03 -0.02 1 --time 1 --observe " + cam.string() +
-                      " --out " + track.string());
+    const Run r = run("simulate " + kScenes + "fig4.json --dynamics full --start 0.03 -0.02 1 --time 1 --observe " +
+                      cam.string() + " --out " + track.string());
     INFO(r.err);
     REQUIRE(r.code == 0);
     const Track tr = read_track_csv(track.string());
@@ -462,12 +462,12 @@ TEST_CASE("plate simulate --observe writes the camera's track, and a bad camera 
     CHECK(tr.t[3] == 3.25 * 0.05);
 
     std::ofstream(cam) << R"({"rate_hz": 100, "noise": {"xy_mm": -0.1}, "frame": "plate"})";
-    const Run bad = run("simulate " + kScenes + "fig4.json --dynamics full --from 0.03 -0.02 1 --time 1 --observe " +
+    const Run bad = run("simulate " + kScenes + "fig4.json --dynamics full --start 0.03 -0.02 1 --time 1 --observe " +
                         cam.string() + " --out " + track.string());
     CHECK(bad.code == 2);
     CHECK(bad.err.find(cam.string() + ": noise.xy_mm: expected a standard deviation from 0 to 1000 mm") != std::string::npos);
     const Run sample = run("simulate " + kScenes +
-                           "fig4.json --dynamics full --from 0.03 -0.02 1 --time 1 --sample 0.01 --observe " + cam.string());
+                           "fig4.json --dynamics full --start 0.03 -0.02 1 --time 1 --sample 0.01 --observe " + cam.string());
     CHECK(sample.code == 2);
     CHECK(sample.err.find("--sample") != std::string::npos);
 }

@@ -54,7 +54,11 @@ int cmd_bench(const BenchArgs& a, Io& cio) {
                                 " --build " + quote(dir.string()) + (a.full ? "" : " --quick");
         const int rc = std::system(cmd.c_str());
         if (rc != 0) throw std::runtime_error("the peers study failed (" + cmd + ")");
-        cio.err << "bench: " << a.out << "/index.html (peers)" << std::endl;
+        // (the study writes the section to DIR/data and splices it into the report's page if there is one)
+        const bool page = std::filesystem::exists(std::filesystem::path(a.out) / "index.html");
+        cio.err << "bench: " << a.out << "/data/peers_section.html (peers"
+                << (page ? "; spliced into " + a.out + "/index.html)" : "; no report page in " + a.out + " to splice it into)")
+                << std::endl;
         return 0;
     }
     report::SpeedOptions o;

@@ -70,12 +70,12 @@ struct DesignArgs : Options {
         number("--period", period, "the plate's period [s]", "the part scene's");
         whole("--seed", seed, 0, 1L << 40, "the seed");
         whole("--threads", threads, 0, 256, "threads (0: all cores)");
-        whole("--starts", starts, 1, 10000, "seeded starts of the search");
+        whole("--starts", starts, 1, 10000, "seeded starts of the search", "4 for sinks and line sinks, 16 otherwise");
         whole("--evaluations", evaluations, 1, 1'000'000, "evaluations per start");
         number("--hold", hold, "seconds a part released at the target must stay within 5 mm (0: not checked)", "120");
         number("--max-coning", max_coning, "a sink's largest coning rate [rad/s] (negative: from the hold)", "from the hold");
         text("--axes", axes, "x,y,z,rx,ry,rz", "the axes the motion may use (default: the target's own)");
-        whole("--harmonics", harmonics, 1, 64, "the highest harmonic n the motion may use (default: the target's own)");
+        whole("--harmonics", harmonics, 1, 64, "the highest harmonic n the motion may use", "the target's own");
         text("--robust", robust, "SPEC.json", "design for the plates this uncertainty spec draws (sinks, fixed points)");
         number("--arrive", arrive, "robust: every start reaches the target within this [s]");
         number("--robust-radius", robust_radius, "robust: the fixed point's 95 % radius over the draws [m]");

@@ -24,16 +24,15 @@ constexpr double kMaxRows = 1e7;   // rows of a trajectory CSV
 
 struct SimulateArgs : Options {
     std::string scene, dynamics, out = "-", observe;
-    std::vector<double> from, twist;
+    std::vector<double> start, twist;
     double time = 0, sample = 0, model_tol = 1e-2;
     double rtol = IntegrationOptions{}.rtol, tol = LimitCycleOptions{}.tol;
-    std::string max_periods;   // (accepted as always, any value: no simulation reads it)
     long max_steps = 0;
     bool verify = false;
     MeasuredArgs measured;
     explicit SimulateArgs(CLI::App& app)
         : Options(app, "simulate", "U-dynamics, full-dynamics or field-integral-curve trajectory, CSV",
-                  "Trajectory from configuration --from with part twist --twist relative to the plate\n"
+                  "Trajectory from configuration --start with part twist --twist relative to the plate\n"
                   "(default: at rest). full: full dynamics (31) with the plate on SO(3); u: U-dynamics (32);\n"
                   "field: integral curve of the asymptotic twist field (RK4, 0.05 s steps). averaged: stroboscopic\n"
                   "averaging of the full dynamics (macro steps of many periods, each slope from a burst of the full\n"
@@ -41,12 +40,13 @@ struct SimulateArgs : Options {
                   "normal forces nan).\n"
                   "auto: the cheapest of point/thin/thick part x field/u/full dynamics whose final configuration\n"
                   "is predicted within --model-tol E (default 1e-2; of rho and radians) of the scene's part\n"
-                  "under full dynamics, decided up front from a few limit cycles at --from and the scene's\n"
+                  "under full dynamics, decided up front from a few limit cycles at --start and the scene's\n"
                   "dimensionless numbers (hierarchy.hpp); --verify also runs the full model and reports the\n"
                   "measured error. The choice and its estimates go to stderr.\n"
-                  "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3 every --sample\n"
-                  "seconds (default T/4 of the plate period... 0.0125 s for T = 0.05), and the contact mode on the\n"
-                  "step that ended there (slide, pivot1-3, stuck: stick-slip is simulated through). Exit code 3\n"
+                  "CSV with header t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode (point parts:\n"
+                  "t,s_x,s_y,s_x_dot,s_y_dot,N1,mode) every --sample seconds (default T/4 of the plate period...\n"
+                  "0.0125 s for T = 0.05); mode is the contact mode on the step that ended there (slide, pivot1-3,\n"
+                  "stuck: stick-slip is simulated through). Exit code 3\n"
                   "when a normal force reaches zero (the part would fly): the CSV then ends at that time.\n"
                   "--max-steps N: the work budget (integrator steps; for field, RK4 steps of the curve; default\n"
                   "2e7, field 1e4). The work is estimated up front from one plate period (or one RK4 step) and a\n"
@@ -59,7 +59,8 @@ struct SimulateArgs : Options {
                   "shown is at t - latency_s. The camera file: docs/guide.md, Observations.\n") {
         scene_file(scene);
         text("--dynamics", dynamics, "full|u|field|averaged|auto", "the model; required");
-        numbers("--from", from, 2, 3, "SX SY THETA", "the start (point parts: SX SY); required");
+        numbers("--start", start, 2, 3, "SX SY THETA", "the start (point parts: SX SY); required");
+        deprecated("--from", "--start");
         number("--time", time, "the duration T [s]; required", "");
         numbers("--twist", twist, 2, 3, "VX VY OMEGA", "the part's twist relative to the plate at the start");
         number("--sample", sample, "seconds between rows", "a quarter of the plate's period");
@@ -67,7 +68,7 @@ struct SimulateArgs : Options {
         text("--observe", observe, "CAMERA.json", "write the camera's track instead of the trajectory");
         number("--rtol", rtol, "integrator tolerance");
         number("--tol", tol, "limit-cycle tolerance of the field curve");
-        text("--max-periods", max_periods, "N", "(not used by simulate)");
+        unused("--max-periods");
         number("--model-tol", model_tol, "auto: the error allowed");
         add_measured_options(*this, measured);
         flag("--verify", verify, "auto: also run the full model and report the measured error");
@@ -155,7 +156,7 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
     std::string dyn = a.dynamics;
     if (dyn != "full" && dyn != "u" && dyn != "field" && dyn != "averaged" && dyn != "auto")
         throw UsageError("--dynamics: expected full, u, field, averaged or auto");
-    const Vec3 q0 = config_arg(a, "--from", a.from, sc, true);
+    const Vec3 q0 = config_arg(a, "--start", a.start, sc, true);
     const Vec3 qd0 = config_arg(a, "--twist", a.twist, sc, false);
     if (!a.has("--time")) throw UsageError("missing --time T");
     const double T = a.time;

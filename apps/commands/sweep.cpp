@@ -26,7 +26,7 @@ struct SweepArgs : Options {
                   "status failed and its reason), DIR/timing.csv and DIR/summary.svg. Under `mpirun -np N` the\n"
                   "cases are shared over the ranks (one at a time, as workers free up), --threads each; the\n"
                   "table is the same, bit for bit. A JSON summary goes to stdout.\n") {
-        scene_file(campaign, "CAMPAIGN");
+        scene_file(campaign, "CAMPAIGN", "the campaign file (JSON, see campaigns/)");
         text("--out", out, "DIR", "the campaign's folder; required");
         whole("--threads", threads, 0, 256, "threads (per MPI rank; 0: the cores over the node's ranks)");
     }

@@ -45,6 +45,20 @@ Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name);
 // ValueError(message) unless ok.
 void require(bool ok, const std::string& message);
 
+// One vocabulary (issue 54): the value of keyword `now`, or of its old spelling `old` (kept for one
+// release: using it warns with a DeprecationWarning); both given is a ValueError; neither, `fallback`.
+template <class T>
+T renamed(const std::optional<T>& now, const std::optional<T>& old, const char* now_name, const char* old_name,
+          const T& fallback) {
+    if (!old) return now ? *now : fallback;
+    require(!now,
+            std::string(now_name) + " and " + old_name + " are the same argument (" + old_name + " its old spelling): give one");
+    const std::string msg =
+        std::string(old_name) + "= is deprecated: use " + now_name + "= (the old spelling goes in the next release)";
+    if (PyErr_WarnEx(PyExc_DeprecationWarning, msg.c_str(), 1) != 0) throw py::error_already_set();
+    return *old;
+}
+
 // A numpy array of the given shape holding data (row-major).
 py::array_t<double> array(const std::vector<double>& data, std::vector<py::ssize_t> shape);
 

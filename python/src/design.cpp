@@ -62,6 +62,86 @@ DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, dou
     }
 }
 
+namespace {
+
+// plate.design: the target and the options as keyword arguments, judged as the command line's.
+void bind_design_function(py::module_& m) {
+    m.def(
+        "design",
+        [](const Scene& part, std::optional<std::pair<double, double>> sink, std::optional<std::pair<double, double>> transport,
+           std::optional<std::tuple<double, double, double>> fixed_point, std::optional<double> orient,
+           std::optional<std::tuple<double, double, double>> line_sink, std::optional<std::pair<double, double>> limits,
+           double period, std::uint64_t seed, int starts, std::optional<int> evaluations, int verify_starts, int threads,
+           double hold, double max_coning, std::vector<std::string> axes, std::optional<int> harmonics,
+           std::optional<std::string> target, std::optional<double> lin_limit, std::optional<double> ang_limit,
+           std::optional<int> local_evaluations, std::optional<int> max_harmonic) {
+            const DesignTarget t =
+                design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink, target, part.part.point);
+            DesignOptions o;   // (judged in the library: validate_design_options, as for the CLI and campaigns)
+            // (the old spellings: lin_limit and ang_limit for limits, local_evaluations, max_harmonic)
+            const std::optional<std::pair<double, double>> old_limits =
+                lin_limit || ang_limit
+                    ? std::optional(std::pair(lin_limit.value_or(o.lin_limit), ang_limit.value_or(o.ang_limit)))
+                    : std::nullopt;
+            const auto [lin, ang] =
+                renamed(limits, old_limits, "limits", lin_limit ? "lin_limit" : "ang_limit", std::pair(o.lin_limit, o.ang_limit));
+            o.lin_limit = lin;
+            o.ang_limit = ang;
+            o.period = period;
+            o.seed = seed;
+            o.starts = starts;
+            o.local_evaluations =
+                renamed(evaluations, local_evaluations, "evaluations", "local_evaluations", o.local_evaluations);
+            o.verify_starts = verify_starts;
+            o.threads = threads;
+            o.hold = hold;
+            o.max_coning = max_coning;
+            for (const std::string& name : axes) {
+                int k = 0;
+                while (k < 6 && name != axis_name(static_cast<Axis>(k))) ++k;
+                require(k < 6, "axes: expected names among x, y, z, rx, ry, rz, got '" + name + "'");
+                o.axes.push_back(static_cast<Axis>(k));
+            }
+            o.max_harmonic = renamed(harmonics, max_harmonic, "harmonics", "max_harmonic", 0);
+            py::gil_scoped_release free;
+            try {
+                return design(part, t, o);
+            } catch (const std::invalid_argument& e) {
+                py::gil_scoped_acquire hold;
+                throw py::value_error(e.what());
+            }
+        },
+        py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
+        py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
+        py::arg("limits") = py::none(), py::arg("period") = 0.0, py::arg("seed") = 1, py::arg("starts") = 0,
+        py::arg("evaluations") = py::none(), py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0,
+        py::arg("max_coning") = -1.0, py::arg("axes") = std::vector<std::string>{}, py::arg("harmonics") = py::none(),
+        py::arg("target") = py::none(), py::arg("lin_limit") = py::none(), py::arg("ang_limit") = py::none(),
+        py::arg("local_evaluations") = py::none(), py::arg("max_harmonic") = py::none(),
+        "Designs a plate motion within the peak limits (limits=(LIN, ANG), default (20, 150): LIN [m/s^2]\n"
+        "for x, y, z and ANG [rad/s^2] for rx, ry, rz bound the peak over the period of each axis' summed\n"
+        "signal; `peaks`; the command line's --limits) and without\n"
+        "flight, and verifies it (grid and\n"
+        "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
+        "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
+        "sink=(x, y) for a rigid part: its position ends at\n"
+        "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
+        "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
+        "transport=(vx, vy) a uniform velocity over the plate (also a rigid part with one friction coefficient). Rigid parts: "
+        "orient=theta for a part whose\n"
+        "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
+        "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
+        "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
+        "pair: theta and theta + pi both stable, unique False; see the README). axes=['x', ...] and\n"
+        "harmonics=n narrow each target's motion family (the others stay zero; an empty family is a ValueError);\n"
+        "evaluations: per start of the search (default 400). The old spellings lin_limit, ang_limit,\n"
+        "local_evaluations and max_harmonic still work, with a DeprecationWarning, for one release.\n"
+        "target='KIND NUMBERS' is any target as the command line's --target writes it (e.g. 'sink 0.02 -0.01'),\n"
+        "judged by the same parser: what one refuses, the other refuses with the same message.");
+}
+
+}   // namespace
+
 void bind_design(py::module_& m) {
     py::class_<DesignSummary>(m, "Design", "A designed plate motion and its verification (plate.design).")
         .def_readonly("verified", &DesignSummary::verified)
@@ -115,7 +195,7 @@ void bind_design(py::module_& m) {
         .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)")
         .def_readonly("peaks", &DesignSummary::peaks,
                       "the designed motion's peak per axis over the period, x y z [m/s^2], rx ry rz [rad/s^2] "
-                      "(plate.axis_peaks): what lin_limit and ang_limit bound")
+                      "(plate.axis_peaks): what limits bound")
         .def_property_readonly(
             "pulls",
             [](const DesignSummary& s) {
@@ -124,64 +204,7 @@ void bind_design(py::module_& m) {
                 return r;
             },
             "a rigid part's sink: (theta, where the position's field vanishes, its eigenvalues) per orientation");
-    m.def(
-        "design",
-        [](const Scene& part, std::optional<std::pair<double, double>> sink, std::optional<std::pair<double, double>> transport,
-           std::optional<std::tuple<double, double, double>> fixed_point, std::optional<double> orient,
-           std::optional<std::tuple<double, double, double>> line_sink, double lin_limit, double ang_limit, double period,
-           std::uint64_t seed, int starts, int local_evaluations, int verify_starts, int threads, double hold, double max_coning,
-           std::vector<std::string> axes, int max_harmonic, std::optional<std::string> target) {
-            const DesignTarget t =
-                design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink, target, part.part.point);
-            DesignOptions o;   // (judged in the library: validate_design_options, as for the CLI and campaigns)
-            o.lin_limit = lin_limit;
-            o.ang_limit = ang_limit;
-            o.period = period;
-            o.seed = seed;
-            o.starts = starts;
-            o.local_evaluations = local_evaluations;
-            o.verify_starts = verify_starts;
-            o.threads = threads;
-            o.hold = hold;
-            o.max_coning = max_coning;
-            for (const std::string& name : axes) {
-                int k = 0;
-                while (k < 6 && name != axis_name(static_cast<Axis>(k))) ++k;
-                require(k < 6, "axes: expected names among x, y, z, rx, ry, rz, got '" + name + "'");
-                o.axes.push_back(static_cast<Axis>(k));
-            }
-            o.max_harmonic = max_harmonic;
-            py::gil_scoped_release free;
-            try {
-                return design(part, t, o);
-            } catch (const std::invalid_argument& e) {
-                py::gil_scoped_acquire hold;
-                throw py::value_error(e.what());
-            }
-        },
-        py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
-        py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
-        py::arg("lin_limit") = 20.0, py::arg("ang_limit") = 150.0, py::arg("period") = 0.0, py::arg("seed") = 1,
-        py::arg("starts") = 0, py::arg("local_evaluations") = 400, py::arg("verify_starts") = 20, py::arg("threads") = 0,
-        py::arg("hold") = 120.0, py::arg("max_coning") = -1.0, py::arg("axes") = std::vector<std::string>{},
-        py::arg("max_harmonic") = 0, py::arg("target") = py::none(),
-        "Designs a plate motion within the peak limits (lin_limit [m/s^2] for x, y, z and ang_limit [rad/s^2]\n"
-        "for rx, ry, rz bound the peak over the period of each axis' summed signal; `peaks`) and without\n"
-        "flight, and verifies it (grid and\n"
-        "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
-        "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
-        "sink=(x, y) for a rigid part: its position ends at\n"
-        "(x, y) whatever its orientation (`pulls`). Point parts: sink=(x, y) the unique stable fixed point of its field,\n"
-        "line_sink=(x, y, phi) every start ends on the line through (x, y) along phi, or\n"
-        "transport=(vx, vy) a uniform velocity over the plate (also a rigid part with one friction coefficient). Rigid parts: "
-        "orient=theta for a part whose\n"
-        "contacts' friction differs (a plate that only translates turns it like a weathervane; `ring` gives\n"
-        "theta' over a turn); fixed_point=(x, y, theta), and orient for one friction coefficient: the summary\n"
-        "gives the basin share and the competing fixed points (where no unique fixed point is found, a half-turn\n"
-        "pair: theta and theta + pi both stable, unique False; see the README). axes=['x', ...] and\n"
-        "max_harmonic=n narrow each target's motion family (the others stay zero; an empty family is a ValueError).\n"
-        "target='KIND NUMBERS' is any target as the command line's --target writes it (e.g. 'sink 0.02 -0.01'),\n"
-        "judged by the same parser: what one refuses, the other refuses with the same message.");
+    bind_design_function(m);
     m.def(
         "orientation_harmonics",
         [](const Scene& sc, std::array<double, 2> at, int n, double tol, double rtol) {

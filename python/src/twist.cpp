@@ -62,19 +62,23 @@ void bind_twist(py::module_& m) {
         });
     m.def(
         "twist",
-        [](const Scene& sc, const std::vector<double>& at, std::optional<std::vector<double>> start, double tol, double rtol,
-           int max_periods, const std::string& solver, long max_rhs) {
+        [](const Scene& sc, const std::vector<double>& at, std::optional<std::vector<double>> twist, double tol, double rtol,
+           int max_periods, const std::string& solver, long max_rhs, std::optional<std::vector<double>> start) {
             PyCycle c{sc, config(sc, at, "at"), {}};
-            const Vec3 qd0 = start ? config(sc, *start, "start") : Vec3::Zero();
+            const std::vector<double> qd = renamed<std::vector<double>>(twist, start, "twist", "start", {});
+            const Vec3 qd0 = twist || start ? config(sc, qd, "twist") : Vec3::Zero();
             const LimitCycleOptions o = cycle_options(tol, rtol, max_periods, solver, max_rhs);
             py::gil_scoped_release free;
             c.lc = limit_cycle(sc, c.at, o, qd0);
             return c;
         },
-        py::arg("scene"), py::arg("at"), py::kw_only(), py::arg("start") = py::none(), py::arg("tol") = 1e-7,
+        py::arg("scene"), py::arg("at"), py::kw_only(), py::arg("twist") = py::none(), py::arg("tol") = 1e-7,
         py::arg("rtol") = 1e-8, py::arg("max_periods") = 400, py::arg("solver") = "shooting", py::arg("max_rhs") = 20'000'000L,
+        py::arg("start") = py::none(),
         "The asymptotic twist (36) at configuration `at` = (s_x, s_y, theta) (point part: (s_x, s_y)): the\n"
-        "limit cycle of the reduced U-dynamics from the twist `start` (default: at rest on the plate).");
+        "limit cycle of the reduced U-dynamics from the part's twist `twist` relative to the plate (default:\n"
+        "at rest on the plate). `start` is twist's old spelling (deprecated: a start is a configuration in\n"
+        "plate.simulate and plate.observe).");
 }
 
 }   // namespace plate::python

@@ -266,3 +266,35 @@ def test_robustness_is_the_command_lines_and_takes_a_spec_as_a_file_or_a_dict(tm
     with pytest.raises(plate.InputError) as err:
         plate.robustness(plate.load_scene(scene), bad, draws=1)
     assert "friction.spread" in str(err.value)
+
+
+def test_one_vocabulary_a_twist_is_twist_and_the_old_spellings_warn():
+    """twist(twist=) is the initial twist (start= is a configuration elsewhere); design's limits=,
+    evaluations= and harmonics= are the command line's names. The old spellings do the same with a
+    DeprecationWarning; both at once is a ValueError."""
+    sc = plate.load_scene(scene_path("fig4"))
+    q = (0.02, 0.01, 0.5)
+    rest, moving = plate.twist(sc, at=q), plate.twist(sc, at=q, twist=(0.05, 0, 0))
+    assert moving.periods != rest.periods  # the initial twist is used (the cycle, not its end, depends on it)
+    with pytest.warns(DeprecationWarning, match="start= is deprecated: use twist="):
+        old = plate.twist(sc, at=q, start=(0.05, 0, 0))
+    assert old.periods == moving.periods and np.array_equal(old.twist, moving.twist)
+    with pytest.raises(ValueError, match="twist and start are the same argument"):
+        plate.twist(sc, at=q, twist=(0.05, 0, 0), start=(0.05, 0, 0))
+    # design: the old names reach the same option, judged by the same check (no search runs).
+    part = plate.load_scene(scene_path("fig1_point"))
+    with pytest.raises(ValueError) as new_err:
+        plate.design(part, sink=(0.02, -0.01), limits=(-1, 150))
+    with pytest.warns(DeprecationWarning, match="lin_limit= is deprecated: use limits="):
+        with pytest.raises(ValueError) as old_err:
+            plate.design(part, sink=(0.02, -0.01), lin_limit=-1)
+    assert str(old_err.value) == str(new_err.value)
+    for now, old, bad in (("evaluations", "local_evaluations", 0), ("harmonics", "max_harmonic", -1)):
+        with pytest.raises(ValueError) as new_err:
+            plate.design(part, sink=(0.02, -0.01), **{now: bad})
+        with pytest.warns(DeprecationWarning, match=f"{old}= is deprecated: use {now}="):
+            with pytest.raises(ValueError) as old_err:
+                plate.design(part, sink=(0.02, -0.01), **{old: bad})
+        assert str(old_err.value) == str(new_err.value)
+        with pytest.raises(ValueError, match="same argument"):
+            plate.design(part, sink=(0.02, -0.01), **{now: 5, old: 5})

@@ -23,7 +23,7 @@ def test_observe_gives_the_command_lines_track_to_the_bit(tmp_path):
     cam = tmp_path / "camera.json"
     cam.write_text(plate.parse_camera(str(CAMERA).replace("'", '"'), "<test>").to_json())
     out = tmp_path / "track.csv"
-    cli = subprocess.run([EXE, "simulate", scene_path("fig4"), "--dynamics", "full", "--from", "0.03", "-0.02", "1",
+    cli = subprocess.run([EXE, "simulate", scene_path("fig4"), "--dynamics", "full", "--start", "0.03", "-0.02", "1",
                           "--time", "1", "--observe", str(cam), "--out", str(out)], capture_output=True, text=True)
     assert cli.returncode == 0, cli.stderr
     scene = plate.load_scene(scene_path("fig4"))

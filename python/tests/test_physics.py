@@ -279,7 +279,7 @@ def test_fig4_field_has_stable_fixed_points_at_the_centre_at_theta_0_and_pi():
 def test_a_designed_sink_gathers_parts_released_anywhere_on_the_plate():
     # Checked here with the module's own full dynamics from starts of our choosing (not the design's).
     part = plate.load_scene(scene_path("fig1_point"))
-    d = plate.design(part, sink=(0.02, -0.01), lin_limit=15, ang_limit=100, starts=8, local_evaluations=200)
+    d = plate.design(part, sink=(0.02, -0.01), limits=(15, 100), starts=8, evaluations=200)
     assert d.verified, d.failure
     sc = d.scene
     # The limits bound each axis' summed signal: its peak, sampled here at 10^5 points (never above the
@@ -330,7 +330,7 @@ def test_a_rubber_footed_part_is_oriented_by_a_plate_that_only_translates():
     # The module's own full dynamics from orientations of our choosing (not the design's): every one
     # ends at THETA, wherever the transport has carried the part.
     part = plate.load_scene(scene_path("foot"))
-    d = plate.design(part, orient=-1.0, starts=2, local_evaluations=80, verify_starts=4)
+    d = plate.design(part, orient=-1.0, starts=2, evaluations=80, verify_starts=4)
     assert d.verified, d.failure
     assert d.unique
     harmonics = d.scene.to_dict()["plate"]["harmonics"]
@@ -348,8 +348,8 @@ def test_a_rubber_footed_part_is_oriented_by_a_plate_that_only_translates():
 
 def test_a_line_sink_gathers_parts_onto_the_line_and_leaves_them_where_they_arrive():
     part = plate.load_scene(scene_path("fig1_point"))
-    d = plate.design(part, line_sink=(0.01, -0.02, 0.6), lin_limit=15, ang_limit=100, starts=2,
-                     local_evaluations=60, verify_starts=4)
+    d = plate.design(part, line_sink=(0.01, -0.02, 0.6), limits=(15, 100), starts=2,
+                     evaluations=60, verify_starts=4)
     assert d.verified, d.failure
     n = np.array([-math.sin(0.6), math.cos(0.6)])
     T_end = 8 / d.rate
@@ -383,12 +383,12 @@ def test_orientation_harmonics_follow_the_exact_symmetries():
         plate.orientation_harmonics(fig4, n=3)
 
 
-def test_axes_and_max_harmonic_narrow_a_design_to_those_harmonics():
+def test_axes_and_harmonics_narrow_a_design_to_those_harmonics():
     # A transport along x from a plate shaken along x alone (its second harmonic skews the shake):
     # the designed scene has nothing else, and a family left empty is a ValueError.
     part = plate.load_scene(scene_path("fig1_point"))
-    d = plate.design(part, transport=(0.02, 0.0), lin_limit=15, starts=4, local_evaluations=150, verify_starts=4,
-                     axes=["x"], max_harmonic=2)
+    d = plate.design(part, transport=(0.02, 0.0), limits=(15, 150), starts=4, evaluations=150, verify_starts=4,
+                     axes=["x"], harmonics=2)
     assert d.verified, d.failure
     harmonics = d.scene.to_dict()["plate"]["harmonics"]
     assert harmonics and all(h["axis"] == "x" and h["n"] <= 2 for h in harmonics)
