@@ -1,10 +1,25 @@
 // plate.Scene, plate.load_scene, plate.parse_scene and plate.Stop (why a run stopped).
 #include "bindings.hpp"
 
+#include "plate/friction.hpp"
+
 namespace plate::python {
 
 void bind_scene(py::module_& m) {
     py::class_<Scene>(m, "Scene", "A part and a periodic plate motion (a scene file's contents).")
+        .def(py::init([](const py::dict& part, const py::dict& plate, const std::string& name, double gravity) {
+                 py::dict d;
+                 d["name"] = name;
+                 d["gravity"] = gravity;
+                 d["part"] = part;
+                 d["plate"] = plate;
+                 const std::string text = py::module_::import("json").attr("dumps")(d).cast<std::string>();
+                 return parse_scene(text, "plate.Scene(...)");
+             }),
+             py::kw_only(), py::arg("part"), py::arg("plate"), py::arg("name") = "scene", py::arg("gravity") = 9.81,
+             "A scene from its part and plate motion in the scene file's form, e.g. part={'mass': 0.02, 'friction': "
+             "0.3},\nplate={'period': 0.05, 'harmonics': [{'axis': 'x', 'n': 1, 'amp': 20, 'phase': 0}]}; checked as a "
+             "file is\n(raises plate.InputError naming the field).")
         .def_readonly("name", &Scene::name)
         .def_readonly("source", &Scene::source)
         .def_readonly("gravity", &Scene::g)
@@ -17,8 +32,57 @@ void bind_scene(py::module_& m) {
         .def_property_readonly("v_ref", &Scene::v_ref, "the slip-speed scale tolerances are relative to [m/s]")
         .def_property_readonly("warnings", &scene_warnings,
                                "admissible but outside the intended regime (the command line prints them)")
+        .def_property_readonly(
+            "inertia", [](const Scene& s) -> py::object { return s.part.point ? py::object(py::none()) : py::cast(s.part.J); },
+            "J, the rotational inertia about the centre of mass in the part's frame S, (3, 3) [kg m^2]; None for a point part")
+        .def_property_readonly(
+            "contacts",
+            [](const Scene& s) -> py::object {
+                if (s.part.point) return py::none();
+                Eigen::Matrix3d c;
+                for (int i = 0; i < 3; ++i) c.row(i) = s.part.c[i].transpose();
+                return py::cast(c);
+            },
+            "the contacts c_i in S, one per row, (3, 3) [m]; None for a point part")
+        .def_property_readonly(
+            "friction",
+            [](const Scene& s) {
+                const ContactFriction f = s.part.friction();
+                py::list kinetic, static_;
+                for (int i = 0; i < s.part.contacts(); ++i) {
+                    kinetic.append(f.kinetic()[i]);
+                    static_.append(f.static_()[i]);
+                }
+                py::dict d;
+                d["kinetic"] = kinetic;
+                d["static"] = static_;
+                return d;
+            },
+            "{'kinetic': [mu_k per contact], 'static': [mu_s per contact]} (one each for a point part)")
+        .def_property_readonly(
+            "harmonics",
+            [](const Scene& s) {
+                py::list l;
+                for (const Harmonic& h : s.plate.harmonics)
+                    l.append(py::dict(py::arg("axis") = axis_name(h.axis), py::arg("n") = h.n, py::arg("amp") = h.amp,
+                                      py::arg("phase") = h.phase));
+                return l;
+            },
+            "the plate's u(t) = sum of amp sin(n 2 pi t / T + phase) per axis: [{'axis', 'n', 'amp' [m/s^2 or "
+            "rad/s^2], 'phase' [rad]}]")
         .def(
             "to_json", [](const Scene& s) { return scene_to_json(s).dump(); }, "the scene in the file form")
+        // Equal: the same file form (name, gravity, part, plate motion), wherever each was read from.
+        .def("__eq__", [](const Scene& a, const Scene& b) { return scene_to_json(a) == scene_to_json(b); })
+        .def("__copy__", [](const Scene& s) { return Scene(s); })
+        .def(
+            "__deepcopy__", [](const Scene& s, py::dict) { return Scene(s); }, py::arg("memo"))
+        // Pickled as the file form (whose numbers read back to the same doubles) and the source.
+        .def(py::pickle([](const Scene& s) { return py::make_tuple(scene_to_json(s).dump(), s.source); },
+                        [](const py::tuple& t) {
+                            require(t.size() == 2, "plate.Scene: a pickled scene is (file text, source)");
+                            return parse_scene(t[0].cast<std::string>(), t[1].cast<std::string>());
+                        }))
         .def("__repr__", [](const Scene& s) {
             return "<plate.Scene '" + s.name + "' " +
                    (s.part.point    ? "point part"

@@ -298,3 +298,39 @@ def test_one_vocabulary_a_twist_is_twist_and_the_old_spellings_warn():
         assert str(old_err.value) == str(new_err.value)
         with pytest.raises(ValueError, match="same argument"):
             plate.design(part, sink=(0.02, -0.01), **{now: 5, old: 5})
+
+
+def test_a_scene_reads_like_its_file_compares_by_content_pickles_and_copies():
+    """Scene attributes against the file's own JSON (read here with the json module); equality by content;
+    pickle and deepcopy give the same scene, to the bit of a computed twist; the constructor checks as a
+    file is."""
+    import copy
+    import pickle
+    path = scene_path("fig4")
+    raw = json.load(open(path))
+    a, b = plate.load_scene(path), plate.load_scene(path)
+    assert a == b and not (a != b)
+    assert a.mass == raw["part"]["mass"] and a.period == raw["plate"]["period"]
+    assert a.contacts.tolist() == raw["part"]["contacts"]
+    assert a.inertia.tolist() == raw["part"]["inertia"]  # (fig4's file gives the whole matrix)
+    assert a.friction == {"kinetic": raw["part"]["friction"], "static": raw["part"]["friction"]}  # (one triple: both)
+    assert a.harmonics == [{k: float(h[k]) if k in ("amp", "phase") else h[k] for k in ("axis", "n", "amp", "phase")}
+                           for h in raw["plate"]["harmonics"]]
+    q = (0.03, -0.02, 1.0)
+    for c in (pickle.loads(pickle.dumps(a)), copy.deepcopy(a), copy.copy(a)):
+        assert c == a and c.source == a.source
+        assert np.array_equal(plate.twist(c, at=q).twist, plate.twist(a, at=q).twist)
+    # A changed parameter is another scene; the name is part of the content, the source is not.
+    d = a.to_dict()
+    d["part"]["friction"] = 0.31
+    assert plate.scene_from_dict(d) != a
+    assert plate.scene_from_dict(a.to_dict(), source="elsewhere") == a
+    # The constructor from the file's part and plate is the file's scene.
+    made = plate.Scene(part=raw["part"], plate=raw["plate"], name=raw["name"], gravity=raw.get("gravity", 9.81))
+    assert made == a
+    with pytest.raises(plate.InputError, match=r"plate.Scene\(...\): part.mass"):
+        plate.Scene(part=dict(raw["part"], mass=-1), plate=raw["plate"])
+    s = plate.Scene(part={"mass": 0.02, "friction": {"static": 0.4, "kinetic": 0.3}},
+                    plate={"period": 0.05, "harmonics": [{"axis": "x", "n": 1, "amp": 20, "phase": 0}]})
+    assert s.point_part and s.inertia is None and s.contacts is None
+    assert s.friction == {"kinetic": [0.3], "static": [0.4]}
