@@ -24,6 +24,10 @@ public:
         goal_ = goal;
         chosen_.clear();
         chosen_.reserve(1024);
+        still_since_ = -1;
+        rest_sum_.setZero();
+        rest_frames_ = 0;
+        last_stamp_ = -1;
     }
 
     Decision decide(const Observation& obs, long period) override {
@@ -31,12 +35,16 @@ public:
         const ControlModel& m = *model_;
         const int still = m.library.still;
         int pick = still >= 0 ? still : 0;   // nothing seen yet: hold still if the library can
-        if (obs.seen) {
-            const Vec3 q = predicted(obs, period);
-            pick = choose(q);
-        }
+        if (obs.seen) pick = choose(estimate(obs, period));
         if (static_cast<long>(chosen_.size()) <= period) chosen_.resize(period + 1, pick);
         chosen_[period] = pick;
+        if (pick != still) {
+            still_since_ = -1;
+        } else if (still_since_ < 0) {
+            still_since_ = period;
+            rest_sum_.setZero();
+            rest_frames_ = 0;
+        }
         return {pick, std::nullopt};
     }
 
@@ -55,6 +63,22 @@ private:
             t = end;
         }
         return q;
+    }
+
+    // Where the part is at the decision's time. On the still plate the part comes to rest within a period
+    // and stays: from the second period on, the frames it shows are averaged (the camera's noise
+    // shrinks as 1/sqrt(n), and a noisy frame alone does not start the plate again).
+    Vec3 estimate(const Observation& obs, long period) {
+        const double T = model_->T();
+        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) {
+            if (obs.stamp != last_stamp_) {
+                rest_sum_ += obs.q;
+                ++rest_frames_;
+                last_stamp_ = obs.stamp;
+            }
+            return rest_sum_ / rest_frames_;
+        }
+        return predicted(obs, period);
     }
 
     int choose(const Vec3& q) {
@@ -80,6 +104,10 @@ private:
     const ControlModel* model_ = nullptr;
     Goal goal_;
     std::vector<int> chosen_;   // the motion chosen for each period so far
+    long still_since_ = -1;     // the period the current stretch on the still plate began (-1: moving)
+    Vec3 rest_sum_ = Vec3::Zero();
+    int rest_frames_ = 0;
+    double last_stamp_ = -1;
 };
 
 }   // namespace

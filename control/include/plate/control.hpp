@@ -164,11 +164,12 @@ public:
 // `library`: each period, from the observed configuration predicted forward to the decision's time with
 // the model's fields of the motions it chose (latency), the motion whose one-period step
 // q + xi_m(q) T lands nearest the goal (Goal::distance). Against chattering: inside stop_radius it
-// holds the still plate (if the library has one); elsewhere it keeps its motion unless another lands
+// holds the still plate (if the library has one), averaging the frames while the part rests there, and
+// leaves it only beyond stop_radius + hysteresis; elsewhere it keeps its motion unless another lands
 // nearer by more than `hysteresis`.
 struct LibraryPolicyOptions {
     double stop_radius = 0.5e-3;   // [m], weighted distance; 0: never stop
-    double hysteresis = 0.05e-3;   // [m]
+    double hysteresis = 0.1e-3;    // [m]
     void validate() const;         // std::invalid_argument naming the option
 };
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
