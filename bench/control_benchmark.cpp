@@ -7,7 +7,10 @@
 // latency (seed = the start's index). Each run lasts DURATION s (default 15): the time to goal is when
 // the part came within 1 mm and stayed there to the end. Per start: time to goal, final error, worst
 // overshoot, switches, mean and largest decision time; then how many met <= 10 s, and the machine.
-//   bench_control [STARTS [DURATION [LIBRARY [FIRST_SEED]]]]
+// HORIZON: the policy's (LibraryPolicyOptions::horizon, default 4); TRANSITIONS 0: the model without the
+// switches' first periods (ControlModel::transitions).
+// LIBRARY "-": the default.
+//   bench_control [STARTS [DURATION [LIBRARY [FIRST_SEED [HORIZON [TRANSITIONS]]]]]]
 #include "plate/control.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
@@ -38,12 +41,15 @@ int main(int argc, char** argv) try {
     const int starts = argc > 1 ? std::stoi(argv[1]) : 20;
     const double duration = argc > 2 ? std::stod(argv[2]) : 15;
     const std::string root = PLATE_SOURCE_DIR;
-    const std::string lib = argc > 3 ? argv[3] : root + "/scenes/control/fig1_point/library.json";
+    const std::string lib = argc > 3 && std::string(argv[3]) != "-" ? argv[3] : root + "/scenes/control/fig1_point/library.json";
     const int first = argc > 4 ? std::stoi(argv[4]) : 0;
+    LibraryPolicyOptions po;
+    po.horizon = argc > 5 ? std::stoi(argv[5]) : po.horizon;
     const Scene sc = load_scene(root + "/scenes/fig1_point.json");
     const auto t_model = std::chrono::steady_clock::now();
     ControlModelOptions mo;
     mo.field.threads = 1;
+    mo.transitions = argc > 6 ? std::stoi(argv[6]) != 0 : true;
     const ControlModel model = build_control_model(sc, load_motion_library(lib, sc), mo);
     const double model_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_model).count();
     Goal goal;
@@ -79,7 +85,7 @@ int main(int argc, char** argv) try {
         cam.frame = CameraFrame::world;
         ControlOptions opt;
         opt.duration = duration;
-        auto policy = make_library_policy();
+        auto policy = make_library_policy(po);
         const auto t0 = std::chrono::steady_clock::now();
         const ControlSummary s = run_control(model, *policy, truth, cam, goal, q0, opt);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

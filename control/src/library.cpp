@@ -2,6 +2,7 @@
 #include "plate/control.hpp"
 
 #include "input_reader.hpp"
+#include "internal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -150,7 +151,13 @@ ControlModel build_control_model(const Scene& nominal, MotionLibrary library, co
         }
         m.fields.push_back(std::move(fld));
     }
+    if (opt.transitions) detail::add_transitions(m, opt);
     return m;
+}
+
+Vec3 ControlModel::step(int from, int to, const Vec3& q) const {
+    if (from < 0 || from == to || transitions.empty()) return fields[to].at(q) * T();
+    return transitions[from * motions() + to].at(q) * T();
 }
 
 double Goal::error(const Vec3& x) const { return std::hypot(x.x() - q.x(), x.y() - q.y()); }

@@ -93,13 +93,6 @@ private:
     std::vector<Frame> frames_;
 };
 
-// The part's world pose from its plate-frame configuration q at phase 0 of sc's plate (which is also its
-// phase T).
-Vec3 world_at_phase0(const Scene& sc, const Vec3& q) {
-    PlateOrientation R1(sc.plate);
-    return world_pose(sc, 0, q, R1.at(0));
-}
-
 // Time to goal, first entry, worst overshoot, switches and decision times from the rows.
 void summarise(ControlSummary& s, const Goal& goal) {
     const auto& rows = s.rows;
@@ -166,7 +159,7 @@ ControlSummary run_control(const ControlModel& model, Policy& policy, const Trut
         ControlRow row;
         row.t = now;
         if (obs.seen) row.observed = obs.q;
-        row.truth = world_at_phase0(tru, q);
+        row.truth = world_pose_at_phase0(tru, q);
         row.motion = d.plate ? -1 : d.motion;
         row.decision_seconds = spent;
         s.rows.push_back(row);
@@ -193,7 +186,7 @@ ControlSummary run_control(const ControlModel& model, Policy& policy, const Trut
     }
     ControlRow last;
     last.t = s.stop.reason != StopReason::None ? s.stop.t : s.periods * Tt;
-    last.truth = world_at_phase0(last_truth, q);   // (a stop's: at its time, taken at phase 0)
+    last.truth = world_pose_at_phase0(last_truth, q);   // (a stop's: at its time, taken at phase 0)
     s.rows.push_back(last);
     summarise(s, goal);
     return s;

@@ -10,6 +10,8 @@ namespace plate {
 void LibraryPolicyOptions::validate() const {
     if (!(stop_radius >= 0) || !std::isfinite(stop_radius)) throw std::invalid_argument("stop_radius: expected a number >= 0");
     if (!(hysteresis >= 0) || !std::isfinite(hysteresis)) throw std::invalid_argument("hysteresis: expected a number >= 0");
+    if (horizon < 1 || horizon > kMaxHorizon)
+        throw std::invalid_argument("horizon: expected 1 to " + std::to_string(kMaxHorizon) + " periods");
 }
 
 namespace {
@@ -59,7 +61,8 @@ private:
         while (t < now - 1e-9 * T) {
             const long j = static_cast<long>(std::floor(t / T + 1e-9));
             const double end = std::min((j + 1) * T, now);
-            if (j >= 0 && j < static_cast<long>(chosen_.size())) q += m.fields[chosen_[j]].at(q) * (end - t);
+            if (j >= 0 && j < static_cast<long>(chosen_.size()))
+                q += m.step(j > 0 ? chosen_[j - 1] : -1, chosen_[j], q) * ((end - t) / T);
             t = end;
         }
         return q;
@@ -81,6 +84,19 @@ private:
         return predicted(obs, period);
     }
 
+    // The mean distance to the goal over the next `horizon` periods on motion k kept, the first period
+    // from `current` (its switch's kick, ControlModel::transitions). Kept, a motion that overshoots or
+    // that lands near the goal only by switching again costs more than one that stays there.
+    double horizon_cost(Vec3 q, int current, int k) const {
+        const ControlModel& m = *model_;
+        double sum = 0;
+        for (int h = 0; h < opt_.horizon; ++h) {
+            q += m.step(h == 0 ? current : k, k, q);
+            sum += goal_.distance(q);
+        }
+        return sum / opt_.horizon;
+    }
+
     int choose(const Vec3& q) {
         const ControlModel& m = *model_;
         const int still = m.library.still, current = chosen_.empty() ? -1 : chosen_.back();
@@ -90,7 +106,7 @@ private:
         int best = 0;
         double best_cost = std::numeric_limits<double>::infinity(), current_cost = best_cost;
         for (int k = 0; k < m.motions(); ++k) {
-            const double cost = goal_.distance(q + m.fields[k].at(q) * m.T());
+            const double cost = horizon_cost(q, current, k);
             if (k == current) current_cost = cost;
             if (cost < best_cost) {
                 best_cost = cost;

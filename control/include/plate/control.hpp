@@ -72,6 +72,8 @@ Scene true_scene(const Truth& truth, const Scene& commanded, int motion, long pe
 // pushes). Returns the part's plate-frame (q, qd) for `to` (qd: relative to the plate, in its frame,
 // as the full dynamics take it). The identity when from == to.
 void carry_state(const Part& part, const PlateMotion& from, const PlateMotion& to, Vec3& q, Vec3& qd);
+// The part's world pose (world_pose, observe.hpp) at phase 0 of sc's plate from its plate-frame q.
+Vec3 world_pose_at_phase0(const Scene& sc, const Vec3& q);
 
 // ---- the library of motions and the controller's model ------------------------------------------
 //
@@ -105,7 +107,8 @@ struct MotionField {
 struct ControlModelOptions {
     GridSpec grid;   // where fields that are not uniform are tabulated (point parts: nth 1)
     FieldOptions field;
-    void validate() const;   // std::invalid_argument naming the option
+    bool transitions = true;   // tabulate the first period after each switch (ControlModel::transitions)
+    void validate() const;     // std::invalid_argument naming the option
 };
 
 // The controller's constant model: the nominal scene, the library and each motion's field,
@@ -115,9 +118,19 @@ struct ControlModel {
     Scene nominal;
     MotionLibrary library;
     std::vector<MotionField> fields;
+    // The first period after a switch from a to b: not xi_b T, because the part arrives with a's cycle
+    // velocity (and, in the world, keeps it: carry_state), which b's cycle does not share -- on the
+    // shipped library up to ~1.6 mm of kick. transitions[a * M + b] holds that period's world
+    // displacement divided by T, from the nominal full dynamics: the part settled kSettlePeriods on a's
+    // cycle, carried to b, one period of b. Pairs of uniform fields are computed once; others on the
+    // grid. Empty when ControlModelOptions::transitions is false.
+    std::vector<MotionField> transitions;
     double T() const { return nominal.plate.T; }
     int motions() const { return static_cast<int>(library.motions.size()); }
+    // The predicted displacement over the next period on motion `to` after a period on `from` (-1: none).
+    Vec3 step(int from, int to, const Vec3& q) const;
 };
+inline constexpr int kSettlePeriods = 6;
 ControlModel build_control_model(const Scene& nominal, MotionLibrary library, const ControlModelOptions& opt = {});
 
 // ---- the goal -----------------------------------------------------------------------------------
@@ -162,16 +175,19 @@ public:
 };
 
 // `library`: each period, from the observed configuration predicted forward to the decision's time with
-// the model's fields of the motions it chose (latency), the motion whose one-period step
-// q + xi_m(q) T lands nearest the goal (Goal::distance). Against chattering: inside stop_radius it
+// the model's steps of the motions it chose (latency), the motion that, kept for `horizon` periods,
+// stays nearest the goal on average (Goal::distance after each period: the first period's step from the
+// current motion, ControlModel::step, then q + xi_m(q) T). Against chattering: inside stop_radius it
 // holds the still plate (if the library has one), averaging the frames while the part rests there, and
 // leaves it only beyond stop_radius + hysteresis; elsewhere it keeps its motion unless another lands
 // nearer by more than `hysteresis`.
 struct LibraryPolicyOptions {
     double stop_radius = 0.5e-3;   // [m], weighted distance; 0: never stop
     double hysteresis = 0.1e-3;    // [m]
+    int horizon = 2;               // [periods], 1 to kMaxHorizon
     void validate() const;         // std::invalid_argument naming the option
 };
+inline constexpr int kMaxHorizon = 1000;
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
 
 // ---- the loop -----------------------------------------------------------------------------------
