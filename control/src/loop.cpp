@@ -119,6 +119,13 @@ void summarise(ControlSummary& s, const Goal& goal) {
         if (k > 0 && (rows[k].motion != rows[k - 1].motion || rows[k].motion < 0)) ++s.switches;
     }
     s.decision_mean = rows.size() > 1 ? sum / static_cast<double>(rows.size() - 1) : 0;
+    std::vector<double> d;
+    for (std::size_t k = 0; k + 1 < rows.size(); ++k) d.push_back(rows[k].decision_seconds);
+    if (!d.empty()) {
+        const std::size_t i = std::min(d.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(d.size())));
+        std::nth_element(d.begin(), d.begin() + static_cast<long>(i), d.end());
+        s.decision_p99 = d[i];
+    }
 }
 
 }   // namespace
@@ -224,6 +231,7 @@ nlohmann::json control_summary_json(const ControlSummary& s, const ControlModel&
     j["switches"] = s.switches;
     j["decision_mean_s"] = s.decision_mean;
     j["decision_max_s"] = s.decision_max;
+    j["decision_p99_s"] = s.decision_p99;
     j["motions"] = model.library.names;
     j["stop"] = s.stop.reason == StopReason::None ? nlohmann::json(nullptr) : nlohmann::json(s.stop.describe());
     j["interrupted"] = s.interrupted;

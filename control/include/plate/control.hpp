@@ -224,7 +224,8 @@ struct ControlSummary {
     double final_error = 0, final_theta_error = 0;
     double worst_overshoot = 0;
     int switches = 0;
-    double decision_mean = 0, decision_max = 0;   // [s]
+    double decision_mean = 0, decision_max = 0;   // [s], wall clock (a preempted decision counts in full)
+    double decision_p99 = 0;                      // [s], the 99th percentile
     StopEvent stop;                               // the truth's dynamics stopped (contact lost, ...)
     bool interrupted = false;                     // keep_going said stop
     std::vector<ControlRow> rows;
