@@ -12,6 +12,7 @@
 // LIBRARY "-": the default.
 // FRICTION_SCALE: the truth's (default 0.8).
 //   bench_control [STARTS [DURATION [LIBRARY [FIRST_SEED [HORIZON [TRANSITIONS [FRICTION_SCALE]]]]]]]
+#include "machine.hpp"
 #include "plate/control.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
@@ -19,24 +20,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 using namespace plate;
-
-namespace {
-
-std::string machine() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
-
-}   // namespace
 
 int main(int argc, char** argv) try {
     const int starts = argc > 1 ? std::stoi(argv[1]) : 20;
@@ -102,7 +90,7 @@ int main(int argc, char** argv) try {
     }
     std::printf("reached and held: %d/%d; within 10 s: %d/%d; slowest %.3g s; largest decision %.3g ms (target 1 ms)\n", reached,
                 starts, met, starts, worst_time, worst_decision * 1e3);
-    std::printf("machine: %s, %u hardware threads (one used)\n", machine().c_str(), std::thread::hardware_concurrency());
+    std::printf("machine: %s, %u hardware threads (one used)\n", bench::machine().c_str(), std::thread::hardware_concurrency());
     return 0;
 } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_control: %s\n", e.what());

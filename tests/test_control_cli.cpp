@@ -14,6 +14,14 @@ std::string write(const std::string& name, const std::string& text) {
     return p.string();
 }
 
+// A one-motion library of the shipped e_fast.json with `from` replaced by `to` in its scene.
+std::string library_changing(const std::string& from, const std::string& to) {
+    std::string scene = slurp(kScenes + "control/fig1_point/e_fast.json");
+    scene.replace(scene.find(from), from.size(), to);
+    write("e_changed.json", scene);
+    return write("lib.json", R"({"motions": [{"name": "e", "scene": "e_changed.json"}]})");
+}
+
 const std::string kBase = "control " + kScenes + "fig1_point.json --goal 0.02 -0.01 --policy library --time 0.5 ";
 const std::string kLibrary = "--library " + kScenes + "control/fig1_point/library.json ";
 
@@ -35,20 +43,14 @@ TEST_CASE("plate control: bad input files exit 2 naming the file and the field, 
         CHECK_THAT(r.err, Contains(t + ": uncertainty: amplitude"));
     }
     SECTION("a library motion of another period") {
-        std::string scene = slurp(kScenes + "control/fig1_point/e_fast.json");
-        scene.replace(scene.find("\"period\": 0.05"), 14, "\"period\": 0.04");
-        write("e_other.json", scene);
-        const std::string lib = write("lib.json", R"({"motions": [{"name": "e", "scene": "e_other.json"}]})");
+        const std::string lib = library_changing("\"period\": 0.05", "\"period\": 0.04");
         const Run r = run(kBase + "--library " + lib + " --out " + out);
         CHECK(r.code == 2);
         CHECK_THAT(r.err, Contains(lib + ": motions[0].scene: "));
         CHECK_THAT(r.err, Contains("every motion must share the period"));
     }
     SECTION("a library motion with another part") {
-        std::string scene = slurp(kScenes + "control/fig1_point/e_fast.json");
-        scene.replace(scene.find("\"friction\": 0.3"), 15, "\"friction\": 0.4");
-        write("e_part.json", scene);
-        const std::string lib = write("lib.json", R"({"motions": [{"name": "e", "scene": "e_part.json"}]})");
+        const std::string lib = library_changing("\"friction\": 0.3", "\"friction\": 0.4");
         const Run r = run(kBase + "--library " + lib + " --out " + out);
         CHECK(r.code == 2);
         CHECK_THAT(r.err, Contains(lib + ": motions[0].scene: "));
