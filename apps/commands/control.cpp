@@ -17,6 +17,7 @@ struct ControlArgs : Options {
     std::vector<double> goal, from;
     double time = 0, tol = Goal{}.tolerance, tol_theta = Goal{}.tolerance_theta, theta_weight = Goal{}.theta_weight;
     double stop_radius = LibraryPolicyOptions{}.stop_radius, hysteresis = LibraryPolicyOptions{}.hysteresis;
+    int horizon = LibraryPolicyOptions{}.horizon;
     GridArgs grid = [] {
         GridArgs g;
         g.n = 13;
@@ -30,11 +31,13 @@ struct ControlArgs : Options {
                   "the scene perturbed by an uncertainty spec, tracking errors drawn per period, friction scaled;\n"
                   "default: the scene itself) run through the full dynamics, stick-slip included. The motion changes\n"
                   "only at period boundaries; the part's world position and in-plane velocity are continuous there.\n"
-                  "--policy library --library LIB.json: each period the library motion whose one-period step\n"
-                  "q + xi(q) T lands nearest the goal (fields tabulated once: a plate that only translates gives a\n"
-                  "point part one velocity everywhere; other motions on the --grid over --x, --y), the observation\n"
-                  "predicted forward over the camera's latency; inside --stop-radius the still plate, and a motion\n"
-                  "kept unless another lands nearer by --hysteresis. The library file: docs/guide.md, Closed-loop control.\n"
+                  "--policy library --library LIB.json: each period the library motion that, kept for --horizon\n"
+                  "periods (default 2), stays nearest the goal on average -- the first period's step from the switch\n"
+                  "(tabulated: the part arrives with the old motion's velocity), then q + xi(q) T (fields tabulated\n"
+                  "once: a plate that only translates gives a point part one velocity everywhere; other motions on\n"
+                  "the --grid over --x, --y); the observation predicted forward over the camera's latency; inside\n"
+                  "--stop-radius the still plate (its frames averaged), and a motion kept unless another does better\n"
+                  "by --hysteresis. The library file: docs/guide.md, control.\n"
                   "--out gets one row per period: t [s], the observed and the true configuration, the motion chosen\n"
                   "and the decision's time [s] (17 significant digits); the summary (time to goal: from when the part\n"
                   "stays within --tol to the end; final error, switches, worst overshoot, decision times) to stdout\n"
@@ -53,6 +56,7 @@ struct ControlArgs : Options {
         number("--theta-weight", theta_weight, "metres per radian in the distance to the goal");
         number("--stop-radius", stop_radius, "library: hold the still plate within this distance [m]");
         number("--hysteresis", hysteresis, "library: switch only for a step nearer by this [m]");
+        whole("--horizon", horizon, 1, kMaxHorizon, "library: periods a motion is judged kept for");
         add_grid_options(*this, grid);
     }
 };
@@ -78,6 +82,7 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     LibraryPolicyOptions lo;
     lo.stop_radius = a.stop_radius;
     lo.hysteresis = a.hysteresis;
+    lo.horizon = a.horizon;
     ControlModelOptions mo;
     mo.grid = grid_opts(a, a.grid);
     mo.field.threads = a.grid.threads;

@@ -119,11 +119,12 @@ struct ControlModel {
     MotionLibrary library;
     std::vector<MotionField> fields;
     // The first period after a switch from a to b: not xi_b T, because the part arrives with a's cycle
-    // velocity (and, in the world, keeps it: carry_state), which b's cycle does not share -- on the
-    // shipped library up to ~1.6 mm of kick. transitions[a * M + b] holds that period's world
-    // displacement divided by T, from the nominal full dynamics: the part settled kSettlePeriods on a's
-    // cycle, carried to b, one period of b. Pairs of uniform fields are computed once; others on the
-    // grid. Empty when ControlModelOptions::transitions is false.
+    // velocity (and, in the world, keeps it: carry_state), which b's cycle does not share (entering
+    // scenes/designs/point_sink.json from a 2 mm/period transport: a ~1.6 mm kick). transitions[a * M + b] holds that period's
+    // world displacement divided by T, from the nominal full dynamics: the part settled kSettlePeriods on a's cycle, carried to
+    // b, one period of b. Pairs of uniform fields are computed once; others on the grid: M (M - 1) one-period runs per grid point
+    // where a field is not uniform (a rigid part's 3-D grid with a large library is costly: coarsen the grid or turn them off).
+    // Empty when ControlModelOptions::transitions is false.
     std::vector<MotionField> transitions;
     double T() const { return nominal.plate.T; }
     int motions() const { return static_cast<int>(library.motions.size()); }
