@@ -48,6 +48,7 @@ constexpr AddCommand kCommands[] = {
     add_sweep,          // plate sweep
     add_robustness,     // plate robustness
     add_identify,       // plate identify
+    add_control,        // plate control
 };
 
 }   // namespace

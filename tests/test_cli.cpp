@@ -277,8 +277,8 @@ TEST_CASE("simulate --dynamics averaged: the full dynamics' end, rows with the t
 }
 
 TEST_CASE("every command has --help", "[cli]") {
-    const std::string commands[] = {"twist",  "field",  "fixed-points", "simulate", "random-scene", "bench",
-                                    "design", "proofs", "report",       "sweep",    "robustness",   "identify"};
+    const std::string commands[] = {"twist",  "field",  "fixed-points", "simulate",   "random-scene", "bench",  "design",
+                                    "proofs", "report", "sweep",        "robustness", "identify",     "control"};
     const Run top = run("--help");
     CHECK(top.code == 0);
     // The program's help names every exit code a command can return.

@@ -41,5 +41,6 @@ Command add_design(CLI::App& app);         // design.cpp
 Command add_sweep(CLI::App& app);          // sweep.cpp
 Command add_robustness(CLI::App& app);     // robustness.cpp
 Command add_identify(CLI::App& app);       // identify.cpp
+Command add_control(CLI::App& app);        // control.cpp
 
 }   // namespace plate::cli

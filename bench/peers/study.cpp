@@ -14,6 +14,7 @@
 // (c) fig4's 343-configuration field, each engine configuration estimated as in (b); plate's field
 //     on one thread over tolerances. Error: the largest over the field.
 // (d) fig6's sticking configurations (stick fraction > 0 in plate's field), as in (c).
+#include "../machine.hpp"
 #include "peers.hpp"
 
 #include "plate/field.hpp"
@@ -39,14 +40,6 @@ namespace {
 
 // CPU time of this thread since t0 (every system runs on one thread: plate's field too).
 double since(double t0) { return peers::cpu_now() - t0; }
-
-std::string machine() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
 
 void say(const std::string& s) { std::cerr << "bench_peers: " << s << std::endl; }
 
@@ -312,7 +305,7 @@ int main(int argc, char** argv) {
     const Scene fig4 = load_scene(source + "/scenes/fig4.json"), fig6 = load_scene(source + "/scenes/fig6.json");
     const std::vector<peers::Engine> engines = peers::engines();
     json j;
-    j["machine"] = machine();
+    j["machine"] = plate::bench::machine();
     j["quick"] = quick;
     j["engines"] = json::array();
     for (const auto& e : engines) {

@@ -2,7 +2,7 @@
 """The layout shows the pipeline (issue 17, point 4): a file's folder tells its layer, and no file
 includes a header of a layer above its own.
 
-    symbolic  <  numeric  <  experiments, proofs, design, identify (siblings: none includes another)
+    symbolic  <  numeric  <  experiments, proofs, design, identify, control (siblings: none includes another)
               <  reports, sweep  <  apps, python, bench  (tests may include anything)
 
 Every #include, quoted or <angled>, is resolved to the file it names (beside the includer, then in
@@ -21,11 +21,11 @@ import re
 import sys
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
-RANK = {"symbolic": 0, "numeric": 1, "experiments": 2, "proofs": 2, "design": 2, "identify": 2, "reports": 3, "sweep": 3, "apps": 4,
+RANK = {"symbolic": 0, "numeric": 1, "experiments": 2, "proofs": 2, "design": 2, "identify": 2, "control": 2, "reports": 3, "sweep": 3, "apps": 4,
         "python": 4, "bench": 4}
 NOT_LAYERS = {"tests", "examples", "scripts", "cmake", "scenes", "campaigns", ".ci", ".git"}   # no library code
 INCLUDE_DIRS = ["symbolic", "numeric/include", "numeric/generated", "numeric/src", "experiments/include", "proofs",
-                "design/include", "identify/include", "sweep/include", "reports", "reports/generated", "apps"]
+                "design/include", "identify/include", "control/include", "sweep/include", "reports", "reports/generated", "apps"]
 include = re.compile(r'^\s*#\s*include\s+(["<])([^">]+)[">]', re.M)
 SOURCES = (".cpp", ".hpp", ".h", ".cc", ".hh", ".hxx")
 

@@ -1,0 +1,248 @@
+// Closed-loop control (issue 53): a controller watches the part through a camera, one frame per plate
+// period, and chooses each period's plate motion; a "true" plate and part -- the controller's model
+// perturbed -- run that motion through the full dynamics (stick-slip included). Read top to bottom:
+// the truth the loop runs against, the carried state at a switch, the library of motions and the
+// model the controller holds, the goal, the policies, the loop and its summary.
+//
+// Frames and times. A configuration q = (s_x, s_y, theta) is the plate frame's, as everywhere in plate;
+// the plate's centre oscillates about the world's origin by its zero-mean displacement (up to about a
+// millimetre for the shipped motions). The goal and the errors are the world's. Period k runs from t = k T to (k + 1) T, the
+// plate at phase 0 of its motion at t = k T; the motion can change only there.
+#pragma once
+
+#include "plate/field.hpp"
+#include "plate/model.hpp"
+#include "plate/observe.hpp"
+#include "plate/simulate.hpp"
+#include "plate/uncertainty.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace plate {
+
+// ---- the truth ----------------------------------------------------------------------------------
+//
+// The plate and part the loop runs against: the nominal scene perturbed by an uncertainty spec
+// (uncertainty.hpp) and its friction scaled. The file (TRUTH.json; unknown or missing fields are errors):
+//
+//   { "friction_scale": 0.8,              // optional (1): every friction coefficient times this
+//     "uncertainty": { ...an uncertainty spec, inline (uncertainty.hpp)... },   // optional (none)
+//     "tracking": "per_period",            // optional ("per_period") | "per_run"
+//     "draw": 0 }                          // optional (0): which draw of the spec this run is
+//
+// The part's deviations (friction, mass, inertia, contacts, centre of mass) and the period's are drawn
+// once per run: they are the part's and the drive's. The plate's tracking errors (amplitude, phase,
+// unmodelled harmonics) are drawn anew every period ("per_period", the default: a real plate's errors
+// vary cycle to cycle) or once per run for each motion ("per_run"). docs/decisions/control.md.
+enum class Tracking { per_period, per_run };
+
+struct Truth {
+    std::string source;   // file it was read from (for messages)
+    double friction_scale = 1;
+    std::optional<UncertaintySpec> uncertainty;
+    Tracking tracking = Tracking::per_period;
+    std::uint64_t draw = 0;
+    // InputError naming source and the field unless friction_scale lies in (0, kMaxFrictionScale] and the
+    // spec is admissible (validate_uncertainty).
+    void validate() const;
+};
+inline constexpr double kMaxFrictionScale = 10;
+
+Truth load_truth(const std::string& path);                               // throws InputError
+Truth parse_truth(const std::string& text, const std::string& source);   // throws InputError
+
+// The true scene of one period: `motion`'s plate with period `period`'s tracking errors (or the run's,
+// per_run), on the run's true part and period. `motion` indexes the motions a loop was given (a
+// motion a policy made itself: index -1, always drawn per period). Without a spec: the nominal part
+// with its friction scaled, the motion as commanded. Deterministic in (spec seed, draw, motion, period).
+Scene true_scene(const Truth& truth, const Scene& commanded, int motion, long period);
+
+// ---- the state carried over a period boundary ---------------------------------------------------
+//
+// At a boundary the plate changes from `from` (at the end of its period, which is its phase 0) to `to`
+// at its phase 0: the plate's position, orientation and velocity may jump (the motions' zero-mean
+// integrals differ at phase 0). The part does not: friction is bounded by mu N and transmits no
+// impulse, so the part's world position and its world velocity in the plate's plane, and its heading
+// and yaw rate about the world's z, are continuous; the normal components follow the plate (the plate
+// pushes). Returns the part's plate-frame (q, qd) for `to` (qd: relative to the plate, in its frame,
+// as the full dynamics take it). The identity when from == to.
+void carry_state(const Part& part, const PlateMotion& from, const PlateMotion& to, Vec3& q, Vec3& qd);
+// The part's world pose (world_pose, observe.hpp) at phase 0 of sc's plate from its plate-frame q.
+Vec3 world_pose_at_phase0(const Scene& sc, const Vec3& q);
+
+// ---- the library of motions and the controller's model ------------------------------------------
+//
+// The library file (JSON; unknown or missing fields are errors; scene paths relative to the file):
+//
+//   { "motions": [ {"name": "east_fast", "scene": "east_fast.json"},
+//                  {"name": "still", "still": true},                 // the plate at rest
+//                  ... ] }
+//
+// Every scene's part must be the nominal scene's and its period the nominal's (else an InputError naming
+// the library file and the motion).
+struct MotionLibrary {
+    std::string source;
+    std::vector<std::string> names;
+    std::vector<PlateMotion> motions;   // all with the nominal's period
+    int still = -1;                     // the still plate's index, -1 if none
+};
+MotionLibrary load_motion_library(const std::string& path, const Scene& nominal);   // throws InputError
+
+// A motion's field as the controller reads it: uniform (a plate that only translates, with a point
+// part: nothing in its dynamics depends on where the part is, so one twist serves everywhere) or
+// tabulated on a grid over the region and interpolated (bilinear in (s_x, s_y) for a point part;
+// trilinear with periodic theta for a rigid part). Outside the grid the nearest edge's value.
+struct MotionField {
+    bool uniform = false;
+    GridSpec grid;
+    std::vector<Vec3> twist;   // GridSpec::index order; one entry when uniform
+    Vec3 at(const Vec3& q) const;
+};
+
+struct ControlModelOptions {
+    GridSpec grid;   // where fields that are not uniform are tabulated (point parts: nth 1)
+    FieldOptions field;
+    bool transitions = true;   // tabulate the first period after each switch (ControlModel::transitions)
+    void validate() const;     // std::invalid_argument naming the option
+};
+
+// The controller's constant model: the nominal scene, the library and each motion's field,
+// computed once before the loop (fields where a motion's twist is undefined -- contact lost -- are an
+// InputError naming the motion).
+struct ControlModel {
+    Scene nominal;
+    MotionLibrary library;
+    std::vector<MotionField> fields;
+    // The first period after a switch from a to b: not xi_b T, because the part arrives with a's cycle
+    // velocity (and, in the world, keeps it: carry_state), which b's cycle does not share (entering
+    // scenes/designs/point_sink.json from a 2 mm/period transport: a ~1.6 mm kick). transitions[a * M + b] holds that period's
+    // world displacement divided by T, from the nominal full dynamics: the part settled kSettlePeriods on a's cycle, carried to
+    // b, one period of b. Pairs of uniform fields are computed once; others on the grid: M (M - 1) one-period runs per grid point
+    // where a field is not uniform (a rigid part's 3-D grid with a large library is costly: coarsen the grid or turn them off).
+    // Empty when ControlModelOptions::transitions is false.
+    std::vector<MotionField> transitions;
+    double T() const { return nominal.plate.T; }
+    int motions() const { return static_cast<int>(library.motions.size()); }
+    // The predicted displacement over the next period on motion `to` after a period on `from` (-1: none).
+    Vec3 step(int from, int to, const Vec3& q) const;
+};
+inline constexpr int kSettlePeriods = 6;
+ControlModel build_control_model(const Scene& nominal, MotionLibrary library, const ControlModelOptions& opt = {});
+
+// ---- the goal -----------------------------------------------------------------------------------
+
+struct Goal {
+    Vec3 q = Vec3::Zero();           // (s_x, s_y, theta); a point part's theta is not read
+    double tolerance = 1e-3;         // [m], on the position
+    double tolerance_theta = 0.02;   // [rad] (rigid parts)
+    // The weighted distance's length for an angle: |(dx, dy, theta_weight * dtheta)| [m/rad].
+    double theta_weight = 0.02;
+    bool point = true;
+    double error(const Vec3& q) const;         // the position's distance to the goal [m]
+    double theta_error(const Vec3& q) const;   // |theta - goal| wrapped (0 for a point part)
+    bool within(const Vec3& q) const;
+    double distance(const Vec3& q) const;   // the weighted distance
+};
+
+// ---- policies -----------------------------------------------------------------------------------
+
+// What the controller sees at a decision: the newest frame it has (a frame stamped at or before the
+// decision's time), the time of the state it shows, and whether any frame has arrived.
+struct Observation {
+    bool seen = false;
+    double stamp = 0;        // [s]
+    double state_time = 0;   // stamp - latency [s]
+    Vec3 q = Vec3::Zero();   // plate frame (a world-frame camera's frames are taken as the plate's)
+};
+
+// A period's plate motion: a library index, or a motion of the policy's own (motion -1).
+struct Decision {
+    int motion = -1;
+    std::optional<PlateMotion> plate;
+};
+
+// A controller. reset() before a run; decide() once per period k, at t = k T, within its time budget.
+class Policy {
+public:
+    virtual ~Policy() = default;
+    virtual std::string name() const = 0;
+    virtual void reset(const ControlModel& model, const Goal& goal) = 0;
+    virtual Decision decide(const Observation& obs, long period) = 0;
+};
+
+// `library`: each period, from the observed configuration predicted forward to the decision's time with
+// the model's steps of the motions it chose (latency), the motion that, kept for `horizon` periods,
+// stays nearest the goal on average (Goal::distance after each period: the first period's step from the
+// current motion, ControlModel::step, then q + xi_m(q) T). Against chattering: inside stop_radius it
+// holds the still plate (if the library has one), averaging the frames while the part rests there, and
+// leaves it only beyond stop_radius + hysteresis; elsewhere it keeps its motion unless another lands
+// nearer by more than `hysteresis`.
+struct LibraryPolicyOptions {
+    double stop_radius = 0.5e-3;   // [m], weighted distance; 0: never stop
+    double hysteresis = 0.1e-3;    // [m]
+    int horizon = 2;               // [periods], 1 to kMaxHorizon
+    void validate() const;         // std::invalid_argument naming the option
+};
+inline constexpr int kMaxHorizon = 1000;
+std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
+
+// ---- the loop -----------------------------------------------------------------------------------
+
+struct ControlOptions {
+    double duration = 10;   // [s]: whole periods of the true plate up to it
+    IntegrationOptions integration;
+    void validate() const;   // std::invalid_argument naming the option
+};
+// The longest run, in periods.
+inline constexpr long kMaxControlPeriods = 10'000'000;
+
+// One row per period, at its start t = k T (and a last one at the run's end): what the controller saw
+// (NaN before the first frame) and chose, and where the part truly was -- in the world: the plate
+// frame's q moved by the plate's displacement at phase 0 (world_pose), which differs from motion to
+// motion by up to a millimetre for the shipped ones, and is 0 on a still plate. The goal is judged there.
+struct ControlRow {
+    double t = 0;
+    Vec3 observed = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    Vec3 truth = Vec3::Zero();   // world pose (x, y, heading)
+    int motion = -1;             // -1: the policy's own motion, or the run's end
+    double decision_seconds = 0;
+};
+
+// What happened. Time to goal: the first row's t from which the true configuration is within the
+// goal's tolerance at every later period start to the end of the run (NaN if the last is not). The
+// worst overshoot: the largest position error after the part first came within tolerance.
+struct ControlSummary {
+    std::string policy;
+    long periods = 0;
+    bool reached = false;
+    double time_to_goal = std::numeric_limits<double>::quiet_NaN();
+    double first_within = std::numeric_limits<double>::quiet_NaN();
+    double final_error = 0, final_theta_error = 0;
+    double worst_overshoot = 0;
+    int switches = 0;
+    double decision_mean = 0, decision_max = 0;   // [s], wall clock (a preempted decision counts in full)
+    double decision_p99 = 0;                      // [s], the 99th percentile
+    StopEvent stop;                               // the truth's dynamics stopped (contact lost, ...)
+    bool interrupted = false;                     // keep_going said stop
+    std::vector<ControlRow> rows;
+};
+
+// Runs the loop from the part at rest on the plate at q0, for options.duration: each period the policy
+// decides from the camera's newest frame, the true plate (true_scene) runs the motion through the full
+// dynamics from the carried state (carry_state at every boundary), the camera films (one stroboscopic
+// frame per period of the true plate: noise, latency, drops -- observe.hpp's Camera; nullopt: a perfect
+// camera at phase 0). `keep_going` (if set) is asked each period; false ends the run (interrupted).
+ControlSummary run_control(const ControlModel& model, Policy& policy, const Truth& truth, const std::optional<Camera>& camera,
+                           const Goal& goal, const Vec3& q0, const ControlOptions& opt = {},
+                           const std::function<bool()>& keep_going = {});
+
+// The run's rows as CSV (units in the header, 17 significant digits) and the summary as JSON.
+void write_control_csv(std::ostream& out, const ControlSummary& s, const ControlModel& model, bool point);
+nlohmann::json control_summary_json(const ControlSummary& s, const ControlModel& model, const Goal& goal);
+
+}   // namespace plate

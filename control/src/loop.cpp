@@ -1,0 +1,241 @@
+// The loop: a period at a time, decide from the camera's newest frame, run the true plate through the
+// full dynamics from the carried state, film; then the summary, the CSV and the JSON.
+#include "plate/control.hpp"
+
+#include "plate/output.hpp"
+#include "plate/random_scene.hpp"
+#include "plate/scene_io.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <ostream>
+#include <stdexcept>
+
+namespace plate {
+
+void ControlOptions::validate() const {
+    if (!(duration > 0) || !std::isfinite(duration)) throw std::invalid_argument("duration: expected a number > 0");
+}
+
+namespace {
+
+// A frame the camera took: when it arrives (its stamp) and what it shows.
+struct Frame {
+    double stamp, state_time;
+    Vec3 q;
+};
+
+// The camera of the loop: one stroboscopic frame per period of the true plate (period Tt), drawing its
+// drop and noise per frame in the order observe.hpp's film() does.
+class LoopCamera {
+public:
+    LoopCamera(const std::optional<Camera>& cam, double Tt) : cam_(cam.value_or(Camera{})), Tt_(Tt), rng_(cam_.seed) {
+        if (!cam) {
+            cam_.per_period = 1;
+        } else {
+            cam_.validate();
+            if (!cam_.stroboscopic() || cam_.per_period != 1)
+                throw InputError(cam_.source + ": stroboscopic.per_period: the loop's camera takes one frame per plate period");
+        }
+        // The first frame whose state time is >= 0.
+        while (state_time(next_) < -1e-12 * Tt_) ++next_;
+    }
+    // The frames whose state times lie in (t0, t0 + Tt] (t0 = 0 also takes the start's), as times within
+    // the period.
+    std::vector<double> due(double t0, bool first) const {
+        std::vector<double> out;
+        for (long j = next_;; ++j) {
+            const double s = state_time(j) - t0;
+            if (s > Tt_ * (1 + 1e-12)) break;
+            if (s > 0 || (first && s >= -1e-12 * Tt_)) out.push_back(std::clamp(s, 0.0, Tt_));
+        }
+        return out;
+    }
+    // Films the next frame: the state q (plate frame) of `sc` at time tau within its period.
+    void film(const Scene& sc, double tau, const Vec3& q) {
+        const double stamp = stamp_of(next_++);
+        const bool dropped = rng_.uniform() < cam_.drop;
+        const double sd = cam_.noise_xy_mm * 1e-3, sdt = cam_.noise_theta_mrad * 1e-3;
+        const Vec3 e(standard_normal(rng_) * sd, standard_normal(rng_) * sd, standard_normal(rng_) * sdt);
+        if (dropped) return;
+        Vec3 x = q;
+        if (cam_.frame == CameraFrame::world) {
+            PlateOrientation R1(sc.plate);
+            x = world_pose(sc, tau, q, R1.at(tau));
+        }
+        x += e;
+        if (sc.part.point) x.z() = 0;
+        frames_.push_back({stamp, stamp - cam_.latency, x});
+    }
+    // The newest frame stamped at or before t.
+    Observation newest(double t) const {
+        Observation o;
+        for (auto it = frames_.rbegin(); it != frames_.rend(); ++it)
+            if (it->stamp <= t + 1e-12 * Tt_) {
+                o.seen = true;
+                o.stamp = it->stamp;
+                o.state_time = it->state_time;
+                o.q = it->q;
+                break;
+            }
+        return o;
+    }
+
+private:
+    double stamp_of(long j) const { return (j + cam_.phase) * Tt_; }
+    double state_time(long j) const { return stamp_of(j) - cam_.latency; }
+    Camera cam_;
+    double Tt_;
+    Rng rng_;
+    long next_ = 0;
+    std::vector<Frame> frames_;
+};
+
+// Time to goal, first entry, worst overshoot, switches and decision times from the rows.
+void summarise(ControlSummary& s, const Goal& goal) {
+    const auto& rows = s.rows;
+    s.final_error = goal.error(rows.back().truth);
+    s.final_theta_error = goal.theta_error(rows.back().truth);
+    s.reached = goal.within(rows.back().truth) && s.stop.reason == StopReason::None && !s.interrupted;
+    if (s.reached) {
+        std::size_t k = rows.size();
+        while (k > 0 && goal.within(rows[k - 1].truth)) --k;
+        s.time_to_goal = rows[k].t;
+    }
+    bool entered = false;
+    for (const ControlRow& r : rows) {
+        if (!entered && goal.within(r.truth)) {
+            entered = true;
+            s.first_within = r.t;
+        }
+        if (entered) s.worst_overshoot = std::max(s.worst_overshoot, goal.error(r.truth));
+    }
+    double sum = 0;
+    for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
+        sum += rows[k].decision_seconds;
+        s.decision_max = std::max(s.decision_max, rows[k].decision_seconds);
+        if (k > 0 && (rows[k].motion != rows[k - 1].motion || rows[k].motion < 0)) ++s.switches;
+    }
+    s.decision_mean = rows.size() > 1 ? sum / static_cast<double>(rows.size() - 1) : 0;
+    std::vector<double> d;
+    for (std::size_t k = 0; k + 1 < rows.size(); ++k) d.push_back(rows[k].decision_seconds);
+    if (!d.empty()) {
+        const std::size_t i = std::min(d.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(d.size())));
+        std::nth_element(d.begin(), d.begin() + static_cast<long>(i), d.end());
+        s.decision_p99 = d[i];
+    }
+}
+
+}   // namespace
+
+ControlSummary run_control(const ControlModel& model, Policy& policy, const Truth& truth, const std::optional<Camera>& camera,
+                           const Goal& goal, const Vec3& q0, const ControlOptions& opt, const std::function<bool()>& keep_going) {
+    opt.validate();
+    truth.validate();
+    Scene cmd = model.nominal;   // the commanded scene of each period
+    const double Tt = true_scene(truth, cmd, -1, 0).plate.T;
+    const long periods = static_cast<long>(std::floor(opt.duration / Tt * (1 + 1e-12)));
+    if (periods < 1 || periods > kMaxControlPeriods)
+        throw std::invalid_argument("duration: expected 1 to " + std::to_string(kMaxControlPeriods) + " plate periods");
+    LoopCamera cam(camera, Tt);
+    ControlSummary s;
+    s.policy = policy.name();
+    s.rows.reserve(periods + 1);
+    policy.reset(model, goal);
+    Vec3 q = q0, qd = Vec3::Zero();   // at rest on the first period's plate
+    PlateMotion prev;
+    Scene last_truth = cmd;
+    using clock = std::chrono::steady_clock;
+    for (long k = 0; k < periods; ++k) {
+        if (keep_going && !keep_going()) {
+            s.interrupted = true;
+            break;
+        }
+        const double now = k * Tt;
+        const Observation obs = cam.newest(now);
+        const auto t0 = clock::now();
+        const Decision d = policy.decide(obs, k);
+        const double spent = std::chrono::duration<double>(clock::now() - t0).count();
+        if (!d.plate && (d.motion < 0 || d.motion >= model.motions()))
+            throw std::logic_error(policy.name() + ": decided motion " + std::to_string(d.motion) + ", not in the library");
+        cmd.plate = d.plate ? *d.plate : model.library.motions[d.motion];
+        const Scene tru = true_scene(truth, cmd, d.plate ? -1 : d.motion, k);
+        if (k > 0) carry_state(tru.part, prev, tru.plate, q, qd);
+        ControlRow row;
+        row.t = now;
+        if (obs.seen) row.observed = obs.q;
+        row.truth = world_pose_at_phase0(tru, q);
+        row.motion = d.plate ? -1 : d.motion;
+        row.decision_seconds = spent;
+        s.rows.push_back(row);
+        std::vector<double> times = cam.due(now, k == 0);
+        const std::size_t frames = times.size();
+        times.push_back(Tt);
+        times.erase(std::unique(times.begin(), times.end()), times.end());
+        const Trajectory tr = simulate_at(tru, Dynamics::Full, q, qd, times, opt.integration);
+        for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
+            if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) cam.film(tru, tr.samples[f].t, tr.samples[f].q);
+        if (tr.stop.reason != StopReason::None) {
+            s.stop = tr.stop;
+            s.stop.t += now;
+            q = tr.samples.back().q;
+            last_truth = tru;
+            ++s.periods;
+            break;
+        }
+        q = tr.samples.back().q;
+        qd = tr.samples.back().qd;
+        prev = tru.plate;
+        last_truth = tru;
+        ++s.periods;
+    }
+    ControlRow last;
+    last.t = s.stop.reason != StopReason::None ? s.stop.t : s.periods * Tt;
+    last.truth = world_pose_at_phase0(last_truth, q);   // (a stop's: at its time, taken at phase 0)
+    s.rows.push_back(last);
+    summarise(s, goal);
+    return s;
+}
+
+void write_control_csv(std::ostream& out, const ControlSummary& s, const ControlModel& model, bool point) {
+    out << "t [s],obs_s_x [m],obs_s_y [m]" << (point ? "" : ",obs_theta [rad]") << ",x [m],y [m]"
+        << (point ? "" : ",heading [rad]") << ",motion,decision [s]\n";
+    out << std::setprecision(17);
+    for (const ControlRow& r : s.rows) {
+        out << r.t << ',' << r.observed.x() << ',' << r.observed.y();
+        if (!point) out << ',' << r.observed.z();
+        out << ',' << r.truth.x() << ',' << r.truth.y();
+        if (!point) out << ',' << r.truth.z();
+        const std::string name = &r == &s.rows.back() ? "end" : r.motion < 0 ? "own" : model.library.names[r.motion];
+        out << ',' << name << ',' << r.decision_seconds << '\n';
+    }
+}
+
+nlohmann::json control_summary_json(const ControlSummary& s, const ControlModel& model, const Goal& goal) {
+    auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+    nlohmann::json j;
+    j["policy"] = s.policy;
+    j["goal"] = goal.point ? nlohmann::json{goal.q.x(), goal.q.y()} : nlohmann::json{goal.q.x(), goal.q.y(), goal.q.z()};
+    j["tolerance_m"] = goal.tolerance;
+    if (!goal.point) j["tolerance_rad"] = goal.tolerance_theta;
+    j["periods"] = s.periods;
+    j["period_s"] = s.periods > 0 ? s.rows[1].t - s.rows[0].t : model.T();
+    j["reached"] = s.reached;
+    j["time_to_goal_s"] = num(s.time_to_goal);
+    j["first_within_s"] = num(s.first_within);
+    j["final_error_m"] = s.final_error;
+    if (!goal.point) j["final_theta_error_rad"] = s.final_theta_error;
+    j["worst_overshoot_m"] = s.worst_overshoot;
+    j["switches"] = s.switches;
+    j["decision_mean_s"] = s.decision_mean;
+    j["decision_max_s"] = s.decision_max;
+    j["decision_p99_s"] = s.decision_p99;
+    j["motions"] = model.library.names;
+    j["stop"] = s.stop.reason == StopReason::None ? nlohmann::json(nullptr) : nlohmann::json(s.stop.describe());
+    j["interrupted"] = s.interrupted;
+    return j;
+}
+
+}   // namespace plate

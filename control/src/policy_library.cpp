@@ -1,0 +1,133 @@
+// The `library` policy: each period the library motion whose one-period step lands nearest the goal.
+#include "plate/control.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace plate {
+
+void LibraryPolicyOptions::validate() const {
+    if (!(stop_radius >= 0) || !std::isfinite(stop_radius)) throw std::invalid_argument("stop_radius: expected a number >= 0");
+    if (!(hysteresis >= 0) || !std::isfinite(hysteresis)) throw std::invalid_argument("hysteresis: expected a number >= 0");
+    if (horizon < 1 || horizon > kMaxHorizon)
+        throw std::invalid_argument("horizon: expected 1 to " + std::to_string(kMaxHorizon) + " periods");
+}
+
+namespace {
+
+class LibraryPolicy : public Policy {
+public:
+    explicit LibraryPolicy(const LibraryPolicyOptions& opt) : opt_(opt) { opt_.validate(); }
+    std::string name() const override { return "library"; }
+
+    void reset(const ControlModel& model, const Goal& goal) override {
+        model_ = &model;
+        goal_ = goal;
+        chosen_.clear();
+        chosen_.reserve(1024);
+        still_since_ = -1;
+        rest_sum_.setZero();
+        rest_frames_ = 0;
+        last_stamp_ = -1;
+    }
+
+    Decision decide(const Observation& obs, long period) override {
+        if (!model_) throw std::logic_error("library policy: decide() before reset()");
+        const ControlModel& m = *model_;
+        const int still = m.library.still;
+        int pick = still >= 0 ? still : 0;   // nothing seen yet: hold still if the library can
+        if (obs.seen) pick = choose(estimate(obs, period));
+        if (static_cast<long>(chosen_.size()) <= period) chosen_.resize(period + 1, pick);
+        chosen_[period] = pick;
+        if (pick != still) {
+            still_since_ = -1;
+        } else if (still_since_ < 0) {
+            still_since_ = period;
+            rest_sum_.setZero();
+            rest_frames_ = 0;
+        }
+        return {pick, std::nullopt};
+    }
+
+private:
+    // The observed configuration carried forward from the time it shows to the decision's, k T, along the
+    // model's field of the motion chosen for each period in between (one Euler step per period or part).
+    Vec3 predicted(const Observation& obs, long period) const {
+        const ControlModel& m = *model_;
+        const double T = m.T(), now = period * T;
+        Vec3 q = obs.q;
+        double t = obs.state_time;
+        while (t < now - 1e-9 * T) {
+            const long j = static_cast<long>(std::floor(t / T + 1e-9));
+            const double end = std::min((j + 1) * T, now);
+            if (j >= 0 && j < static_cast<long>(chosen_.size()))
+                q += m.step(j > 0 ? chosen_[j - 1] : -1, chosen_[j], q) * ((end - t) / T);
+            t = end;
+        }
+        return q;
+    }
+
+    // Where the part is at the decision's time. On the still plate the part comes to rest within a period
+    // and stays: from the second period on, the frames it shows are averaged (the camera's noise
+    // shrinks as 1/sqrt(n), and a noisy frame alone does not start the plate again).
+    Vec3 estimate(const Observation& obs, long period) {
+        const double T = model_->T();
+        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) {
+            if (obs.stamp != last_stamp_) {
+                rest_sum_ += obs.q;
+                ++rest_frames_;
+                last_stamp_ = obs.stamp;
+            }
+            return rest_sum_ / rest_frames_;
+        }
+        return predicted(obs, period);
+    }
+
+    // The mean distance to the goal over the next `horizon` periods on motion k kept, the first period
+    // from `current` (its switch's kick, ControlModel::transitions). Kept, a motion that overshoots or
+    // that lands near the goal only by switching again costs more than one that stays there.
+    double horizon_cost(Vec3 q, int current, int k) const {
+        const ControlModel& m = *model_;
+        double sum = 0;
+        for (int h = 0; h < opt_.horizon; ++h) {
+            q += m.step(h == 0 ? current : k, k, q);
+            sum += goal_.distance(q);
+        }
+        return sum / opt_.horizon;
+    }
+
+    int choose(const Vec3& q) {
+        const ControlModel& m = *model_;
+        const int still = m.library.still, current = chosen_.empty() ? -1 : chosen_.back();
+        // Inside the stop radius the still plate (left again only beyond the radius plus the hysteresis).
+        const double d = goal_.distance(q);
+        if (still >= 0 && (d < opt_.stop_radius || (current == still && d < opt_.stop_radius + opt_.hysteresis))) return still;
+        int best = 0;
+        double best_cost = std::numeric_limits<double>::infinity(), current_cost = best_cost;
+        for (int k = 0; k < m.motions(); ++k) {
+            const double cost = horizon_cost(q, current, k);
+            if (k == current) current_cost = cost;
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = k;
+            }
+        }
+        return current >= 0 && current != still && current_cost <= best_cost + opt_.hysteresis ? current : best;
+    }
+
+    LibraryPolicyOptions opt_;
+    const ControlModel* model_ = nullptr;
+    Goal goal_;
+    std::vector<int> chosen_;   // the motion chosen for each period so far
+    long still_since_ = -1;     // the period the current stretch on the still plate began (-1: moving)
+    Vec3 rest_sum_ = Vec3::Zero();
+    int rest_frames_ = 0;
+    double last_stamp_ = -1;
+};
+
+}   // namespace
+
+std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt) { return std::make_unique<LibraryPolicy>(opt); }
+
+}   // namespace plate

@@ -1,0 +1,76 @@
+// plate control's command line (issue 53): bad inputs exit 2 naming the file and the field, nothing
+// written; a good run writes its rows and its summary.
+#include <catch2/catch.hpp>
+
+#include "cli_run.hpp"
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+std::string write(const std::string& name, const std::string& text) {
+    const fs::path p = tmpdir() / name;
+    std::ofstream(p) << text;
+    return p.string();
+}
+
+// A one-motion library of the shipped e_fast.json with `from` replaced by `to` in its scene.
+std::string library_changing(const std::string& from, const std::string& to) {
+    std::string scene = slurp(kScenes + "control/fig1_point/e_fast.json");
+    scene.replace(scene.find(from), from.size(), to);
+    write("e_changed.json", scene);
+    return write("lib.json", R"({"motions": [{"name": "e", "scene": "e_changed.json"}]})");
+}
+
+const std::string kBase = "control " + kScenes + "fig1_point.json --goal 0.02 -0.01 --policy library --time 0.5 ";
+const std::string kLibrary = "--library " + kScenes + "control/fig1_point/library.json ";
+
+}   // namespace
+
+TEST_CASE("plate control: bad input files exit 2 naming the file and the field, and write nothing", "[control][cli]") {
+    const std::string out = (tmpdir() / "run.csv").string();
+    fs::remove(out);
+    SECTION("a truth with an unknown field") {
+        const std::string t = write("truth.json", R"({"friction_scale": 0.8, "tracking_error": 0.03})");
+        const Run r = run(kBase + kLibrary + "--truth " + t + " --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains(t + ": tracking_error: unknown field"));
+    }
+    SECTION("a truth's uncertainty spec with a bad spread") {
+        const std::string t = write("truth.json", R"({"uncertainty": {"seed": 1, "amplitude": {"spread": -1}}})");
+        const Run r = run(kBase + kLibrary + "--truth " + t + " --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains(t + ": uncertainty: amplitude"));
+    }
+    SECTION("a library motion of another period") {
+        const std::string lib = library_changing("\"period\": 0.05", "\"period\": 0.04");
+        const Run r = run(kBase + "--library " + lib + " --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains(lib + ": motions[0].scene: "));
+        CHECK_THAT(r.err, Contains("every motion must share the period"));
+    }
+    SECTION("a library motion with another part") {
+        const std::string lib = library_changing("\"friction\": 0.3", "\"friction\": 0.4");
+        const Run r = run(kBase + "--library " + lib + " --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains(lib + ": motions[0].scene: "));
+        CHECK_THAT(r.err, Contains("its part differs"));
+    }
+    SECTION("a camera that films more than once a period") {
+        const std::string c = write("cam.json", R"({"rate_hz": 200, "noise": {"xy_mm": 0.1}, "frame": "world"})");
+        const Run r = run(kBase + kLibrary + "--camera " + c + " --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains(c + ": stroboscopic.per_period"));
+    }
+    CHECK_FALSE(fs::exists(out));
+}
+
+TEST_CASE("plate control: a run writes a row per period with units and its summary", "[control][cli]") {
+    const std::string out = (tmpdir() / "run.csv").string();
+    const Run r = run(kBase + kLibrary + "--from 0.019 -0.01 --out " + out);
+    CHECK(r.code == 0);
+    CHECK_THAT(r.out, Contains("\"reached\": true"));
+    const std::string csv = slurp(out);
+    CHECK(csv.rfind("t [s],obs_s_x [m],obs_s_y [m],x [m],y [m],motion,decision [s]\n", 0) == 0);
+    CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 10 + 1);   // header, 10 periods, the end
+}
