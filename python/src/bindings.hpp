@@ -45,6 +45,9 @@ Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name);
 // ValueError(message) unless ok.
 void require(bool ok, const std::string& message);
 
+// x with `digits` significant digits, for reprs.
+std::string num(double x, int digits = 4);
+
 // One vocabulary (issue 54): the value of keyword `now`, or of its old spelling `old` (kept for one
 // release: using it warns with a DeprecationWarning); both given is a ValueError; neither, `fallback`.
 template <class T>

@@ -1,6 +1,8 @@
 // The conversions the module's pieces share (bindings.hpp): options, configurations, arrays, JSON.
 #include "bindings.hpp"
 
+#include <sstream>
+
 #include <cmath>
 
 namespace plate::python {
@@ -22,6 +24,13 @@ Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name) {
 
 void require(bool ok, const std::string& message) {
     if (!ok) throw py::value_error(message);
+}
+
+std::string num(double x, int digits) {
+    std::ostringstream s;
+    s.precision(digits);
+    s << x;
+    return s.str();
 }
 
 py::array_t<double> array(const std::vector<double>& data, std::vector<py::ssize_t> shape) {

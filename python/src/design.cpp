@@ -144,6 +144,12 @@ void bind_design_function(py::module_& m) {
 
 void bind_design(py::module_& m) {
     py::class_<DesignSummary>(m, "Design", "A designed plate motion and its verification (plate.design).")
+        .def("__repr__",
+             [](const DesignSummary& d) {
+                 return "<plate.Design '" + d.scene.name + "': " + (d.verified ? "verified" : "not verified") +
+                        (d.unique ? ", unique" : "") + ", rate " + num(d.rate) + " 1/s" +
+                        (d.failure.empty() ? "" : " (" + d.failure + ")") + ">";
+             })
         .def_readonly("verified", &DesignSummary::verified)
         .def_readonly("unique", &DesignSummary::unique)
         .def_readonly("failure", &DesignSummary::failure)

@@ -27,6 +27,17 @@ py::array_t<double> field_array(const Field& f, int what) {
 
 void bind_field(py::module_& m) {
     py::class_<PyField>(m, "Field", "The asymptotic twist field on a grid (point parts: velocity field, ntheta = 1).")
+        .def("__repr__",
+             [](const PyField& p) {
+                 const GridSpec& g = p.f.grid;
+                 long converged = 0;
+                 for (const FieldPoint& q : p.f.points) converged += q.converged;
+                 return "<plate.Field of '" + p.scene.name + "': " + std::to_string(g.nx) + "x" + std::to_string(g.ny) +
+                        (p.f.point_part ? " velocity field" : "x" + std::to_string(g.nth) + " twist field") + " over s_x [" +
+                        num(g.x0) + ", " + num(g.x1) + "] m, s_y [" + num(g.y0) + ", " + num(g.y1) + "] m; " +
+                        std::to_string(converged) + " of " + std::to_string(p.f.points.size()) + " converged; " +
+                        num(p.f.seconds, 3) + " s>";
+             })
         .def_property_readonly("x",
                                [](const PyField& f) {
                                    std::vector<double> v;
@@ -131,7 +142,11 @@ void bind_fixed_points(py::module_& m) {
         .def_readonly("direction", &FixedLine::direction)
         .def_property_readonly("stability", [](const FixedLine& l) { return stability_name(l.stability); })
         .def_readonly("eigenvalues", &FixedLine::eigenvalues)
-        .def_readonly("length", &FixedLine::length);
+        .def_readonly("length", &FixedLine::length)
+        .def("__repr__", [](const FixedLine& l) {
+            return "<plate.FixedLine " + std::string(stability_name(l.stability)) + ", " + std::to_string(l.points.size()) +
+                   " points, length " + num(l.length) + " m>";
+        });
     py::class_<PyFixedPoints>(m, "FixedPoints")
         .def_property_readonly("points", [](const PyFixedPoints& f) { return f.fp.points; })
         .def_property_readonly("lines", [](const PyFixedPoints& f) { return f.fp.lines; })
@@ -140,7 +155,8 @@ void bind_fixed_points(py::module_& m) {
         .def_property_readonly("stuck_cells", [](const PyFixedPoints& f) { return f.fp.stuck_cells; })
         .def_property_readonly(
             "summary", [](const PyFixedPoints& f) { return json_to_python(to_json(f.scene, f.fp)); },
-            "the command line's JSON (`plate fixed-points`) as a dict");
+            "the command line's JSON (`plate fixed-points`) as a dict")
+        .def("__repr__", [](const PyFixedPoints& f) { return "<plate.FixedPoints: " + fixed_points_sentence(f.fp) + ">"; });
     m.def(
         "fixed_points",
         [](const PyField& f, double ftol, long max_rhs) {

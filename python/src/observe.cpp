@@ -48,6 +48,14 @@ py::object run_observe(const Scene& sc, const std::vector<double>& start, const 
 
 void bind_observe(py::module_& m) {
     py::class_<Camera>(m, "Camera", "A camera filming the plate (numeric/include/plate/observe.hpp: the file's form).")
+        .def("__repr__",
+             [](const Camera& c) {
+                 return "<plate.Camera " +
+                        (c.stroboscopic() ? std::to_string(c.per_period) + " frame(s) per period from phase " + num(c.phase)
+                                          : num(c.rate) + " frames/s") +
+                        ", noise " + num(c.noise_xy_mm) + " mm / " + num(c.noise_theta_mrad) + " mrad, latency " +
+                        num(c.latency) + " s, drop " + num(c.drop) + ", " + frame_name(c.frame) + " frame>";
+             })
         .def_readonly("source", &Camera::source)
         .def_readonly("rate", &Camera::rate, "frames per second; 0: stroboscopic")
         .def_readonly("per_period", &Camera::per_period, "stroboscopic: frames per plate period (0 if rate > 0)")

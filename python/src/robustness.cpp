@@ -28,18 +28,28 @@ UncertaintySpec spec_of(const py::object& u) {
 }   // namespace
 
 void bind_robustness(py::module_& m) {
-    py::class_<PyRobustness>(m, "Robustness",
-                             "Where the part goes on the plates a real rig may be (plate robustness): per draw an outcome, the "
-                             "target's fixed point, arrival times; the spread and its first-order prediction.")
-        .def_property_readonly(
-            "outcomes",
-            [](const PyRobustness& r) {
-                py::dict d;
-                const int n = static_cast<int>(r.s.draws.size());
-                for (int k = 0; k < kOutcomes; ++k) d[outcome_name(static_cast<Outcome>(k))] = double(r.s.counts[k]) / n;
-                return d;
-            },
-            "each outcome's share of the draws (unique, competing, none, contact lost, failed)")
+    py::class_<PyRobustness> cls(
+        m, "Robustness",
+        "Where the part goes on the plates a real rig may be (plate robustness): per draw an outcome, the "
+        "target's fixed point, arrival times; the spread and its first-order prediction.");
+    cls.def("__repr__", [](const PyRobustness& r) {
+        const int n = static_cast<int>(r.s.draws.size());
+        std::string shares;
+        for (int c = 0; c < kOutcomes; ++c)
+            if (r.s.counts[c] > 0)
+                shares += std::string(shares.empty() ? "" : ", ") + outcome_name(static_cast<Outcome>(c)) + " " +
+                          num(double(r.s.counts[c]) / n, 3);
+        return "<plate.Robustness " + std::to_string(n) + " draws: " + shares + "; radius95 " + num(r.s.radius95) + " m>";
+    });
+    cls.def_property_readonly(
+           "outcomes",
+           [](const PyRobustness& r) {
+               py::dict d;
+               const int n = static_cast<int>(r.s.draws.size());
+               for (int k = 0; k < kOutcomes; ++k) d[outcome_name(static_cast<Outcome>(k))] = double(r.s.counts[k]) / n;
+               return d;
+           },
+           "each outcome's share of the draws (unique, competing, none, contact lost, failed)")
         .def_property_readonly(
             "outcome",
             [](const PyRobustness& r) {

@@ -26,6 +26,14 @@ py::array_t<double> samples_array(const Trajectory& tr, int what) {
 
 void bind_simulate(py::module_& m) {
     py::class_<PyTrajectory>(m, "Trajectory", "Samples of a simulation, with the contact mode on each step.")
+        .def("__repr__",
+             [](const PyTrajectory& p) {
+                 const auto& s = p.tr.samples;
+                 return "<plate.Trajectory of '" + p.scene.name + "' (" + p.dynamics + "): " + std::to_string(s.size()) +
+                        " samples" + (s.empty() ? "" : ", t " + num(s.front().t) + " to " + num(s.back().t) + " s") +
+                        (p.tr.stop.reason == StopReason::None ? "" : ", stopped: " + std::string(stop_name(p.tr.stop.reason))) +
+                        ">";
+             })
         .def_property_readonly("t",
                                [](const PyTrajectory& p) {
                                    std::vector<double> t;

@@ -334,3 +334,28 @@ def test_a_scene_reads_like_its_file_compares_by_content_pickles_and_copies():
                     plate={"period": 0.05, "harmonics": [{"axis": "x", "n": 1, "amp": 20, "phase": 0}]})
     assert s.point_part and s.inertia is None and s.contacts is None
     assert s.friction == {"kinetic": [0.3], "static": [0.4]}
+
+
+def test_every_result_says_what_it_is_when_printed():
+    """No '<... object at 0x...>': each result's repr names its kind and its figures (seen failing before
+    the reprs: Field, FixedPoints, FixedLine, Trajectory, Camera, Design and Robustness printed addresses)."""
+    s = plate.load_scene(scene_path("fig1_point"))
+    f = plate.field(s, grid=5)
+    fp = plate.fixed_points(f)
+    cam = plate.parse_camera('{"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1}, "frame": "plate"}', "cam")
+    results = {
+        "Scene": (s, "fig1_point"),
+        "Cycle": (plate.twist(s, at=(0.01, 0.02)), "converged=True"),
+        "Field": (f, "5x5 velocity field"),
+        "FixedPoints": (fp, fp.sentence),
+        "FixedLine": (fp.lines[0], "stable"),
+        "Trajectory": (plate.simulate(s, start=(0.01, 0.02), time=0.2, dynamics="u"), "17 samples"),
+        "Camera": (cam, "noise 0.1 mm"),
+        "Track": (plate.observe(s, cam, start=(0.01, 0.02), time=0.2), "frames"),
+        "Design": (plate.design(s, sink=(0.02, -0.01), starts=1, evaluations=30, verify_starts=2, hold=0), "verified"),
+        "Robustness": (plate.robustness(plate.load_scene(scene_path("designs/point_sink")),
+                                        scene_path("uncertainty/ppod"), draws=3), "3 draws"),
+    }
+    for kind, (obj, says) in results.items():
+        r = repr(obj)
+        assert r.startswith("<plate." + kind) and "object at 0x" not in r and says in r, (kind, r)
