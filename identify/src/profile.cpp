@@ -19,6 +19,8 @@ namespace {
 using namespace identify_detail;
 using Clock = std::chrono::steady_clock;
 
+constexpr int kRefinements = 3;   // re-minimised points at most to place a crossing, within max_steps
+
 // Ends the re-minimisation under way once the profiles' simulations or time are spent.
 class Budget final : public ceres::IterationCallback {
 public:
@@ -111,14 +113,17 @@ double walk(const Walk& w, double v_hat, double bound, double dir, double delta,
                 return a.value + (r - sa) / (sb - sa) * (b.value - a.value);
             };
             double c = cross();
-            if (step + 1 < w.po.max_steps && std::abs(b.value - a.value) > 0.1 * std::abs(c - v_hat)) {
+            // Refined by re-minimised points at the interpolated crossing while the bracket is wider than a
+            // tenth of the distance to the estimate (a profile that is a step, not a parabola, needs several).
+            for (int refine = 0; refine < kRefinements && step + 1 + refine < w.po.max_steps &&
+                                 std::abs(b.value - a.value) > 0.1 * std::abs(c - v_hat);
+                 ++refine) {
                 const Walk::Point m = w.at(c, a);
-                if (m.ok) {
-                    out.push_back({m.value, m.dchi2});
-                    drop = std::max(drop, -m.dchi2);
-                    (m.dchi2 >= kProfileThreshold95 ? b : a) = m;
-                    c = cross();
-                }
+                if (!m.ok) break;
+                out.push_back({m.value, m.dchi2});
+                drop = std::max(drop, -m.dchi2);
+                (m.dchi2 >= kProfileThreshold95 ? b : a) = m;
+                c = cross();
             }
             end = ProfileEnd::Crossed;
             return c;
