@@ -113,17 +113,21 @@ double walk(const Walk& w, double v_hat, double bound, double dir, double delta,
                 return a.value + (r - sa) / (sb - sa) * (b.value - a.value);
             };
             double c = cross();
-            // Refined by re-minimised points at the interpolated crossing while the bracket is wider than a
-            // tenth of the distance to the estimate (a profile that is a step, not a parabola, needs several).
+            // Refined by re-minimised points while the bracket is wider than a tenth of the distance to the
+            // estimate and the last point is off the line by 0.02 or more (a profile that is a step, not a
+            // parabola, needs several).
             for (int refine = 0; refine < kRefinements && step + 1 + refine < w.po.max_steps &&
                                  std::abs(b.value - a.value) > 0.1 * std::abs(c - v_hat);
                  ++refine) {
-                const Walk::Point m = w.at(c, a);
+                // The first at the interpolated crossing; then the bracket's middle (sqrt-interpolation
+                // creeps along a step's flat side).
+                const Walk::Point m = w.at(refine == 0 ? c : 0.5 * (a.value + b.value), a);
                 if (!m.ok) break;
                 out.push_back({m.value, m.dchi2});
                 drop = std::max(drop, -m.dchi2);
                 (m.dchi2 >= kProfileThreshold95 ? b : a) = m;
                 c = cross();
+                if (std::abs(m.dchi2 - kProfileThreshold95) < 0.02) break;   // on the line: done
             }
             end = ProfileEnd::Crossed;
             return c;
