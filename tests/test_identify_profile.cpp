@@ -8,9 +8,12 @@
 #include "plate/profile.hpp"
 #include "plate/scene_io.hpp"
 
+#include "cli_run.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <fstream>
 
 using namespace plate;
 using namespace plate::test;
@@ -95,4 +98,31 @@ TEST_CASE("a static coefficient seen only through a brief stick: the profile int
     CHECK(m.hi_end == ProfileEnd::Crossed);
     CHECK(m.lo < 0.33);
     CHECK(0.33 < m.hi);
+}
+
+// plate identify --profile writes each profile with its units into the JSON, and the reported interval
+// beside the linearised one; a name not fitted, or a profile option without --profile, exits 2 naming it.
+TEST_CASE("plate identify --profile writes the profiles; a name not fitted exits 2", "[identify][profile][cli]") {
+    const fs::path cam = tmpdir() / "camera.json", track = tmpdir() / "track.csv", out = tmpdir() / "est.json";
+    std::ofstream(cam) << R"({"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1}, "seed": 1, "frame": "plate"})";
+    REQUIRE(run("simulate " + kScenes + "fig1_point.json --dynamics full --from 0.01 -0.02 --time 2 --observe " + cam.string() +
+                " --out " + track.string())
+                .code == 0);
+    const std::string head = "identify " + kScenes + "fig1_point.json --tracks " + track.string() + " --params mu_k";
+    const Run ok = run(head + " --profile all --out " + out.string());
+    REQUIRE(ok.code == 0);
+    std::ifstream in(out);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    REQUIRE(j["profiles"].size() == 1u);
+    CHECK(j["profiles"][0]["points_columns"][0] == "value [1]");
+    CHECK(j["profiles"][0]["interval95"]["lo_end"] == "crossed");
+    CHECK(j["profiles"][0]["points"].size() >= 5u);
+    CHECK(j["parameters"][0]["interval_method"] == "linearised");
+    CHECK(j["parameters"][0]["interval95"] == j["parameters"][0]["interval95_linearised"]);
+    const Run bad = run(head + " --profile mu_s --out " + out.string());
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--profile: mu_s is not among --params") != std::string::npos);
+    const Run lone = run(head + " --profile-steps 3 --out " + out.string());
+    CHECK(lone.code == 2);
+    CHECK(lone.err.find("--profile-steps: only with --profile") != std::string::npos);
 }
