@@ -102,7 +102,7 @@ TEST_CASE("a static coefficient seen only through a brief stick: the profile int
 
 // plate identify --profile writes each profile with its units into the JSON, and the reported interval
 // beside the linearised one; a name not fitted, or a profile option without --profile, exits 2 naming it.
-TEST_CASE("plate identify --profile writes the profiles; a name not fitted exits 2", "[identify][profile][cli]") {
+TEST_CASE("plate identify --profile writes the profiles, and a name not fitted exits 2", "[identify][profile][cli]") {
     const fs::path cam = tmpdir() / "camera.json", track = tmpdir() / "track.csv", out = tmpdir() / "est.json";
     std::ofstream(cam) << R"({"stroboscopic": {"phase": 0.25}, "noise": {"xy_mm": 0.1}, "seed": 1, "frame": "plate"})";
     REQUIRE(run("simulate " + kScenes + "fig1_point.json --dynamics full --from 0.01 -0.02 --time 2 --observe " + cam.string() +
