@@ -5,15 +5,16 @@
 // chi-square quantile of one degree of freedom), found by stepping p from the estimate outward in each
 // direction, each step re-minimised by the fit's own Levenberg-Marquardt warm-started from the last,
 // until the profile crosses 3.84 (the end by interpolation on sqrt(profile), exact for a quadratic one,
-// then one re-minimised refinement) or p reaches its physical bound (the interval then runs to it).
+// then up to 3 re-minimised refinements: at the interpolated crossing, then bisecting) or p reaches its
+// physical bound (the interval then runs to it).
 //
 // The bounds along a profile: a kinetic coefficient [mu_min, mu_max]; a static one from its kinetic
 // base at the estimate (static >= kinetic: along its profile the base is kept at or below the value)
 // to mu_max; a centre-of-mass offset +-com_max.
 //
 // Which interval is THE interval (ParameterProfile::interval_is_profile): the linearised one (estimate
-// -+ 1.96 sd) where both of the profile's ends crossed 3.84 within `agreement` of the linearised
-// half-width of the linearised ends; otherwise the profile's -- one that runs to a bound says so, one
+// -+ 1.96 sd) where both of the profile's ends crossed 3.84 and each lies within `agreement` times the
+// linearised half-width of the linearised end; otherwise the profile's -- one that runs to a bound says so, one
 // that runs to both bounds is "not identifiable"; a profile cut short (a cap reached) keeps the
 // linearised interval and says so (docs/decisions/identification.md, "Profile likelihood").
 #pragma once
