@@ -4,6 +4,7 @@
 //   report_sections_fields.cpp  fields (with stick-slip against the regularised-friction limit)
 //   report_sections_design.cpp  design, orient, fixed-point
 //   report_sections_robustness.cpp  robustness (the shipped designs under the PPOD spec)
+//   report_sections_identify.cpp  identify (a filmed track fitted, with profile likelihoods)
 #pragma once
 
 #include "report.hpp"
@@ -23,5 +24,6 @@ void section_design(html::Ctx& c, const std::filesystem::path& src, const Report
 void section_orient(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_fixed_point(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_robustness(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
+void section_identify(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 
 }   // namespace plate::report

@@ -478,6 +478,10 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
                           "robustness_point_sink_arrival.svg", "share of the position variance", "95 % radius [mm]"})
         CHECK(html.find(s) != std::string::npos);
     CHECK(html.find("robustness_point_sink_scatter_xtheta") == std::string::npos);   // (a point part has no theta)
+    // The identification section: the fitted track, its residuals and both parameters' profiles.
+    for (const char* s : {"<h2>Identification", "identify_track.svg", "identify_residuals.svg", "identify_profile_mu_k.svg",
+                          "identify_profile_mu_s.svg", "linearised 95 %"})
+        CHECK(html.find(s) != std::string::npos);
     // Every paper figure's run from rest reached its full duration (a run that stops, as all of them
     // did when sticking stopped the program, is marked FAIL by the report and draws a dot).
     const std::size_t stopped = html.find("FAIL: the run from rest stopped");
@@ -510,12 +514,12 @@ TEST_CASE("plate report --sections computes only the named sections and says whi
     CHECK(html.find("Symbolic derivation") != std::string::npos);
     CHECK(html.find("fig3.svg") != std::string::npos);
     // Each left-out section's heading is absent (not computed, not only not named).
-    for (const char* h : {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields",
-                          "<h2>Inverse design", "Orienting a part", "Fixing a rigid part", "<h2>Robustness"})
+    for (const char* h :
+         {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields", "<h2>Inverse design",
+          "Orienting a part", "Fixing a rigid part", "<h2>Robustness", "<h2>Identification"})
         CHECK(html.find(h) == std::string::npos);
-    CHECK(html.find(
-              "Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point, robustness.") !=
-          std::string::npos);
+    CHECK(html.find("Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point, "
+                    "robustness, identify.") != std::string::npos);
     fs::remove_all(dir);
     r = run("report --quick --sections fig3 figure4 --out " + dir.string());
     CHECK(r.code == 2);

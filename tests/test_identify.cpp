@@ -2,12 +2,12 @@
 // the value the track was filmed at, its 95 % interval covering it, an understated noise seen in the
 // chi-square, a static coefficient that a never-sticking part cannot show reported as such, and bad
 // input refused with its file and line.
+#include "identify_fixtures.hpp"
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/scene_io.hpp"
 
 #include "cli_run.hpp"
-#include "shipped_scenes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -15,40 +15,7 @@
 #include <fstream>
 
 using namespace plate;
-
-namespace {
-
-using plate_tests::scene;
-
-Camera strobe(double xy_mm, double theta_mrad, std::uint64_t seed) {
-    Camera c;
-    c.per_period = 1;
-    c.phase = 0.25;
-    c.noise_xy_mm = xy_mm;
-    c.noise_theta_mrad = theta_mrad;
-    c.seed = seed;
-    return c;
-}
-
-// What a camera films of the part with the named parameters at `truth`, started at rest at q0: the
-// track's scene_id is the set-up's (plate motion, gravity), so it matches the nominal scene's.
-Track filmed(const Scene& nominal, const std::vector<std::string>& names, const std::vector<double>& truth, const Camera& cam,
-             const Vec3& q0, double duration, Trajectory* exact = nullptr) {
-    const Scene truth_scene = apply_parameters(nominal, names, truth);
-    Track tr = observe(truth_scene, cam, Dynamics::Full, q0, Vec3::Zero(), duration, {}, exact);
-    tr.source = "track.csv";
-    return tr;
-}
-
-IdentifyOptions options(const std::vector<std::string>& params) {
-    IdentifyOptions o;
-    o.params = params;
-    o.starts = 2;
-    o.threads = 1;
-    return o;
-}
-
-}   // namespace
+using namespace plate::test;
 
 // fig1_point (x and ry at 20 m/s^2 and 100 rad/s^2) slides: 5 s of stroboscopic frames (100) at
 // 0.1 mm. Measured: estimate 0.2677 (error -0.0023), sd 0.0014, reduced chi-square 0.94; +-0.005 is the

@@ -68,7 +68,8 @@ TEST_CASE("write_report rejects an unknown section before it touches the report'
         message = e.what();
     }
     CHECK(message ==
-          "'figure4' is not a section (derivation, kernels, proofs, fig3, fields, design, orient, fixed-point, robustness)");
+          "'figure4' is not a section (derivation, kernels, proofs, fig3, fields, design, orient, fixed-point, robustness, "
+          "identify)");
 }
 
 TEST_CASE("report: the captions that state a result follow this run's measurements", "[report][text]") {

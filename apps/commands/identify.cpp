@@ -5,9 +5,11 @@
 
 #include "plate/identify.hpp"
 #include "plate/output.hpp"
+#include "plate/profile.hpp"
 #include "plate/scene_io.hpp"
 #include "plate/suggest.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -17,12 +19,13 @@ namespace plate::cli {
 namespace {
 
 struct IdentifyArgs : Options {
-    std::string scene, params, dynamics = "full", out = "-", camera, scene_out;
+    std::string scene, params, dynamics = "full", out = "-", camera, scene_out, profile;
     std::vector<std::string> tracks;
     std::vector<double> limits;
     bool suggest = false;
     IdentifyOptions o;
     SuggestOptions so;
+    ProfileOptions po;
     explicit IdentifyArgs(CLI::App& app)
         : Options(app, "identify", "friction coefficients and centre-of-mass offset from camera tracks, JSON",
                   "Fits the named parameters of SCENE's part (--params, comma-separated: mu_k, mu_k1..3 kinetic\n"
@@ -37,6 +40,13 @@ struct IdentifyArgs : Options {
                   "RMS per track [mm, mrad], chi-square and its reduced value (near 1 when model and noise are\n"
                   "right), the solver's report, and the parameter combinations the tracks cannot place within the\n"
                   "physical ranges (friction 0.05-1.5): \"not identifiable from these tracks\", with no interval.\n"
+                  "--profile NAMES|all: after the fit, each named fitted parameter's profile likelihood (chi-square\n"
+                  "minimised over the other parameters and the starts, stepped outward until it rises by 3.84 or\n"
+                  "reaches the physical bound; at most --profile-steps re-minimisations a side, all within\n"
+                  "--profile-time-limit s): its points and 95 % interval (ends \"crossed\", \"at bound\", \"cut short\")\n"
+                  "under \"profiles\"; a parameter's \"interval95\" is the profile's where it runs to a bound or its\n"
+                  "ends differ from the linearised ones by more than a fifth of the half-width, \"not identifiable\"\n"
+                  "where it runs to both bounds.\n"
                   "Exit 2 for a track of another scene, too few frames or a bad cell (file and line named), a name\n"
                   "that is no parameter or one the part has not (mu_k2, com_x for a point part).\n"
                   "--suggest: no fit; which plate motion to film so that the --params are identifiable. Candidate\n"
@@ -60,6 +70,9 @@ struct IdentifyArgs : Options {
         number("--settle", o.settle_periods, "plate periods of each track left out at its start");
         number("--rtol", o.rtol, "the simulation's tolerance");
         whole("--threads", o.threads, 1, 1024, "tracks simulated in parallel");
+        text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");
+        whole("--profile-steps", po.max_steps, 1, 1000, "--profile: re-minimisations per side");
+        number("--profile-time-limit", po.time_limit, "--profile: seconds for every profile");
         flag("--suggest", suggest, "propose the plate motion to film instead of fitting");
         text("--camera", camera, "CAMERA.json", "--suggest: the camera that will film");
         numbers("--limits", limits, 2, 2, "LIN ANG", "--suggest: each axis' peak [m/s^2, rad/s^2]");
@@ -139,9 +152,24 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
     std::vector<Track> tracks;
     for (const std::string& f : a.tracks) tracks.push_back(read_track_csv(f));
     check_tracks(sc, tracks, o);
+    ProfileOptions po = a.po;
+    if (a.has("--profile") && a.profile != "all") po.params = split_names(a.profile);
+    if (a.has("--profile")) try {
+            po.validate();
+            for (const std::string& name : po.params)
+                if (std::find(o.params.begin(), o.params.end(), name) == o.params.end())
+                    throw std::invalid_argument(name + " is not among --params");
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(std::string("--profile: ") + e.what());
+        }
+    else
+        for (const char* f : {"--profile-steps", "--profile-time-limit"})
+            if (a.has(f)) throw UsageError(std::string(f) + ": only with --profile");
     const IdentifySummary s = identify(sc, tracks, o);
+    const nlohmann::json j =
+        a.has("--profile") ? identify_json(s, o, profile_likelihood(sc, tracks, o, s, po), po) : identify_json(s, o);
     write_file_atomic(
-        a.out, [&](std::ostream& out) { out << identify_json(s, o).dump(2) << "\n"; }, cio.out);
+        a.out, [&](std::ostream& out) { out << j.dump(2) << "\n"; }, cio.out);
     return 0;
 }
 

@@ -24,12 +24,13 @@ struct ReportArgs : Options {
                   "Theorem 1 checks (10^4 thin, 10^3 thick parts; --quick: a few), limit surfaces, Fig. 3, and the\n"
                   "paper's fields with full-dynamics trajectories and fixed-point tables, the inverse designs, and\n"
                   "the robustness of each design in scenes/designs/ under scenes/uncertainty/ppod.json (200 draws;\n"
-                  "--quick: 40). ROOT: the project folder (scenes/, reports/generated/), default the one this\n"
+                  "--quick: 40), and an identification (fig1_point's part filmed at other friction, fitted, with profile\n"
+                  "likelihoods). ROOT: the project folder (scenes/, reports/generated/), default the one this\n"
                   "program was built from. --sections computes only the named ones (derivation kernels proofs fig3\n"
-                  "fields design orient fixed-point robustness; the page names those left out).\n") {
+                  "fields design orient fixed-point robustness identify; the page names those left out).\n") {
         text("--out", out, "DIR", "the report's folder; required");
         flag("--quick", quick, "small campaigns and grids");
-        words("--sections", sections, 1, 9, "NAME ...", "only these sections (default all)");
+        words("--sections", sections, 1, 10, "NAME ...", "only these sections (default all)");
         whole("--seed", seed, 0, 1L << 40, "the seed");
         whole("--threads", threads, 0, 256, "threads (0: all cores)");
         text("--source", source, "ROOT", "the project folder");

@@ -7,6 +7,7 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -23,73 +24,6 @@ namespace {
 // stepped across its whole range, into a regime it does not hold (docs/decisions/identification.md).
 constexpr double kMinLmDiagonal = 1e4;
 constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // central-difference steps of a track's start
-
-// One track's residual block: parameter blocks (the named parameters, internal coordinates) and (the
-// track's start: s_x, s_y [mm], theta [rad]; a point part without theta).
-class TrackCost final : public ceres::CostFunction {
-public:
-    TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o)
-        : scene_(scene), layout_(layout), track_(track), first_(first), o_(o) {
-        dim_ = track.point ? 2 : 3;
-        mutable_parameter_block_sizes()->push_back(layout.size());
-        mutable_parameter_block_sizes()->push_back(dim_);
-        set_num_residuals(dim_ * (static_cast<int>(track.t.size()) - first));
-        opt_.rtol = o.rtol;
-    }
-
-    bool residuals(const double* x, const double* q0, double* r) const {
-        const Scene s = at(scene_, layout_, std::vector<double>(x, x + layout_.size()));
-        const Vec3 q(q0[0] * 1e-3, q0[1] * 1e-3, dim_ == 3 ? q0[2] : 0.0);
-        std::vector<Vec3> pred;
-        if (!predict(s, track_, o_.level, q, opt_, pred)) return false;
-        const double sxy = track_.camera.noise_xy_mm * 1e-3, sth = track_.camera.noise_theta_mrad * 1e-3;
-        for (std::size_t k = first_; k < pred.size(); ++k) {
-            const Vec3 d = pred[k] - track_.q[k];
-            double* rk = r + dim_ * (k - first_);
-            rk[0] = d.x() / sxy;
-            rk[1] = d.y() / sxy;
-            if (dim_ == 3) rk[2] = std::remainder(d.z(), 2 * kPi) / sth;
-        }
-        return true;
-    }
-
-    bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override {
-        if (!residuals(parameters[0], parameters[1], r)) return false;
-        if (!jacobians) return true;
-        const int m = num_residuals();
-        std::vector<double> plus(m), minus(m);
-        for (int b = 0; b < 2; ++b) {
-            if (!jacobians[b]) continue;
-            const int n = b == 0 ? layout_.size() : dim_;
-            std::vector<double> x(parameters[b], parameters[b] + n);
-            for (int j = 0; j < n; ++j) {
-                const double h = b == 0 ? layout_.step(j) : (j < 2 ? kStartStepMm : kStartStepRad);
-                const double x0 = x[j];
-                // One-sided at a bound (a static excess at 0: below it the part would have static < kinetic).
-                const bool down = b != 0 || x0 - h >= layout_.lower(j, o_);
-                const bool up = b != 0 || x0 + h <= layout_.upper(j, o_);
-                const double* blocks[2] = {parameters[0], parameters[1]};
-                blocks[b] = x.data();
-                x[j] = x0 + (up ? h : 0);
-                if (up && !residuals(blocks[0], blocks[1], plus.data())) return false;
-                x[j] = x0 - (down ? h : 0);
-                if (down && !residuals(blocks[0], blocks[1], minus.data())) return false;
-                x[j] = x0;
-                const double span = (up ? h : 0) + (down ? h : 0);
-                for (int i = 0; i < m; ++i) jacobians[b][i * n + j] = ((up ? plus[i] : r[i]) - (down ? minus[i] : r[i])) / span;
-            }
-        }
-        return true;
-    }
-
-private:
-    const Scene& scene_;
-    const Layout& layout_;
-    const Track& track_;
-    int first_, dim_;
-    const IdentifyOptions& o_;
-    IntegrationOptions opt_;
-};
 
 // The starts: the scene's values (clamped into the bounds), then draws within them.
 std::vector<std::vector<double>> starts(const Layout& layout, const IdentifyOptions& o) {
@@ -147,6 +81,134 @@ std::vector<int> unseen_parameters(const std::vector<std::unique_ptr<TrackCost>>
 }
 
 }   // namespace
+
+TrackCost::TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o)
+    : scene_(scene), layout_(layout), track_(track), first_(first), o_(o) {
+    dim_ = track.point ? 2 : 3;
+    mutable_parameter_block_sizes()->push_back(layout.size());
+    mutable_parameter_block_sizes()->push_back(dim_);
+    set_num_residuals(dim_ * (static_cast<int>(track.t.size()) - first));
+    opt_.rtol = o.rtol;
+    for (int j = 0; j < layout.size(); ++j) {
+        lo_.push_back(layout.lower(j, o));
+        hi_.push_back(layout.upper(j, o));
+    }
+}
+
+void TrackCost::profile(int j, const std::vector<double>& lo, const std::vector<double>& hi) {
+    profiled_ = j;
+    lo_ = lo;
+    hi_ = hi;
+}
+
+bool TrackCost::internal_of(const double* z, std::vector<double>& x) const {
+    x.assign(z, z + layout_.size());
+    const int j = profiled_;
+    if (j < 0) return true;
+    const Param::Kind kind = layout_.p[j].kind;
+    if (kind == Param::ComX || kind == Param::ComY) x[j] = z[j] * 1e3;
+    if (kind != Param::Static) return true;
+    x[j] = 0;
+    const double base = layout_.natural(x)[j];   // the kinetic coefficient(s) the static one must exceed
+    x[j] = z[j] - base;
+    if (x[j] < -1e-12) return false;
+    x[j] = std::max(x[j], 0.0);
+    return true;
+}
+
+bool TrackCost::residuals(const double* z, const double* q0, double* r) const {
+    std::vector<double> x;
+    if (!internal_of(z, x)) return false;
+    const Scene s = at(scene_, layout_, x);
+    const Vec3 q(q0[0] * 1e-3, q0[1] * 1e-3, dim_ == 3 ? q0[2] : 0.0);
+    std::vector<Vec3> pred;
+    ++sims_;
+    if (!predict(s, track_, o_.level, q, opt_, pred)) return false;
+    const double sxy = track_.camera.noise_xy_mm * 1e-3, sth = track_.camera.noise_theta_mrad * 1e-3;
+    for (std::size_t k = first_; k < pred.size(); ++k) {
+        const Vec3 d = pred[k] - track_.q[k];
+        double* rk = r + dim_ * (k - first_);
+        rk[0] = d.x() / sxy;
+        rk[1] = d.y() / sxy;
+        if (dim_ == 3) rk[2] = std::remainder(d.z(), 2 * kPi) / sth;
+    }
+    return true;
+}
+
+bool TrackCost::Evaluate(double const* const* parameters, double* r, double** jacobians) const {
+    if (!residuals(parameters[0], parameters[1], r)) return false;
+    if (!jacobians) return true;
+    const int m = num_residuals();
+    std::vector<double> plus(m), minus(m);
+    for (int b = 0; b < 2; ++b) {
+        if (!jacobians[b]) continue;
+        const int n = b == 0 ? layout_.size() : dim_;
+        std::vector<double> x(parameters[b], parameters[b] + n);
+        for (int j = 0; j < n; ++j) {
+            if (b == 0 && j == profiled_) {   // held along the profile
+                for (int i = 0; i < m; ++i) jacobians[b][i * n + j] = 0;
+                continue;
+            }
+            const double h = b == 0 ? layout_.step(j) : (j < 2 ? kStartStepMm : kStartStepRad);
+            const double x0 = x[j];
+            // One-sided at a bound (a static excess at 0: below it the part would have static < kinetic).
+            const bool down = b != 0 || x0 - h >= lo_[j];
+            const bool up = b != 0 || x0 + h <= hi_[j];
+            const double* blocks[2] = {parameters[0], parameters[1]};
+            blocks[b] = x.data();
+            x[j] = x0 + (up ? h : 0);
+            if (up && !residuals(blocks[0], blocks[1], plus.data())) return false;
+            x[j] = x0 - (down ? h : 0);
+            if (down && !residuals(blocks[0], blocks[1], minus.data())) return false;
+            x[j] = x0;
+            const double span = (up ? h : 0) + (down ? h : 0);
+            for (int i = 0; i < m; ++i) jacobians[b][i * n + j] = ((up ? plus[i] : r[i]) - (down ? minus[i] : r[i])) / span;
+        }
+    }
+    return true;
+}
+
+Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
+               const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
+               double seconds, int threads, ceres::IterationCallback* callback) {
+    const int n = static_cast<int>(x.size());
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    for (std::size_t t = 0; t < costs.size(); ++t) problem.AddResidualBlock(costs[t], nullptr, x.data(), q0[t].data());
+    if (static_cast<int>(held.size()) == n)
+        problem.SetParameterBlockConstant(x.data());
+    else if (!held.empty())
+        problem.SetManifold(x.data(), new ceres::SubsetManifold(n, held));
+    for (int j = 0; j < n; ++j) {
+        problem.SetParameterLowerBound(x.data(), j, lo[j]);
+        problem.SetParameterUpperBound(x.data(), j, hi[j]);
+    }
+    ceres::Solver::Options so;
+    so.minimizer_type = ceres::TRUST_REGION;
+    so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.min_lm_diagonal = kMinLmDiagonal;
+    so.max_num_iterations = max_iterations;
+    so.max_solver_time_in_seconds = seconds;
+    so.num_threads = threads;
+    // Converged when an iteration changes the chi-square by under 1e-6 of itself (about 1e-6 dof,
+    // far below its sd sqrt(2 dof) at the truth) or the parameters by under 1e-6 of themselves:
+    // tighter, the search only wanders along directions the tracks hardly see.
+    so.function_tolerance = 1e-6;
+    so.parameter_tolerance = 1e-6;
+    so.logging_type = ceres::SILENT;
+    if (callback) so.callbacks.push_back(callback);
+    ceres::Solver::Summary sum;
+    ceres::Solve(so, &problem, &sum);
+    Solve out;
+    out.chi2 = 2 * sum.final_cost;
+    out.usable = sum.IsSolutionUsable();
+    out.converged = sum.termination_type == ceres::CONVERGENCE;
+    out.iterations = static_cast<int>(sum.iterations.size()) - 1;
+    out.termination = std::string(ceres::TerminationTypeToString(sum.termination_type)) + ": " + sum.message;
+    return out;
+}
 
 bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
                     const std::vector<double>& x, const std::vector<double>& q0, Eigen::VectorXd& r, Eigen::MatrixXd& Jx,
@@ -226,50 +288,29 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     const std::vector<std::vector<double>> xs = starts(layout, o);
     const std::vector<int> held = unseen_parameters(costs, xs[0], first_frames(tracks, d), n);
     s.held = static_cast<int>(held.size());
+    std::vector<TrackCost*> cost_ptrs;
+    for (const auto& c : costs) cost_ptrs.push_back(c.get());
+    std::vector<double> lo, hi;
+    for (int j = 0; j < n; ++j) {
+        lo.push_back(layout.lower(j, o));
+        hi.push_back(layout.upper(j, o));
+    }
     for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
         const double left = o.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (left <= 0) break;
         std::vector<double> x = xs[k];
         std::vector<std::vector<double>> q0 = first_frames(tracks, d);
-        ceres::Problem::Options po;
-        po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-        ceres::Problem problem(po);
-        for (int t = 0; t < nt; ++t) problem.AddResidualBlock(costs[t].get(), nullptr, x.data(), q0[t].data());
-        if (static_cast<int>(held.size()) == n)
-            problem.SetParameterBlockConstant(x.data());
-        else if (!held.empty())
-            problem.SetManifold(x.data(), new ceres::SubsetManifold(n, held));
-        for (int j = 0; j < n; ++j) {
-            problem.SetParameterLowerBound(x.data(), j, layout.lower(j, o));
-            problem.SetParameterUpperBound(x.data(), j, layout.upper(j, o));
-        }
-        ceres::Solver::Options so;
-        so.minimizer_type = ceres::TRUST_REGION;
-        so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-        so.linear_solver_type = ceres::DENSE_QR;
-        so.min_lm_diagonal = kMinLmDiagonal;
-        so.max_num_iterations = o.max_iterations;
-        so.max_solver_time_in_seconds = left;
-        so.num_threads = o.threads;
-        // Converged when an iteration changes the chi-square by under 1e-6 of itself (about 1e-6 dof,
-        // far below its sd sqrt(2 dof) at the truth) or the parameters by under 1e-6 of themselves:
-        // tighter, the search only wanders along directions the tracks hardly see.
-        so.function_tolerance = 1e-6;
-        so.parameter_tolerance = 1e-6;
-        so.logging_type = ceres::SILENT;
-        ceres::Solver::Summary sum;
-        ceres::Solve(so, &problem, &sum);
+        const Solve sol = minimise(cost_ptrs, x, q0, held, lo, hi, o.max_iterations, left, o.threads);
         ++s.starts_run;
-        const double chi2 = 2 * sum.final_cost;
-        s.start_costs.push_back(chi2);
-        if (sum.IsSolutionUsable() && chi2 < best_cost) {
-            best_cost = chi2;
+        s.start_costs.push_back(sol.chi2);
+        if (sol.usable && sol.chi2 < best_cost) {
+            best_cost = sol.chi2;
             best = x;
             best_q0 = q0;
             s.best_start = k;
-            s.iterations = static_cast<int>(sum.iterations.size()) - 1;
-            s.termination = std::string(ceres::TerminationTypeToString(sum.termination_type)) + ": " + sum.message;
-            s.converged = sum.termination_type == ceres::CONVERGENCE;
+            s.iterations = sol.iterations;
+            s.termination = sol.termination;
+            s.converged = sol.converged;
         }
         if (best_cost <= enough) break;
     }

@@ -5,6 +5,9 @@
 #include "plate/identify.hpp"
 #include "plate/simulate.hpp"
 
+#include <ceres/ceres.h>
+
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -69,5 +72,48 @@ Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& 
 // named parameters' columns, then the starts'), into s.params, s.covariance, s.unidentifiable (judge.cpp).
 void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
            int starts_size, IdentifySummary& s);
+
+// One track's residual block: parameter blocks (the named parameters, internal coordinates) and (the
+// track's start: s_x, s_y [mm], theta [rad]; a point part without theta). Its Jacobian by the fit's own
+// central differences, one-sided at a bound (docs/decisions/identification.md).
+//
+// Profile mode (profile.cpp): block 0 holds z, the internal coordinates with the profiled parameter j's
+// own replaced by its value in scene units (held: its column is left zero), so that a static
+// coefficient stays at that value while its kinetic base moves; the differences stay within [lo, hi].
+class TrackCost final : public ceres::CostFunction {
+public:
+    TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o);
+    void profile(int j, const std::vector<double>& lo, const std::vector<double>& hi);
+    // The internal coordinates x of block 0 (the identity outside profile mode); false if z puts a
+    // static coefficient below its kinetic base.
+    bool internal_of(const double* z, std::vector<double>& x) const;
+    bool residuals(const double* z, const double* q0, double* r) const;
+    bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override;
+    long simulations() const { return sims_; }   // predictions run so far
+
+private:
+    const Scene& scene_;
+    const Layout& layout_;
+    const Track& track_;
+    int first_, dim_;
+    const IdentifyOptions& o_;
+    IntegrationOptions opt_;
+    int profiled_ = -1;
+    std::vector<double> lo_, hi_;
+    mutable std::atomic<long> sims_{0};
+};
+
+// One Levenberg-Marquardt solve over block 0 (`x`, the coordinates in `held` kept) and the tracks'
+// starts q0, within [lo, hi], as the fit runs it; x and q0 hold the result. `callback` (may be null)
+// can end it early.
+struct Solve {
+    double chi2 = 0;
+    bool usable = false, converged = false;
+    int iterations = 0;
+    std::string termination;
+};
+Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
+               const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
+               double seconds, int threads, ceres::IterationCallback* callback = nullptr);
 
 }   // namespace plate::identify_detail

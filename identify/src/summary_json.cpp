@@ -1,5 +1,6 @@
 // The identification's summary as JSON (plate identify --out).
 #include "plate/identify.hpp"
+#include "plate/profile.hpp"
 
 #include <cmath>
 
@@ -77,6 +78,50 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
                   {"converged", s.converged}}},
                 {"seconds", s.seconds},
                 {"options", opts}};
+}
+
+json identify_json(const IdentifySummary& s, const IdentifyOptions& o, const ProfileSummary& p, const ProfileOptions& po) {
+    json j = identify_json(s, o);
+    json profiles = json::array();
+    for (const ParameterProfile& pr : p.profiles) {
+        json points = json::array();
+        for (const ProfilePoint& q : pr.points) points.push_back({q.value, q.dchi2});
+        const json interval{{"lo", pr.lo}, {"lo_end", to_string(pr.lo_end)}, {"hi", pr.hi}, {"hi_end", to_string(pr.hi_end)}};
+        profiles.push_back({{"name", pr.name},
+                            {"unit", pr.unit},
+                            {"estimate", pr.estimate},
+                            {"points", points},
+                            {"points_columns", {"value [" + pr.unit + "]", "chi2 - chi2_min"}},
+                            {"bounds", {pr.bound_lo, pr.bound_hi}},
+                            {"interval95", interval},
+                            {"chi2_drop", pr.chi2_drop},
+                            {"simulations", pr.simulations},
+                            {"seconds", pr.seconds}});
+        for (json& q : j["parameters"]) {
+            if (q["name"] != pr.name) continue;
+            q["interval95_linearised"] = q["interval95"];
+            q["interval95_profile"] = interval;
+            q["interval_method"] = pr.interval_is_profile ? "profile likelihood" : "linearised";
+            q["profile_verdict"] = pr.verdict;
+            if (pr.interval_is_profile) q["interval95"] = pr.identifiable ? json{pr.lo, pr.hi} : json(nullptr);
+            if (!pr.identifiable)
+                q["identifiable"] = "not identifiable from these tracks";
+            else if (q.contains("identifiable") && pr.interval_is_profile)
+                q.erase("identifiable");
+        }
+    }
+    j["profiles"] = profiles;
+    j["profile"] = {{"threshold_dchi2", kProfileThreshold95},
+                    {"chi2_min", p.chi2_min},
+                    {"simulations", p.simulations},
+                    {"seconds", p.seconds},
+                    {"options",
+                     {{"max_steps", po.max_steps},
+                      {"max_iterations", po.max_iterations},
+                      {"max_simulations", po.max_simulations},
+                      {"time_limit_s", po.time_limit},
+                      {"agreement", po.agreement}}}};
+    return j;
 }
 
 }   // namespace plate

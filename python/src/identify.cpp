@@ -3,7 +3,9 @@
 #include "bindings.hpp"
 
 #include "plate/identify.hpp"
+#include "plate/profile.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace plate::python {
@@ -13,6 +15,9 @@ namespace {
 struct PyIdentification {
     IdentifySummary s;
     IdentifyOptions o;
+    bool profiled = false;
+    ProfileSummary p;
+    ProfileOptions po;
 };
 
 // A track from a plate.Track or a track file's path (read as the command line reads it).
@@ -77,8 +82,38 @@ void bind_identify(py::module_& m) {
         .def_property_readonly(
             "fitted", [](const PyIdentification& r) { return r.s.fitted; }, "the scene at the estimates")
         .def_property_readonly(
-            "summary", [](const PyIdentification& r) { return json_to_python(identify_json(r.s, r.o)); },
-            "the command line's JSON (plate identify --out), as a dict")
+            "profiles",
+            [](const PyIdentification& r) {
+                py::list out;
+                for (const ParameterProfile& pr : r.p.profiles) {
+                    std::vector<double> pts;
+                    for (const ProfilePoint& q : pr.points) pts.insert(pts.end(), {q.value, q.dchi2});
+                    py::dict d;
+                    d["name"] = pr.name;
+                    d["unit"] = pr.unit;
+                    d["estimate"] = pr.estimate;
+                    d["points"] = array(pts, {static_cast<py::ssize_t>(pr.points.size()), 2});
+                    d["interval"] = py::make_tuple(pr.lo, pr.hi);
+                    d["ends"] = py::make_tuple(to_string(pr.lo_end), to_string(pr.hi_end));
+                    d["bounds"] = py::make_tuple(pr.bound_lo, pr.bound_hi);
+                    d["interval_is_profile"] = pr.interval_is_profile;
+                    d["identifiable"] = pr.identifiable;
+                    d["verdict"] = pr.verdict;
+                    d["simulations"] = pr.simulations;
+                    d["seconds"] = pr.seconds;
+                    out.append(d);
+                }
+                return out;
+            },
+            "the profile likelihoods asked (profile=): per parameter a dict -- points (value, chi2 - chi2_min) as an "
+            "(n, 2) array, interval (lo, hi), ends ('crossed', 'at bound' or 'cut short'), bounds, interval_is_profile "
+            "(the reported 95 % interval is the profile's, else the linearised one), identifiable, verdict; [] if none")
+        .def_property_readonly(
+            "summary",
+            [](const PyIdentification& r) {
+                return json_to_python(r.profiled ? identify_json(r.s, r.o, r.p, r.po) : identify_json(r.s, r.o));
+            },
+            "the command line's JSON (plate identify --out, with --profile when profile= was given), as a dict")
         .def("__repr__", [](const PyIdentification& r) {
             std::string s = "<plate.Identification:";
             for (const FittedParameter& p : r.s.params)
@@ -89,8 +124,8 @@ void bind_identify(py::module_& m) {
     m.def(
         "identify",
         [](const Scene& sc, const py::list& tracks, const std::vector<std::string>& params, const std::string& dynamics,
-           int starts, std::uint64_t seed, int max_iterations, double time_limit, double settle_periods, double rtol,
-           int threads) {
+           int starts, std::uint64_t seed, int max_iterations, double time_limit, double settle_periods, double rtol, int threads,
+           const py::object& profile, int profile_steps, double profile_time_limit) {
             require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
             std::vector<Track> tr;
             for (const py::handle& t : tracks) tr.push_back(track_of(t));
@@ -104,9 +139,19 @@ void bind_identify(py::module_& m) {
             r.o.settle_periods = settle_periods;
             r.o.rtol = rtol;
             r.o.threads = threads;
+            r.profiled = !profile.is_none();
+            if (r.profiled && !(py::isinstance<py::str>(profile) && profile.cast<std::string>() == "all"))
+                r.po.params = profile.cast<std::vector<std::string>>();
+            r.po.max_steps = profile_steps;
+            r.po.time_limit = profile_time_limit;
+            if (r.profiled) r.po.validate();
+            for (const std::string& name : r.po.params)
+                require(std::find(params.begin(), params.end(), name) != params.end(),
+                        "profile: " + name + " is not among the fitted params");
             {
                 py::gil_scoped_release free;
                 r.s = identify(sc, tr, r.o);
+                if (r.profiled) r.p = profile_likelihood(sc, tr, r.o, r.s, r.po);
             }
             return r;
         },
@@ -114,10 +159,13 @@ void bind_identify(py::module_& m) {
         py::arg("starts") = IdentifyOptions{}.starts, py::arg("seed") = IdentifyOptions{}.seed,
         py::arg("max_iterations") = IdentifyOptions{}.max_iterations, py::arg("time_limit") = IdentifyOptions{}.time_limit,
         py::arg("settle_periods") = IdentifyOptions{}.settle_periods, py::arg("rtol") = IdentifyOptions{}.rtol,
-        py::arg("threads") = IdentifyOptions{}.threads,
+        py::arg("threads") = IdentifyOptions{}.threads, py::arg("profile") = py::none(),
+        py::arg("profile_steps") = ProfileOptions{}.max_steps, py::arg("profile_time_limit") = ProfileOptions{}.time_limit,
         "Fits the named parameters of `scene`'s part (mu_k, mu_k1..3, mu_s, mu_s1..3, com_x, com_y) to `tracks`\n"
         "(plate.Track objects or track files' paths) by least squares over the hybrid simulation, as `plate identify`.\n"
-        "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.");
+        "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.\n"
+        "profile='all' or a list of fitted names: their profile likelihoods too (plate identify --profile; at most\n"
+        "profile_steps re-minimisations a side, all within profile_time_limit s), in .profiles and .summary.");
 }
 
 }   // namespace plate::python

@@ -59,6 +59,25 @@ def test_a_static_coefficient_the_track_cannot_show(tmp_path):
     assert "not identifiable" in repr(r)
 
 
+def test_profile_likelihood_of_a_static_coefficient_the_track_cannot_show(tmp_path):
+    # The same track, profiled: mu_s's chi-square stays at its minimum from its kinetic base to the bound 1.5
+    # (not identifiable, no interval reported), while mu_k's profile crosses 3.84 on both sides. A profile
+    # that did not reach the bound (a cap on its steps of 1) is reported cut short.
+    path = filmed(tmp_path, point_scene(0.27, 0.36, np.pi / 2), start=(0.005, -0.02), time=3.0)
+    r = plate.identify(point_scene(0.30, 0.40, np.pi / 2), [path], ["mu_k", "mu_s"], profile="all")
+    k, s = r.profiles
+    assert k["ends"] == ("crossed", "crossed") and k["interval"][0] < 0.27 < k["interval"][1]
+    assert s["ends"] == ("at bound", "at bound") and not s["identifiable"]
+    assert s["points"].shape[1] == 2 and np.all(np.abs(s["points"][:, 1]) < 0.01)
+    assert s["bounds"][1] == 1.5 and abs(s["bounds"][0] - r.estimates[0]) < 1e-9
+    assert r.summary["parameters"][1]["interval95"] is None
+    assert r.summary["profiles"][1]["interval95"]["hi_end"] == "at bound"
+    short = plate.identify(point_scene(0.30, 0.40, np.pi / 2), [path], ["mu_k", "mu_s"], profile=["mu_s"], profile_steps=1)
+    assert [p["name"] for p in short.profiles] == ["mu_s"] and "cut short" in short.profiles[0]["ends"]
+    with pytest.raises(ValueError, match="com_x"):
+        plate.identify(point_scene(0.30), [path], ["mu_k"], profile=["com_x"])
+
+
 def test_tracks_from_another_set_up_are_refused(tmp_path):
     path = filmed(tmp_path, point_scene(0.27))
     other = plate.scene_to_dict(point_scene(0.27))
