@@ -21,6 +21,7 @@ Results carry numpy arrays and ``summary``, the command line's JSON as a dict.  
 names them), ValueError (bad options) or RuntimeError.  The GIL is released while the library works.
 """
 import json as _json
+from typing import Any, Dict
 
 from ._plate import (Camera, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
                      Robustness, Scene, Stop, Track, Trajectory, axis_peaks, check_track_scene, coning_rate, design, field,
@@ -37,15 +38,16 @@ __all__ = ["Camera", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "Fix
            "simulate", "twist", "uncertain_parameters", "write_track_csv"]
 
 
-def scene_from_dict(d, source="<dict>"):
+def scene_from_dict(d: Dict[str, Any], source: str = "<dict>") -> Scene:
     """A scene from a dict in the scene file's form (see scenes/*.json); checked as a file is."""
     return parse_scene(_json.dumps(d), source)
 
 
-def scene_to_dict(scene):
+def scene_to_dict(scene: Scene) -> Dict[str, Any]:
     """The scene in the file form, as a dict (scene_from_dict(scene_to_dict(s)) gives s back)."""
-    return _json.loads(scene.to_json())
+    d: Dict[str, Any] = _json.loads(scene.to_json())
+    return d
 
 
-Scene.to_dict = scene_to_dict
-Scene.from_dict = staticmethod(scene_from_dict)
+Scene.to_dict = scene_to_dict  # type: ignore  # (methods added in Python: the stubs declare them)
+Scene.from_dict = staticmethod(scene_from_dict)  # type: ignore

@@ -73,7 +73,8 @@ void bind_scene(py::module_& m) {
         .def(
             "to_json", [](const Scene& s) { return scene_to_json(s).dump(); }, "the scene in the file form")
         // Equal: the same file form (name, gravity, part, plate motion), wherever each was read from.
-        .def("__eq__", [](const Scene& a, const Scene& b) { return scene_to_json(a) == scene_to_json(b); })
+        .def(
+            "__eq__", [](const Scene& a, const Scene& b) { return scene_to_json(a) == scene_to_json(b); }, py::is_operator())
         .def("__copy__", [](const Scene& s) { return Scene(s); })
         .def(
             "__deepcopy__", [](const Scene& s, py::dict) { return Scene(s); }, py::arg("memo"))

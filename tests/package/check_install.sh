@@ -46,7 +46,9 @@ print("consumer's design target and campaign (%s cases) as expected" % cases)
 PY
 python=${3:-}
 if [ -n "$python" ]; then
-  [ -f "$prefix/lib/python3/dist-packages/plate/__init__.py" ] || { echo "the Python module was not installed"; exit 1; }
+  for f in __init__.py _plate.pyi py.typed; do
+    [ -f "$prefix/lib/python3/dist-packages/plate/$f" ] || { echo "the Python module's $f was not installed"; exit 1; }
+  done
   PYTHONPATH="$prefix/lib/python3/dist-packages" "$python" - "$work/twist.json" "$prefix" <<'PY'
 import json, sys
 import plate

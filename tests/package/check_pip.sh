@@ -28,5 +28,8 @@ assert any(r.split(";")[0].strip().startswith("numpy") for r in requires), f"num
 t = json.load(open(work + "/twist.json"))["twist"]
 c = plate.twist(plate.load_scene(scene), at=(0.02, 0.01, 0.5)).twist.tolist()
 assert t == c, f"installed plate {t} vs pip-installed module {c}"
+import os
+here = os.path.dirname(plate.__file__)
+assert all(os.path.isfile(os.path.join(here, f)) for f in ("_plate.pyi", "py.typed")), os.listdir(here)
 print("pip-installed plate", version, "from", plate.__file__, "requires", requires, "agrees with the program:", c)
 PY
