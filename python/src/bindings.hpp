@@ -34,6 +34,7 @@ void bind_simulate(py::module_& m);       // simulate.cpp: Trajectory, simulate
 void bind_robustness(py::module_& m);     // robustness.cpp: Robustness, robustness, uncertain_parameters
 void bind_observe(py::module_& m);        // observe.cpp:  Camera, Track, observe, read_track_csv, ...
 void bind_identify(py::module_& m);       // identify.cpp: Identification, identify
+void bind_control(py::module_& m);        // control.cpp:  ControlRun, control, ControlEnv
 
 // --- conversions (conversions.cpp) ---------------------------------------------------------------
 
