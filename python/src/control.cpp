@@ -32,10 +32,7 @@ Truth truth_of(const py::object& t) {
 }
 std::optional<Camera> camera_opt(const py::object& c) {
     if (c.is_none()) return std::nullopt;
-    if (py::isinstance<Camera>(c)) return c.cast<Camera>();
-    if (py::isinstance<py::str>(c)) return load_camera(c.cast<std::string>());
-    require(py::isinstance<py::dict>(c), "camera: expected a plate.Camera, a camera file's path or a dict in its form");
-    return parse_camera(dumps(c), "<dict>");
+    return camera_of(c);
 }
 MotionLibrary library_of(const py::object& l, const Scene& sc) {
     if (py::isinstance<py::str>(l)) return load_motion_library(l.cast<std::string>(), sc);
@@ -100,8 +97,7 @@ py::dict observation_dict(const Observation& o, long period, const ControlModel&
 // or a list of harmonics dicts (the scene file's plate.harmonics). ValueError naming what was expected.
 Decision decision_of(const py::handle& a, const ControlModel& m) {
     const std::string expected = "expected a library index (0 to " + std::to_string(m.motions() - 1) +
-                                 "), a motion's name, a plate.Scene of period " + num(m.T()) +
-                                 " s or a list of harmonics dicts";
+                                 "), a motion's name, a plate.Scene of period " + num(m.T()) + " s or a list of harmonics dicts";
     if (py::isinstance<py::int_>(a) && !py::isinstance<py::bool_>(a)) {
         const long k = a.cast<long>();
         require(k >= 0 && k < m.motions(), "motion index " + std::to_string(k) + ": not in the library; " + expected);
