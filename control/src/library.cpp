@@ -29,14 +29,19 @@ bool same_part(const Part& a, const Part& b) {
 }   // namespace
 
 MotionLibrary load_motion_library(const std::string& path, const Scene& nominal) {
-    const Reader r{path};
-    const json doc = r.parse(detail::read_input_file(path, "motion library"));
+    return parse_motion_library(detail::read_input_file(path, "motion library"), path,
+                                std::filesystem::path(path).parent_path().string(), nominal);
+}
+
+MotionLibrary parse_motion_library(const std::string& text, const std::string& source, const std::string& dir,
+                                   const Scene& nominal) {
+    const Reader r{source};
+    const json doc = r.parse(text);
     r.only_keys(doc, "", {"motions"}, {"motions"});
     const json& M = doc["motions"];
     if (!M.is_array() || M.empty()) r.fail("motions", "expected a non-empty array of motions");
     MotionLibrary lib;
-    lib.source = path;
-    const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    lib.source = source;
     for (std::size_t k = 0; k < M.size(); ++k) {
         const std::string f = "motions[" + std::to_string(k) + "]";
         const json& m = M[k];
@@ -55,7 +60,7 @@ MotionLibrary load_motion_library(const std::string& path, const Scene& nominal)
             lib.still = static_cast<int>(k);
         } else {
             if (!m["scene"].is_string()) r.fail(f + ".scene", "expected a scene file's path");
-            const std::filesystem::path p = dir / m["scene"].get<std::string>();
+            const std::filesystem::path p = std::filesystem::path(dir) / m["scene"].get<std::string>();
             const Scene sc = load_scene(p.string());
             if (!same_part(sc.part, nominal.part))
                 r.fail(f + ".scene", p.string() + ": its part differs from the controlled scene's (" + nominal.source + ")");

@@ -72,6 +72,7 @@ public:
     // The newest frame stamped at or before t.
     Observation newest(double t) const {
         Observation o;
+        o.t = t;
         for (auto it = frames_.rbegin(); it != frames_.rend(); ++it)
             if (it->stamp <= t + 1e-12 * Tt_) {
                 o.seen = true;
@@ -130,73 +131,117 @@ void summarise(ControlSummary& s, const Goal& goal) {
 
 }   // namespace
 
-ControlSummary run_control(const ControlModel& model, Policy& policy, const Truth& truth, const std::optional<Camera>& camera,
-                           const Goal& goal, const Vec3& q0, const ControlOptions& opt, const std::function<bool()>& keep_going) {
+// The loop's state between periods: the commanded scene, the camera, the rows, the part's plate-frame
+// state (q, qd) on the last period's true plate `prev`/`last_truth`.
+struct ControlLoop::State {
+    Scene cmd;
+    double Tt = 0;
+    long periods = 0, k = 0;
+    LoopCamera cam;
+    IntegrationOptions integration;
+    Truth truth;
+    std::vector<ControlRow> rows;
+    StopEvent stop;
+    Vec3 q, qd = Vec3::Zero();
+    PlateMotion prev;
+    Scene last_truth;
+    State(const Scene& nominal, double Tt_, const std::optional<Camera>& camera)
+        : cmd(nominal), Tt(Tt_), cam(camera, Tt_), last_truth(nominal) {}
+};
+
+ControlLoop::ControlLoop(const ControlModel& model, const Truth& truth, const std::optional<Camera>& camera, const Goal& goal,
+                         const Vec3& q0, const ControlOptions& opt)
+    : model_(&model), goal_(goal) {
     opt.validate();
     truth.validate();
-    Scene cmd = model.nominal;   // the commanded scene of each period
-    const double Tt = true_scene(truth, cmd, -1, 0).plate.T;
+    const double Tt = true_scene(truth, model.nominal, -1, 0).plate.T;
     const long periods = static_cast<long>(std::floor(opt.duration / Tt * (1 + 1e-12)));
     if (periods < 1 || periods > kMaxControlPeriods)
         throw std::invalid_argument("duration: expected 1 to " + std::to_string(kMaxControlPeriods) + " plate periods");
-    LoopCamera cam(camera, Tt);
-    ControlSummary s;
-    s.policy = policy.name();
-    s.rows.reserve(periods + 1);
-    policy.reset(model, goal);
-    Vec3 q = q0, qd = Vec3::Zero();   // at rest on the first period's plate
-    PlateMotion prev;
-    Scene last_truth = cmd;
-    using clock = std::chrono::steady_clock;
-    for (long k = 0; k < periods; ++k) {
-        if (keep_going && !keep_going()) {
-            s.interrupted = true;
-            break;
-        }
-        const double now = k * Tt;
-        const Observation obs = cam.newest(now);
-        const auto t0 = clock::now();
-        const Decision d = policy.decide(obs, k);
-        const double spent = std::chrono::duration<double>(clock::now() - t0).count();
-        if (!d.plate && (d.motion < 0 || d.motion >= model.motions()))
-            throw std::logic_error(policy.name() + ": decided motion " + std::to_string(d.motion) + ", not in the library");
-        cmd.plate = d.plate ? *d.plate : model.library.motions[d.motion];
-        const Scene tru = true_scene(truth, cmd, d.plate ? -1 : d.motion, k);
-        if (k > 0) carry_state(tru.part, prev, tru.plate, q, qd);
-        ControlRow row;
-        row.t = now;
-        if (obs.seen) row.observed = obs.q;
-        row.truth = world_pose_at_phase0(tru, q);
-        row.motion = d.plate ? -1 : d.motion;
-        row.decision_seconds = spent;
-        s.rows.push_back(row);
-        std::vector<double> times = cam.due(now, k == 0);
-        const std::size_t frames = times.size();
-        times.push_back(Tt);
-        times.erase(std::unique(times.begin(), times.end()), times.end());
-        const Trajectory tr = simulate_at(tru, Dynamics::Full, q, qd, times, opt.integration);
-        for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
-            if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) cam.film(tru, tr.samples[f].t, tr.samples[f].q);
-        if (tr.stop.reason != StopReason::None) {
-            s.stop = tr.stop;
-            s.stop.t += now;
-            q = tr.samples.back().q;
-            last_truth = tru;
-            ++s.periods;
-            break;
-        }
-        q = tr.samples.back().q;
-        qd = tr.samples.back().qd;
-        prev = tru.plate;
-        last_truth = tru;
-        ++s.periods;
+    st_ = std::make_unique<State>(model.nominal, Tt, camera);
+    st_->periods = periods;
+    st_->integration = opt.integration;
+    st_->truth = truth;
+    st_->q = q0;   // at rest on the first period's plate
+    st_->rows.reserve(periods + 1);
+}
+ControlLoop::ControlLoop(ControlLoop&&) noexcept = default;
+ControlLoop& ControlLoop::operator=(ControlLoop&&) noexcept = default;
+ControlLoop::~ControlLoop() = default;
+
+long ControlLoop::periods() const { return st_->periods; }
+long ControlLoop::period() const { return st_->k; }
+bool ControlLoop::done() const { return st_->k >= st_->periods || st_->stop.reason != StopReason::None; }
+Observation ControlLoop::observe() const { return st_->cam.newest(st_->k * st_->Tt); }
+Vec3 ControlLoop::true_pose() const { return world_pose_at_phase0(st_->last_truth, st_->q); }
+const StopEvent& ControlLoop::stop() const { return st_->stop; }
+
+void ControlLoop::step(const Decision& d, double decision_seconds) {
+    State& S = *st_;
+    if (done()) throw std::logic_error("the control loop has run its periods");
+    if (!d.plate && (d.motion < 0 || d.motion >= model_->motions()))
+        throw std::invalid_argument("decided motion " + std::to_string(d.motion) + ", not in the library");
+    const long k = S.k;
+    const double now = k * S.Tt;
+    const Observation obs = S.cam.newest(now);
+    S.cmd.plate = d.plate ? *d.plate : model_->library.motions[d.motion];
+    const Scene tru = true_scene(S.truth, S.cmd, d.plate ? -1 : d.motion, k);
+    if (k > 0) carry_state(tru.part, S.prev, tru.plate, S.q, S.qd);
+    ControlRow row;
+    row.t = now;
+    if (obs.seen) row.observed = obs.q;
+    row.truth = world_pose_at_phase0(tru, S.q);
+    row.motion = d.plate ? -1 : d.motion;
+    row.decision_seconds = decision_seconds;
+    S.rows.push_back(row);
+    std::vector<double> times = S.cam.due(now, k == 0);
+    const std::size_t frames = times.size();
+    times.push_back(S.Tt);
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    const Trajectory tr = simulate_at(tru, Dynamics::Full, S.q, S.qd, times, S.integration);
+    for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
+        if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) S.cam.film(tru, tr.samples[f].t, tr.samples[f].q);
+    S.q = tr.samples.back().q;
+    S.last_truth = tru;
+    ++S.k;
+    if (tr.stop.reason != StopReason::None) {
+        S.stop = tr.stop;
+        S.stop.t += now;
+        return;
     }
+    S.qd = tr.samples.back().qd;
+    S.prev = tru.plate;
+}
+
+ControlSummary ControlLoop::summary(const std::string& policy, bool interrupted) const {
+    ControlSummary s;
+    s.policy = policy;
+    s.periods = st_->k;
+    s.stop = st_->stop;
+    s.interrupted = interrupted;
+    s.rows = st_->rows;
     ControlRow last;
-    last.t = s.stop.reason != StopReason::None ? s.stop.t : s.periods * Tt;
-    last.truth = world_pose_at_phase0(last_truth, q);   // (a stop's: at its time, taken at phase 0)
+    last.t = s.stop.reason != StopReason::None ? s.stop.t : s.periods * st_->Tt;
+    last.truth = true_pose();   // (a stop's: at its time, taken at phase 0)
     s.rows.push_back(last);
-    summarise(s, goal);
+    summarise(s, goal_);
     return s;
+}
+
+ControlSummary run_control(const ControlModel& model, Policy& policy, const Truth& truth, const std::optional<Camera>& camera,
+                           const Goal& goal, const Vec3& q0, const ControlOptions& opt, const std::function<bool()>& keep_going) {
+    ControlLoop loop(model, truth, camera, goal, q0, opt);
+    policy.reset(model, goal);
+    using clock = std::chrono::steady_clock;
+    while (!loop.done()) {
+        if (keep_going && !keep_going()) return loop.summary(policy.name(), true);
+        const Observation obs = loop.observe();
+        const auto t0 = clock::now();
+        const Decision d = policy.decide(obs, loop.period());
+        const double spent = std::chrono::duration<double>(clock::now() - t0).count();
+        loop.step(d, spent);
+    }
+    return loop.summary(policy.name());
 }
 
 void write_control_csv(std::ostream& out, const ControlSummary& s, const ControlModel& model, bool point) {

@@ -15,6 +15,12 @@ program, from Python::
     tk = plate.observe(scene, cam, start=(0.03, -0.02, 1.0), time=5.0)   # tk.t, tk.q: what a camera records
     est = plate.identify(scene, [tk], ["mu_k1", "mu_k2", "mu_k3"])     # est.estimates, est.intervals
     plate.write_track_csv(tk, "track.csv"); tk = plate.read_track_csv("track.csv")
+    lib = "scenes/control/fig1_point/library.json"
+    run = plate.control(plate.load_scene("scenes/fig1_point.json"), (0.02, -0.01), library=lib, time=5.0,
+                        start=(-0.04, 0.03), camera=cam)          # run.t, run.truth, run.motion, run.summary
+    run = plate.control(..., policy=lambda obs: "e_fast")      # a Python policy: obs -> a motion, once a period
+    env = plate.ControlEnv(plate.load_scene("scenes/fig1_point.json"), (0.02, -0.01), library=lib, time=5.0)
+    obs = env.reset(seed=0); obs, reward, terminated, truncated, info = env.step("still")   # one plate period
 
 Results carry numpy arrays and ``summary``, the command line's JSON as a dict.  Errors raise
 ``plate.InputError`` (a ValueError; bad scenes, with the file and field named as the command line
@@ -23,16 +29,16 @@ names them), ValueError (bad options) or RuntimeError.  The GIL is released whil
 import json as _json
 from typing import Any, Dict
 
-from ._plate import (Camera, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
-                     Robustness, Scene, Stop, Track, Trajectory, axis_peaks, check_track_scene, coning_rate, design, field,
+from ._plate import (Camera, ControlEnv, ControlRun, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
+                     Robustness, Scene, Stop, Track, Trajectory, axis_peaks, check_track_scene, coning_rate, control, design, field,
                      fixed_points, frame_stamps, identify, load_camera, load_scene, observe, observe_at,
                      orientation_harmonics, parse_camera, parse_scene, read_track_csv, robustness, scene_id, simulate,
                      twist, uncertain_parameters, write_track_csv)
 from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
-__all__ = ["Camera", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "Identification", "InputError",
-           "Robustness", "Scene", "Stop", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "design",
+__all__ = ["Camera", "ControlEnv", "ControlRun", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "Identification", "InputError",
+           "Robustness", "Scene", "Stop", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "control", "design",
            "field", "fixed_points", "frame_stamps", "identify", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
            "parse_camera", "parse_scene", "read_track_csv", "robustness", "scene_from_dict", "scene_id", "scene_to_dict",
            "simulate", "twist", "uncertain_parameters", "write_track_csv"]

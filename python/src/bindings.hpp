@@ -5,6 +5,7 @@
 
 #include "plate/design.hpp"
 #include "plate/field.hpp"
+#include "plate/observe.hpp"
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
 
@@ -34,6 +35,7 @@ void bind_simulate(py::module_& m);       // simulate.cpp: Trajectory, simulate
 void bind_robustness(py::module_& m);     // robustness.cpp: Robustness, robustness, uncertain_parameters
 void bind_observe(py::module_& m);        // observe.cpp:  Camera, Track, observe, read_track_csv, ...
 void bind_identify(py::module_& m);       // identify.cpp: Identification, identify
+void bind_control(py::module_& m);        // control.cpp:  ControlRun, control, ControlEnv
 
 // --- conversions (conversions.cpp) ---------------------------------------------------------------
 
@@ -61,6 +63,10 @@ T renamed(const std::optional<T>& now, const std::optional<T>& old, const char* 
     if (PyErr_WarnEx(PyExc_DeprecationWarning, msg.c_str(), 1) != 0) throw py::error_already_set();
     return *old;
 }
+
+// A camera from a plate.Camera, a camera file's path (str) or a dict in the file's form (checked as a
+// file is: plate.InputError). observe.cpp.
+Camera camera_of(const py::object& c);
 
 // A numpy array of the given shape holding data (row-major).
 py::array_t<double> array(const std::vector<double>& data, std::vector<py::ssize_t> shape);

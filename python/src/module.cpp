@@ -36,4 +36,5 @@ PYBIND11_MODULE(_plate, m) {
     bind_robustness(m);
     bind_observe(m);
     bind_identify(m);
+    bind_control(m);
 }

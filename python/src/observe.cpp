@@ -9,16 +9,14 @@
 
 namespace plate::python {
 
-namespace {
-
-// A camera from a plate.Camera, a camera file's path (str) or a dict in the file's form (checked as a
-// file is: plate.InputError).
 Camera camera_of(const py::object& c) {
     if (py::isinstance<Camera>(c)) return c.cast<Camera>();
     if (py::isinstance<py::str>(c)) return load_camera(c.cast<std::string>());
     require(py::isinstance<py::dict>(c), "camera: expected a plate.Camera, a camera file's path or a dict in its form");
     return parse_camera(py::module_::import("json").attr("dumps")(c).cast<std::string>(), "<dict>");
 }
+
+namespace {
 
 // plate.observe and plate.observe_at: the options checked, `run` (the library's observe or observe_at)
 // called without the GIL, the track returned with the run's stop as track.stop.

@@ -207,12 +207,20 @@ def test_the_point_part_breaks_away_when_the_needed_force_reaches_mu_N():
     assert tr.events[1][0] == pytest.approx(hi, rel=1e-9)
 
 
-def test_the_gil_is_released_while_a_field_is_computed():
-    # The main thread counts while a worker thread computes a field. Were the GIL held through the
-    # call, the main thread could count for at most about one switch interval of it; released, it
-    # counts all along (even sharing the cores with other work: the bound asks for 4 intervals' worth
-    # while the worker computes fields for at least 60 intervals, one after another).
-    sc = plate.load_scene(scene_path("fig4"))
+def control_run():
+    # A long loop (6000 periods, about 0.5 s) on a library whose model is built in a millisecond.
+    lib = {"motions": [{"name": "e", "scene": os.path.join(SOURCE, "scenes", "control", "fig1_point", "e_slow.json")},
+                       {"name": "still", "still": True}]}
+    plate.control(plate.load_scene(scene_path("fig1_point")), (0.02, -0.01), library=lib, time=300.0)
+
+
+@pytest.mark.parametrize("call", [lambda: plate.field(plate.load_scene(scene_path("fig4")), grid=9, threads=1), control_run],
+                         ids=["field", "control"])
+def test_the_gil_is_released_while_the_library_works(call):
+    # The main thread counts while a worker thread computes a field (or runs a closed loop). Were the GIL
+    # held through the call, the main thread could count for at most about one switch interval of it;
+    # released, it counts all along (even sharing the cores with other work: the bound asks for 4
+    # intervals' worth while the worker calls for at least 60 intervals, one call after another).
     interval = sys.getswitchinterval()
     state = {"done": False, "count": 0}
 
@@ -228,7 +236,7 @@ def test_the_gil_is_released_while_a_field_is_computed():
     def work():
         state["start"] = (time.perf_counter(), state["count"])
         while time.perf_counter() - state["start"][0] < 60 * interval:   # however fast the machine
-            plate.field(sc, grid=9, threads=1)
+            call()
         state["end"] = (time.perf_counter(), state["count"])
         state["done"] = True
 
@@ -238,7 +246,7 @@ def test_the_gil_is_released_while_a_field_is_computed():
     t.join()
     seconds = state["end"][0] - state["start"][0]
     counted = state["end"][1] - state["start"][1]
-    assert seconds > 20 * interval, "the field must outlast many switch intervals for this test to mean anything"
+    assert seconds > 20 * interval, "the calls must outlast many switch intervals for this test to mean anything"
     assert counted > 4 * interval * rate, (counted, interval * rate)
 
 

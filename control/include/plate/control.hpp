@@ -92,6 +92,9 @@ struct MotionLibrary {
     int still = -1;                     // the still plate's index, -1 if none
 };
 MotionLibrary load_motion_library(const std::string& path, const Scene& nominal);   // throws InputError
+// The same from the file's text; `source` names it in messages, scene paths are relative to `dir`.
+MotionLibrary parse_motion_library(const std::string& text, const std::string& source, const std::string& dir,
+                                   const Scene& nominal);
 
 // A motion's field as the controller reads it: uniform (a plate that only translates, with a point
 // part: nothing in its dynamics depends on where the part is, so one twist serves everywhere) or
@@ -154,6 +157,7 @@ struct Goal {
 // What the controller sees at a decision: the newest frame it has (a frame stamped at or before the
 // decision's time), the time of the state it shows, and whether any frame has arrived.
 struct Observation {
+    double t = 0;   // the decision's time k T [s] (T the true plate's period)
     bool seen = false;
     double stamp = 0;        // [s]
     double state_time = 0;   // stamp - latency [s]
@@ -232,11 +236,45 @@ struct ControlSummary {
     std::vector<ControlRow> rows;
 };
 
+// The loop a period at a time, for a caller that decides itself (Python's ControlEnv): observe() what
+// the camera shows at the period's start, step() the period with a decision, summary() at any time.
+// run_control is this with a Policy deciding. Construction validates opt and truth and starts the part at
+// rest on the plate at q0; the camera's frames are drawn as run_control draws them.
+class ControlLoop {
+public:
+    ControlLoop(const ControlModel& model, const Truth& truth, const std::optional<Camera>& camera, const Goal& goal,
+                const Vec3& q0, const ControlOptions& opt = {});
+    ControlLoop(ControlLoop&&) noexcept;
+    ControlLoop& operator=(ControlLoop&&) noexcept;
+    ~ControlLoop();
+    long periods() const;          // the run's length: whole periods of the true plate within opt.duration
+    long period() const;           // the next period's index k
+    bool done() const;             // every period run, or the truth's dynamics stopped
+    Observation observe() const;   // the camera's newest frame at t = k T
+    // Runs period k on decision d (a library index, or the policy's own motion when d.plate is set;
+    // std::invalid_argument for an index outside the library, std::logic_error when done()): the row
+    // (decision_seconds recorded in it), the true dynamics from the carried state, the frames.
+    void step(const Decision& d, double decision_seconds = 0);
+    // The part's world pose at phase 0 of the last period's true plate (at q0 before the first step): the
+    // run's end row would show it.
+    Vec3 true_pose() const;
+    const StopEvent& stop() const;
+    // The rows so far and the end row, summarised under the policy's name (interrupted: keep_going said stop).
+    ControlSummary summary(const std::string& policy, bool interrupted = false) const;
+
+private:
+    struct State;
+    const ControlModel* model_;
+    Goal goal_;
+    std::unique_ptr<State> st_;
+};
+
 // Runs the loop from the part at rest on the plate at q0, for options.duration: each period the policy
 // decides from the camera's newest frame, the true plate (true_scene) runs the motion through the full
 // dynamics from the carried state (carry_state at every boundary), the camera films (one stroboscopic
 // frame per period of the true plate: noise, latency, drops -- observe.hpp's Camera; nullopt: a perfect
 // camera at phase 0). `keep_going` (if set) is asked each period; false ends the run (interrupted).
+// A ControlLoop stepped with the policy's decisions.
 ControlSummary run_control(const ControlModel& model, Policy& policy, const Truth& truth, const std::optional<Camera>& camera,
                            const Goal& goal, const Vec3& q0, const ControlOptions& opt = {},
                            const std::function<bool()>& keep_going = {});
