@@ -89,6 +89,17 @@ void axis_cell(double x, double x0, double h, int n, int& i, double& w) {
     w = u - i;
 }
 
+// A point part, or a rigid part whose contacts share one friction coefficient (kinetic and static): on a
+// plate that only translates the latter moves as the point part does, without turning, at every
+// position and orientation (design_target.hpp's transport), so its field there is uniform too.
+bool moves_as_point(const Part& part) {
+    if (part.point) return true;
+    const ContactFriction mu = part.friction();
+    for (int i = 1; i < part.contacts(); ++i)
+        if (mu.kinetic(i) != mu.kinetic(0) || mu.static_(i) != mu.static_(0)) return false;
+    return true;
+}
+
 }   // namespace
 
 Vec3 MotionField::at(const Vec3& q) const {
@@ -134,7 +145,7 @@ ControlModel build_control_model(const Scene& nominal, MotionLibrary library, co
         const bool translates = std::all_of(u.harmonics.begin(), u.harmonics.end(), [](const Harmonic& h) {
             return h.axis == Axis::x || h.axis == Axis::y || h.axis == Axis::z;
         });
-        if (u.harmonics.empty() || (nominal.part.point && translates)) {
+        if (u.harmonics.empty() || (translates && moves_as_point(nominal.part))) {
             fld.uniform = true;
             Vec3 xi = Vec3::Zero();   // a still plate: a part at rest stays put
             try {
@@ -161,7 +172,8 @@ ControlModel build_control_model(const Scene& nominal, MotionLibrary library, co
 }
 
 Vec3 ControlModel::step(int from, int to, const Vec3& q) const {
-    if (from < 0 || from == to || transitions.empty()) return fields[to].at(q) * T();
+    if (from < 0 || from == to || transitions.empty() || transitions[from * motions() + to].twist.empty())
+        return fields[to].at(q) * T();
     return transitions[from * motions() + to].at(q) * T();
 }
 

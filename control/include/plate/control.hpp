@@ -97,7 +97,8 @@ MotionLibrary parse_motion_library(const std::string& text, const std::string& s
                                    const Scene& nominal);
 
 // A motion's field as the controller reads it: uniform (a plate that only translates, with a point
-// part: nothing in its dynamics depends on where the part is, so one twist serves everywhere) or
+// part or a rigid part whose contacts share one friction coefficient, which moves as that point part
+// without turning: nothing in its dynamics depends on where the part is, so one twist serves everywhere) or
 // tabulated on a grid over the region and interpolated (bilinear in (s_x, s_y) for a point part;
 // trilinear with periodic theta for a rigid part). Outside the grid the nearest edge's value.
 struct MotionField {
@@ -111,7 +112,11 @@ struct ControlModelOptions {
     GridSpec grid;   // where fields that are not uniform are tabulated (point parts: nth 1)
     FieldOptions field;
     bool transitions = true;   // tabulate the first period after each switch (ControlModel::transitions)
-    void validate() const;     // std::invalid_argument naming the option
+    // Also the pairs where a field is tabulated on the grid (M (M - 1) one-period runs per grid point:
+    // affordable on a point part's 2-D grid, not on a rigid part's 3-D one); false: those pairs step by
+    // the new motion's field.
+    bool grid_transitions = true;
+    void validate() const;   // std::invalid_argument naming the option
 };
 
 // The controller's constant model: the nominal scene, the library and each motion's field,
@@ -125,9 +130,9 @@ struct ControlModel {
     // velocity (and, in the world, keeps it: carry_state), which b's cycle does not share (entering
     // scenes/designs/point_sink.json from a 2 mm/period transport: a ~1.6 mm kick). transitions[a * M + b] holds that period's
     // world displacement divided by T, from the nominal full dynamics: the part settled kSettlePeriods on a's cycle, carried to
-    // b, one period of b. Pairs of uniform fields are computed once; others on the grid: M (M - 1) one-period runs per grid point
-    // where a field is not uniform (a rigid part's 3-D grid with a large library is costly: coarsen the grid or turn them off).
-    // Empty when ControlModelOptions::transitions is false.
+    // b, one period of b. Pairs of uniform fields are computed once; others on the grid (unless grid_transitions is false): M (M
+    // - 1) one-period runs per grid point where a field is not uniform (a rigid part's 3-D grid with a large library is costly:
+    // coarsen the grid or turn them off). Empty when ControlModelOptions::transitions is false.
     std::vector<MotionField> transitions;
     double T() const { return nominal.plate.T; }
     int motions() const { return static_cast<int>(library.motions.size()); }
@@ -186,10 +191,22 @@ public:
 // holds the still plate (if the library has one), averaging the frames while the part rests there, and
 // leaves it only beyond stop_radius + hysteresis; elsewhere it keeps its motion unless another lands
 // nearer by more than `hysteresis`.
+//
+// A rigid part (two_phase, the default): the motions split into those that keep its orientation (the
+// still plate and uniform fields -- translating plates, which do not turn a part whose contacts share
+// one friction coefficient) and those that turn it. While the orientation is off by more than
+// turn_enter (a fraction of the goal's tolerance_theta) it turns: the turning motion whose theta, kept
+// for `horizon` periods, stays nearest the goal's on average, until within turn_exit; then the position
+// is steered with the keeping motions as for a point part (the distance is the position's), and the
+// orientation, which they do not change, is the mean of the frames since the turning ended (the
+// camera's noise shrinks as 1/sqrt(n)). false: one choice over every motion by Goal::distance.
 struct LibraryPolicyOptions {
     double stop_radius = 0.5e-3;   // [m], weighted distance; 0: never stop
     double hysteresis = 0.1e-3;    // [m]
     int horizon = 2;               // [periods], 1 to kMaxHorizon
+    bool two_phase = true;         // rigid parts only
+    double turn_enter = 0.6;       // of Goal::tolerance_theta, in (turn_exit, 1]
+    double turn_exit = 0.25;       // of Goal::tolerance_theta, in (0, turn_enter)
     void validate() const;         // std::invalid_argument naming the option
 };
 inline constexpr int kMaxHorizon = 1000;
