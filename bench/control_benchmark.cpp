@@ -10,11 +10,13 @@
 //   bench_control [--rigid] [--starts N] [--first SEED] [--duration S] [--scene SCENE] [--library LIB]
 //                 [--goal X Y [THETA]] [--horizon H] [--transitions 0|1] [--grid-transitions 0|1]
 //                 [--friction-scale F] [--spread S] [--single-phase] [--open-loop SCENE] [--open-loop-time S]
+//                 [--open-loop-tol MM RAD]
 // Defaults: the point-part target (scenes/fig1_point.json, scenes/control/fig1_point/library.json,
 // goal (0.02, -0.01), 15 s runs, target 10 s). --rigid: the rigid-part target (scenes/fig4.json,
 // scenes/control/fig4/library.json, goal (0.02, -0.01, 0.5), 40 s runs, target 30 s) and, beside each
 // start, the open-loop fixed-point design scenes/designs/fig4_fixed_point.json run on the same truth
-// from the same start (its time to goal, cap --open-loop-time, default 300 s). --single-phase: a rigid
+// from the same start (its time to goal, cap --open-loop-time, default 300 s; judged within --open-loop-tol,
+// default the goal's 1 mm and 0.02 rad). --single-phase: a rigid
 // part's one weighted distance (LibraryPolicyOptions::two_phase false, theta weighted by rho).
 // --spread: the tracking errors' (amplitude relative, phase rad; default 0.03); --grid-transitions 1: the
 // rigid part's transition table also for the turning motions (on the 3-D grid).
@@ -37,6 +39,7 @@ namespace {
 struct Args {
     int starts = 20, first = 0;
     double duration = 15, target = 10, friction_scale = 0.8, open_loop_time = 300, spread = 0.03;
+    double open_loop_tol = 1e-3, open_loop_tol_theta = 0.02;
     std::string scene, library, open_loop;
     Vec3 goal = Vec3(0.02, -0.01, 0);
     bool rigid = false;
@@ -94,7 +97,10 @@ Args parse(int argc, char** argv) {
             a.open_loop = next();
         else if (o == "--open-loop-time")
             a.open_loop_time = std::stod(next());
-        else
+        else if (o == "--open-loop-tol") {
+            a.open_loop_tol = std::stod(next()) * 1e-3;
+            a.open_loop_tol_theta = std::stod(next());
+        } else
             throw std::invalid_argument("unknown option " + o);
     }
     return a;
@@ -202,7 +208,10 @@ int main(int argc, char** argv) try {
             ControlOptions olo;
             olo.duration = a.open_loop_time;
             const auto t1 = std::chrono::steady_clock::now();
-            const ControlSummary o = run_control(ol, always, truth, std::nullopt, goal, q0, olo);
+            Goal ol_goal = goal;
+            ol_goal.tolerance = a.open_loop_tol;
+            ol_goal.tolerance_theta = a.open_loop_tol_theta;
+            const ControlSummary o = run_control(ol, always, truth, std::nullopt, ol_goal, q0, olo);
             const double ol_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
             ol_reached += o.reached;
             ol_worst = std::max(ol_worst, o.reached ? o.time_to_goal : 1e300);
@@ -215,8 +224,8 @@ int main(int argc, char** argv) try {
     std::printf("reached and held: %d/%d; within %g s: %d/%d; slowest %.3g s; largest decision %.3g ms (target 1 ms)\n", reached,
                 a.starts, a.target, met, a.starts, worst_time, worst_decision * 1e3);
     if (!a.open_loop.empty())
-        std::printf("open loop (%s): reached and held %d/%d within %g s; slowest %.3g s\n", a.open_loop.c_str(), ol_reached,
-                    a.starts, a.open_loop_time, ol_worst);
+        std::printf("open loop (%s): within %g mm and %g rad and held %d/%d within %g s; slowest %.3g s\n", a.open_loop.c_str(),
+                    a.open_loop_tol * 1e3, a.open_loop_tol_theta, ol_reached, a.starts, a.open_loop_time, ol_worst);
     std::printf("machine: %s, %u hardware threads (one used)\n", bench::machine().c_str(), std::thread::hardware_concurrency());
     return 0;
 } catch (const std::exception& e) {

@@ -76,6 +76,26 @@ Vec3 sink_point(const Scene& sc, Vec3 q) {
     return q;
 }
 
+// Each motion of the model kept for 50 periods from rest at q0 on a perfect truth: the world displacement
+// over periods 5 to 45 (rows at phase 0 of the same motion, the part on its cycle) is 40 xi T to `tol`,
+// and the heading does not change (1e-9 rad).
+void check_transports(const ControlModel& model, const Vec3& q0, double tol) {
+    for (int m = 0; m < model.motions(); ++m) {
+        Always policy(m);
+        ControlOptions opt;
+        opt.duration = 2.5;
+        const ControlSummary s = run_control(model, policy, Truth{}, std::nullopt, Goal{}, q0, opt);
+        REQUIRE(s.periods == 50);
+        const Vec3 moved = s.rows[45].truth - s.rows[5].truth;
+        const Vec3 predicted = model.fields[m].at(Vec3::Zero()) * (40 * model.T());
+        INFO("motion " << model.library.names[m] << ": moved " << moved.transpose() << ", predicted " << predicted.transpose()
+                       << ", off by " << (moved - predicted).norm());
+        CHECK_THAT(moved.x(), WithinAbs(predicted.x(), tol));
+        CHECK_THAT(moved.y(), WithinAbs(predicted.y(), tol));
+        CHECK_THAT(s.rows[45].truth.z() - s.rows[0].truth.z(), WithinAbs(0, 1e-9));
+    }
+}
+
 }   // namespace
 
 TEST_CASE("a goal at one motion's fixed point: the controller settles on that motion and the part stays there", "[control]") {
@@ -119,20 +139,7 @@ TEST_CASE("a perfect truth on a translating plate moves the part by xi T a perio
     // averaged field); tolerance 1e-7 m. A loop that restarted the part from rest on the plate each
     // period (its velocity not carried) is 0.24 m off.
     const Scene part = load_scene(kScenes + "fig1_point.json");
-    const ControlModel model = build_control_model(part, library_of(part, {"ne_fast", "w_mid"}));
-    for (int m = 0; m < 2; ++m) {
-        Always policy(m);
-        ControlOptions opt;
-        opt.duration = 2.5;
-        const ControlSummary s = run_control(model, policy, Truth{}, std::nullopt, Goal{}, Vec3(-0.01, 0.01, 0), opt);
-        REQUIRE(s.periods == 50);
-        const Vec3 moved = s.rows[45].truth - s.rows[5].truth;
-        const Vec3 predicted = model.fields[m].at(Vec3::Zero()) * (40 * part.plate.T);
-        INFO("motion " << model.library.names[m] << ": moved " << moved.transpose() << ", predicted " << predicted.transpose()
-                       << ", off by " << (moved - predicted).norm());
-        CHECK_THAT(moved.x(), WithinAbs(predicted.x(), 1e-7));
-        CHECK_THAT(moved.y(), WithinAbs(predicted.y(), 1e-7));
-    }
+    check_transports(build_control_model(part, library_of(part, {"ne_fast", "w_mid"})), Vec3(-0.01, 0.01, 0), 1e-7);
 }
 
 TEST_CASE("at a switch the part's world velocity is continuous: its plate-frame velocity jumps by the plate's change",
@@ -187,18 +194,8 @@ TEST_CASE("fig4's part on a translating plate keeps its orientation and moves at
     for (int m = 0; m < 2; ++m) {
         REQUIRE(model.fields[m].uniform);
         CHECK(std::abs(model.fields[m].at(Vec3::Zero()).z()) < 1e-9);
-        Always policy(m);
-        ControlOptions opt;
-        opt.duration = 2.5;
-        const ControlSummary s = run_control(model, policy, Truth{}, std::nullopt, Goal{}, Vec3(-0.01, 0.01, 1.2), opt);
-        REQUIRE(s.periods == 50);
-        const Vec3 moved = s.rows[45].truth - s.rows[5].truth;
-        const Vec3 predicted = model.fields[m].at(Vec3::Zero()) * (40 * part.plate.T);
-        INFO("motion " << model.library.names[m] << ": moved " << moved.transpose() << ", predicted " << predicted.transpose());
-        CHECK_THAT(moved.x(), WithinAbs(predicted.x(), 2.5e-6));
-        CHECK_THAT(moved.y(), WithinAbs(predicted.y(), 2.5e-6));
-        CHECK_THAT(s.rows[45].truth.z() - s.rows[0].truth.z(), WithinAbs(0, 1e-9));
     }
+    check_transports(model, Vec3(-0.01, 0.01, 1.2), 2.5e-6);
 }
 
 TEST_CASE("the library policy turns fig4's part, then steers it to (0.02, -0.01, 0.5) and holds it there", "[control]") {
@@ -213,7 +210,6 @@ TEST_CASE("the library policy turns fig4's part, then steers it to (0.02, -0.01,
     mo.grid.nth = 8;
     mo.grid.x0 = mo.grid.y0 = -0.04;
     mo.grid.x1 = mo.grid.y1 = 0.04;
-    mo.grid_transitions = false;
     mo.field.threads = 1;
     const ControlModel model =
         build_control_model(part,

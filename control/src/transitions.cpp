@@ -44,6 +44,7 @@ void add_transitions(ControlModel& m, const ControlModelOptions& opt) {
     const int M = m.motions();
     m.transitions.assign(static_cast<std::size_t>(M) * M, MotionField{});
     const IntegrationOptions io;
+    const bool grid_pairs = opt.grid_transitions.value_or(m.nominal.part.point);
     GridSpec g = opt.grid;
     if (m.nominal.part.point) g.nth = 1;
     for (int a = 0; a < M; ++a) {
@@ -53,7 +54,7 @@ void add_transitions(ControlModel& m, const ControlModelOptions& opt) {
         std::vector<Vec3> v_a;
         if (m.fields[a].uniform)
             v_a.assign(g.size(), cycle_velocity(sa, Vec3::Zero(), io));
-        else if (opt.grid_transitions)
+        else if (grid_pairs)
             for (int n = 0; n < g.size(); ++n)
                 v_a.push_back(cycle_velocity(sa, g.at(n / (g.ny * g.nth), n / g.nth % g.ny, n % g.nth), io));
         for (int b = 0; b < M; ++b) {
@@ -67,7 +68,7 @@ void add_transitions(ControlModel& m, const ControlModelOptions& opt) {
                 f.twist = {first_period_step(sa, sb, Vec3::Zero(), v_a[0], io) / m.T()};
                 continue;
             }
-            if (!opt.grid_transitions) continue;   // left empty: ControlModel::step takes b's field
+            if (!grid_pairs) continue;   // left empty: ControlModel::step takes b's field
             f.grid = g;
             f.twist.resize(g.size());
             for (int i = 0; i < g.nx; ++i)

@@ -112,10 +112,10 @@ struct ControlModelOptions {
     GridSpec grid;   // where fields that are not uniform are tabulated (point parts: nth 1)
     FieldOptions field;
     bool transitions = true;   // tabulate the first period after each switch (ControlModel::transitions)
-    // Also the pairs where a field is tabulated on the grid (M (M - 1) one-period runs per grid point:
-    // affordable on a point part's 2-D grid, not on a rigid part's 3-D one); false: those pairs step by
-    // the new motion's field.
-    bool grid_transitions = true;
+    // Also the pairs where a field is tabulated on the grid (M (M - 1) one-period runs per grid point);
+    // false: those pairs step by the new motion's field. Unset: on a point part's 2-D grid, not on a rigid
+    // part's 3-D one (fig4's library: 84 s against 1.3 s, for nothing measurable; docs/decisions/control.md).
+    std::optional<bool> grid_transitions;
     void validate() const;   // std::invalid_argument naming the option
 };
 
@@ -130,7 +130,7 @@ struct ControlModel {
     // velocity (and, in the world, keeps it: carry_state), which b's cycle does not share (entering
     // scenes/designs/point_sink.json from a 2 mm/period transport: a ~1.6 mm kick). transitions[a * M + b] holds that period's
     // world displacement divided by T, from the nominal full dynamics: the part settled kSettlePeriods on a's cycle, carried to
-    // b, one period of b. Pairs of uniform fields are computed once; others on the grid (unless grid_transitions is false): M (M
+    // b, one period of b. Pairs of uniform fields are computed once; others on the grid (as grid_transitions says): M (M
     // - 1) one-period runs per grid point where a field is not uniform (a rigid part's 3-D grid with a large library is costly:
     // coarsen the grid or turn them off). Empty when ControlModelOptions::transitions is false.
     std::vector<MotionField> transitions;
