@@ -34,12 +34,13 @@ public:
         rest_frames_ = 0;
         last_stamp_ = -1;
         keeps_.assign(model.motions(), false);
-        bool turns = false;
+        bool turns = false, carries = false;   // some motion turns the part; some carries it without
         for (int k = 0; k < model.motions(); ++k) {
             keeps_[k] = model.fields[k].uniform;
             turns = turns || !keeps_[k];
+            carries = carries || (keeps_[k] && k != model.library.still);
         }
-        rigid_ = opt_.two_phase && !model.nominal.part.point && turns;
+        rigid_ = opt_.two_phase && !model.nominal.part.point && turns && carries;
         position_goal_ = goal;
         position_goal_.point = true;   // its distance: the position's alone
         turning_ = false;

@@ -199,7 +199,8 @@ public:
 // for `horizon` periods, stays nearest the goal's on average, until within turn_exit; then the position
 // is steered with the keeping motions as for a point part (the distance is the position's), and the
 // orientation, which they do not change, is the mean of the frames since the turning ended (the
-// camera's noise shrinks as 1/sqrt(n)). false: one choice over every motion by Goal::distance.
+// camera's noise shrinks as 1/sqrt(n)). false, or a library without both kinds of motion (a part whose
+// contacts' friction differs has no uniform field): one choice over every motion by Goal::distance.
 struct LibraryPolicyOptions {
     double stop_radius = 0.5e-3;   // [m], weighted distance; 0: never stop
     double hysteresis = 0.1e-3;    // [m]
