@@ -67,7 +67,7 @@ TEST_CASE("plate control: bad input files exit 2 naming the file and the field, 
 
 TEST_CASE("plate control: a run writes a row per period with units and its summary", "[control][cli]") {
     const std::string out = (tmpdir() / "run.csv").string();
-    const Run r = run(kBase + kLibrary + "--from 0.019 -0.01 --out " + out);
+    const Run r = run(kBase + kLibrary + "--start 0.019 -0.01 --out " + out);
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Contains("\"reached\": true"));
     const std::string csv = slurp(out);

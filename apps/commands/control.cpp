@@ -14,7 +14,7 @@ namespace {
 
 struct ControlArgs : Options {
     std::string scene, policy, library, camera, truth, out;
-    std::vector<double> goal, from;
+    std::vector<double> goal, start;
     double time = 0, tol = Goal{}.tolerance, tol_theta = Goal{}.tolerance_theta, theta_weight = Goal{}.theta_weight;
     double stop_radius = LibraryPolicyOptions{}.stop_radius, hysteresis = LibraryPolicyOptions{}.hysteresis;
     int horizon = LibraryPolicyOptions{}.horizon;
@@ -25,7 +25,7 @@ struct ControlArgs : Options {
     }();
     explicit ControlArgs(CLI::App& app)
         : Options(app, "control", "closed-loop control: a policy steers the part from camera frames, CSV",
-                  "Steers the part of SCENE from --from (default: the origin) to --goal, choosing each plate period's\n"
+                  "Steers the part of SCENE from --start (default: the origin) to --goal, choosing each plate period's\n"
                   "motion from what a camera sees (--camera CAM.json: one stroboscopic frame per period, with noise,\n"
                   "latency and drops; default: a perfect camera), against a true plate and part (--truth TRUTH.json:\n"
                   "the scene perturbed by an uncertainty spec, tracking errors drawn per period, friction scaled;\n"
@@ -44,7 +44,7 @@ struct ControlArgs : Options {
                   "as JSON. Exit 1 if the goal is not reached and held at the end, 3 if the true part loses contact.\n") {
         scene_file(scene);
         numbers("--goal", goal, 2, 3, "X Y [THETA]", "the goal (point parts: X Y); required");
-        numbers("--from", from, 2, 3, "SX SY [THETA]", "the start, at rest on the plate");
+        numbers("--start", start, 2, 3, "SX SY [THETA]", "the start, at rest on the plate");
         text("--policy", policy, "library", "the policy; required");
         text("--library", library, "LIB.json", "library: the motions");
         text("--camera", camera, "CAMERA.json", "the camera (stroboscopic, one frame per period)");
@@ -71,7 +71,7 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     goal.theta_weight = a.theta_weight;
     if (!(a.tol > 0) || !(a.tol_theta > 0) || !(a.theta_weight >= 0))
         throw UsageError("--tol and --tol-theta must be > 0, --theta-weight >= 0");
-    const Vec3 q0 = config_arg(a, "--from", a.from, sc, false);
+    const Vec3 q0 = config_arg(a, "--start", a.start, sc, false);
     if (!a.has("--policy")) throw UsageError("missing --policy library");
     if (a.policy != "library") throw UsageError("--policy: expected library (mpc and python are to come)");
     if (!a.has("--library")) throw UsageError("--policy library needs --library LIB.json");

@@ -33,7 +33,7 @@ def test_the_library_policy_gives_the_command_lines_run_to_the_bit(tmp_path):
     (tmp_path / "truth.json").write_text(json.dumps(TRUTH))
     (tmp_path / "camera.json").write_text(json.dumps(CAMERA))
     out = tmp_path / "run.csv"
-    cli = subprocess.run([EXE, "control", SCENE, "--goal", "0.02", "-0.01", "--from", "-0.04", "0.03", "--policy",
+    cli = subprocess.run([EXE, "control", SCENE, "--goal", "0.02", "-0.01", "--start", "-0.04", "0.03", "--policy",
                           "library", "--library", LIBRARY, "--camera", str(tmp_path / "camera.json"), "--truth",
                           str(tmp_path / "truth.json"), "--time", "3", "--out", str(out)], capture_output=True, text=True)
     assert cli.returncode == 0, cli.stderr
