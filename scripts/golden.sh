@@ -7,8 +7,9 @@
 # What is checked: the field (JSON and CSV) and fixed points of every shipped scene, twists at a
 # configuration, full / U / averaged trajectories, random scenes, Theorem 1's proofs JSON, the point sink,
 # line sink, transport, orienter and fig4 fixed-point designs (summary and scene) and a campaign's table.
-# Wall-clock figures (seconds, threads, timing.csv, the machine) are taken out before hashing: everything
-# else must agree to the bit. --quick leaves out the two slowest (fig4's fixed-point design, the campaign).
+# Wall-clock figures (seconds, threads, timing.csv, the machine) and statements of units are taken out
+# before hashing, and CSV numbers are compared as the doubles they read back to: everything else must
+# agree to the bit. --quick leaves out the two slowest (fig4's fixed-point design, the campaign).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -18,7 +19,7 @@ import json, re, sys
 path, out = sys.argv[1], sys.argv[2]
 text = open(path).read().replace(out, "OUT")
 TIMING = {"seconds", "threads", "machine", "wall_seconds", "elapsed", "decision_seconds", "cpu_seconds",
-          "busy_seconds", "load_balance_efficiency"}
+          "busy_seconds", "load_balance_efficiency", "units"}
 def strip(x, key=None):
     if isinstance(x, dict):
         return {k: strip(v, k) for k, v in x.items() if k not in TIMING}
@@ -43,10 +44,20 @@ elif path.endswith(".jsonl"):   # (a journal's lines come in the order the cases
     for line in sorted(json.dumps(strip(json.loads(l)), sort_keys=True) for l in text.splitlines()):
         print(line)
 else:
-    # CSV and text: lines that name a wall-clock figure are dropped
-    for line in text.splitlines():
+    # CSV and text: lines that name a wall-clock figure are dropped; a CSV's headings lose their units
+    # and its numbers are written shortest, so that a change of notation alone (issue 54: 17 digits ->
+    # std::to_chars, units in the headings) compares equal while any changed value does not
+    def cell(c):
+        try:
+            return repr(float(c)) if re.fullmatch(r"[-+0-9.eE]+", c) and not re.fullmatch(r"[-+]?[0-9]+", c) else c
+        except ValueError:
+            return c
+    csv = path.endswith(".csv")
+    for k, line in enumerate(text.splitlines()):
         if re.search(r"seconds|threads|machine|wall", line) and line.startswith("#"):
             continue
+        if csv and not line.startswith("#"):
+            line = ",".join(re.sub(r" \[[^]]*\]$", "", cell(c)) for c in line.split(","))
         print(line)
 EOF
 }

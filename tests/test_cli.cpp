@@ -177,7 +177,7 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     Run r = run("field " + kScenes + "fig4.json --grid 2 --format csv --out " + out.string());
     REQUIRE(r.code == 0);
     const std::string csv = slurp(out);
-    CHECK(csv.rfind("s_x,s_y,theta,v_x,v_y,omega,", 0) == 0);
+    CHECK(csv.rfind("s_x [m],s_y [m],theta [rad],v_x [m/s],v_y [m/s],omega [rad/s],", 0) == 0);
     CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 8);
     r = run("field " + kScenes + "fig1_point.json --grid 3");
     REQUIRE(r.code == 0);
@@ -186,7 +186,8 @@ TEST_CASE("plate field writes JSON and CSV, simulate writes a CSV with a header"
     r = run("simulate " + kScenes + "fig4.json --dynamics full --start 0.02 0.01 0.5 --time 0.5 --out " + sim.string());
     REQUIRE(r.code == 0);
     const std::string s = slurp(sim);
-    CHECK(s.rfind("t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n", 0) == 0);
+    CHECK(s.rfind("t [s],s_x [m],s_y [m],theta [rad],s_x_dot [m/s],s_y_dot [m/s],theta_dot [rad/s],N1 [N],N2 [N],N3 [N],mode\n",
+                  0) == 0);
     r = run("fixed-points " + kScenes + "fig1_point.json --grid 5");
     REQUIRE(r.code == 0);
     CHECK(nlohmann::json::parse(r.out)["lines"].size() == 1);

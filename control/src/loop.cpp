@@ -247,14 +247,13 @@ ControlSummary run_control(const ControlModel& model, Policy& policy, const Trut
 void write_control_csv(std::ostream& out, const ControlSummary& s, const ControlModel& model, bool point) {
     out << "t [s],obs_s_x [m],obs_s_y [m]" << (point ? "" : ",obs_theta [rad]") << ",x [m],y [m]"
         << (point ? "" : ",heading [rad]") << ",motion,decision [s]\n";
-    out << std::setprecision(17);
     for (const ControlRow& r : s.rows) {
-        out << r.t << ',' << r.observed.x() << ',' << r.observed.y();
-        if (!point) out << ',' << r.observed.z();
-        out << ',' << r.truth.x() << ',' << r.truth.y();
-        if (!point) out << ',' << r.truth.z();
+        out << shortest(r.t) << ',' << shortest(r.observed.x()) << ',' << shortest(r.observed.y());
+        if (!point) out << ',' << shortest(r.observed.z());
+        out << ',' << shortest(r.truth.x()) << ',' << shortest(r.truth.y());
+        if (!point) out << ',' << shortest(r.truth.z());
         const std::string name = &r == &s.rows.back() ? "end" : r.motion < 0 ? "own" : model.library.names[r.motion];
-        out << ',' << name << ',' << r.decision_seconds << '\n';
+        out << ',' << name << ',' << shortest(r.decision_seconds) << '\n';
     }
 }
 

@@ -1,5 +1,6 @@
 #include "plate/output.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdarg>
@@ -111,6 +112,13 @@ json to_json(const Scene& sc, const Field& f) {
                        {"stick_fraction", stick_fractions(p.stick_fraction, d == 2 ? 1 : 3)}});
     }
     j["points"] = pts;
+    j["units"] = {{"grid", {{"x", "m"}, {"y", "m"}, {"theta0", "rad"}}},
+                  {"at", d == 2 ? json{"m", "m"} : json{"m", "m", "rad"}},
+                  {"twist", d == 2 ? json{"m/s", "m/s"} : json{"m/s", "m/s", "rad/s"}},
+                  {"residual", "1 (relative to v_ref)"},
+                  {"min_normal_force", "N"},
+                  {"stick_fraction", "period"},
+                  {"seconds", "s (wall clock)"}};
     return j;
 }
 
@@ -146,63 +154,57 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
     j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
     j["rhs_evaluations"] = fp.rhs_evaluations;
+    j["units"] = {{"at", d == 2 ? json{"m", "m"} : json{"m", "m", "rad"}},
+                  {"eigenvalues", "1/s (real, imaginary)"},
+                  {"residual", "m/s (|xi_a|, the angular part times rho)"},
+                  {"length", "m (in s_x, s_y, rho theta)"}};
     return j;
 }
 
+std::string shortest(double x) {
+    if (!std::isfinite(x)) return std::string();
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, r.ptr);
+}
+
 void write_field_csv(std::ostream& out, const Field& f) {
-    // 17 significant digits (the numbers read back to the same doubles); an undefined twist (no
-    // cycle there: converged = 0, stop says why) is left empty, not "nan".
-    out << std::setprecision(17);
+    // An undefined twist (no cycle there: converged = 0, stop says why) is left empty, not "nan". The
+    // residual is the cycle's last fixed-point step relative to v_ref (limit_cycle.hpp).
     if (f.point_part)
-        out << "s_x,s_y,v_x,v_y,converged,periods,residual,min_normal_force,stop,stick_1\n";
+        out << "s_x [m],s_y [m],v_x [m/s],v_y [m/s],converged,periods,residual [1],min_normal_force [N],stop,"
+               "stick_1 [period]\n";
     else
-        out << "s_x,s_y,theta,v_x,v_y,omega,converged,periods,residual,min_normal_force,stop,stick_1,stick_2,stick_3\n";
-    auto v = [](double x) {
-        if (!std::isfinite(x)) return std::string();
-        std::ostringstream s;
-        s.precision(17);
-        s << x;
-        return s.str();
-    };
+        out << "s_x [m],s_y [m],theta [rad],v_x [m/s],v_y [m/s],omega [rad/s],converged,periods,residual [1],"
+               "min_normal_force [N],stop,stick_1 [period],stick_2 [period],stick_3 [period]\n";
     for (const auto& p : f.points) {
-        out << p.q[0] << ',' << p.q[1] << ',';
-        if (!f.point_part) out << p.q[2] << ',';
-        out << v(p.twist[0]) << ',' << v(p.twist[1]) << ',';
-        if (!f.point_part) out << v(p.twist[2]) << ',';
-        out << (p.converged ? 1 : 0) << ',' << p.periods << ',' << v(p.residual) << ',' << v(p.min_normal_force) << ','
-            << stop_name(p.stop);
-        for (int i = 0; i < (f.point_part ? 1 : 3); ++i) out << ',' << v(p.stick_fraction[i]);
+        out << shortest(p.q[0]) << ',' << shortest(p.q[1]) << ',';
+        if (!f.point_part) out << shortest(p.q[2]) << ',';
+        out << shortest(p.twist[0]) << ',' << shortest(p.twist[1]) << ',';
+        if (!f.point_part) out << shortest(p.twist[2]) << ',';
+        out << (p.converged ? 1 : 0) << ',' << p.periods << ',' << shortest(p.residual) << ',' << shortest(p.min_normal_force)
+            << ',' << stop_name(p.stop);
+        for (int i = 0; i < (f.point_part ? 1 : 3); ++i) out << ',' << shortest(p.stick_fraction[i]);
         out << '\n';
     }
 }
 
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part) {
-    // 17 significant digits: the numbers read back to the same doubles. A quantity the dynamics
-    // does not define (the normal forces of a field integral curve) is left empty, not "nan".
-    out << std::setprecision(17);
-    auto num = [&](double x) -> std::ostream& {
-        if (std::isfinite(x)) out << x;
-        return out;
-    };
+    // A quantity the dynamics does not define (the normal forces of a field integral curve) is left
+    // empty, not "nan".
     if (point_part)
-        out << "t,s_x,s_y,s_x_dot,s_y_dot,N1,mode\n";
+        out << "t [s],s_x [m],s_y [m],s_x_dot [m/s],s_y_dot [m/s],N1 [N],mode\n";
     else
-        out << "t,s_x,s_y,theta,s_x_dot,s_y_dot,theta_dot,N1,N2,N3,mode\n";
+        out << "t [s],s_x [m],s_y [m],theta [rad],s_x_dot [m/s],s_y_dot [m/s],theta_dot [rad/s],N1 [N],N2 [N],N3 [N],"
+               "mode\n";
     for (const auto& s : tr.samples) {
-        num(s.t) << ',';
-        num(s.q[0]) << ',';
-        num(s.q[1]) << ',';
-        if (!point_part) num(s.q[2]) << ',';
-        num(s.qd[0]) << ',';
-        num(s.qd[1]) << ',';
-        if (!point_part) {
-            num(s.qd[2]) << ',';
-            num(s.n[0]) << ',';
-            num(s.n[1]) << ',';
-            num(s.n[2]);
-        } else {
-            num(s.n[0]);
-        }
+        out << shortest(s.t) << ',' << shortest(s.q[0]) << ',' << shortest(s.q[1]) << ',';
+        if (!point_part) out << shortest(s.q[2]) << ',';
+        out << shortest(s.qd[0]) << ',' << shortest(s.qd[1]) << ',';
+        if (!point_part)
+            out << shortest(s.qd[2]) << ',' << shortest(s.n[0]) << ',' << shortest(s.n[1]) << ',' << shortest(s.n[2]);
+        else
+            out << shortest(s.n[0]);
         out << ',' << mode_name(s.mode) << '\n';
     }
 }

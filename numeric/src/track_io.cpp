@@ -2,6 +2,7 @@
 // naming the file and the line.
 #include "plate/observe.hpp"
 
+#include "plate/output.hpp"
 #include "plate/scene_io.hpp"
 
 #include "input_reader.hpp"
@@ -29,11 +30,9 @@ void write_track_csv(std::ostream& out, const Track& tr) {
         << "# frame: " << frame_name(tr.camera.frame) << "\n"
         << "# part: " << (tr.point ? "point" : "rigid") << "\n"
         << columns(tr.point) << "\n";
-    // 17 significant digits: the numbers read back to the same doubles.
-    out << std::setprecision(17);
     for (std::size_t k = 0; k < tr.t.size(); ++k) {
-        out << tr.t[k] << ',' << tr.q[k].x() << ',' << tr.q[k].y();
-        if (!tr.point) out << ',' << tr.q[k].z();
+        out << shortest(tr.t[k]) << ',' << shortest(tr.q[k].x()) << ',' << shortest(tr.q[k].y());
+        if (!tr.point) out << ',' << shortest(tr.q[k].z());
         out << '\n';
     }
 }

@@ -392,4 +392,30 @@ std::vector<std::string> columns(const Campaign& c) {
     return col;
 }
 
+std::string column_heading(const Campaign& c, const std::string& column) {
+    for (const auto& p : c.parameters)
+        if (p.name == column) return column + " [as " + p.pointer + "]";
+    auto ends = [&](const char* tail) {
+        const std::string t(tail);
+        return column.size() >= t.size() && column.compare(column.size() - t.size(), t.size(), t) == 0;
+    };
+    const char* unit = nullptr;
+    if (column.rfind("twist", 0) == 0)
+        unit = ends("_omega") ? "rad/s" : ends("_stick") ? "period" : "m/s";
+    else if (column == "field_mean_speed" || column == "field_max_speed")
+        unit = "m/s";
+    else if (column == "field_mean_abs_omega")
+        unit = "rad/s";
+    else if (column == "field_mean_stick")
+        unit = "period";
+    else if (column == "stable_x" || column == "stable_y" || column == "design_x" || column == "design_y" ||
+             column == "design_worst_end_distance")
+        unit = "m";
+    else if (column == "stable_theta")
+        unit = "rad";
+    else if (column == "stable_rate" || column == "design_rate")
+        unit = "1/s";
+    return unit ? column + " [" + unit + "]" : column;
+}
+
 }   // namespace plate::sweep

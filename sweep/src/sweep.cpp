@@ -318,11 +318,7 @@ std::string csv_cell(const Row& v) {
     if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
     if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
     if (v.is_number_float()) {
-        const double x = v.get<double>();
-        if (!std::isfinite(x)) return "";
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%.17g", x);
-        return buf;
+        return shortest(v.get<double>());
     }
     const std::string s = v.is_string() ? v.get<std::string>() : v.dump();
     if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -493,7 +489,7 @@ void write_tables(const std::string& dir, const Campaign& c, const Journal& j) {
     const std::vector<std::string> col = columns(c);
     const fs::path d(dir);
     write_file_atomic((d / "table.csv").string(), [&](std::ostream& o) {
-        for (std::size_t k = 0; k < col.size(); ++k) o << (k ? "," : "") << col[k];
+        for (std::size_t k = 0; k < col.size(); ++k) o << (k ? "," : "") << csv_cell(Row(column_heading(c, col[k])));
         o << "\n";
         for (const auto* e : by_case) {
             for (std::size_t k = 0; k < col.size(); ++k)
@@ -505,7 +501,7 @@ void write_tables(const std::string& dir, const Campaign& c, const Journal& j) {
         for (const auto* e : by_case) o << e->row.dump() << "\n";
     });
     write_file_atomic((d / "timing.csv").string(), [&](std::ostream& o) {
-        o << "case,rank,seconds,rhs_evaluations\n";
+        o << "case,rank,seconds [s],rhs_evaluations\n";
         for (const auto* e : by_case)
             o << e->index << "," << e->rank << "," << csv_cell(Row(e->seconds)) << "," << csv_cell(e->row["rhs_evaluations"])
               << "\n";

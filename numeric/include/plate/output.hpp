@@ -17,8 +17,14 @@ namespace plate {
 nlohmann::json to_json(const Scene& scene, const Vec3& q, const LimitCycleSummary& lc);
 nlohmann::json to_json(const Scene& scene, const Field& field);
 nlohmann::json to_json(const Scene& scene, const FixedPoints& fp);
+// The CSV tables state each column's unit in its header, "name [unit]" (a column without brackets is
+// a count, a flag or a name; [1] a ratio), and write numbers by `shortest` below; an undefined value is empty.
 void write_field_csv(std::ostream& out, const Field& field);
 void write_trajectory_csv(std::ostream& out, const Trajectory& tr, bool point_part);
+
+// x in the shortest decimal form that reads back to the same double (std::to_chars: 0.2, not
+// 0.20000000000000001); "" when x is not finite. Every text table writes its numbers with it.
+std::string shortest(double x);
 
 // A text's FNV-1a 64-bit hash as 16 lowercase hex digits: a fingerprint of a canonical text (a
 // campaign file, a scene), the same on every platform.

@@ -90,6 +90,9 @@ Scene case_scene(const Campaign& c, int index);
 Row run_case(const Campaign& c, int index);
 // The table's columns, in order (run_case's keys; the JSON lines also carry "fixed_points").
 std::vector<std::string> columns(const Campaign& c);
+// A column's heading in table.csv: its name and unit, "stable_x [m]"; a parameter's unit is the scene
+// field's it sets, "x_amp [as /plate/harmonics/0/amp]"; counts, flags and words have no unit.
+std::string column_heading(const Campaign& c, const std::string& column);
 
 // ---- the journal: finished cases, appended durably -------------------------------------------
 // DIR/journal.jsonl: a header line (campaign name, fingerprint, cases), then one line per finished
