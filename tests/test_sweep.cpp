@@ -251,7 +251,10 @@ TEST_CASE("the table: full precision, missing values empty, text quoted, written
     std::getline(in, header);
     std::getline(in, r0);
     std::getline(in, r1);
-    CHECK(header.rfind("case,mu,status,reason,note,rhs_evaluations,twist0_vx,twist0_vy,twist0_stick", 0) == 0);
+    // Each heading with its unit; the parameter's is the scene field's it sets.
+    CHECK(header.rfind("case,mu [as /part/friction],status,reason,note,rhs_evaluations,twist0_vx [m/s],twist0_vy [m/s],"
+                       "twist0_stick [period]",
+                       0) == 0);
     // Row 0's speed reads back to the same double.
     std::vector<std::string> cells;
     std::stringstream s(r0);
