@@ -17,6 +17,43 @@ namespace plate::report {
 namespace fs = std::filesystem;
 using namespace html;
 
+namespace {
+
+// The sections run apart from the report (their anchors stand before their markers in the page).
+const std::pair<const char*, const char*> kStudies[] = {{"speed", "Speed and accuracy (plate bench)"},
+                                                        {"peers", "Side by side with Bullet, ODE and MuJoCo"},
+                                                        {"campaigns", "Campaigns (bench/scaling.py)"},
+                                                        {"mutations", "Mutation score (scripts/mutants.py)"}};
+
+// The contents list and the verdict table at the top of the page: each check the page states, linked.
+std::string contents_and_verdicts(const Ctx& c) {
+    std::ostringstream o;
+    o << "<nav><h2 id=\"contents\">Contents</h2><ol>\n<li><a href=\"#verdicts\">Verdicts</a></li>\n";
+    for (const auto& [id, title] : c.contents) o << "<li><a href=\"#" << id << "\">" << esc(title) << "</a></li>\n";
+    for (const auto& [id, title] : kStudies) o << "<li><a href=\"#" << id << "\">" << esc(title) << "</a></li>\n";
+    o << "<li><a href=\"#timings\">Time per part</a></li>\n</ol></nav>\n";
+    int failed = 0, checks = 0, printed = 0, differ = 0;
+    for (const auto& k : c.checks) {
+        (k.paper ? printed : checks) += 1;
+        (k.paper ? differ : failed) += !k.ok;
+    }
+    o << "<h2 id=\"verdicts\">Verdicts</h2>\n<p>" << checks << " checks stated in this run: "
+      << (failed == 0 ? std::string("<span class=\"pass\">all pass</span>")
+                      : "<span class=\"fail\">" + std::to_string(failed) + " failed</span>")
+      << ". " << printed << " of the paper's printed equations compared with the derivation: " << differ
+      << " differ, each row saying why (findings on the print, not failures). Each line links to where the page states "
+         "it, with its evidence. The studies run apart (speed, peers, campaigns, mutation score) state their verdicts in "
+         "their own sections.</p>\n"
+      << "<table id=\"verdict-table\"><tr><th>section</th><th>check</th><th>verdict</th></tr>\n";
+    for (const auto& k : c.checks)
+        o << "<tr><td>" << esc(k.section) << "</td><td><a href=\"#" << k.id << "\">" << k.what << "</a></td><td class=\""
+          << (k.ok ? "pass" : "fail") << "\">" << esc(k.shown) << "</td></tr>\n";
+    o << "</table>\n";
+    return o.str();
+}
+
+}   // namespace
+
 void write_report(const ReportOptions& opt) {
     if (opt.out.empty()) throw std::runtime_error("report: no output folder");
     check_sections(opt.sections);
@@ -63,8 +100,9 @@ void write_report(const ReportOptions& opt) {
          << "</head><body>\n<h1>Sliding manipulation on a 6-DoF plate: verification report</h1>\n";
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
          << "; machine: " << esc(machine_description()) << "; total " << fmt(total, 4) << " s."
-         << (left_out.empty() ? "" : " Sections left out of this run (--sections): " + esc(left_out) + ".")
-         << "</p>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
+         << (left_out.empty() ? "" : " Sections left out of this run (--sections): " + esc(left_out) + ".") << "</p>\n";
+    html << contents_and_verdicts(c);
+    html << "<h2 id=\"timings\">Time per part</h2>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
     html << "</table>\n" << c.html.str();
     // The studies run apart from the report keep their sections between their markers: DIR/data/NAME_section.html
@@ -72,7 +110,7 @@ void write_report(const ReportOptions& opt) {
     const std::string out = esc(opt.out);
     auto study = [&](const char* begin, const char* end, const char* name, const std::string& stub) {
         const fs::path file = c.dir / "data" / (std::string(name) + "_section.html");
-        html << begin;
+        html << "<a id=\"" << name << "\"></a>" << begin;
         if (fs::exists(file))
             html << std::ifstream(file).rdbuf();
         else
@@ -80,19 +118,22 @@ void write_report(const ReportOptions& opt) {
         html << end << "\n";
     };
     study(kSpeedBegin, kSpeedEnd, "speed",   // plate bench
-          "<h2>Speed and accuracy</h2><p>Not run yet: <code>plate bench --out " + out +
-              "</code> writes this section (work-precision charts, failure maps, limit-cycle solvers, model hierarchy).</p>\n");
+          "<h2>Speed and accuracy</h2><p>Not run yet. To fill it: <code>plate bench --out " + out +
+              "</code> writes this section into this page (work-precision charts, failure maps, limit-cycle solvers, model "
+              "hierarchy).</p>\n");
     study(kPeersBegin, kPeersEnd, "peers",   // bench/peers/study.py
-          "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet: <code>bench/peers/study.py --out " + out +
-              "</code> writes this section (the same questions to the engines found at build time and to plate, "
+          "<h2>Side by side with Bullet, ODE and MuJoCo</h2><p>Not run yet. To fill it: <code>bench/peers/study.py --out " + out +
+              "</code> writes this section into this page (the same questions to the engines found at build time and to plate, "
               "error against CPU time).</p>\n");
     study(kCampaignsBegin, kCampaignsEnd, "campaigns",   // bench/scaling.py
-          "<h2>Campaigns</h2><p>Not run yet: <code>bench/scaling.py --out " + out +
-              "</code> writes this section (strong and weak scaling of <code>plate sweep</code> over threads and MPI ranks, "
+          "<h2>Campaigns</h2><p>Not run yet. To fill it: <code>bench/scaling.py --out " + out +
+              "</code> writes this section into this page (strong and weak scaling of <code>plate sweep</code> over threads and "
+              "MPI ranks, "
               "load balance, the cost of a 1 000-core campaign).</p>\n");
     study(kMutationsBegin, kMutationsEnd, "mutations",   // scripts/mutants.py --report
-          "<h2>Mutation score</h2><p>Not run yet: <code>scripts/mutants.py --report " + out +
-              "</code> writes this section (one-line physics bugs from tests/mutations/catalogue.json, each applied to a "
+          "<h2>Mutation score</h2><p>Not run yet. To fill it: <code>scripts/mutants.py --report " + out +
+              "</code> writes this section into this page (one-line physics bugs from tests/mutations/catalogue.json, each "
+              "applied to a "
               "scratch copy, and the tests that caught it).</p>\n");
     html << kPageCheck << "</body></html>\n";
     write_file_atomic((c.dir / "index.html").string(), [&](std::ostream& o) { o << html.str(); });

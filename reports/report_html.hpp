@@ -80,6 +80,34 @@ struct Ctx {
         f();
         timings.push_back({what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
     }
+    // The page's contents (anchor, heading) and the checks it states, for the list and the verdict
+    // table at the top: a check belongs to the section whose heading came last.
+    struct Check {
+        std::string section, what, id, shown;   // shown: the verdict's words where the page states it
+        bool ok;
+        bool paper = false;   // the paper's print compared with the derivation: "differs" is a finding, not a failure
+    };
+    std::vector<std::pair<std::string, std::string>> contents;
+    std::vector<Check> checks;
+    // A section's heading with its anchor, listed in the contents.
+    std::string heading(const std::string& title, const std::string& id) {
+        contents.push_back({id, title});
+        return "<h2 id=\"" + id + "\">" + esc(title) + "</h2>\n";
+    }
+    // A check's verdict where the page states it: `pass_text` or `fail_text` marked pass or fail, with
+    // the anchor the verdict table links to.
+    std::string verdict(const std::string& what, bool ok, const std::string& pass_text = "pass",
+                        const std::string& fail_text = "FAIL") {
+        const std::string id = "check-" + std::to_string(checks.size() + 1);
+        checks.push_back({contents.empty() ? std::string() : contents.back().second, what, id, ok ? pass_text : fail_text, ok});
+        return "<span id=\"" + id + "\" class=\"" + (ok ? "pass" : "fail") + "\">" + esc(ok ? pass_text : fail_text) + "</span>";
+    }
+    // An equation as printed in the paper against the derivation's: "agrees" or "differs" (the row says why).
+    std::string paper_check(const std::string& equation, bool agrees) {
+        const std::string v = verdict("equation " + equation + " as printed in the paper", agrees, "agrees", "differs");
+        checks.back().paper = true;
+        return v;
+    }
     std::ofstream data(const std::string& name) {
         std::ofstream o(dir / "data" / name);
         o << std::setprecision(9);
@@ -112,8 +140,6 @@ figcaption{font-size:85%;max-width:640px}code,pre{background:#f6f6f6}
 #zoom img{display:block;margin:2vh auto;width:auto;height:96vh;max-width:96vw;object-fit:contain;background:#fff}
 pre{overflow-x:auto;padding:.5em}.math{overflow-x:auto}</style>
 )";
-
-inline std::string verdict(bool ok) { return ok ? "<span class=\"pass\">pass</span>" : "<span class=\"fail\">FAIL</span>"; }
 
 
 // The report's page keeps the speed-accuracy section (written by `plate bench`) between these.

@@ -20,23 +20,26 @@ using namespace html;
 // with its fixed point, and full-dynamics runs from the verification's random starts.
 // A design table row's first cells: the target, the verdict (with why it failed), unique, the rate,
 // evaluations, cycles and the designed signal's peaks (the axes that move).
-std::string design_cells(const std::string& target, const DesignSummary& d) {
+std::string design_cells(Ctx& c, const std::string& target, const DesignSummary& d) {
     std::string peaks;
     for (int a = 0; a < 6; ++a)
         if (d.peaks[a] > 0)
             peaks += (peaks.empty() ? "" : ", ") + std::string(axis_name(static_cast<Axis>(a))) + " " + fmt(d.peaks[a], 3) +
                      (a < 3 ? " m/s²" : " rad/s²");
-    return "<tr><td>" + target + "</td><td>" + verdict(d.verified) + (d.verified ? "" : " " + esc(d.failure)) + "</td><td>" +
-           (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) + "</td><td>" + std::to_string(d.evaluations) + "</td><td>" +
-           std::to_string(d.cycles) + "</td><td>" + peaks + "</td>";
+    return "<tr><td>" + target + "</td><td>" + c.verdict("design verified: " + target, d.verified) +
+           (d.verified ? "" : " " + esc(d.failure)) + "</td><td>" + (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) +
+           "</td><td>" + std::to_string(d.evaluations) + "</td><td>" + std::to_string(d.cycles) + "</td><td>" + peaks + "</td>";
 }
 
 // The cell of the part released at the target: how far it is after the hold, marked beyond `allowed`,
 // and why its run stopped early (`stop`), if it did.
-std::string held_cell(double walked, double allowed, const std::string& from, const std::string& stop) {
+std::string held_cell(Ctx& c, const std::string& target, double walked, double allowed, const std::string& from,
+                      const std::string& stop) {
     const std::string v = fmt(1e3 * walked, 3);
-    return "<td>" + (walked > allowed ? "<span class=\"fail\">" + v + "</span>" : v) + from +
-           (stop.empty() ? "" : " (" + esc(stop) + ")") + "</td></tr>\n";
+    return "<td>" +
+           c.verdict("released at rest on " + target + ", it stays within " + fmt(1e3 * allowed, 3) + " mm", !(walked > allowed),
+                     v, v) +
+           from + (stop.empty() ? "" : " (" + esc(stop) + ")") + "</td></tr>\n";
 }
 
 void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
@@ -51,8 +54,8 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         o.local_evaluations = 120;
         o.verify_starts = 6;
     }
-    c.html << "<h2>Inverse design</h2>\n<p>Plate motions designed by <code>design()</code> (NLopt COBYLA from " << o.starts
-           << " seeded feasible starts, " << o.local_evaluations << " evaluations each) so that " << esc(part.name)
+    c.html << c.heading("Inverse design", "design") << "<p>Plate motions designed by <code>design()</code> (NLopt COBYLA from "
+           << o.starts << " seeded feasible starts, " << o.local_evaluations << " evaluations each) so that " << esc(part.name)
            << "'s point part has its unique stable fixed point at the target, within peak limits of " << fmt(o.lin_limit, 3)
            << " m/s² and " << fmt(o.ang_limit, 3)
            << " rad/s² (each axis' summed signal over the period) and keeping g + a<sub>z</sub> ≥ " << fmt(o.flight_margin, 3)
@@ -80,9 +83,10 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         DesignTarget t;
         t.at = at;
         const DesignSummary d = design(part, t, o);
-        c.html << design_cells("sink (" + fmt(at.x(), 3) + ", " + fmt(at.y(), 3) + ")", d) << "<td>"
-               << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td><td>" << fmt(d.coning, 3)
-               << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop);
+        const std::string name = "sink (" + fmt(at.x(), 3) + ", " + fmt(at.y(), 3) + ")";
+        c.html << design_cells(c, name, d) << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3)
+               << "</td><td>" << fmt(d.coning, 3) << "</td>"
+               << held_cell(c, name, d.held.end_distance, o.verify_distance, "", d.held.stop);
         if (k++ == 0) {   // the figures are the first target's
             first = d;
             first_at = at;
@@ -93,11 +97,11 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         DesignTarget t;
         t.at = targets[0];
         const DesignSummary d = design(rigid, t, o);
-        c.html << design_cells(esc(rigid.name) + "'s rigid part: sink (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) +
-                                   "), any orientation",
-                               d)
-               << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3) << "</td><td>"
-               << fmt(d.coning, 3) << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop);
+        const std::string name =
+            esc(rigid.name) + "'s rigid part: sink (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + "), any orientation";
+        c.html << design_cells(c, name, d) << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << "</td><td>" << fmt(d.seconds, 3)
+               << "</td><td>" << fmt(d.coning, 3) << "</td>"
+               << held_cell(c, name, d.held.end_distance, o.verify_distance, "", d.held.stop);
     }
     {   // a line sink (design.cpp: y and rx, turned and shifted onto the line)
         DesignTarget t;
@@ -109,12 +113,11 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const Trajectory hold = simulate(d.scene, Dynamics::Full, Vec3(t.at.x(), t.at.y(), 0), Vec3::Zero(), o.hold, o.hold);
         const double walked = hold.samples.empty() ? std::numeric_limits<double>::quiet_NaN()
                                                    : std::abs((hold.samples.back().q.head<2>() - t.at).dot(nrm));
-        c.html << design_cells(
-                      "line sink through (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ") along " + fmt(t.theta, 3) + " rad",
-                      d)
-               << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << " (from the line)</td><td>" << fmt(d.seconds, 3) << "</td><td>"
-               << fmt(coning_rate(d.scene.plate), 3) << "</td>"
-               << held_cell(walked, o.verify_distance, " (from the line)",
+        const std::string name =
+            "line sink through (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ") along " + fmt(t.theta, 3) + " rad";
+        c.html << design_cells(c, name, d) << "<td>" << fmt(1e3 * d.worst_end_distance, 3) << " (from the line)</td><td>"
+               << fmt(d.seconds, 3) << "</td><td>" << fmt(coning_rate(d.scene.plate), 3) << "</td>"
+               << held_cell(c, name, walked, o.verify_distance, " (from the line)",
                             hold.stop.reason != StopReason::None ? hold.stop.describe() : "");
     }
     c.html << "</table>\n<p>For the sinks the last column is the verification's hold; the line sink's (y and rx "
@@ -221,7 +224,7 @@ void section_orient(Ctx& c, const fs::path& src, const ReportOptions& opt) {
            << "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
               "<th>cycles</th><th>peaks over the period</th><th>worst end angle [rad]</th><th>travel at θ "
               "[m/s]</th><th>seconds</th></tr>\n"
-           << design_cells("orient " + fmt(t.theta, 3), d) << "<td>" << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3)
+           << design_cells(c, "orient " + fmt(t.theta, 3), d) << "<td>" << fmt(d.worst_end_distance / o.verify_distance * 0.05, 3)
            << "</td><td>" << fmt(d.transport_mean.norm(), 3) << "</td><td>" << fmt(d.seconds, 3) << "</td></tr>\n</table>\n";
     if (d.ring_theta.empty()) return;
     {
@@ -283,6 +286,7 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
     t.at = Vec2(0.02, -0.01);
     t.theta = 0.5;
     const DesignSummary d = design(part, t, o);
+    const std::string name = "fixed point (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ", " + fmt(t.theta, 3) + ")";
     c.html << "<h3>Fixing a rigid part: position and orientation</h3>\n<p>" << esc(part.name) << "'s part, target (x, y, θ) = ("
            << fmt(t.at.x(), 3) << ", " << fmt(t.at.y(), 3) << ", " << fmt(t.theta, 3) << "), default limits, " << d.starts
            << " starts in all, " << o.local_evaluations
@@ -292,13 +296,12 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
               "<th>cycles</th><th>peaks over the period</th><th>target's share of the runs</th><th>other stable fixed points "
               "(share)</th><th>seconds</th>"
               "<th>from the target, after the hold [mm]</th></tr>\n"
-           << design_cells("fixed point (" + fmt(t.at.x(), 3) + ", " + fmt(t.at.y(), 3) + ", " + fmt(t.theta, 3) + ")", d)
-           << "<td>" << fmt(d.basin_share, 3) << "</td><td>";
+           << design_cells(c, name, d) << "<td>" << fmt(d.basin_share, 3) << "</td><td>";
     for (const DesignSummary::Competitor& k : d.competitors)
         c.html << "(" << fmt(k.point.q[0], 4) << ", " << fmt(k.point.q[1], 4) << ", " << fmt(k.point.q[2], 4)
                << "): " << fmt(k.basin_share, 3) << "<br>";
-    c.html << "</td><td>" << fmt(d.seconds, 3) << "</td>" << held_cell(d.held.end_distance, o.verify_distance, "", d.held.stop)
-           << "</table>\n";
+    c.html << "</td><td>" << fmt(d.seconds, 3) << "</td>"
+           << held_cell(c, name, d.held.end_distance, o.verify_distance, "", d.held.stop) << "</table>\n";
     if (d.runs.empty()) return;
     {
         auto runs = c.data("design_fixed_point_runs.dat");

@@ -18,6 +18,24 @@ using namespace html;
 
 namespace {
 
+// The largest of 1, 2, 5 times a power of ten not above x (x > 0).
+double nice_floor(double x) {
+    const double p = std::pow(10.0, std::floor(std::log10(x)));
+    for (double m : {5.0, 2.0, 1.0})
+        if (m * p <= x) return m * p;
+    return p;
+}
+
+// The quiver's scale: a reference arrow above a 2-D field plot, drawn in the axis it measures (`horizontal`:
+// along x, else along y), `length` [axis units] for `speed` [unit]; gnuplot commands.
+std::string scale_arrow(double length, double speed, const char* unit, bool horizontal) {
+    const std::string rto = horizontal ? "rto first " + fmt(length, 6) + ", first 0" : "rto first 0, first " + fmt(length, 6);
+    return "set tmargin 4\nset label 90 'arrow scale: " + fmt(speed, 3) + " " + unit +
+           "' at graph 0, graph 1.06 left\nset arrow 90 from graph 0.3, graph 1.04 " + rto +
+           " lw 2 lc rgb '#000000' front nohead\nset arrow 91 from graph 0.3, graph 1.04 " + rto +
+           " lw 2 lc rgb '#000000' front head size 0.004,20\n";
+}
+
 // Stick-slip against the regularised-friction limit (study.hpp): a cycle that pivots and one with a
 // short phase stuck as a whole, on fig6's thick part.
 void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
@@ -114,7 +132,7 @@ void section_stick_reference(Ctx& c, const fs::path& src, bool quick) {
 }   // namespace
 
 void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
-    c.html << "<h2>6. The paper's fields</h2>\n";
+    c.html << c.heading("6. The paper's fields", "fields");
     struct F {
         const char* scene;
         Vec3 start;
@@ -148,6 +166,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         });
         const bool pt = sc.part.point;
         const std::string n = f.scene;
+        double k = 0;   // [s]: an arrow is the twist times k
         {
             // Arrows = twist x one time scale, the longest 0.8 of a grid cell (in x, y and theta).
             double lmax = 0;
@@ -156,7 +175,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                 if (p.converged)
                     lmax = std::max(
                         {lmax, std::abs(p.twist[0]) / dx, std::abs(p.twist[1]) / dy, pt ? 0.0 : std::abs(p.twist[2]) / dth});
-            const double k = lmax > 0 ? 0.8 / lmax : 0;
+            k = lmax > 0 ? 0.8 / lmax : 0;
             auto o = c.data(n + "_field.dat");
             for (const auto& p : field.points) {
                 if (!p.converged) continue;
@@ -176,36 +195,48 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             // A paper figure's run must reach its full duration (a run that stops at once draws a dot).
             const double want = opt.quick ? std::min(f.duration, 4.0) : f.duration;
             const double reached = tr.samples.empty() ? 0.0 : tr.samples.back().t;
-            if (tr.stop.reason != StopReason::None || reached < want * (1 - 1e-9))
-                c.html << "<p><span class=\"fail\">FAIL: the run from rest stopped at t = " << fmt(reached, 4) << " s of "
-                       << fmt(want, 3) << " s" << (tr.stop.reason != StopReason::None ? " (" + esc(tr.stop.describe()) + ")" : "")
-                       << "</span></p>\n";
+            const bool full = tr.stop.reason == StopReason::None && reached >= want * (1 - 1e-9);
+            c.html << "<p>The run from rest reaches its full " << fmt(want, 3) << " s: "
+                   << c.verdict(std::string(f.what) + ": the run from rest reaches its full duration", full, "pass",
+                                "FAIL: the run from rest stopped at t = " + fmt(reached, 4) + " s of " + fmt(want, 3) + " s" +
+                                    (tr.stop.reason != StopReason::None ? " (" + tr.stop.describe() + ")" : ""))
+                   << "</p>\n";
         }
         const std::string F = "'data/" + n + "_field.dat'", T = "'data/" + n + "_traj.dat'";
         const std::string arrows = " w vec head size 0.004,20 lc rgb '#777777' notitle";
         const std::string kFieldSize = "800,640";   // field figures: large enough to read the arrows
+        // The arrows' scale: a reference arrow of a round speed on the s_x (or s_y) axis, and the caption's
+        // statement of what a grid cell's length stands for along each axis.
+        std::string scale, scale_y, scale_text;
+        if (k > 0 && g.dx() > 0) {
+            const double v = nice_floor(0.8 * g.dx() / k), w = nice_floor(0.8 * g.dth() / k);
+            scale = scale_arrow(k * v, 1e3 * v, "mm/s", true);
+            scale_y = g.dy() > 0 ? scale_arrow(k * v, 1e3 * v, "mm/s", true) : "";
+            scale_text = " Arrows: the twist times " + fmt(k, 3) + " s; the black one above the plot is " + fmt(1e3 * v, 3) +
+                         " mm/s" + (pt ? "" : "; a θ-component of " + fmt(k * w, 3) + " rad is " + fmt(w, 3) + " rad/s") + ".";
+        }
         if (pt) {
             c.plot(n + "_xy",
-                   "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
-                       " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
-                   std::string(f.what) + ": s_x–s_y", kFieldSize);
+                   scale + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows +
+                       ", " + T + " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
+                   std::string(f.what) + ": s_x–s_y." + scale_text, kFieldSize);
         } else {
             c.plot(n + "_3d",
-                   "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nsplot " + F + " u 1:2:3:4:5:6" + arrows +
-                       ", " + T + " u 1:2:3 w l lw 2 lc rgb '#c02020' notitle\n",
-                   std::string(f.what) + ": (s_x, s_y, θ)", kFieldSize);
+                   "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset zlabel 'θ [rad]'\nset view 60,30\nsplot " + F +
+                       " u 1:2:3:4:5:6" + arrows + ", " + T + " u 1:2:3 w l lw 2 lc rgb '#c02020' notitle\n",
+                   std::string(f.what) + ": (s_x, s_y, θ). Arrows: the twist times " + fmt(k, 3) + " s.", kFieldSize);
             c.plot(n + "_xy",
-                   "set xlabel 's_x'\nset ylabel 's_y'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
+                   scale + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
                        " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
-                   "s_x–s_y projection", kFieldSize);
+                   "s_x–s_y projection." + scale_text, kFieldSize);
             c.plot(n + "_xt",
-                   "set xlabel 's_x'\nset ylabel 'θ'\nplot " + F + " u 1:3:4:6" + arrows + ", " + T +
+                   scale + "set xlabel 's_x [m]'\nset ylabel 'θ [rad]'\nplot " + F + " u 1:3:4:6" + arrows + ", " + T +
                        " u 1:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
-                   "s_x–θ projection", kFieldSize);
+                   "s_x–θ projection." + scale_text, kFieldSize);
             c.plot(n + "_yt",
-                   "set xlabel 's_y'\nset ylabel 'θ'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T +
+                   scale_y + "set xlabel 's_y [m]'\nset ylabel 'θ [rad]'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T +
                        " u 2:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
-                   "s_y–θ projection", kFieldSize);
+                   "s_y–θ projection." + scale_text, kFieldSize);
         }
         int stuck = 0, lost = 0, sticks = 0, held_all = 0;
         for (const auto& p : field.points) {
@@ -222,10 +253,12 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
             // The largest stick fraction of the three contacts over the cycle, per configuration.
             const std::string SF = "'data/" + n + "_field.dat'";
             c.plot(n + "_stick",
-                   pt ? "set xlabel 's_x'\nset ylabel 's_y'\nset size ratio -1\nset cblabel 'stick fraction'\nset cbrange [0:1]\n"
+                   pt ? "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nset cblabel 'stick fraction'\nset "
+                        "cbrange [0:1]\n"
                         "plot " +
                             SF + " u 1:2:7 w p pt 5 ps 2 palette notitle\n"
-                      : "set xlabel 's_x'\nset ylabel 's_y'\nset zlabel 'θ'\nset view 60,30\nset cblabel 'stick fraction'\n"
+                      : "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset zlabel 'θ [rad]'\nset view 60,30\nset cblabel 'stick "
+                        "fraction'\n"
                         "set cbrange [0:1]\nsplot " +
                             SF + " u 1:2:3:7 w p pt 7 ps 1 palette notitle\n",
                    std::string(f.what) + ": fraction of the cycle a contact is held (largest of the contacts)", kFieldSize);

@@ -129,7 +129,8 @@ void section_identify(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     clean.noise_xy_mm = 0;
     const Track fitted = observe_at(s.fitted, clean, Dynamics::Full, s.tracks[0].start, Vec3::Zero(), tr.t);
 
-    c.html << "<h2>Identification: friction from a filmed track</h2>\n<p>The point part of <code>scenes/fig1_point.json</code> "
+    c.html << c.heading("Identification: friction from a filmed track", "identify")
+           << "<p>The point part of <code>scenes/fig1_point.json</code> "
            << "(which declares kinetic 0.30 and, here, static 0.36) filmed at kinetic " << fmt(truth[0]) << " and static "
            << fmt(truth[1]) << " from (" << fmt(1e3 * start.x()) << ", " << fmt(1e3 * start.y()) << ") mm for " << fmt(duration)
            << " s: one frame a period, 0.1 mm noise (seed " << cam.seed << "). <code>plate identify --params mu_k,mu_s "

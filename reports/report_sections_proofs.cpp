@@ -20,15 +20,15 @@ using namespace html;
 
 void section_derivation(Ctx& c) {
     const symbolic::Derivation d = symbolic::derive();   // run here: every line below is this run's
-    c.html << "<h2>1. Symbolic derivation</h2>\n<p>Derived with GiNaC from frames, contact kinematics, Coulomb "
+    c.html << c.heading("1. Symbolic derivation", "derivation")
+           << "<p>Derived with GiNaC from frames, contact kinematics, Coulomb "
               "forces and Newton–Euler (<code>symbolic/derivation.cpp</code>), time derivatives by a jet rule; each printed "
               "equation compared with the derived one:</p>\n<table><tr><th>equation</th><th>verdict</th><th>printed</th>"
               "<th>derived</th><th>why</th></tr>\n";
     int differ = 0;
     for (const auto& f : d.findings) {
         differ += !f.agrees;
-        c.html << "<tr><td>" << esc(f.equation) << "</td><td>"
-               << (f.agrees ? "<span class=\"pass\">agrees</span>" : "<span class=\"fail\">differs</span>") << "</td><td><code>"
+        c.html << "<tr><td>" << esc(f.equation) << "</td><td>" << c.paper_check(f.equation, f.agrees) << "</td><td><code>"
                << esc(f.printed) << "</code></td><td><code>" << esc(f.derived) << "</code></td><td>" << esc(f.reason)
                << "</td></tr>\n";
     }
@@ -65,9 +65,11 @@ void section_kernels(Ctx& c, std::uint64_t seed) {
                               std::abs(g.qdd[2] - f.qdd[2]) * sc.part.rho() / sc.g, (g.n - f.n).norm() / mg});
         }
     }
-    c.html << "<h2>2. Generated kernels against the hand-written reference</h2>\n<table><tr><th>states</th><th>parts</th>"
+    c.html << c.heading("2. Generated kernels against the hand-written reference", "kernels")
+           << "<table><tr><th>states</th><th>parts</th>"
               "<th>worst difference (relative to g, m g)</th><th>bound</th><th>verdict</th></tr><tr><td>"
-           << n << "</td><td>thick, thin, point</td><td>" << fmt(worst, 3) << "</td><td>1e-12</td><td>" << verdict(worst < 1e-12)
+           << n << "</td><td>thick, thin, point</td><td>" << fmt(worst, 3) << "</td><td>1e-12</td><td>"
+           << c.verdict("generated kernels equal the hand-written reference within 1e-12", worst < 1e-12)
            << "</td></tr></table>\n";
 }
 
@@ -123,8 +125,8 @@ void proofs_contraction(Ctx& c, const ReportOptions& opt, int n_thin, int n_thic
     };
     c.timed("Theorem 1 contraction, thin parts", [&] { thin = run(true, n_thin, opt.seed); });
     c.timed("contraction beyond the theorem, thick parts", [&] { thick = run(false, n_thick, opt.seed + 50'000'000); });
-    c.html << "<h2>3. Theorem 1: contraction of the relative twist (Appendix C)</h2>\n"
-              "<p>Two copies of a random part at a random configuration, from random twists, integrated on one step "
+    c.html << c.heading("3. Theorem 1: contraction of the relative twist (Appendix C)", "theorem1")
+           << "<p>Two copies of a random part at a random configuration, from random twists, integrated on one step "
               "sequence; V = ½|ξ<sub>rel</sub>|² in scaled coordinates (ξ<sub>θ</sub> = ρω). A rise of V between steps "
               "is compared with the bound on its integration error, |ξ<sub>rel</sub>|·2√3δ + 6δ², δ = rtol (v<sub>ref</sub> "
               "+ |ξ|) (the controller's acceptance test on the scaled state). Floquet multipliers: eigenvalues of the "
@@ -147,10 +149,10 @@ void proofs_contraction(Ctx& c, const ReportOptions& opt, int n_thin, int n_thic
                << fmt(s.max_spectral_radius, 3) << "</td><td>" << s.unique << "</td><td>" << (ce.empty() ? "none" : ce)
                << "</td><td>";
         if (theorem)
-            c.html << "Theorem 1: " << verdict(s.passed());
+            c.html << "Theorem 1: " << c.verdict("Theorem 1, thin parts", s.passed());
         else   // beyond the theorem V may rise: an observation, not a verdict
             c.html << "V rose beyond its error bound in " << s.valid - s.monotone << " of " << s.valid
-                   << " cases (observed, no verdict); Observation 1: " << verdict(observation1);
+                   << " cases (observed, no verdict); Observation 1: " << c.verdict("Observation 1, thick parts", observation1);
         c.html << "</td></tr>\n";
     };
     theorem = true;
@@ -165,7 +167,7 @@ void proofs_contraction(Ctx& c, const ReportOptions& opt, int n_thin, int n_thic
               "twist, both to "
            << fmt(proofs::kTieTolerance, 1) << " m g: worst " << fmt(thin.tie.worst_statics, 2) << " and "
            << fmt(thin.tie.worst_wrench, 2) << " m g, "
-           << (thin.tie.passed() ? verdict(true) : "<span class=\"fail\">" + esc(thin.tie.failure) + "</span>")
+           << c.verdict("thin parts' dynamics tied to statics and the limit surface", thin.tie.passed(), "pass", thin.tie.failure)
            << " (a wrong normal force, a swapped lever arm and a wrong mu on one contact each fail it: test).</p>\n";
     c.html << "<p>Thick parts are outside Theorem 1: V may rise (the normal forces depend on the twist). "
            << esc(observation1_sentence(thick.valid, thick.converged, thick.unique, thick.floquet_below_one))
@@ -203,14 +205,15 @@ void proofs_periodicity(Ctx& c, const ReportOptions& opt) {
               "|P(x*) − x*| / v<sub>ref</sub></th><th>worst |P²(x*) − x*| / v<sub>ref</sub></th><th>tolerance</th>"
               "<th>verdict</th></tr><tr><td>"
            << n << "</td><td>" << fmt(worst1, 3) << "</td><td>" << fmt(worst2, 3) << "</td><td>1e-8</td><td>"
-           << verdict(n > 0 && ok == n) << "</td></tr></table>\n";
+           << c.verdict("periodicity of the cycle (Appendix D)", n > 0 && ok == n) << "</td></tr></table>\n";
 }
 
 // Limit surfaces (Appendix B): the campaign's table and one thin part's surface.
 void proofs_limit_surfaces(Ctx& c, const ReportOptions& opt, int n_surf) {
     proofs::LimitSurfaceCampaign ls;
     c.timed("limit surfaces", [&] { ls = proofs::check_limit_surfaces(n_surf, opt.seed); });
-    c.html << "<h2>4. Limit surfaces (Appendix B)</h2>\n<p>Wrenches of random thin parts sampled on 300 twist directions; "
+    c.html << c.heading("4. Limit surfaces (Appendix B)", "limit-surfaces")
+           << "<p>Wrenches of random thin parts sampled on 300 twist directions; "
               "all pairs tested. Maximum work: ξ<sub>i</sub>·w<sub>j</sub> ≥ ξ<sub>i</sub>·w<sub>i</sub> (convex surface, twist "
               "normal to it); (40): (ξ<sub>i</sub>−ξ<sub>j</sub>)·(w<sub>i</sub>−w<sub>j</sub>) ≤ 0; no vertices: distinct "
               "directions give distinct wrenches; no flat faces: the max-work inequality is strict between distinct "
@@ -223,7 +226,8 @@ void proofs_limit_surfaces(Ctx& c, const ReportOptions& opt, int n_surf) {
            << ls.parts << "</td><td>" << ls.convex << "</td><td>" << fmt(ls.max_work_margin, 3) << "</td><td>"
            << fmt(ls.monotonicity_margin, 3) << "</td><td>" << ls.strict << "</td><td>" << fmt(ls.min_strict_margin, 3)
            << "</td><td>" << fmt(ls.min_separation, 3) << "</td><td>" << ls.on_set << "</td><td>" << fmt(ls.support_margin, 2)
-           << "</td><td>" << fmt(ls.outside_margin, 2) << "</td><td>" << verdict(ls.passed())
+           << "</td><td>" << fmt(ls.outside_margin, 2) << "</td><td>"
+           << c.verdict("limit surfaces strictly convex, on the friction set", ls.passed())
            << "</td></tr></table>\n<p>Maximum work and (40) hold by construction: for any wrench of "
               "the form −Σ c<sub>i</sub> G<sub>i</sub> v<sub>i</sub>/|v<sub>i</sub>| with c<sub>i</sub> ≥ 0 (Cauchy-Schwarz), so "
               "a kernel fed a wrong μ or lever arm passes them. What can fail: strict convexity (collinear contacts fail it: "
@@ -234,7 +238,8 @@ void proofs_limit_surfaces(Ctx& c, const ReportOptions& opt, int n_surf) {
               "fails it: test).</p>\n<p>Each part's dynamics tied to its surface at "
            << ls.tie.samples << " states (statics and wrench, as above): worst " << fmt(ls.tie.worst_statics, 2) << " and "
            << fmt(ls.tie.worst_wrench, 2) << " m g"
-           << (ls.tie.passed() ? "." : ": <span class=\"fail\">" + esc(ls.tie.failure) + "</span>") << "</p>\n";
+           << ": " << c.verdict("random parts' dynamics tied to their limit surfaces", ls.tie.passed(), "pass", ls.tie.failure)
+           << ".</p>\n";
     {
         const Scene sc = random_scene(opt.seed + 90'000'000, RandomSceneOptions{true});
         double scale = 0;
@@ -328,10 +333,11 @@ void section_fig3(Ctx& c, const fs::path& src) {
         const Vec3 d = ends[0][k] - ends[1][k];
         return std::sqrt(d.head<2>().squaredNorm() + std::pow(sc.part.rho() * d[2], 2)) / v;
     };
-    c.html << "<h2>5. Observation 1 (Fig. 3)</h2>\n<p>Scene <code>fig3_random</code> at (0.01, −0.01, 0.5): two initial "
+    c.html << c.heading("5. Observation 1 (Fig. 3)", "fig3")
+           << "<p>Scene <code>fig3_random</code> at (0.01, −0.01, 0.5): two initial "
               "twists, ten periods of the reduced U-dynamics; open circles every T.</p>\n";
     c.plot("fig3",
-           "set xlabel 'ṡ_x'\nset ylabel 'ṡ_y'\nset zlabel 'θ̇'\nset view 60,40\n"
+           "set xlabel 'ṡ_x [m/s]'\nset ylabel 'ṡ_y [m/s]'\nset zlabel 'θ̇ [rad/s]'\nset view 60,40\n"
            "splot 'data/fig3a.dat' u 1:2:3 w l lc rgb '#c03030' t 'start 1', 'data/fig3b.dat' u 1:2:3 w l lc rgb '#3050c0' t "
            "'start 2', "
            "'data/fig3a_T.dat' w p pt 6 lc rgb '#c03030' notitle, 'data/fig3b_T.dat' w p pt 6 lc rgb '#3050c0' notitle\n",

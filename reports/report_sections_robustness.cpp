@@ -133,10 +133,11 @@ void scatter_figures(Ctx& c, const std::string& n, const RobustnessSummary& s, c
         auto e2 = c.data(n + "_ellipse_xt.dat");
         for (const Vec2& p : covariance_ellipse(xt)) e2 << p.x() << ' ' << p.y() << '\n';
     }
-    const std::string marks = std::to_string(over) + " draws more than 30 % off their linear prediction (×)" +
-                              (over == s.nonlinear_draws ? ""
-                                                         : "; <span class=\"fail\">FAIL</span>: the summary counts " +
-                                                               std::to_string(s.nonlinear_draws));
+    const std::string marks = std::to_string(over) + " draws more than 30 % off their linear prediction (×)";
+    c.html << "<p>" << marks << "; the robustness summary counts "
+           << c.verdict(n + ": the summary counts the draws off their linear prediction", over == s.nonlinear_draws, "the same",
+                        "FAIL: " + std::to_string(s.nonlinear_draws))
+           << ".</p>\n";
     const std::string common = "set key outside right\nset grid\n";
     const std::string pts = "'data/" + n + "_scatter_linear.dat' u %X:%Y w p pt 7 ps 0.6 lc rgb '#3050c0' t 'draw', 'data/" + n +
                             "_scatter_nonlinear.dat' u %X:%Y w p pt 2 ps 1.2 lw 2 lc rgb '#d07000' t 'draw, over 30 % off', ";
@@ -286,7 +287,7 @@ void section_robustness(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     std::sort(designs.begin(), designs.end());
     std::ifstream in(spec_file);
     const nlohmann::json spec_text = nlohmann::json::parse(in);
-    c.html << "<h2>Robustness</h2>\n<p>Each shipped design (<code>scenes/designs/</code>) on " << o.draws
+    c.html << c.heading("Robustness", "robustness") << "<p>Each shipped design (<code>scenes/designs/</code>) on " << o.draws
            << " plates and parts drawn from the uncertainty spec <code>scenes/uncertainty/ppod.json</code> (<code>"
            << esc(spec_text.dump()) << "</code>: PPOD-type tracking errors)"
            << (opt.quick ? ", 40 draws in this quick run (the full report draws 200)" : "")

@@ -479,7 +479,7 @@ void cycle_solvers(Ctx& c, const Scene& sc, bool full) {
     // ratio divides R by the mean of the fields on either side of it. Reported: the median of five.
     if (best_name.empty() || rk_best.n == 0) {
         c.html << "<p>At max error &le; " << fmt(kTarget, 2) << ": " << (best_name.empty() ? "no cycle solver" : "no RK4 setting")
-               << " reached it: " << verdict(false) << ".</p>\n";
+               << " reached it: " << c.verdict("a cycle solver and RK4 reach the target error", false) << ".</p>\n";
         return;
     }
     constexpr int kRounds = 5;

@@ -473,23 +473,43 @@ TEST_CASE("plate report writes index.html whose every figure exists", "[cli][rep
         CHECK(html.find(s) != std::string::npos);
     // The robustness section: every shipped design (scenes/designs/*.json) with its outcomes, scatter against
     // the first-order ellipse (a rigid part's x-theta too) and arrival times; sensitivities and the spread.
-    for (const char* s : {"<h2>Robustness", "40 draws in this quick run", "robustness_fig4_fixed_point_outcomes.svg",
+    for (const char* s : {"\">Robustness</h2>", "40 draws in this quick run", "robustness_fig4_fixed_point_outcomes.svg",
                           "robustness_fig4_fixed_point_scatter_xy.svg", "robustness_fig4_fixed_point_scatter_xtheta.svg",
                           "robustness_fig4_fixed_point_arrival.svg", "robustness_point_sink_scatter_xy.svg",
                           "robustness_point_sink_arrival.svg", "share of the position variance", "95 % radius [mm]"})
         CHECK(html.find(s) != std::string::npos);
     CHECK(html.find("robustness_point_sink_scatter_xtheta") == std::string::npos);   // (a point part has no theta)
     // The identification section: the fitted track, its residuals and both parameters' profiles.
-    for (const char* s : {"<h2>Identification", "identify_track.svg", "identify_residuals.svg", "identify_profile_mu_k.svg",
-                          "identify_profile_mu_s.svg", "linearised 95 %"})
+    for (const char* s : {"\">Identification: friction", "identify_track.svg", "identify_residuals.svg",
+                          "identify_profile_mu_k.svg", "identify_profile_mu_s.svg", "linearised 95 %"})
         CHECK(html.find(s) != std::string::npos);
     // Every paper figure's run from rest reached its full duration (a run that stops, as all of them
     // did when sticking stopped the program, is marked FAIL by the report and draws a dot).
     const std::size_t stopped = html.find("FAIL: the run from rest stopped");
     INFO((stopped == std::string::npos ? std::string() : html.substr(stopped, 200)));
     CHECK(stopped == std::string::npos);
+    // The contents list and the verdict table at the top: every check the page states (each verdict has an
+    // anchor check-N) is one row, linked to it, with the same outcome; and the sections are listed.
+    const std::size_t t0 = html.find("<table id=\"verdict-table\">"), t1 = html.find("</table>", t0);
+    REQUIRE(t0 != std::string::npos);
+    REQUIRE(t1 != std::string::npos);
+    const std::string table = html.substr(t0, t1 - t0), body = html.substr(0, t0) + html.substr(t1);
+    int rows = 0, anchors = 0;
+    for (std::size_t p = 0; (p = body.find(" id=\"check-", p)) != std::string::npos; ++p) ++anchors;
+    for (std::size_t p = 0; (p = table.find("<a href=\"#check-", p)) != std::string::npos; ++p, ++rows) {
+        const std::string id = table.substr(p + 10, table.find('"', p + 10) - p - 10);
+        const std::size_t cell = table.find("<td class=\"", p);
+        const std::string outcome = table.substr(cell + 11, table.find('"', cell + 11) - cell - 11);
+        INFO(id);
+        CHECK(body.find("<span id=\"" + id + "\" class=\"" + outcome + "\">") != std::string::npos);
+    }
+    CHECK(rows == anchors);
+    CHECK(rows >= 30);
+    for (const char* s : {"<a href=\"#verdicts\">", "<a href=\"#theorem1\">", "<a href=\"#fields\">", "<a href=\"#identify\">",
+                          "<a href=\"#speed\">", "<a id=\"speed\"></a>"})
+        CHECK(html.find(s) != std::string::npos);
     // Every verdict marked FAIL is one this test expects, with its reason; any other fails it.
-    const std::vector<std::string> unexpected = unexpected_fails(html);
+    const std::vector<std::string> unexpected = unexpected_fails(body);
     for (const std::string& u : unexpected) INFO("unexpected FAIL: " << u);
     CHECK(unexpected.empty());
 }
@@ -516,8 +536,8 @@ TEST_CASE("plate report --sections computes only the named sections and says whi
     CHECK(html.find("fig3.svg") != std::string::npos);
     // Each left-out section's heading is absent (not computed, not only not named).
     for (const char* h :
-         {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields", "<h2>Inverse design",
-          "Orienting a part", "Fixing a rigid part", "<h2>Robustness", "<h2>Identification"})
+         {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields", "\">Inverse design</h2>",
+          "Orienting a part", "Fixing a rigid part", "\">Robustness</h2>", "\">Identification: friction"})
         CHECK(html.find(h) == std::string::npos);
     CHECK(html.find("Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point, "
                     "robustness, identify.") != std::string::npos);
