@@ -26,6 +26,13 @@ double nice_floor(double x) {
     return p;
 }
 
+// The arrows' scale for arrows that are the twist times k [s] on grid g: a reference arrow of a round
+// speed along s_x (gnuplot commands), and the caption's statement of it and of a theta component.
+struct QuiverScale {
+    std::string arrow, caption;
+};
+QuiverScale quiver_scale(const GridSpec& g, double k, bool point);
+
 // The quiver's scale: a reference arrow above a 2-D field plot, drawn in the axis it measures (`horizontal`:
 // along x, else along y), `length` [axis units] for `speed` [unit]; gnuplot commands.
 std::string scale_arrow(double length, double speed, const char* unit, bool horizontal) {
@@ -34,6 +41,14 @@ std::string scale_arrow(double length, double speed, const char* unit, bool hori
            "' at graph 0, graph 1.06 left\nset arrow 90 from graph 0.3, graph 1.04 " + rto +
            " lw 2 lc rgb '#000000' front nohead\nset arrow 91 from graph 0.3, graph 1.04 " + rto +
            " lw 2 lc rgb '#000000' front head size 0.004,20\n";
+}
+
+QuiverScale quiver_scale(const GridSpec& g, double k, bool point) {
+    if (!(k > 0) || !(g.dx() > 0)) return {};
+    const double v = nice_floor(0.8 * g.dx() / k), w = nice_floor(0.8 * g.dth() / k);
+    return {scale_arrow(k * v, 1e3 * v, "mm/s", true),
+            " Arrows: the twist times " + fmt(k, 3) + " s; the black one above the plot is " + fmt(1e3 * v, 3) + " mm/s" +
+                (point ? "" : "; a θ-component of " + fmt(k * w, 3) + " rad is " + fmt(w, 3) + " rad/s") + "."};
 }
 
 // Stick-slip against the regularised-friction limit (study.hpp): a cycle that pivots and one with a
@@ -205,16 +220,8 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const std::string F = "'data/" + n + "_field.dat'", T = "'data/" + n + "_traj.dat'";
         const std::string arrows = " w vec head size 0.004,20 lc rgb '#777777' notitle";
         const std::string kFieldSize = "800,640";   // field figures: large enough to read the arrows
-        // The arrows' scale: a reference arrow of a round speed on the s_x (or s_y) axis, and the caption's
-        // statement of what a grid cell's length stands for along each axis.
-        std::string scale, scale_y, scale_text;
-        if (k > 0 && g.dx() > 0) {
-            const double v = nice_floor(0.8 * g.dx() / k), w = nice_floor(0.8 * g.dth() / k);
-            scale = scale_arrow(k * v, 1e3 * v, "mm/s", true);
-            scale_y = g.dy() > 0 ? scale_arrow(k * v, 1e3 * v, "mm/s", true) : "";
-            scale_text = " Arrows: the twist times " + fmt(k, 3) + " s; the black one above the plot is " + fmt(1e3 * v, 3) +
-                         " mm/s" + (pt ? "" : "; a θ-component of " + fmt(k * w, 3) + " rad is " + fmt(w, 3) + " rad/s") + ".";
-        }
+        const QuiverScale qs = quiver_scale(g, k, pt);
+        const std::string &scale = qs.arrow, &scale_y = qs.arrow, &scale_text = qs.caption;
         if (pt) {
             c.plot(n + "_xy",
                    scale + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows +

@@ -42,6 +42,7 @@ def clean_type(t):
     t = out + t[i:]
     t = re.sub(r"numpy\.ndarray(?!\[)", "numpy.ndarray[Any, Any]", t)
     t = re.sub(r"\b(float|int|bool|str)\[\d+\]", r"\1", t)   # std::array's float[2]: a list of floats
+    t = re.sub(r"\bos\.PathLike\b", "Union[str, os.PathLike[str]]", t)   # std::filesystem::path takes both
     t = {"dict": "Dict[str, Any]", "tuple": "Tuple[Any, ...]", "list": "List[Any]", "object": "Any",
          "function": "Callable[..., Any]"}.get(t, t)
     return t
@@ -138,7 +139,7 @@ def stubs(module):
             functions.append(signature(obj.__doc__, name))
         elif name == "__version__":
             values.append("__version__: str")
-    head = BANNER + "from typing import Any, Callable, Dict, List, Optional, Tuple, Union\n\nimport numpy\n"
+    head = BANNER + "import os\nfrom typing import Any, Callable, Dict, List, Optional, Tuple, Union\n\nimport numpy\n"
     return head + "\n" + "\n".join(values) + "\n\n" + "\n\n".join(classes) + "\n\n" + "\n".join(functions) + "\n"
 
 

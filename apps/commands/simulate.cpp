@@ -173,20 +173,16 @@ int cmd_simulate(const SimulateArgs& a, Io& cio) {
         if (!qd0.isZero()) throw UsageError("--dynamics auto answers from rest: drop --twist");
         const double tol = a.model_tol;
         if (!(tol > 0)) throw UsageError("--model-tol must be > 0");
-        const ModelEstimate est = estimate_model_errors(sc, q0, T);
-        PartModel part;
-        Dynamics d;
-        const double predicted = a_priori_pick(sc, est, tol, part, d);
-        Rung picked;
-        picked.part = part;
-        picked.dynamics = d;
-        cio.err << "auto model, decided up front (tolerance " << tol << "): picked " << picked.name() << " (predicted error "
-                << predicted << ")\n  estimates: |xi| " << est.xi << "/s, point " << est.e_point << ", thin " << est.e_thin
+        const ModelPick pick = pick_model(sc, q0, T, tol);
+        const ModelEstimate& est = pick.estimate;
+        cio.err << "auto model, decided up front (tolerance " << tol << "): picked " << pick.rung.name() << " (predicted error "
+                << pick.predicted << ")\n  estimates: |xi| " << est.xi << "/s, point " << est.e_point << ", thin " << est.e_thin
                 << ", eps_U " << est.eps_U << ", transient offset " << est.offset << ", growth " << est.growth()
                 << (est.ok ? "" : " (" + est.note + ")") << "\n";
-        used = simplified(sc, part);
+        used = pick.scene;
+        const Dynamics d = pick.rung.dynamics;
         dyn = d == Dynamics::Full ? "full" : d == Dynamics::U ? "u" : "field";
-        verify_auto = a.verify && picked.name() != Rung{}.name();
+        verify_auto = a.verify && pick.rung.name() != Rung{}.name();
     } else if (a.verify) {
         throw UsageError("--verify goes with --dynamics auto");
     }

@@ -65,19 +65,7 @@ int cmd_sweep(const SweepArgs& a, Io& cio) {
         return 1;
     }
     if (!farm->root()) return 0;
-    nlohmann::json j = {{"campaign", a.campaign},
-                        {"out", a.out},
-                        {"cases", s.cases},
-                        {"resumed", s.resumed},
-                        {"computed", s.computed},
-                        {"failed", s.failed},
-                        {"torn_journal_lines_dropped", s.torn},
-                        {"seconds", s.seconds},
-                        {"busy_seconds", s.busy_seconds},
-                        {"workers", s.workers},
-                        {"farm", s.farm},
-                        {"load_balance_efficiency", s.computed && s.seconds > 0 ? s.busy_seconds / (s.seconds * s.workers) : 0.0},
-                        {"tables", {a.out + "/table.csv", a.out + "/table.jsonl"}}};
+    const nlohmann::json j = sweep::sweep_summary_json(a.campaign, a.out, s);
     cio.out << j.dump(2) << std::endl;
     return 0;
 }

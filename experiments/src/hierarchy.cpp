@@ -316,4 +316,12 @@ APrioriChoice choose_model_a_priori(const Scene& sc, const Vec3& q0, double dura
     return c;
 }
 
+ModelPick pick_model(const Scene& sc, const Vec3& q0, double duration, double tol) {
+    ModelPick m;
+    m.estimate = estimate_model_errors(sc, q0, duration);
+    m.predicted = a_priori_pick(sc, m.estimate, tol, m.rung.part, m.rung.dynamics);
+    m.scene = simplified(sc, m.rung.part);
+    return m;
+}
+
 }   // namespace plate

@@ -36,6 +36,7 @@ void bind_robustness(py::module_& m);     // robustness.cpp: Robustness, robustn
 void bind_observe(py::module_& m);        // observe.cpp:  Camera, Track, observe, read_track_csv, ...
 void bind_identify(py::module_& m);       // identify.cpp: Identification, identify
 void bind_control(py::module_& m);        // control.cpp:  ControlRun, control, ControlEnv
+void bind_commands(py::module_& m);       // commands.cpp: random_scene, sweep
 
 // --- conversions (conversions.cpp) ---------------------------------------------------------------
 
@@ -43,6 +44,9 @@ py::object json_to_python(const nlohmann::json& j);
 
 // A configuration or twist: 3 numbers for a rigid part, 2 for a point part (theta meaningless).
 Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name);
+
+// A file's path from a str or an os.PathLike (pathlib.Path): the path, else nothing.
+std::optional<std::string> path_of(const py::handle& o);
 
 // ValueError(message) unless ok.
 void require(bool ok, const std::string& message);

@@ -22,11 +22,11 @@ std::string num(double x) {
 
 std::string dumps(const py::handle& d) { return py::module_::import("json").attr("dumps")(d).cast<std::string>(); }
 
-// A truth, a camera or a library from a file's path (str) or a dict in the file's form (checked as a file
+// A truth, a camera or a library from a file's path (str or os.PathLike) or a dict in the file's form (checked as a file
 // is: plate.InputError naming '<dict>'); a library dict's scene paths are relative to the working folder.
 Truth truth_of(const py::object& t) {
     if (t.is_none()) return Truth{};
-    if (py::isinstance<py::str>(t)) return load_truth(t.cast<std::string>());
+    if (const auto path = path_of(t)) return load_truth(*path);
     require(py::isinstance<py::dict>(t), "truth: expected a truth file's path or a dict in its form");
     return parse_truth(dumps(t), "<dict>");
 }
@@ -35,7 +35,7 @@ std::optional<Camera> camera_opt(const py::object& c) {
     return camera_of(c);
 }
 MotionLibrary library_of(const py::object& l, const Scene& sc) {
-    if (py::isinstance<py::str>(l)) return load_motion_library(l.cast<std::string>(), sc);
+    if (const auto path = path_of(l)) return load_motion_library(*path, sc);
     require(py::isinstance<py::dict>(l), "library: expected a library file's path or a dict in its form");
     return parse_motion_library(dumps(l), "<dict>", "", sc);
 }

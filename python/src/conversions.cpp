@@ -61,4 +61,12 @@ PyStop to_py(const StopEvent& e) {
     return {stop_name(e.reason), e.contact + 1, e.t, e.reason == StopReason::None ? "" : e.describe()};
 }
 
+std::optional<std::string> path_of(const py::handle& o) {
+    if (py::isinstance<py::str>(o)) return o.cast<std::string>();
+    if (!py::hasattr(o, "__fspath__")) return std::nullopt;
+    const py::object p = py::module_::import("os").attr("fspath")(o);
+    if (!py::isinstance<py::str>(p)) return std::nullopt;   // (a bytes path: not a file name this library takes)
+    return p.cast<std::string>();
+}
+
 }   // namespace plate::python

@@ -75,9 +75,10 @@ void bind_field(py::module_& m) {
             [](const PyField& f) {
                 std::vector<std::string> s;
                 for (const FieldPoint& p : f.f.points) s.push_back(stop_name(p.stop));
-                return s;
+                const GridSpec& g = f.f.grid;
+                return py::module_::import("numpy").attr("array")(s).attr("reshape")(g.nx, g.ny, g.nth);
             },
-            "why each configuration has no twist ('none' where it has), grid order")
+            "why each configuration has no twist ('none' where it has): a numpy array of str, shape (nx, ny, ntheta)")
         .def_property_readonly("seconds", [](const PyField& f) { return f.f.seconds; })
         .def_property_readonly("rhs_evaluations", [](const PyField& f) { return f.f.rhs_evals; })
         .def_property_readonly("threads", [](const PyField& f) { return f.f.threads; })

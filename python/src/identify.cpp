@@ -20,11 +20,12 @@ struct PyIdentification {
     ProfileOptions po;
 };
 
-// A track from a plate.Track or a track file's path (read as the command line reads it).
+// A track from a plate.Track or a track file's path, str or os.PathLike (read as the command line reads it).
 Track track_of(const py::handle& t) {
     if (py::isinstance<Track>(t)) return t.cast<Track>();
-    require(py::isinstance<py::str>(t), "tracks: expected plate.Track objects or track files' paths");
-    return read_track_csv(t.cast<std::string>());
+    const auto path = path_of(t);
+    require(path.has_value(), "tracks: expected plate.Track objects or track files' paths (str or os.PathLike)");
+    return read_track_csv(*path);
 }
 
 // One number per fitted parameter, in the order asked.

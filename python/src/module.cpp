@@ -37,4 +37,5 @@ PYBIND11_MODULE(_plate, m) {
     bind_observe(m);
     bind_identify(m);
     bind_control(m);
+    bind_commands(m);
 }

@@ -2,6 +2,10 @@
 // the track file (plate.read_track_csv, plate.write_track_csv): numeric/include/plate/observe.hpp.
 #include "bindings.hpp"
 
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+
 #include "plate/observe.hpp"
 
 #include <cmath>
@@ -11,7 +15,7 @@ namespace plate::python {
 
 Camera camera_of(const py::object& c) {
     if (py::isinstance<Camera>(c)) return c.cast<Camera>();
-    if (py::isinstance<py::str>(c)) return load_camera(c.cast<std::string>());
+    if (const auto path = path_of(c)) return load_camera(*path);
     require(py::isinstance<py::dict>(c), "camera: expected a plate.Camera, a camera file's path or a dict in its form");
     return parse_camera(py::module_::import("json").attr("dumps")(c).cast<std::string>(), "<dict>");
 }
@@ -67,7 +71,9 @@ void bind_observe(py::module_& m) {
         .def_property_readonly("stroboscopic", &Camera::stroboscopic)
         .def(
             "to_json", [](const Camera& c) { return camera_to_json(c).dump(); }, "the camera in the file form");
-    m.def("load_camera", &load_camera, py::arg("path"), "Reads a camera file (raises plate.InputError).");
+    m.def(
+        "load_camera", [](const std::filesystem::path& p) { return load_camera(p.string()); }, py::arg("path"),
+        "Reads a camera file, its path a str or os.PathLike (raises plate.InputError).");
     m.def("parse_camera", &parse_camera, py::arg("text"), py::arg("source"),
           "Reads a camera from JSON text; `source` names it in messages (raises plate.InputError).");
     m.def("scene_id", &scene_id, py::arg("scene"), "The scene's fingerprint (16 hex digits), as a track's header names it.");
@@ -137,11 +143,14 @@ void bind_observe(py::module_& m) {
         "plate.observe at the given camera stamps (increasing, none before the camera's latency): e.g. a model's\n"
         "prediction of a recorded track -- track.t, a camera without noise and drops.");
     m.def(
-        "read_track_csv", &read_track_csv, py::arg("path"),
-        "Reads a track file (raises plate.InputError naming the file and the line: a bad header, cell or time, too few frames).");
+        "read_track_csv", [](const std::filesystem::path& p) { return read_track_csv(p.string()); }, py::arg("path"),
+        "Reads a track file, its path a str or os.PathLike (raises plate.InputError naming the file and the line: a bad header, "
+        "cell or time, too few frames).");
     m.def(
         "write_track_csv",
-        [](const Track& t, const std::string& path) { write_file_atomic(path, [&](std::ostream& o) { write_track_csv(o, t); }); },
+        [](const Track& t, const std::filesystem::path& path) {
+            write_file_atomic(path.string(), [&](std::ostream& o) { write_track_csv(o, t); });
+        },
         py::arg("track"), py::arg("path"), "Writes a track file (the form read_track_csv reads).");
     m.def("check_track_scene", &check_track_scene, py::arg("track"), py::arg("scene"),
           "Raises plate.InputError ('tracks from another scene', naming the file and line) unless the track was taken "

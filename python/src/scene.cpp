@@ -1,6 +1,10 @@
 // plate.Scene, plate.load_scene, plate.parse_scene and plate.Stop (why a run stopped).
 #include "bindings.hpp"
 
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+
 #include "plate/friction.hpp"
 
 namespace plate::python {
@@ -91,7 +95,9 @@ void bind_scene(py::module_& m) {
                                     : "thick part") +
                    ", T = " + std::to_string(s.plate.T) + " s, " + std::to_string(s.plate.harmonics.size()) + " harmonics>";
         });
-    m.def("load_scene", &load_scene, py::arg("path"), "Reads a scene file (raises plate.InputError).");
+    m.def(
+        "load_scene", [](const std::filesystem::path& p) { return load_scene(p.string()); }, py::arg("path"),
+        "Reads a scene file, its path a str or os.PathLike (raises plate.InputError).");
     m.def("parse_scene", &parse_scene, py::arg("text"), py::arg("source"),
           "Reads a scene from JSON text; `source` names it in messages (raises plate.InputError).");
 

@@ -1,5 +1,8 @@
-// plate.simulate: a trajectory in the full or U-dynamics or along the field (plate.Trajectory).
+// plate.simulate: a trajectory in the full, U- or averaged dynamics, along the field, or in the model `auto`
+// picks (plate.Trajectory).
 #include "bindings.hpp"
+
+#include "plate/hierarchy.hpp"
 
 #include <cmath>
 
@@ -11,6 +14,12 @@ struct PyTrajectory {
     Scene scene;
     Trajectory tr;
     std::string dynamics;
+    struct Model {   // dynamics='auto': what was picked, its predicted error, why the estimate failed if it did
+        std::string picked;
+        double predicted = 0;
+        std::string note;
+    };
+    std::optional<Model> model;
 };
 
 py::array_t<double> samples_array(const Trajectory& tr, int what) {
@@ -70,13 +79,25 @@ void bind_simulate(py::module_& m) {
             "time each contact had zero slip [s]")
         .def_property_readonly("stop", [](const PyTrajectory& p) { return to_py(p.tr.stop); })
         .def_property_readonly("steps", [](const PyTrajectory& p) { return p.tr.stats.steps; })
-        .def_property_readonly("dynamics", [](const PyTrajectory& p) { return p.dynamics; });
+        .def_property_readonly("dynamics", [](const PyTrajectory& p) { return p.dynamics; })
+        .def_property_readonly(
+            "model",
+            [](const PyTrajectory& p) -> py::object {
+                if (!p.model) return py::none();
+                py::dict d;
+                d["picked"] = p.model->picked;
+                d["predicted_error"] = p.model->predicted;
+                d["note"] = p.model->note;
+                return std::move(d);
+            },
+            "dynamics='auto': {'picked': part / dynamics, 'predicted_error': of rho and radians, 'note'}; else None");
     m.def(
         "simulate",
         [](const Scene& sc, const std::vector<double>& start, double time, const std::string& dynamics,
-           std::optional<std::vector<double>> twist, std::optional<double> sample, double rtol, long max_steps, double tol) {
-            require(dynamics == "full" || dynamics == "u" || dynamics == "field",
-                    "dynamics: expected 'full', 'u' or 'field', got '" + dynamics + "'");
+           std::optional<std::vector<double>> twist, std::optional<double> sample, double rtol, long max_steps, double tol,
+           double model_tol) {
+            require(dynamics == "full" || dynamics == "u" || dynamics == "field" || dynamics == "averaged" || dynamics == "auto",
+                    "dynamics: expected 'full', 'u', 'field', 'averaged' or 'auto', got '" + dynamics + "'");
             const Vec3 q0 = config(sc, start, "start");
             const Vec3 qd0 = twist ? config(sc, *twist, "twist") : Vec3::Zero();
             const double dt = sample.value_or(sc.plate.T / 4);
@@ -86,27 +107,42 @@ void bind_simulate(py::module_& m) {
             require(rtol > 0 && rtol < 1e-2, "rtol: expected a number in (0, 1e-2)");
             require(max_steps >= 1, "max_steps: expected >= 1");
             require(dynamics != "field" || qd0.isZero(), "twist: has no meaning for dynamics='field'");
-            PyTrajectory p{sc, {}, dynamics};
+            require(dynamics != "auto" || qd0.isZero(), "twist: dynamics='auto' answers from rest");
+            require(model_tol > 0, "model_tol: expected a number > 0");
+            PyTrajectory p{sc, {}, dynamics, std::nullopt};
             py::gil_scoped_release free;
-            if (dynamics == "field") {
+            Scene run = sc;
+            std::string level = dynamics;
+            if (dynamics == "auto") {   // the command line's choice (experiments/hierarchy.hpp), decided up front
+                const ModelPick pick = pick_model(sc, q0, time, model_tol);
+                run = pick.scene;
+                level = pick.rung.dynamics == Dynamics::Full ? "full" : pick.rung.dynamics == Dynamics::U ? "u" : "field";
+                p.model = {pick.rung.name(), pick.predicted, pick.estimate.ok ? "" : pick.estimate.note};
+                p.dynamics = "auto: " + pick.rung.name();
+            }
+            if (level == "field") {
                 LimitCycleOptions lo;
                 lo.tol = tol;
-                p.tr = field_curve(sc, q0, time, dt, lo);
+                p.tr = field_curve(run, q0, time, dt, lo);
             } else {
                 IntegrationOptions io;
                 io.rtol = rtol;
                 io.max_steps = max_steps;
-                p.tr = simulate(sc, dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
+                p.tr = level == "averaged" ? simulate_averaged(run, q0, qd0, time, dt, io)
+                                           : simulate(run, level == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
             }
             return p;
         },
         py::arg("scene"), py::arg("start"), py::arg("time"), py::kw_only(), py::arg("dynamics") = "full",
         py::arg("twist") = py::none(), py::arg("sample") = py::none(), py::arg("rtol") = 1e-9, py::arg("max_steps") = 20'000'000L,
-        py::arg("tol") = 1e-7,
+        py::arg("tol") = 1e-7, py::arg("model_tol") = 1e-2,
         "A trajectory from configuration `start` with the part's twist `twist` relative to the plate (default:\n"
         "at rest) for `time` seconds, sampled every `sample` (default T/4): 'full' dynamics (31), 'u'\n"
-        "U-dynamics (32) or the 'field' integral curve. Stick-slip is simulated through. A run that leaves\n"
-        "the model (a normal force reaches zero) ends there: trajectory.stop says when and which contact.");
+        "U-dynamics (32), the 'field' integral curve, 'averaged' (full dynamics in bursts, the field's drift\n"
+        "between them, as `plate simulate --dynamics averaged`) or 'auto' (the cheapest part model and\n"
+        "dynamics predicted within `model_tol` of the full model, decided up front from rest: the choice in\n"
+        "trajectory.model). Stick-slip is simulated through. A run that leaves the model (a normal force\n"
+        "reaches zero) ends there: trajectory.stop says when and which contact.");
 }
 
 }   // namespace plate::python

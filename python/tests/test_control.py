@@ -45,7 +45,8 @@ def test_the_library_policy_gives_the_command_lines_run_to_the_bit(tmp_path):
     with open(out) as f:
         rows = list(csv.reader(f))[1:]
     assert len(rows) == len(run.t) == 61
-    cells = np.array([[float(c) for c in r[:5]] for r in rows])   # t, observed s_x s_y, true x y: shortest round-trip digits
+    # t, observed s_x s_y, true x y, in shortest round-trip digits; no observation yet: an empty cell
+    cells = np.array([[float(c) if c else math.nan for c in r[:5]] for r in rows])
     assert np.array_equal(cells[:, 0], run.t)
     assert np.array_equal(cells[:, 1:3], run.observed[:, :2], equal_nan=True)
     assert np.array_equal(cells[:, 3:5], run.truth[:, :2])

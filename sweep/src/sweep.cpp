@@ -513,6 +513,22 @@ void write_tables(const std::string& dir, const Campaign& c, const Journal& j) {
 
 // ---- running -------------------------------------------------------------------------------------
 
+nlohmann::json sweep_summary_json(const std::string& campaign_file, const std::string& out, const SweepSummary& s) {
+    return {{"campaign", campaign_file},
+            {"out", out},
+            {"cases", s.cases},
+            {"resumed", s.resumed},
+            {"computed", s.computed},
+            {"failed", s.failed},
+            {"torn_journal_lines_dropped", s.torn},
+            {"seconds", s.seconds},
+            {"busy_seconds", s.busy_seconds},
+            {"workers", s.workers},
+            {"farm", s.farm},
+            {"load_balance_efficiency", s.computed && s.seconds > 0 ? s.busy_seconds / (s.seconds * s.workers) : 0.0},
+            {"tables", {out + "/table.csv", out + "/table.jsonl"}}};
+}
+
 SweepSummary run_sweep(const std::string& campaign_file, const SweepOptions& opt, Farm& farm) {
     const auto t0 = std::chrono::steady_clock::now();
     SweepSummary s;

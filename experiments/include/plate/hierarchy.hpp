@@ -105,4 +105,14 @@ APrioriChoice choose_model_a_priori(const Scene& scene, const Vec3& q0, double d
 // part under full dynamics when none is, or when the estimate failed). Returns its prediction.
 double a_priori_pick(const Scene& scene, const ModelEstimate& estimate, double tol, PartModel& part, Dynamics& dynamics);
 
+// `auto` for a run from rest at q0 (the command line's and Python's simulate): the rung picked from the
+// estimate, not run; `scene` is the scene with its part simplified to the rung's.
+struct ModelPick {
+    ModelEstimate estimate;
+    Rung rung;              // part and dynamics (error, seconds, work unset: not run)
+    double predicted = 0;   // its predicted error [of rho and radians]
+    Scene scene;
+};
+ModelPick pick_model(const Scene& scene, const Vec3& q0, double duration, double tol);
+
 }   // namespace plate

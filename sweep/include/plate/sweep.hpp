@@ -157,6 +157,10 @@ struct SweepSummary {
     std::string farm;          // how the cases were shared
 };
 
+// The command line's JSON summary of a campaign run (`plate sweep`, Python's plate.sweep): the counts,
+// times [s], the farm and the tables written.
+nlohmann::json sweep_summary_json(const std::string& campaign_file, const std::string& out, const SweepSummary& s);
+
 // Collective over the farm. Rank 0 reads the campaign file, opens the journal under opt.out and
 // sends the campaign to the other ranks (Farm::broadcast: they read no file); the cases not in the
 // journal are computed on the farm, each appended to the journal as it finishes; rank 0 then
