@@ -7,13 +7,17 @@ import re
 import sys
 from xml.etree import ElementTree
 
+from breathe.directives.content_block import DoxygenGroupDirective
 from breathe.renderer.sphinxrenderer import SphinxRenderer
+from docutils import nodes
+from sphinx import addnodes
+from sphinx.util import logging
 
 sys.path.insert(0, os.environ["PLATE_PYTHON_DIR"])
 import plate  # noqa: E402  (the module the Python pages document; an import error stops the build)
 
 project = "plate"
-author = "the plate authors"
+author = "The plate developers"   # (CITATION.cff)
 copyright = "2026, " + author
 version = release = plate.__version__
 
@@ -23,24 +27,27 @@ root_doc = "index"
 default_role = "literal"   # (`name` in docstrings and comments is code)
 nitpicky = True            # (-n: every cross-reference must resolve; the ones that cannot are listed below)
 highlight_language = "none"
+smartquotes = False        # (quotes stay as typed: the docstrings' dicts and names are code)
 
 html_theme = "alabaster"
 html_theme_options = {"page_width": "1200px", "sidebar_width": "260px", "fixed_sidebar": True,
                       "description": "sliding manipulation on a vibrating 6-DoF plate"}
 html_sidebars = {"**": ["about.html", "navigation.html", "searchbox.html"]}
-html_static_path = []
+html_static_path = ["_static"]   # (custom.css, which alabaster loads)
 html_show_sourcelink = False
 
 # --- Python: the module `plate` (pybind11). Its classes live in plate._plate and are re-exported by
 # plate; signatures and docstrings name them as plate.X, which is where these pages put them.
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
-autodoc_default_options = {"members": True, "undoc-members": True, "show-inheritance": True}
+autodoc_default_options = {"members": True, "undoc-members": True}
+autoclass_content = "both"   # (a class's docstring and its constructor's, whose signature pybind11 writes)
 
 
 def _public_names(app, what, name, obj, options, signature, return_annotation):
     if signature:
         signature = signature.replace("plate._plate.", "plate.")
+        signature = re.sub(r"^\(self(: [\w.]+)?(, )?", "(", signature)   # (pybind11 names self in methods)
     if return_annotation:
         return_annotation = return_annotation.replace("plate._plate.", "plate.")
     return signature, return_annotation
@@ -67,9 +74,32 @@ def _public_docstring(app, what, name, obj, options, lines):
         lines[i] = line if what == "module" else _plain_text(line)
 
 
+class HeaderDescription(DoxygenGroupDirective):
+    """`.. header-description:: field_hpp`: the comment at the top of a header (its group's
+    description, doxygen_filter.py), as paragraphs -- without breathe's "group field_hpp" line."""
+
+    def run(self):
+        self.options["desc-only"] = None
+        for node in super().run():
+            if isinstance(node, nodes.Element):
+                for content in node.traverse(addnodes.desc_content):
+                    return list(content.children)
+        return []
+
+
+def _every_public_name_documented(app, env):
+    """A name in plate.__all__ that python.rst does not document is a warning (an error under -W)."""
+    documented = env.get_domain("py").objects
+    for name in plate.__all__:
+        if "plate." + name not in documented:
+            logging.getLogger(__name__).warning("plate.%s (in plate.__all__) is not documented: add it to python.rst", name)
+
+
 def setup(app):
+    app.connect("env-check-consistency", _every_public_name_documented)
     app.connect("autodoc-process-signature", _public_names)
     app.connect("autodoc-process-docstring", _public_docstring)
+    app.add_directive("header-description", HeaderDescription)
 
 
 # Names from outside the project: not documented here, so not cross-referenced (numpy, Eigen, the

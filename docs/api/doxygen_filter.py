@@ -20,6 +20,8 @@ import re
 import sys
 
 SPECIAL = re.compile(r"([\\@<>&#%$])")
+DASHES = re.compile(r"-{2,3}")
+NUMBERED = re.compile(r"\b([A-Z][A-Za-z]+)(?= [0-9])")
 HEADING = re.compile(r"^//\s*---")
 DIGIT_SEPARATOR = re.compile(r"(?<=[0-9])'(?=[0-9])")
 OUT_OF_CLASS = re.compile(r"^\s*(inline\s+)?[\w:<>,\s*&]+?\s[*&]?[A-Z]\w*::~?\w+\s*\(")
@@ -30,9 +32,18 @@ def escape(text):
     """Doxygen's special characters escaped; `code spans` as <tt> (Markdown is off: Doxyfile)."""
     parts = text.split("`")
     if len(parts) % 2 == 0:   # (an unpaired backtick: no code span)
-        return SPECIAL.sub(r"\\\1", text)
-    parts = [SPECIAL.sub(r"\\\1", p) for p in parts]
-    return "".join(p if i % 2 == 0 else "<tt>" + p + "</tt>" for i, p in enumerate(parts))
+        parts = [text]
+    parts = [plain(p) if i % 2 == 0 else "<tt>" + plain(p, link_names=False) + "</tt>" for i, p in enumerate(parts)]
+    return "".join(parts)
+
+
+def plain(text, link_names=True):
+    """Prose escaped: special characters; dashes kept as typed (Doxygen makes -- an en dash, which
+    breathe shows as an entity); no link from a numbered name of the paper ("Observation 1": a word
+    before a number is not the struct of that name)."""
+    text = SPECIAL.sub(r"\\\1", text)
+    text = DASHES.sub(lambda m: "\\" + m.group(0), text)
+    return NUMBERED.sub(r"%\1", text) if link_names else text
 
 
 def split_code_comment(line):
@@ -123,10 +134,9 @@ def filter_header(path, lines):
     # namespace line its start, the last closing brace (the namespace's) its end.
     if pragma is not None:
         head = [i for i in range(pragma) if lines[i].lstrip().startswith("//")]
-        doc_block(lines, head, out)
         name = os.path.basename(path)
         group = name.replace(".", "_")
-        out[pragma] = "/// \\defgroup %s %s\n" % (group, name)
+        doc_block(lines, head, out, (pragma, "\\defgroup %s %s" % (group, name)))
         first = next((i for i, l in enumerate(lines) if re.match(r"^namespace [\w:]+ \{\s*$", l)), None)
         last = max((i for i, l in enumerate(lines) if l.startswith("}")), default=None)
         if first is not None and last is not None:
@@ -156,8 +166,9 @@ def filter_header(path, lines):
         code, col = split_code_comment(line)
         at_scope = scopes.at_scope()
         # (digit separators, 20'000'000: Sphinx's C++ parser does not read them in a default value)
-        code = DIGIT_SEPARATOR.sub("", code)
-        out[i] = code + line[len(split_code_comment(line)[0]):]
+        if DIGIT_SEPARATOR.search(code):
+            code = DIGIT_SEPARATOR.sub("", code)
+            out[i] = code + line[len(split_code_comment(line)[0]):]
         # A class member defined at namespace scope (Part::friction in friction.hpp) is documented where
         # the class declares it; here it is hidden, else the page would show it twice.
         if hidden_from is None and at_scope and not scopes.in_class() and OUT_OF_CLASS.match(code):
@@ -176,32 +187,54 @@ def filter_header(path, lines):
     return out
 
 
-def doc_block(lines, block, out):
-    """The comment lines `block` as one documentation block; a run of lines indented past the text
-    (a table, a formula, a JSON sample) kept as laid out, <pre> -- unless they continue a list item."""
+def doc_block(lines, block, out, last=None):
+    """The comment lines `block` as one documentation block, and the line `last` = (index, text) after
+    them if given (a Doxygen command). A run of lines indented past the text (a table, a formula, a
+    JSON sample) -- unless they continue a list item -- is kept as laid out, verbatim: such a block is
+    written as one /** ... */ comment (in a /// block Doxygen 1.9.4 leaves the slashes, or an asterisk,
+    in a verbatim's lines), each line where it was."""
     texts = [lines[j][lines[j].index("//") + 2:].rstrip("\n") for j in block]
-    indented = [t.startswith("   ") for t in texts]
-    in_list = False
-    k = 0
-    while k < len(block):
+    runs = verbatim_runs(texts)
+    if not runs or any("*/" in t for t in texts):
+        for j in block:
+            out[j] = to_doc(lines[j], "///")
+        if last:
+            out[last[0]] = "/// " + last[1] + "\n"
+        return
+    verbatim = {k for a, b in runs for k in range(a, b + 1)}
+    starts, ends = {a for a, _ in runs}, {b for _, b in runs}
+    for k, j in enumerate(block):
+        pre = lines[j][:lines[j].index("//")]
+        text = texts[k] if k in verbatim else escape(texts[k])
+        if k in starts and k == 0:
+            text = "\\verbatim" + text
+        if k + 1 in starts:
+            text += " \\verbatim"
+        if k in ends:
+            text += " \\endverbatim"
+        out[j] = pre + ("/**" if k == 0 else "  ") + text + ("\n" if last or k + 1 < len(block) else " */\n")
+    if last:
+        out[last[0]] = "   " + last[1] + " */\n"
+
+
+def verbatim_runs(texts):
+    """[(first, last)] of the runs of lines indented past the text, list items' continuations aside."""
+    runs, in_list, k = [], False, 0
+    while k < len(texts):
         t = texts[k]
         if re.match(r"^\s*- ", t):
             in_list = True
         elif not t.startswith("  "):
             in_list = False
-        if indented[k] and not in_list:
+        if t.startswith("   ") and not in_list:
             end = k
-            while end + 1 < len(block) and indented[end + 1]:
+            while end + 1 < len(texts) and texts[end + 1].startswith("   "):
                 end += 1
-            for j in range(k, end + 1):
-                line = lines[block[j]]
-                pre = line[:line.index("//")]
-                out[block[j]] = pre + "/// " + ("<pre>" if j == k else "") + SPECIAL.sub(r"\\\1", texts[j][1:]) + \
-                    (" </pre>" if j == end else "") + "\n"
+            runs.append((k, end))
             k = end + 1
             continue
-        out[block[k]] = to_doc(lines[block[k]], "///")
         k += 1
+    return runs
 
 
 def to_doc(comment_line, marker):
