@@ -10,7 +10,8 @@ set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-build}
 out=${2:-$build/docs/api}
-python=/usr/bin/python3   # (Debian's interpreter: the module is built for it, and Sphinx and breathe are its)
+# (Debian's interpreter: the module is built for it, and Sphinx and breathe are its; PLATE_PYTHON overrides)
+python=${PLATE_PYTHON:-/usr/bin/python3}
 
 missing=()
 command -v doxygen >/dev/null || missing+=(doxygen)
