@@ -10,10 +10,14 @@ documentation on the fly, line for line (Doxygen's line numbers stay right), the
   - a trailing `// ...` after a declaration documents that member (`///<`), and so do the `//` lines
     below it that start in the same column (its continuation).
 Only at namespace and class scope: comments inside function bodies stay comments, and so do blocks
-followed by a blank line, a preprocessor line or a closing brace, and `// --- headings ---`. The comment text
-is escaped for Doxygen (backslash, @, <, >, &, #, %, $), outside `code spans`.
+followed by a blank line, a preprocessor line or a closing brace, and `// --- headings ---`. The
+comment text is escaped for Doxygen (backslash, @, <, >, &, #, %, $, dashes), `code spans` become
+<tt>, and lines indented past the text (tables, formulas, samples) are kept verbatim. Two changes to
+the code, for Sphinx's C++ parser and breathe: digit separators dropped (20'000'000), and a class
+member defined at namespace scope hidden (it is shown where its class declares it).
 
-  doxygen_filter.py HEADER        (prints the filtered header)
+  doxygen_filter.py HEADER        prints the filtered header
+  doxygen_filter.py --self-test   checks the rules above on a small header (exit 1 naming a broken one)
 """
 import os
 import re
@@ -171,14 +175,15 @@ def filter_header(path, lines):
             out[i] = code + line[len(split_code_comment(line)[0]):]
         # A class member defined at namespace scope (Part::friction in friction.hpp) is documented where
         # the class declares it; here it is hidden, else the page would show it twice.
-        if hidden_from is None and at_scope and not scopes.in_class() and OUT_OF_CLASS.match(code):
+        hide = hidden_from is None and at_scope and not scopes.in_class() and OUT_OF_CLASS.match(code)
+        if hide:
             hidden_from = len(scopes.stack)
             out[i] = "/** \\cond */ " + out[i]
         if at_scope and documentable(code):
             doc_block(lines, block, out)
         block, trailing_col = [], -1
         if col >= 0 and at_scope and documentable(code) and not code.rstrip().endswith("{"):
-            out[i] = code + to_doc(line[col:], "///<")
+            out[i] = ("/** \\cond */ " if hide else "") + code + to_doc(line[col:], "///<")
             trailing_col = col
         scopes.feed(code)
         if hidden_from is not None and len(scopes.stack) == hidden_from and re.search(r"[;}]\s*$", code):
@@ -244,7 +249,70 @@ def to_doc(comment_line, marker):
     return comment_line[:k] + marker + escape(text) + "\n"
 
 
+SAMPLE = """\
+// The sample header.
+#pragma once
+
+#include <string>
+
+namespace plate {
+
+// --- a heading ------------------------------------------------------
+// Documents S: a < b & c # d, `x<y>`, e.g. -- a dash.
+struct S {
+    int n = 20'000'000;   // the count
+                          // (continued)
+    int f() const {
+        // inside a body
+        return n;   // trailing, in a body
+    }
+};
+// Followed by a blank line: a comment.
+
+// A table:
+//   a    b
+//        c
+void g();
+inline int S::f2() const { return 1; }
+}   // namespace plate
+"""
+
+# (line of SAMPLE, what the filtered line must contain, what the rule is)
+EXPECTED = [
+    (0, "/// The sample header.", "the file's block documents the file's group"),
+    (1, "\\defgroup sample_hpp sample.hpp", "#pragma once carries the group's definition"),
+    (5, "/** \\addtogroup sample_hpp */ /** @{ */", "the namespace line opens the group"),
+    (7, "// --- a heading", "a heading stays a comment"),
+    (8, "/// Documents S: a \\< b \\& c \\# d, <tt>x\\<y\\></tt>, e.g. \\-- a dash.", "a block above a declaration, escaped"),
+    (10, "int n = 20000000;   ///< the count", "a trailing comment, digit separators dropped"),
+    (11, "///< (continued)", "a trailing comment's continuation in its column"),
+    (13, "// inside a body", "a comment in a function body stays"),
+    (14, "return n;   // trailing, in a body", "a trailing comment in a function body stays"),
+    (17, "// Followed by a blank line", "a block before a blank line stays"),
+    (19, "/** A table: \\verbatim", "a table is verbatim in a /** */ block"),
+    (21, "       c \\endverbatim", "the table's last line ends the verbatim"),
+    (22, "void g();", "the declaration the block documents"),
+    (23, "/** \\cond */ inline int S::f2() const { return 1; } /** \\endcond */", "an out-of-class member hidden"),
+    (24, "/** @} */ }", "the namespace's closing brace closes the group"),
+]
+
+
+def self_test():
+    lines = SAMPLE.splitlines(keepends=True)
+    out = filter_header("sample.hpp", lines)
+    failed = [(k, want, rule, out[k]) for k, want, rule in EXPECTED if want not in out[k]]
+    if len(out) != len(lines) or "".join(out).count("\n") != len(lines):
+        failed.append((-1, "%d lines" % len(lines), "line for line", "%d lines" % len(out)))
+    for k, want, rule, got in failed:
+        print("doxygen_filter.py: %s: line %d is %r, not containing %r" % (rule, k + 1, got.rstrip("\n"), want))
+    if failed:
+        sys.exit(1)
+    print("doxygen_filter.py: %d rules hold on the sample" % (len(EXPECTED) + 1))
+
+
 def main():
+    if sys.argv[1:] == ["--self-test"]:
+        return self_test()
     if len(sys.argv) != 2:
         sys.exit(__doc__)
     with open(sys.argv[1], encoding="utf-8") as f:
