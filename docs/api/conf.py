@@ -27,7 +27,7 @@ root_doc = "index"
 default_role = "literal"   # (`name` in docstrings and comments is code)
 nitpicky = True            # (-n: every cross-reference must resolve; the ones that cannot are listed below)
 highlight_language = "none"
-smartquotes = False        # (quotes stay as typed: the docstrings' dicts and names are code)
+smartquotes_action = "D"   # (-- an en dash, --- an em dash; quotes stay as typed: docstrings' dicts are code)
 
 html_theme = "alabaster"
 html_theme_options = {"page_width": "1200px", "sidebar_width": "260px", "fixed_sidebar": True,

@@ -23,7 +23,7 @@ import os
 import re
 import sys
 
-SPECIAL = re.compile(r"([\\@<>&#%$])")
+SPECIAL = re.compile(r"([\\@<>&#%$\"])")
 DASHES = re.compile(r"-{2,3}")
 NUMBERED = re.compile(r"\b([A-Z][A-Za-z]+)(?= [0-9])")
 HEADING = re.compile(r"^//\s*---")
@@ -85,6 +85,8 @@ def documentable(code):
     if not s or s.startswith("#") or s.startswith("}") or s.startswith("{"):
         return False
     if re.match(r"^(namespace\b|using\s+namespace\b|public:|private:|protected:|extern\s+\"C\")", s):
+        return False
+    if re.match(r"^(class|struct)\s+\w+\s*;", s):   # (a forward declaration: documented where it is defined)
         return False
     return True
 
@@ -274,6 +276,7 @@ struct S {
 //        c
 void g();
 inline int S::f2() const { return 1; }
+class T;   // t.hpp
 }   // namespace plate
 """
 
@@ -293,7 +296,8 @@ EXPECTED = [
     (21, "       c \\endverbatim", "the table's last line ends the verbatim"),
     (22, "void g();", "the declaration the block documents"),
     (23, "/** \\cond */ inline int S::f2() const { return 1; } /** \\endcond */", "an out-of-class member hidden"),
-    (24, "/** @} */ }", "the namespace's closing brace closes the group"),
+    (24, "class T;   // t.hpp", "a forward declaration's comment stays"),
+    (25, "/** @} */ }", "the namespace's closing brace closes the group"),
 ]
 
 
