@@ -26,9 +26,9 @@ if ! ls "$build"/python/plate/_plate*.so >/dev/null 2>&1; then
   exit 2
 fi
 build=$(cd "$build" && pwd)
-mkdir -p "$out"
-out=$(cd "$out" && pwd)
+out=$(realpath -m "$out")
 case "$out/" in "$src"/docs/*) echo "docs.sh: OUT_DIR $out is inside the source's docs/" >&2; exit 2 ;; esac
+mkdir -p "$out"
 
 # Doxygen: XML only, into OUT_DIR/.doxygen (a fresh one: stale XML of a removed header would linger).
 rm -rf "$out/.doxygen"
