@@ -43,5 +43,8 @@ fi
 # Sphinx: -W warnings are errors, --keep-going lists them all, -n every cross-reference must resolve;
 # -E a fresh environment (no page kept from a run on older XML).
 export PLATE_PYTHON_DIR=$build/python PLATE_DOXYGEN_XML=$out/.doxygen/xml
-"$python" -m sphinx -b html -W --keep-going -n -E -q -d "$out/.doctrees" "$src/docs/api" "$out"
+if ! "$python" -m sphinx -b html -W --keep-going -n -E -q -d "$out/.doctrees" "$src/docs/api" "$out"; then
+  echo "docs.sh: Sphinx warned or failed (above): fix the page, the docstring or the header comment" >&2
+  exit 1
+fi
 echo "docs.sh: API reference in $out/index.html"
