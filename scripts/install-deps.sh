@@ -6,6 +6,7 @@ pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-d
       python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libnlopt-cxx-dev libceres-dev
       python3-venv python3-pip python3-setuptools python3-wheel   # (pip install ., tests/package/check_pip.sh)
       mypy                    # (the type stubs' check, tests/package/check_stubs.sh)
+      doxygen python3-sphinx python3-breathe   # (the API reference, scripts/docs.sh)
       clang libclang-rt-dev   # (the sanitizer build, scripts/test-sanitizers.sh)
       clang-format            # (the format check, scripts/check-format.sh)
       ccache                  # (the mutation catalogue's scratch build reuses the build's objects)
