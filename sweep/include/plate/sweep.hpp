@@ -157,7 +157,7 @@ struct SweepSummary {
     std::string farm;          // how the cases were shared
 };
 
-// The command line's JSON summary of a campaign run (`plate sweep`, Python's plate.sweep): the counts,
+// The command line's JSON summary of a campaign run (`plate sweep`; Python's sweep()): the counts,
 // times [s], the farm and the tables written.
 nlohmann::json sweep_summary_json(const std::string& campaign_file, const std::string& out, const SweepSummary& s);
 
