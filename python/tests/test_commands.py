@@ -91,6 +91,26 @@ def test_a_campaign_from_python_writes_the_programs_table(tmp_path):
     assert again["resumed"] == 2 and again["computed"] == 0
 
 
+@needs_exe
+def test_proofs_from_python_are_the_programs_and_fail_on_a_wrong_model(tmp_path):
+    out = tmp_path / "proofs.json"
+    subprocess.run([EXE, "proofs", "--thin", "40", "--thick", "4", "--surfaces", "5", "--threads", "2", "--out", str(out)],
+                   check=True)
+
+    def no_times(x):
+        if isinstance(x, dict):
+            return {k: no_times(v) for k, v in x.items() if k != "seconds"}
+        return [no_times(v) for v in x] if isinstance(x, list) else x
+    j = plate.proofs(thin=40, thick=4, surfaces=5, threads=2)
+    assert no_times(j) == no_times(json.load(open(out)))
+    assert j["passed"] and j["failed"] == []
+    # Pushing friction (mu -> -mu) breaks Theorem 1's contraction: the verdict names it.
+    wrong = plate.proofs(thin=10, thick=0, surfaces=0, threads=2, wrong_model="pushing-friction")
+    assert not wrong["passed"] and wrong["failed"] == ["thin"] and wrong["wrong_model"] == "pushing-friction"
+    with pytest.raises(ValueError, match="wrong_model: expected none"):
+        plate.proofs(thin=1, wrong_model="mu4")
+
+
 def test_paths_may_be_pathlike():
     p = pathlib.Path(scene_path("fig4"))
     assert plate.load_scene(p) == plate.load_scene(str(p))
