@@ -23,10 +23,63 @@ py::array_t<double> field_array(const Field& f, int what) {
     return array(d, {g.nx, g.ny, g.nth, 3});
 }
 
+// Pickled state: the scene, the grid, and every configuration's numbers (Python floats are doubles: the
+// field comes back to the bit).
+py::tuple field_state(const PyField& p) {
+    const Field& f = p.f;
+    const GridSpec& g = f.grid;
+    py::list points;
+    for (const FieldPoint& q : f.points)
+        points.append(py::make_tuple(q.q[0], q.q[1], q.q[2], q.twist[0], q.twist[1], q.twist[2], q.converged, q.periods,
+                                     q.residual, q.min_normal_force, static_cast<int>(q.stop), q.rhs_evals, q.stick_fraction[0],
+                                     q.stick_fraction[1], q.stick_fraction[2]));
+    return py::make_tuple(p.scene, py::make_tuple(g.nx, g.ny, g.nth, g.x0, g.x1, g.y0, g.y1, g.th0), f.point_part, points,
+                          py::make_tuple(f.seconds, f.rhs_evals, f.threads, f.budget_spent));
+}
+PyField field_of(const py::tuple& t) {
+    require(t.size() == 5, "plate.Field: not a pickled field");
+    PyField p{t[0].cast<Scene>(), {}};
+    Field& f = p.f;
+    const auto g = t[1].cast<py::tuple>();
+    f.grid.nx = g[0].cast<int>();
+    f.grid.ny = g[1].cast<int>();
+    f.grid.nth = g[2].cast<int>();
+    f.grid.x0 = g[3].cast<double>();
+    f.grid.x1 = g[4].cast<double>();
+    f.grid.y0 = g[5].cast<double>();
+    f.grid.y1 = g[6].cast<double>();
+    f.grid.th0 = g[7].cast<double>();
+    f.point_part = t[2].cast<bool>();
+    for (const py::handle& h : t[3].cast<py::list>()) {
+        const auto v = h.cast<py::tuple>();
+        FieldPoint q;
+        for (int i = 0; i < 3; ++i) {
+            q.q[i] = v[static_cast<std::size_t>(i)].cast<double>();
+            q.twist[i] = v[static_cast<std::size_t>(3 + i)].cast<double>();
+            q.stick_fraction[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(12 + i)].cast<double>();
+        }
+        q.converged = v[6].cast<bool>();
+        q.periods = v[7].cast<int>();
+        q.residual = v[8].cast<double>();
+        q.min_normal_force = v[9].cast<double>();
+        q.stop = static_cast<StopReason>(v[10].cast<int>());
+        q.rhs_evals = v[11].cast<long>();
+        f.points.push_back(q);
+    }
+    require(static_cast<int>(f.points.size()) == f.grid.size(), "plate.Field: a pickled field's points do not fill its grid");
+    const auto r = t[4].cast<py::tuple>();
+    f.seconds = r[0].cast<double>();
+    f.rhs_evals = r[1].cast<long>();
+    f.threads = r[2].cast<int>();
+    f.budget_spent = r[3].cast<bool>();
+    return p;
+}
+
 }   // namespace
 
 void bind_field(py::module_& m) {
     py::class_<PyField>(m, "Field", "The asymptotic twist field on a grid (point parts: velocity field, ntheta = 1).")
+        .def(py::pickle(&field_state, &field_of))
         .def("__repr__",
              [](const PyField& p) {
                  const GridSpec& g = p.f.grid;

@@ -107,6 +107,32 @@ void bind_observe(py::module_& m) {
             "(n, 3): s_x [m], s_y [m], theta [rad]")
         .def_readonly("lines", &Track::lines, "read from a file: each frame's line")
         .def("__len__", [](const Track& t) { return t.t.size(); })
+        // Pickled as its fields, the camera in its file form, with the attributes a run gave it (stop).
+        .def(py::pickle(
+            [](const py::object& self) {
+                const Track& t = self.cast<const Track&>();
+                py::list q;
+                for (const Vec3& v : t.q) q.append(py::make_tuple(v[0], v[1], v[2]));
+                return py::make_tuple(t.source, t.scene_name, t.scene_id, camera_to_json(t.camera).dump(), t.point, t.t, q,
+                                      t.lines, t.scene_id_line, self.attr("__dict__"));
+            },
+            [](const py::tuple& s) {
+                require(s.size() == 10, "plate.Track: not a pickled track");
+                Track t;
+                t.source = s[0].cast<std::string>();
+                t.scene_name = s[1].cast<std::string>();
+                t.scene_id = s[2].cast<std::string>();
+                t.camera = parse_camera(s[3].cast<std::string>(), "<pickled track>");
+                t.point = s[4].cast<bool>();
+                t.t = s[5].cast<std::vector<double>>();
+                for (const py::handle& h : s[6].cast<py::list>()) {
+                    const auto v = h.cast<py::tuple>();
+                    t.q.emplace_back(v[0].cast<double>(), v[1].cast<double>(), v[2].cast<double>());
+                }
+                t.lines = s[7].cast<std::vector<int>>();
+                t.scene_id_line = s[8].cast<int>();
+                return std::make_pair(t, s[9].cast<py::dict>());
+            }))
         .def("__repr__", [](const Track& t) {
             return "<plate.Track of '" + t.scene_name + "': " + std::to_string(t.t.size()) + " frames, " +
                    frame_name(t.camera.frame) + " frame>";

@@ -107,6 +107,12 @@ void bind_scene(py::module_& m) {
         .def_readonly("t", &PyStop::t, "[s]")
         .def_readonly("message", &PyStop::message)
         .def("__bool__", [](const PyStop& s) { return s.reason != "none"; })
+        .def(py::pickle(
+            [](const PyStop& s) { return py::make_tuple(s.reason, s.contact, s.t, s.message); },
+            [](const py::tuple& t) {
+                require(t.size() == 4, "plate.Stop: not a pickled stop");
+                return PyStop{t[0].cast<std::string>(), t[1].cast<int>(), t[2].cast<double>(), t[3].cast<std::string>()};
+            }))
         .def("__repr__",
              [](const PyStop& s) { return "<plate.Stop " + s.reason + (s.message.empty() ? "" : ": " + s.message) + ">"; });
 }

@@ -125,3 +125,30 @@ def test_the_fields_stops_lie_on_its_grid():
     # A configuration has a twist exactly where its cycle converged; elsewhere the stop says why.
     assert ((f.stops == "none") == f.converged).all()
     assert np.isnan(f.twist[~f.converged]).all()
+
+
+def test_results_pickle_and_deepcopy_to_the_bit(tmp_path):
+    """A field, a trajectory through stick-slip and a camera track come back from pickle (and deepcopy,
+    and across processes as multiprocessing sends them) with every number, mode and stop the same."""
+    import copy
+    import pickle
+    sc = plate.load_scene(scene_path("heave_yaw"))   # sticks over part of its field and of its runs
+    f = plate.field(sc, grid=3)
+    tr = plate.simulate(sc, [0.02, 0.01, 0.3], 2.0)
+    assert "stuck" in tr.mode or any("pivot" in m for m in tr.mode)
+    tk = plate.observe(sc, {"rate_hz": 100, "noise": {"xy_mm": 0.1, "theta_mrad": 5}, "seed": 3, "frame": "plate"}, [0.02, 0.01, 0.3], 1.0)
+    for g in (pickle.loads(pickle.dumps(f)), copy.deepcopy(f)):
+        assert repr(g) == repr(f) and g.summary == f.summary
+        assert np.array_equal(g.twist, f.twist, equal_nan=True) and (g.stops == f.stops).all()
+    for u in (pickle.loads(pickle.dumps(tr)), copy.deepcopy(tr)):
+        assert np.array_equal(u.q, tr.q) and np.array_equal(u.qd, tr.qd) and np.array_equal(u.normal_forces, tr.normal_forces)
+        assert u.mode == tr.mode and u.events == tr.events and u.held_time == tr.held_time
+        assert repr(u.stop) == repr(tr.stop) and u.dynamics == tr.dynamics
+    for k in (pickle.loads(pickle.dumps(tk)), copy.deepcopy(tk)):
+        assert np.array_equal(k.t, tk.t) and np.array_equal(k.q, tk.q) and k.scene_id == tk.scene_id
+        assert repr(k.stop) == repr(tk.stop)   # (the run's stop, an attribute observe gave it)
+        assert plate.check_track_scene(k, sc) is None
+    # A pickled field that does not fill its grid is refused, not half read.
+    state = f.__getstate__()
+    with pytest.raises(ValueError, match="do not fill its grid"):
+        plate.Field.__new__(plate.Field).__setstate__((state[0], state[1], state[2], state[3][:-1], state[4]))
