@@ -58,6 +58,13 @@ void bind_observe(py::module_& m) {
                         ", noise " + num(c.noise_xy_mm) + " mm / " + num(c.noise_theta_mrad) + " mrad, latency " +
                         num(c.latency) + " s, drop " + num(c.drop) + ", " + frame_name(c.frame) + " frame>";
              })
+        .def(py::pickle([](const Camera& c) { return py::make_tuple(camera_to_json(c).dump(), c.source); },
+                        [](const py::tuple& t) {
+                            require(t.size() == 2, "plate.Camera: a pickled camera is (file text, source)");
+                            Camera c = parse_camera(t[0].cast<std::string>(), t[1].cast<std::string>());
+                            c.source = t[1].cast<std::string>();
+                            return c;
+                        }))
         .def_readonly("source", &Camera::source)
         .def_readonly("rate", &Camera::rate, "frames per second; 0: stroboscopic")
         .def_readonly("per_period", &Camera::per_period, "stroboscopic: frames per plate period (0 if rate > 0)")

@@ -148,6 +148,8 @@ def test_results_pickle_and_deepcopy_to_the_bit(tmp_path):
         assert np.array_equal(k.t, tk.t) and np.array_equal(k.q, tk.q) and k.scene_id == tk.scene_id
         assert repr(k.stop) == repr(tk.stop)   # (the run's stop, an attribute observe gave it)
         assert plate.check_track_scene(k, sc) is None
+    for c in (pickle.loads(pickle.dumps(tk.camera)), copy.deepcopy(tk.camera)):
+        assert c.to_json() == tk.camera.to_json() and repr(c) == repr(tk.camera)
     # A pickled field that does not fill its grid is refused, not half read.
     state = f.__getstate__()
     with pytest.raises(ValueError, match="do not fill its grid"):
