@@ -45,6 +45,19 @@ py::object json_to_python(const nlohmann::json& j);
 // A configuration or twist: 3 numbers for a rigid part, 2 for a point part (theta meaningless).
 Vec3 config(const Scene& sc, const std::vector<double>& v, const char* name);
 
+// The library's run records as pickled state (tuples of Python numbers and str: doubles to the bit),
+// and back; what the results' py::pickle are made of.
+py::tuple mode_state(const Mode& m);
+Mode mode_of(const py::handle& state);
+py::tuple event_state(const ModeEvent& e);
+ModeEvent event_of(const py::handle& state);
+py::tuple stop_state(const StopEvent& e);
+StopEvent stop_of(const py::handle& state);
+py::tuple stats_state(const Stats& s);
+Stats stats_of(const py::handle& state);
+py::tuple sample_state(const Sample& s);
+Sample sample_of(const py::handle& state);
+
 // A file's path from a str or an os.PathLike (pathlib.Path): the path, else nothing.
 std::optional<std::string> path_of(const py::handle& o);
 

@@ -69,4 +69,66 @@ std::optional<std::string> path_of(const py::handle& o) {
     return p.cast<std::string>();
 }
 
+py::tuple mode_state(const Mode& m) { return py::make_tuple(static_cast<int>(m.kind), m.k, m.sense); }
+Mode mode_of(const py::handle& state) {
+    const auto t = state.cast<py::tuple>();
+    require(t.size() == 3, "a pickled contact mode is (kind, contact, sense)");
+    Mode m;
+    m.kind = static_cast<ModeKind>(t[0].cast<int>());
+    m.k = t[1].cast<int>();
+    m.sense = t[2].cast<double>();
+    return m;
+}
+
+py::tuple event_state(const ModeEvent& e) { return py::make_tuple(e.t, mode_state(e.from), mode_state(e.to)); }
+ModeEvent event_of(const py::handle& state) {
+    const auto t = state.cast<py::tuple>();
+    require(t.size() == 3, "a pickled mode event is (t, from, to)");
+    return {t[0].cast<double>(), mode_of(t[1]), mode_of(t[2])};
+}
+
+py::tuple stop_state(const StopEvent& e) { return py::make_tuple(static_cast<int>(e.reason), e.contact, e.t); }
+StopEvent stop_of(const py::handle& state) {
+    const auto t = state.cast<py::tuple>();
+    require(t.size() == 3, "a pickled stop is (reason, contact, t)");
+    StopEvent e;
+    e.reason = static_cast<StopReason>(t[0].cast<int>());
+    e.contact = t[1].cast<int>();
+    e.t = t[2].cast<double>();
+    return e;
+}
+
+py::tuple stats_state(const Stats& s) {
+    return py::make_tuple(s.rhs_evals, s.steps, s.rejected, s.slip_reversals, s.mode_switches, s.min_normal_force);
+}
+Stats stats_of(const py::handle& state) {
+    const auto t = state.cast<py::tuple>();
+    require(t.size() == 6, "pickled run counts are 6 numbers");
+    Stats s;
+    s.rhs_evals = t[0].cast<long>();
+    s.steps = t[1].cast<long>();
+    s.rejected = t[2].cast<long>();
+    s.slip_reversals = t[3].cast<long>();
+    s.mode_switches = t[4].cast<long>();
+    s.min_normal_force = t[5].cast<double>();
+    return s;
+}
+
+py::tuple sample_state(const Sample& s) {
+    return py::make_tuple(s.t, s.q[0], s.q[1], s.q[2], s.qd[0], s.qd[1], s.qd[2], s.n[0], s.n[1], s.n[2], mode_state(s.mode));
+}
+Sample sample_of(const py::handle& state) {
+    const auto v = state.cast<py::tuple>();
+    require(v.size() == 11, "a pickled sample is (t, q, qd, n, mode)");
+    Sample s;
+    s.t = v[0].cast<double>();
+    for (std::size_t i = 0; i < 3; ++i) {
+        s.q[static_cast<int>(i)] = v[1 + i].cast<double>();
+        s.qd[static_cast<int>(i)] = v[4 + i].cast<double>();
+        s.n[static_cast<int>(i)] = v[7 + i].cast<double>();
+    }
+    s.mode = mode_of(v[10]);
+    return s;
+}
+
 }   // namespace plate::python

@@ -33,28 +33,14 @@ py::array_t<double> samples_array(const Trajectory& tr, int what) {
 
 // Pickled state: the scene, how it ran, and every sample, event and count as numbers (Python floats
 // are doubles: the trajectory comes back to the bit).
-py::tuple mode_state(const Mode& m) { return py::make_tuple(static_cast<int>(m.kind), m.k, m.sense); }
-Mode mode_of(const py::handle& h) {
-    const auto t = h.cast<py::tuple>();
-    Mode m;
-    m.kind = static_cast<ModeKind>(t[0].cast<int>());
-    m.k = t[1].cast<int>();
-    m.sense = t[2].cast<double>();
-    return m;
-}
 py::tuple trajectory_state(const PyTrajectory& p) {
     py::list samples, events;
-    for (const Sample& s : p.tr.samples)
-        samples.append(
-            py::make_tuple(s.t, s.q[0], s.q[1], s.q[2], s.qd[0], s.qd[1], s.qd[2], s.n[0], s.n[1], s.n[2], mode_state(s.mode)));
-    for (const ModeEvent& e : p.tr.events) events.append(py::make_tuple(e.t, mode_state(e.from), mode_state(e.to)));
-    const Stats& st = p.tr.stats;
-    return py::make_tuple(
-        p.scene, p.dynamics,
-        p.model ? py::object(py::make_tuple(p.model->picked, p.model->predicted, p.model->note)) : py::none(), samples,
-        py::make_tuple(static_cast<int>(p.tr.stop.reason), p.tr.stop.contact, p.tr.stop.t),
-        py::make_tuple(st.rhs_evals, st.steps, st.rejected, st.slip_reversals, st.mode_switches, st.min_normal_force), events,
-        py::make_tuple(p.tr.held_time[0], p.tr.held_time[1], p.tr.held_time[2]));
+    for (const Sample& s : p.tr.samples) samples.append(sample_state(s));
+    for (const ModeEvent& e : p.tr.events) events.append(event_state(e));
+    return py::make_tuple(p.scene, p.dynamics,
+                          p.model ? py::object(py::make_tuple(p.model->picked, p.model->predicted, p.model->note)) : py::none(),
+                          samples, stop_state(p.tr.stop), stats_state(p.tr.stats), events,
+                          py::make_tuple(p.tr.held_time[0], p.tr.held_time[1], p.tr.held_time[2]));
 }
 PyTrajectory trajectory_of(const py::tuple& t) {
     require(t.size() == 8, "plate.Trajectory: not a pickled trajectory");
@@ -63,35 +49,12 @@ PyTrajectory trajectory_of(const py::tuple& t) {
         const auto m = t[2].cast<py::tuple>();
         p.model = PyTrajectory::Model{m[0].cast<std::string>(), m[1].cast<double>(), m[2].cast<std::string>()};
     }
-    for (const py::handle& h : t[3].cast<py::list>()) {
-        const auto v = h.cast<py::tuple>();
-        Sample s;
-        s.t = v[0].cast<double>();
-        for (int i = 0; i < 3; ++i) {
-            s.q[i] = v[1 + i].cast<double>();
-            s.qd[i] = v[4 + i].cast<double>();
-            s.n[i] = v[7 + i].cast<double>();
-        }
-        s.mode = mode_of(v[10]);
-        p.tr.samples.push_back(s);
-    }
-    const auto stop = t[4].cast<py::tuple>();
-    p.tr.stop.reason = static_cast<StopReason>(stop[0].cast<int>());
-    p.tr.stop.contact = stop[1].cast<int>();
-    p.tr.stop.t = stop[2].cast<double>();
-    const auto st = t[5].cast<py::tuple>();
-    p.tr.stats.rhs_evals = st[0].cast<long>();
-    p.tr.stats.steps = st[1].cast<long>();
-    p.tr.stats.rejected = st[2].cast<long>();
-    p.tr.stats.slip_reversals = st[3].cast<long>();
-    p.tr.stats.mode_switches = st[4].cast<long>();
-    p.tr.stats.min_normal_force = st[5].cast<double>();
-    for (const py::handle& h : t[6].cast<py::list>()) {
-        const auto e = h.cast<py::tuple>();
-        p.tr.events.push_back({e[0].cast<double>(), mode_of(e[1]), mode_of(e[2])});
-    }
+    for (const py::handle& h : t[3].cast<py::list>()) p.tr.samples.push_back(sample_of(h));
+    p.tr.stop = stop_of(t[4]);
+    p.tr.stats = stats_of(t[5]);
+    for (const py::handle& h : t[6].cast<py::list>()) p.tr.events.push_back(event_of(h));
     const auto held = t[7].cast<py::tuple>();
-    for (int i = 0; i < 3; ++i) p.tr.held_time[static_cast<std::size_t>(i)] = held[static_cast<std::size_t>(i)].cast<double>();
+    for (std::size_t i = 0; i < 3; ++i) p.tr.held_time[i] = held[i].cast<double>();
     return p;
 }
 

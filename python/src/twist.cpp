@@ -1,6 +1,8 @@
 // plate.twist: a limit cycle of the reduced U-dynamics and its asymptotic twist (plate.Cycle).
 #include "bindings.hpp"
 
+#include <algorithm>
+
 namespace plate::python {
 
 namespace {
@@ -11,10 +13,61 @@ struct PyCycle {
     LimitCycleSummary lc;
 };
 
+// Pickled state: the scene, the configuration and every field of the summary (path and transients
+// included), numbers as Python floats (doubles: back to the bit).
+py::tuple cycle_state(const PyCycle& c) {
+    const LimitCycleSummary& l = c.lc;
+    py::list events, path, transient;
+    for (const ModeEvent& e : l.mode_events) events.append(event_state(e));
+    for (const Sample& s : l.path) path.append(sample_state(s));
+    for (const StopEvent& e : l.transient_stops) transient.append(stop_state(e));
+    std::vector<double> mono(l.monodromy.data(), l.monodromy.data() + 9);
+    return py::make_tuple(
+        c.scene, std::vector<double>{c.at[0], c.at[1], c.at[2]},
+        py::make_tuple(l.converged, l.periods, l.residual, l.error_estimate, l.contraction, l.twist[0], l.twist[1], l.twist[2],
+                       l.qd_start[0], l.qd_start[1], l.qd_start[2], l.has_monodromy, mono, l.min_normal_force, l.step_hint),
+        py::make_tuple(l.stick_fraction[0], l.stick_fraction[1], l.stick_fraction[2]), mode_state(l.start_mode), events,
+        stop_state(l.stop), stats_state(l.stats), l.restarts, transient, path, l.note);
+}
+PyCycle cycle_of(const py::tuple& t) {
+    require(t.size() == 12, "plate.Cycle: not a pickled cycle");
+    PyCycle c{t[0].cast<Scene>(), Vec3::Zero(), {}};
+    const auto at = t[1].cast<std::vector<double>>();
+    require(at.size() == 3, "plate.Cycle: a pickled configuration has 3 numbers");
+    c.at = Vec3(at[0], at[1], at[2]);
+    LimitCycleSummary& l = c.lc;
+    const auto v = t[2].cast<py::tuple>();
+    l.converged = v[0].cast<bool>();
+    l.periods = v[1].cast<int>();
+    l.residual = v[2].cast<double>();
+    l.error_estimate = v[3].cast<double>();
+    l.contraction = v[4].cast<double>();
+    l.twist = Vec3(v[5].cast<double>(), v[6].cast<double>(), v[7].cast<double>());
+    l.qd_start = Vec3(v[8].cast<double>(), v[9].cast<double>(), v[10].cast<double>());
+    l.has_monodromy = v[11].cast<bool>();
+    const auto mono = v[12].cast<std::vector<double>>();
+    require(mono.size() == 9, "plate.Cycle: a pickled monodromy has 9 numbers");
+    std::copy(mono.begin(), mono.end(), l.monodromy.data());
+    l.min_normal_force = v[13].cast<double>();
+    l.step_hint = v[14].cast<double>();
+    const auto sf = t[3].cast<py::tuple>();
+    for (std::size_t i = 0; i < 3; ++i) l.stick_fraction[i] = sf[i].cast<double>();
+    l.start_mode = mode_of(t[4]);
+    for (const py::handle& h : t[5].cast<py::list>()) l.mode_events.push_back(event_of(h));
+    l.stop = stop_of(t[6]);
+    l.stats = stats_of(t[7]);
+    l.restarts = t[8].cast<int>();
+    for (const py::handle& h : t[9].cast<py::list>()) l.transient_stops.push_back(stop_of(h));
+    for (const py::handle& h : t[10].cast<py::list>()) l.path.push_back(sample_of(h));
+    l.note = t[11].cast<std::string>();
+    return c;
+}
+
 }   // namespace
 
 void bind_twist(py::module_& m) {
     py::class_<PyCycle>(m, "Cycle", "A limit cycle of the reduced U-dynamics and its asymptotic twist (36).")
+        .def(py::pickle(&cycle_state, &cycle_of))
         .def_property_readonly("at", [](const PyCycle& c) { return c.at; })
         .def_property_readonly(
             "twist", [](const PyCycle& c) { return c.lc.twist; },

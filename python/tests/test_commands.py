@@ -128,7 +128,7 @@ def test_the_fields_stops_lie_on_its_grid():
 
 
 def test_results_pickle_and_deepcopy_to_the_bit(tmp_path):
-    """A field, a trajectory through stick-slip and a camera track come back from pickle (and deepcopy,
+    """A field, a trajectory through stick-slip, a cycle and a camera track come back from pickle (and deepcopy,
     and across processes as multiprocessing sends them) with every number, mode and stop the same."""
     import copy
     import pickle
@@ -148,6 +148,11 @@ def test_results_pickle_and_deepcopy_to_the_bit(tmp_path):
         assert np.array_equal(k.t, tk.t) and np.array_equal(k.q, tk.q) and k.scene_id == tk.scene_id
         assert repr(k.stop) == repr(tk.stop)   # (the run's stop, an attribute observe gave it)
         assert plate.check_track_scene(k, sc) is None
+    cy = plate.twist(sc, at=[0.04, -0.02, 1.0])   # a cycle that pivots on contact 1, the others part held
+    assert cy.stick_fraction[0] == 1 and 0 < cy.stick_fraction[1] < 1
+    for c in (pickle.loads(pickle.dumps(cy)), copy.deepcopy(cy)):
+        assert c.summary == cy.summary and np.array_equal(c.twist, cy.twist) and c.report() == cy.report()
+        assert (c.monodromy is None) == (cy.monodromy is None) and c.mode_sequence == cy.mode_sequence
     for c in (pickle.loads(pickle.dumps(tk.camera)), copy.deepcopy(tk.camera)):
         assert c.to_json() == tk.camera.to_json() and repr(c) == repr(tk.camera)
     # A pickled field that does not fill its grid is refused, not half read.
