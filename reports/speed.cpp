@@ -104,12 +104,12 @@ void work_precision(Ctx& c, const std::string& id, const std::string& title, con
         gp << "\n";
         c.plot(name, gp.str(), cap, "900,520");
     };
-    const std::string ey = path_errors ? "final-configuration error" : "twist error (relative to v_{ref})";
+    const std::string ey = path_errors ? "final-configuration error (of ρ and rad)" : "twist error (relative to v_{ref})";
     chart(id + "_time", 1, 3, "wall time [s]", ey,
           esc(title) + ": error against wall time. Red crosses at the top: failed runs.");
     chart(id + "_evals", 2, 3, "right-hand-side evaluations", ey, esc(title) + ": error against right-hand-side evaluations.");
     if (path_errors)
-        chart(id + "_max", 2, 4, "right-hand-side evaluations", "largest error along the path",
+        chart(id + "_max", 2, 4, "right-hand-side evaluations", "largest error along the path (of ρ and rad)",
               esc(title) + ": largest configuration error over the samples, against evaluations.");
     // Cost at the target accuracy.
     double fastest = std::numeric_limits<double>::infinity();
@@ -321,7 +321,7 @@ void stickslip_chart(Ctx& c, const Scene& sc, const Vec3& q0, bool full) {
 void plot_cycle_solvers(Ctx& c, const std::vector<std::string>& names) {
     std::ostringstream gp;
     gp << "set logscale xy\nset format y '10^{%L}'\nset xlabel 'wall time, one thread [s]'\nset ylabel 'max twist error over the "
-          "field'\n"
+          "field (relative to v_{ref})'\n"
           "set key outside right top font ',8'\nset grid\nset arrow from graph 0, first "
        << kTarget << " to graph 1, first " << kTarget << " nohead dt 2 lc rgb '#888'\nplot ";
     int i = 0;

@@ -14,13 +14,16 @@ rm -rf "$out"; mkdir -p "$out"
 "$check" "$out/report" --screenshot "$out/report_screenshot.png" --min-images 40 --min-formulas 8
 
 # No verdict says FAIL but the three the derivation expects (printed (28), Appendix A and (38) differ
-# from the derived equations: tests/test_symbolic.cpp); shown failing on a page with one more.
+# from the derived equations: tests/test_symbolic.cpp); shown failing on a page with one more. The
+# verdict table at the top repeats the page's verdicts (the [report] test checks it row by row): left
+# out here, so that each verdict counts once.
 unexpected_fails() {   # PAGE: prints the count of FAILs not expected, and each one
-  local total expected
-  total=$(grep -o 'class="fail"' "$1" | wc -l)
-  expected=$(grep -oE '<tr><td>(\(28\)|Appendix A \(block diagonal\)|\(38\))</td><td><span class="fail">differs<' "$1" | wc -l)
+  local total expected body
+  body=$(sed '/<table id="verdict-table">/,/<\/table>/d' "$1")
+  total=$(grep -o 'class="fail"' <<< "$body" | wc -l)
+  expected=$(grep -oE '<tr><td>(\(28\)|Appendix A \(block diagonal\)|\(38\))</td><td><span id="check-[0-9]+" class="fail">differs<' <<< "$body" | wc -l)
   echo $((total - expected))
-  grep -oE '.{0,160}class="fail".{0,40}' "$1" | grep -vE '<tr><td>(\(28\)|Appendix A \(block diagonal\)|\(38\))</td><td><span class="fail">differs<' >&2 || true
+  grep -oE '.{0,160}class="fail".{0,40}' <<< "$body" | grep -vE '<tr><td>(\(28\)|Appendix A \(block diagonal\)|\(38\))</td><td><span id="check-[0-9]+" class="fail">differs<' >&2 || true
 }
 n=$(unexpected_fails "$out/report/index.html")
 [ "$n" -eq 0 ] || { echo "the report has $n FAIL verdicts no test expects (above)"; exit 1; }
