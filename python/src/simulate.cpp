@@ -1,5 +1,6 @@
 // plate.simulate: a trajectory in the full or U-dynamics or along the field (plate.Trajectory).
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include <cmath>
 
@@ -87,17 +88,17 @@ void bind_simulate(py::module_& m) {
             require(max_steps >= 1, "max_steps: expected >= 1");
             require(dynamics != "field" || qd0.isZero(), "twist: has no meaning for dynamics='field'");
             PyTrajectory p{sc, {}, dynamics};
-            py::gil_scoped_release free;
-            if (dynamics == "field") {
-                LimitCycleOptions lo;
-                lo.tol = tol;
-                p.tr = field_curve(sc, q0, time, dt, lo);
-            } else {
+            p.tr = interruptible(py::none(), [&](Watch&) {
+                if (dynamics == "field") {
+                    LimitCycleOptions lo;
+                    lo.tol = tol;
+                    return field_curve(sc, q0, time, dt, lo);
+                }
                 IntegrationOptions io;
                 io.rtol = rtol;
                 io.max_steps = max_steps;
-                p.tr = simulate(sc, dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
-            }
+                return simulate(sc, dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
+            });
             return p;
         },
         py::arg("scene"), py::arg("start"), py::arg("time"), py::kw_only(), py::arg("dynamics") = "full",
