@@ -39,7 +39,7 @@ def latency_of_ctrl_c(call, after=1.0):
 
 
 def test_ctrl_c_stops_a_long_field_within_half_a_second():
-    # fig6 at grid 25 (15625 configurations) takes about 20 minutes on two cores. The interpreter's
+    # fig6 at grid 25 (15625 configurations) takes about 12 s on two cores. The interpreter's
     # thread looks at signals every 0.05 s while the field runs and the field's workers see the request
     # at their next integrator step: measured 0.05-0.06 s here on the loaded 2-core machine. Without
     # PyErr_CheckSignals in that poll the KeyboardInterrupt came only after the whole field (the test

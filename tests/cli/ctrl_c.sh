@@ -1,6 +1,6 @@
 #!/bin/sh
 # Ctrl-C stops a long `plate field` within 0.5 s (issue 54, point 4): SIGINT 1 s into a fig6 field at
-# grid 25 (about 20 minutes on two cores); the program must be gone within 0.5 s of the signal, with a
+# grid 25 (12.5 s here when not stopped); the program must be gone within 0.5 s of the signal, with a
 # non-zero status and no output file (nor its temporary).
 # Usage: ctrl_c.sh PLATE_EXE SCENES_DIR
 set -u
