@@ -9,19 +9,38 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <thread>
 
 using namespace plate;
 using plate_tests::scene;
 
 namespace {
-double since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+
+// Seconds from stop.request(), made from another thread `after_ms` into call() under a StopScope of
+// it, to the Interrupted that call() throws (-1: it returned).
+double latency_of_request(StopRequest& stop, int after_ms, const std::function<void()>& call) {
+    std::chrono::steady_clock::time_point asked;
+    std::thread asker([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
+        asked = std::chrono::steady_clock::now();
+        stop.request();
+    });
+    double latency = -1;
+    try {
+        const StopScope scope(&stop);
+        call();
+    } catch (const Interrupted&) {
+        latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+    }
+    asker.join();
+    return latency;
 }
+
 }   // namespace
 
 TEST_CASE("A stop request stops a field on every worker within 0.5 s and throws Interrupted", "[field][interrupt]") {
-    // fig6 at grid 25 takes about 12 s on two cores. The request is set from another thread 0.3 s
+    // fig6 at grid 25 takes about 12 s on two cores. The request (given in the options) is set 0.3 s
     // in; the field's two workers see it at their next integrator step: measured 1-5 ms from the
     // request to the exception here (without the engine's poll, between configurations: 5 ms too, fig6's
     // cycles being short; the simulation below is where that poll is needed).
@@ -32,19 +51,7 @@ TEST_CASE("A stop request stops a field on every worker within 0.5 s and throws 
     FieldOptions o;
     o.threads = 2;
     o.stop = &stop;
-    std::chrono::steady_clock::time_point asked;
-    std::thread asker([&] {
-        std::this_thread::sleep_for(std::chrono::milliseconds(300));
-        asked = std::chrono::steady_clock::now();
-        stop.request();
-    });
-    double latency = -1;
-    try {
-        compute_field(sc, g, o);
-    } catch (const Interrupted&) {
-        latency = since(asked);
-    }
-    asker.join();
+    const double latency = latency_of_request(stop, 300, [&] { compute_field(sc, g, o); });
     INFO("latency " << latency << " s");
     CHECK(latency >= 0);
     CHECK(latency < 0.5);
@@ -56,20 +63,8 @@ TEST_CASE("A stop request stops a long simulation within 0.5 s: the integrator p
     // ran to its end, 6.6 s after the request.
     const Scene sc = scene("fig4");
     StopRequest stop;
-    std::chrono::steady_clock::time_point asked;
-    std::thread asker([&] {
-        std::this_thread::sleep_for(std::chrono::milliseconds(200));
-        asked = std::chrono::steady_clock::now();
-        stop.request();
-    });
-    double latency = -1;
-    try {
-        const StopScope scope(&stop);
-        simulate(sc, Dynamics::Full, Vec3(0.01, 0, 0), Vec3::Zero(), 2000.0, 1.0);
-    } catch (const Interrupted&) {
-        latency = since(asked);
-    }
-    asker.join();
+    const double latency =
+        latency_of_request(stop, 200, [&] { simulate(sc, Dynamics::Full, Vec3(0.01, 0, 0), Vec3::Zero(), 2000.0, 1.0); });
     INFO("latency " << latency << " s");
     CHECK(latency >= 0);
     CHECK(latency < 0.5);
