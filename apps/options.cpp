@@ -311,23 +311,11 @@ GridSpec grid_opts(const Options& a, const GridArgs& ga) {
 // ---- work budgets and MPI ranks ----------------------------------------------------------------
 
 long check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, long budget) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const double dth = 2 * kPi / 5;
-    const Vec3 samples[] = {{(g.x0 + g.x1) / 2, (g.y0 + g.y1) / 2, g.th0},
-                            {g.x0 + 0.25 * (g.x1 - g.x0), g.y0 + 0.25 * (g.y1 - g.y0), g.th0 + dth},
-                            {g.x0 + 0.75 * (g.x1 - g.x0), g.y0 + 0.25 * (g.y1 - g.y0), g.th0 + 2 * dth},
-                            {g.x0 + 0.25 * (g.x1 - g.x0), g.y0 + 0.75 * (g.y1 - g.y0), g.th0 + 3 * dth},
-                            {g.x0 + 0.75 * (g.x1 - g.x0), g.y0 + 0.75 * (g.y1 - g.y0), g.th0 + 4 * dth}};
-    double total = 0;
-    for (const Vec3& q : samples) total += std::max<double>(limit_cycle(sc, q, lo).stats.rhs_evals, 1);
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const double per = total / 5, n = static_cast<double>(g.size());
-    if (per * n > static_cast<double>(budget))
-        throw UsageError("a " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" + std::to_string(g.nth) +
-                         " grid would take about " + fmt(per * n) + " right-hand sides (" + fmt(per) +
-                         " per configuration, the mean of five cycles run first: about " + fmt(secs / 5 * n) +
-                         " s on one core here), above the budget of " + fmt(static_cast<double>(budget)) +
-                         ": raise it with --max-work or use a coarser grid");
+    try {
+        require_field_work(sc, g, lo, budget, "--max-work");
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
     return budget;
 }
 

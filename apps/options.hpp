@@ -219,12 +219,9 @@ GridSpec grid_opts(const Options& a, const GridArgs& ga);
 // The largest --max-work of a field.
 constexpr long kMaxWorkLimit = 1'000'000'000'000'000L;
 
-// Bounded work for a field (issue 18): five cycles from rest (the grid's centre and four spread
-// configurations) run first; the field costs about their mean per configuration (warm starts save,
-// sticking cycles cost more), and a field estimated over the budget --max-work (right-hand sides,
-// default 2e9: minutes on two cores) is refused with the estimate (UsageError). Returns the budget,
-// which also holds while the field runs (require_within_budget). (docs/decisions.md, A field's work
-// is estimated up front and bounded)
+// Bounded work for a field: the library's estimate (field.hpp, require_field_work) against --max-work
+// (default kDefaultFieldWork); a field estimated over it is refused with the estimate (UsageError).
+// Returns the budget, which also holds while the field runs (require_within_budget).
 long check_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo, long budget);
 
 // A field whose budget ran out while it was computed (the estimate was low) is not a result: throws.

@@ -13,7 +13,7 @@ struct FieldArgs : Options {
     GridArgs grid;
     CycleArgs cycle;
     MeasuredArgs measured;
-    long max_work = 2'000'000'000L;
+    long max_work = kDefaultFieldWork;
     explicit FieldArgs(CLI::App& app)
         : Options(app, "field", "asymptotic twist field on a grid over (s_x, s_y, theta), JSON or CSV",
                   "Asymptotic twist field on a regular grid (default 7x7x7 over [-0.05,0.05]^2 m x [0, 2pi)),\n"

@@ -14,7 +14,7 @@ struct FixedPointsArgs : Options {
     GridArgs grid;
     CycleArgs cycle;
     MeasuredArgs measured;
-    long max_work = 2'000'000'000L;
+    long max_work = kDefaultFieldWork;
     explicit FixedPointsArgs(CLI::App& app)
         : Options(app, "fixed-points", "zeros of the field, refined and classified (stable, unstable, saddle; lines)",
                   "Computes the field, finds cells where every component changes sign, refines the zeros\n"

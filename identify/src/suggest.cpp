@@ -7,17 +7,16 @@
 #include "plate/peaks.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
+#include "plate/tasks.hpp"
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 namespace plate {
 namespace {
@@ -135,14 +134,13 @@ void weigh_motion(const Scene& scene, const Camera& camera, const SuggestOptions
     const std::vector<double> x = layout.internal(layout.scene_values());
     const std::vector<Vec3> q0 = planned_starts(o);
     std::vector<PlannedTrack> planned(q0.size());
-    std::atomic<int> next{0};
-    auto work = [&] {
-        for (int k; (k = next++) < o.tracks;) planned[k] = plan_track(s, camera, o, layout, x, q0[k]);
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < std::min(o.fit.threads, o.tracks); ++t) pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool) t.join();
+    thread_tasks(std::max(1, std::min(o.fit.threads, o.tracks)))(
+        o.tracks,
+        [&](int k) {
+            planned[k] = plan_track(s, camera, o, layout, x, q0[k]);
+            return std::string();
+        },
+        [](int, const std::string&) {});
 
     const int n = layout.size(), d = scene.part.point ? 2 : 3;
     int rows = 0;

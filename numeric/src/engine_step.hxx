@@ -4,6 +4,7 @@
 #pragma once
 
 #include "engine.hpp"
+#include "plate/progress.hpp"
 
 #include <cstring>
 
@@ -41,6 +42,7 @@ bool Engine<Model>::advance(double t_end, OnStep on_step) {
     if (stop.reason != StopReason::None) return false;
     const double T = scene_.plate.T;
     while (t_ < t_end) {
+        throw_if_stopped();   // (progress.hpp: a request to stop is seen within a step)
         if (stats.steps >= opt_.max_steps || stats.rhs_evals >= 10 * opt_.max_steps) {
             stop = StopEvent{StopReason::StepLimit, -1, t_};
             return false;

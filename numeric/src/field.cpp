@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <functional>
 #include <cmath>
+#include <exception>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -80,6 +81,7 @@ struct FieldRun {
     std::atomic<long> spent{0};
     bool report_progress = true;   // (with a task runner, the runner's done reports)
     std::atomic<bool> over{false};
+    std::atomic<bool> failed{false};   // a worker threw (Interrupted): the others take no more work
     const bool rotation_invariant;
     std::vector<double> hint;      // each point's step hint (run_line)
     std::vector<char> switching;   // the point's cycle changes mode (or failed)
@@ -135,6 +137,7 @@ LimitCycleSummary FieldRun::solve(int i, int j, int k, const Vec3& warm, double&
     const int idx = grid.index(i, j, k);
     FieldPoint& p = f.points[idx];
     p.q = grid.at(i, j, k);
+    throw_if_stopped();
     if (opt.max_rhs_evaluations > 0 && spent.load() >= opt.max_rhs_evaluations) {
         over = true;
         LimitCycleSummary none;
@@ -409,14 +412,29 @@ void FieldRun::run_tasks(int first_done) {
     f.threads = 0;
 }
 
-// min(threads, units) workers, this thread one of them.
+// min(threads, units) workers, this thread one of them, each polling this thread's stop request.
+// The first exception a worker throws (Interrupted) is rethrown once all have returned.
 void FieldRun::run_workers(int threads, int units, const std::function<void()>& worker) {
     threads = std::max(1, std::min(threads, units));
     f.threads = threads;
+    const StopRequest* request = current_stop_request();
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto guarded = [&] {
+        const StopScope scope(request);
+        try {
+            worker();
+        } catch (...) {
+            const std::lock_guard<std::mutex> lock(error_mutex);
+            if (!error) error = std::current_exception();
+            failed = true;
+        }
+    };
     std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
+    for (int t = 1; t < threads; ++t) pool.emplace_back(guarded);
+    guarded();
     for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
 }
 
 // Threads take a line whose predecessors are done (the one with the most behind it).
@@ -449,12 +467,19 @@ void FieldRun::run_lines_on_threads(int threads) {
             cv.wait(lock, [&] {
                 for (int c = 0; c < n; ++c)
                     if (!taken[c] && waiting[c] == 0 && (l < 0 || behind[c] > behind[l])) l = c;
-                return l >= 0 || finished == n;
+                return l >= 0 || finished == n || failed;
             });
-            if (l < 0) return;
+            if (l < 0 || failed) return;
             taken[l] = 1;
             lock.unlock();
-            run_line(lines[l]);
+            try {
+                run_line(lines[l]);
+            } catch (...) {   // (the line is never finished: wake the workers waiting for it)
+                lock.lock();
+                failed = true;
+                cv.notify_all();
+                throw;
+            }
             lock.lock();
             ++finished;
             for (int a : after[l]) --waiting[a];
@@ -486,6 +511,7 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
     f.points.resize(grid.size());
     const auto t_start = std::chrono::steady_clock::now();
     const int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency());
+    const StopScope scope(opt.stop);
     FieldRun run(sc, grid, opt, f);
     if (opt.tasks) {
         // With shooting every process solves the A and B lines, the runner shares the planes.
@@ -499,12 +525,49 @@ Field compute_field(const Scene& sc, GridSpec grid, const FieldOptions& opt) {
         run.run_lines_on_threads(threads);
     } else {
         run.run_workers(threads, run.tasks, [&]() {
-            for (int t; (t = run.next.fetch_add(1)) < run.tasks;) run.run_task(t);
+            for (int t; !run.failed && (t = run.next.fetch_add(1)) < run.tasks;) run.run_task(t);
         });
     }
     run.settle_budget();
     f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return f;
+}
+
+FieldWorkEstimate estimate_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& lo) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double dth = 2 * kPi / 5;
+    const Vec3 samples[] = {{(g.x0 + g.x1) / 2, (g.y0 + g.y1) / 2, g.th0},
+                            {g.x0 + 0.25 * (g.x1 - g.x0), g.y0 + 0.25 * (g.y1 - g.y0), g.th0 + dth},
+                            {g.x0 + 0.75 * (g.x1 - g.x0), g.y0 + 0.25 * (g.y1 - g.y0), g.th0 + 2 * dth},
+                            {g.x0 + 0.25 * (g.x1 - g.x0), g.y0 + 0.75 * (g.y1 - g.y0), g.th0 + 3 * dth},
+                            {g.x0 + 0.75 * (g.x1 - g.x0), g.y0 + 0.75 * (g.y1 - g.y0), g.th0 + 4 * dth}};
+    double total = 0;
+    for (const Vec3& q : samples) total += std::max<double>(limit_cycle(sc, q, lo).stats.rhs_evals, 1);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double n = static_cast<double>(g.size());
+    FieldWorkEstimate e;
+    e.per_configuration = total / 5;
+    e.total = e.per_configuration * n;
+    e.seconds = secs / 5 * n;
+    return e;
+}
+
+void require_field_work(const Scene& sc, const GridSpec& g, const LimitCycleOptions& cycle, long budget,
+                        const std::string& raise_with) {
+    if (budget <= 0) return;
+    const FieldWorkEstimate e = estimate_field_work(sc, g, cycle);
+    if (e.total <= static_cast<double>(budget)) return;
+    auto fmt = [](double x) {
+        std::ostringstream s;
+        s.precision(3);
+        s << x;
+        return s.str();
+    };
+    throw std::invalid_argument("a " + std::to_string(g.nx) + "x" + std::to_string(g.ny) + "x" + std::to_string(g.nth) +
+                                " grid would take about " + fmt(e.total) + " right-hand sides (" + fmt(e.per_configuration) +
+                                " per configuration, the mean of five cycles run first: about " + fmt(e.seconds) +
+                                " s on one core here), above the budget of " + fmt(static_cast<double>(budget)) +
+                                ": raise it with " + raise_with + " or use a coarser grid");
 }
 
 Trajectory field_curve(const Scene& sc, const Vec3& q0, double duration, double sample_dt, const LimitCycleOptions& opt,

@@ -305,6 +305,7 @@ bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::V
 }   // namespace
 
 FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPointOptions& opt) {
+    const StopScope scope(opt.stop);
     FixedPointSearch run(sc, field, opt);
     const GridSpec& g = run.g;
     const int dim = run.dim;

@@ -1,4 +1,5 @@
 #include "plate/limit_cycle.hpp"
+#include "plate/progress.hpp"
 
 #include "cycle_solvers.hpp"
 #include "engine.hpp"
@@ -351,13 +352,20 @@ struct NewtonData {
     Stats stats;
     StopEvent stop;
     bool failed = false;
+    bool interrupted = false;
     int periods = 0;
 };
 
 int newton_f(const gsl_vector* xs, void* p, gsl_vector* f) {
     auto* d = static_cast<NewtonData*>(p);
     const Vec3 x = Vec3(gsl_vector_get(xs, 0), gsl_vector_get(xs, 1), gsl_vector_get(xs, 2)).cwiseProduct(d->scale);
-    const PeriodResult r = one_period(*d->sc, d->q0, x, d->io, d->stats);
+    PeriodResult r;
+    try {   // (no C++ exception through GSL's C: a request to stop ends the solve, rethrown after it)
+        r = one_period(*d->sc, d->q0, x, d->io, d->stats);
+    } catch (const Interrupted&) {
+        d->interrupted = true;
+        return GSL_EBADFUNC;
+    }
     ++d->periods;
     if (!r.ok) {
         d->failed = true;
@@ -402,7 +410,7 @@ int newton_fdf(const gsl_vector* x, void* p, gsl_vector* f, gsl_matrix* J) {
 LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0) {
     gsl_set_error_handler_off();
     const detail::Scales sc_(sc);
-    NewtonData d{&sc, q0, Vec3(sc_.v, sc_.v, sc_.w), opt.integration, {}, {}, false, 0};
+    NewtonData d{&sc, q0, Vec3(sc_.v, sc_.v, sc_.w), opt.integration, {}, {}, false, false, 0};
     gsl_multiroot_function_fdf fdf{newton_f, newton_df, newton_fdf, 3, &d};
     gsl_vector* x = gsl_vector_alloc(3);
     const Vec3 x0 = qd0.cwiseQuotient(d.scale);
@@ -422,6 +430,7 @@ LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycle
     const Vec3 xs = Vec3(gsl_vector_get(s->x, 0), gsl_vector_get(s->x, 1), gsl_vector_get(s->x, 2)).cwiseProduct(d.scale);
     gsl_multiroot_fdfsolver_free(s);
     gsl_vector_free(x);
+    if (d.interrupted) throw Interrupted();
     out.periods = d.periods;
     if (!d.failed && step <= opt.tol) {
         const PeriodResult r = one_period(sc, q0, xs, opt.integration, d.stats);

@@ -1,4 +1,5 @@
 #include "plate/output.hpp"
+#include "plate/progress.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -242,7 +243,9 @@ void ProgressPrinter::operator()(int done, int total) {
     const double el = std::chrono::duration<double>(now - start).count();
     if ((el > 1.5 && std::chrono::duration<double>(now - last).count() > every) || (shown && done == total)) {
         std::ostringstream s;
-        s << what << ": " << done << "/" << total << " (" << std::fixed << std::setprecision(1) << el << " s)\n";
+        s << what << ": " << done << "/" << total << " (" << std::fixed << std::setprecision(1) << el << " s";
+        if (done > 0 && done < total) s << ", about " << seconds_left(done, total, el) << " s left";
+        s << ")\n";
         *to << s.str() << std::flush;
         last = now;
         shown = true;

@@ -1,10 +1,12 @@
 #include "plate/tasks.hpp"
+#include "plate/progress.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -15,13 +17,25 @@ namespace plate {
 TaskRunner thread_tasks(int threads) {
     return
         [threads](int n, const std::function<std::string(int)>& work, const std::function<void(int, const std::string&)>& done) {
+            // Each worker polls the caller's stop request (progress.hpp); the first exception one throws
+            // stops the others taking tasks and is rethrown once all have returned.
             std::atomic<int> next{0};
+            std::atomic<bool> failed{false};
+            std::exception_ptr error;
             std::mutex done_mutex;
+            const StopRequest* request = current_stop_request();
             auto worker = [&] {
-                for (int i; (i = next.fetch_add(1)) < n;) {
-                    const std::string r = work(i);
+                const StopScope scope(request);
+                try {
+                    for (int i; !failed && (i = next.fetch_add(1)) < n;) {
+                        const std::string r = work(i);
+                        std::lock_guard<std::mutex> lock(done_mutex);
+                        done(i, r);
+                    }
+                } catch (...) {
                     std::lock_guard<std::mutex> lock(done_mutex);
-                    done(i, r);
+                    if (!error) error = std::current_exception();
+                    failed = true;
                 }
             };
             const int hw = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -30,6 +44,7 @@ TaskRunner thread_tasks(int threads) {
             for (int t = 1; t < nt; ++t) pool.emplace_back(worker);
             worker();
             for (auto& t : pool) t.join();
+            if (error) std::rethrow_exception(error);
         };
 }
 

@@ -26,6 +26,7 @@ namespace py = pybind11;
 
 // --- the module's classes and functions, registered in this order --------------------------------
 
+void bind_progress(py::module_& m);       // progress.cpp: Progress
 void bind_scene(py::module_& m);          // scene.cpp:    Scene, load_scene, parse_scene, Stop
 void bind_twist(py::module_& m);          // twist.cpp:    Cycle, twist
 void bind_field(py::module_& m);          // field.cpp:    Field, field

@@ -1,6 +1,7 @@
 // plate.control (a closed-loop run, plate.ControlRun), the `python` policy (a Python callable deciding each
 // period) and plate.ControlEnv (the same loop a step at a time, Gym-like): control/include/plate/control.hpp.
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include "plate/control.hpp"
 #include "plate/observe.hpp"
@@ -77,8 +78,7 @@ Setup setup(const Scene& sc, const std::vector<double>& goal, const py::object& 
         require(false, std::string("grid: ") + e.what());
     }
     MotionLibrary lib = library_of(library, sc);
-    py::gil_scoped_release free;
-    s.model = build_control_model(sc, std::move(lib), mo);
+    s.model = interruptible(py::none(), [&](Watch&) { return build_control_model(sc, std::move(lib), mo); });
     return s;
 }
 
@@ -243,11 +243,8 @@ void bind_control(py::module_& m) {
                         "policy: expected 'library', a callable or an object with decide(observation)");
                 p = std::make_unique<PythonPolicy>(policy);
             }
-            ControlSummary s;
-            {
-                py::gil_scoped_release free;
-                s = run_control(st.model, *p, st.truth, st.camera, st.goal, st.q0, st.opt);
-            }
+            const ControlSummary s = interruptible(
+                py::none(), [&](Watch&) { return run_control(st.model, *p, st.truth, st.camera, st.goal, st.q0, st.opt); });
             return make_run(s, st);
         },
         py::arg("scene"), py::arg("goal"), py::kw_only(), py::arg("library"), py::arg("time"), py::arg("truth") = py::none(),

@@ -1,6 +1,7 @@
 // plate.design (a plate motion for a target, verified: plate.Design), plate.orientation_harmonics,
 // plate.coning_rate and plate.axis_peaks.
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include <array>
 #include <cmath>
@@ -103,13 +104,7 @@ void bind_design_function(py::module_& m) {
                 o.axes.push_back(static_cast<Axis>(k));
             }
             o.max_harmonic = renamed(harmonics, max_harmonic, "harmonics", "max_harmonic", 0);
-            py::gil_scoped_release free;
-            try {
-                return design(part, t, o);
-            } catch (const std::invalid_argument& e) {
-                py::gil_scoped_acquire hold;
-                throw py::value_error(e.what());
-            }
+            return interruptible(py::none(), [&](Watch&) { return design(part, t, o); });   // (invalid_argument: ValueError)
         },
         py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
         py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),

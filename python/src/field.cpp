@@ -1,5 +1,6 @@
 // plate.field (the asymptotic twist field on a grid, plate.Field) and plate.fixed_points (its zeros).
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -142,7 +143,7 @@ void bind_field(py::module_& m) {
         "field",
         [](const Scene& sc, int grid, std::optional<int> nx, std::optional<int> ny, std::optional<int> ntheta,
            std::pair<double, double> x, std::pair<double, double> y, double theta0, int threads, double tol, double rtol,
-           int max_periods, const std::string& solver, long max_rhs, long max_work) {
+           int max_periods, const std::string& solver, long max_rhs, long max_work, const py::object& progress) {
             GridSpec g;
             g.nx = nx.value_or(grid);
             g.ny = ny.value_or(grid);
@@ -162,11 +163,11 @@ void bind_field(py::module_& m) {
             o.cycle = cycle_options(tol, rtol, max_periods, solver, max_rhs);
             o.threads = threads;
             o.max_rhs_evaluations = max_work;
-            PyField f{sc, {}};
-            {
-                py::gil_scoped_release free;
-                f.f = compute_field(sc, g, o);
-            }
+            PyField f{sc, interruptible(progress, [&](Watch& watch) {
+                          require_field_work(sc, g, o.cycle, max_work, "max_work= (0: no budget)");
+                          o.progress = [&watch](int done, int total) { watch.report(done, total); };
+                          return compute_field(sc, g, o);
+                      })};
             if (f.f.budget_spent)
                 throw std::runtime_error("the work budget of max_work = " + std::to_string(max_work) +
                                          " right-hand sides was spent before the field was complete");
@@ -175,10 +176,15 @@ void bind_field(py::module_& m) {
         py::arg("scene"), py::kw_only(), py::arg("grid") = 7, py::arg("nx") = py::none(), py::arg("ny") = py::none(),
         py::arg("ntheta") = py::none(), py::arg("x") = std::make_pair(-0.05, 0.05), py::arg("y") = std::make_pair(-0.05, 0.05),
         py::arg("theta0") = 0.0, py::arg("threads") = 0, py::arg("tol") = 1e-7, py::arg("rtol") = 1e-8,
-        py::arg("max_periods") = 400, py::arg("solver") = "shooting", py::arg("max_rhs") = 20'000'000L, py::arg("max_work") = 0L,
+        py::arg("max_periods") = 400, py::arg("solver") = "shooting", py::arg("max_rhs") = 20'000'000L,
+        py::arg("max_work") = kDefaultFieldWork, py::arg("progress") = py::none(),
         "The asymptotic twist field on a regular grid over (s_x, s_y, theta), theta covering a full turn;\n"
         "configurations in parallel on `threads` cores (0: all). max_work: a budget in right-hand sides\n"
-        "for the whole field (0: none); a field that spends it raises RuntimeError.");
+        "for the whole field, as the command line's --max-work (default 2e9; 0: none): the work is\n"
+        "estimated up front from five cycles and a larger field is refused (ValueError with the estimate);\n"
+        "a field that spends it anyway raises RuntimeError. progress: a callable given a plate.Progress\n"
+        "(configurations done of total, an estimate of the seconds left) every 0.05 s while it changes.\n"
+        "Ctrl-C stops it within 0.1 s (KeyboardInterrupt, no result).");
 }
 
 void bind_fixed_points(py::module_& m) {
@@ -219,14 +225,11 @@ void bind_fixed_points(py::module_& m) {
             require(max_rhs >= 0, "max_rhs: expected >= 0 (0: no budget)");
             o.ftol = ftol;
             o.max_rhs_evaluations = max_rhs;
-            PyFixedPoints r{f.scene, {}};
-            py::gil_scoped_release free;
-            r.fp = find_fixed_points(f.scene, f.f, o);
-            return r;
+            return PyFixedPoints{f.scene, interruptible(py::none(), [&](Watch&) { return find_fixed_points(f.scene, f.f, o); })};
         },
         py::arg("field"), py::kw_only(), py::arg("ftol") = 1e-6, py::arg("max_rhs") = 20'000'000L,
         "Zeros of a field (from plate.field): candidate cells refined by Gauss-Newton, classified by the\n"
-        "Jacobian's eigenvalues; curves of zeros as lines.");
+        "Jacobian's eigenvalues; curves of zeros as lines. Ctrl-C stops it (KeyboardInterrupt).");
 }
 
 }   // namespace plate::python

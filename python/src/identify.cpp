@@ -1,6 +1,7 @@
 // plate.identify: a part's friction and centre-of-mass offset from camera tracks (plate.Identification),
 // identify/include/plate/identify.hpp.
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include "plate/identify.hpp"
 #include "plate/profile.hpp"
@@ -149,11 +150,8 @@ void bind_identify(py::module_& m) {
             for (const std::string& name : r.po.params)
                 require(std::find(params.begin(), params.end(), name) != params.end(),
                         "profile: " + name + " is not among the fitted params");
-            {
-                py::gil_scoped_release free;
-                r.s = identify(sc, tr, r.o);
-                if (r.profiled) r.p = profile_likelihood(sc, tr, r.o, r.s, r.po);
-            }
+            r.s = interruptible(py::none(), [&](Watch&) { return identify(sc, tr, r.o); });
+            if (r.profiled) r.p = interruptible(py::none(), [&](Watch&) { return profile_likelihood(sc, tr, r.o, r.s, r.po); });
             return r;
         },
         py::arg("scene"), py::arg("tracks"), py::arg("params"), py::kw_only(), py::arg("dynamics") = "full",

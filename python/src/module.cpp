@@ -5,8 +5,8 @@
 // contact mode of every sample. Options are keyword arguments with the library's defaults; results
 // are objects whose arrays are numpy arrays, and whose `summary` is the command line's JSON as a dict.
 // The GIL is released while the library works (fields and long simulations take seconds), so other
-// Python threads run meanwhile. Errors are Python exceptions with the command line's messages:
-// plate.InputError (a ValueError) for a bad scene, ValueError for a bad option, RuntimeError else.
+// Python threads run meanwhile; long calls stop on Ctrl-C and report progress (interrupt.hpp). Errors are Python exceptions with
+// the command line's messages: plate.InputError (a ValueError) for a bad scene, ValueError for a bad option, RuntimeError else.
 //
 // The pieces, one file per topic, are declared in bindings.hpp and registered here in order.
 #include "bindings.hpp"
@@ -24,9 +24,12 @@ PYBIND11_MODULE(_plate, m) {
             if (p) std::rethrow_exception(p);
         } catch (const InputError& e) {
             input_error(e.what());
+        } catch (const Interrupted& e) {   // (asked to stop from C++: interrupt.hpp raises Python's own)
+            PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
         }
     });
 
+    bind_progress(m);
     bind_scene(m);
     bind_twist(m);
     bind_field(m);

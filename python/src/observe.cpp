@@ -1,6 +1,7 @@
 // plate.observe: what a camera records of a simulation (plate.Track), the camera (plate.Camera) and
 // the track file (plate.read_track_csv, plate.write_track_csv): numeric/include/plate/observe.hpp.
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include <pybind11/stl/filesystem.h>
 
@@ -36,11 +37,8 @@ py::object run_observe(const Scene& sc, const std::vector<double>& start, const 
     io.rtol = rtol;
     io.max_steps = max_steps;
     Trajectory exact;
-    Track tr;
-    {
-        py::gil_scoped_release free;
-        tr = run(dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, io, &exact);
-    }
+    Track tr = interruptible(py::none(),
+                             [&](Watch&) { return run(dynamics == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, io, &exact); });
     py::object out = py::cast(std::move(tr));
     out.attr("stop") = py::cast(to_py(exact.stop));
     return out;

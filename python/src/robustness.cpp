@@ -1,6 +1,7 @@
 // plate.robustness (outcome shares, the fixed point's spread and its sensitivities under an uncertainty
 // spec: plate.Robustness) and plate.uncertain_parameters (the spec's parameters, in draw order).
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include "plate/robustness.hpp"
 
@@ -123,12 +124,8 @@ void bind_robustness(py::module_& m) {
             r.o.sensitivities = sensitivities;
             r.o.threads = threads;
             r.o.fixed.cycle = cycle_options(tol, rtol, max_periods, solver, max_rhs);
-            py::gil_scoped_release unlocked;
-            try {
-                r.s = robustness(sc, r.spec, r.o);
-            } catch (const std::invalid_argument& e) {
-                throw py::value_error(e.what());
-            }
+            r.s = interruptible(py::none(),
+                                [&](Watch&) { return robustness(sc, r.spec, r.o); });   // (invalid_argument: ValueError)
             return r;
         },
         py::arg("scene"), py::arg("uncertainty"), py::kw_only(), py::arg("draws") = 200, py::arg("target") = py::none(),

@@ -1,6 +1,7 @@
 // plate.simulate: a trajectory in the full, U- or averaged dynamics, along the field, or in the model `auto`
 // picks (plate.Trajectory).
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include "plate/hierarchy.hpp"
 
@@ -138,27 +139,27 @@ void bind_simulate(py::module_& m) {
             require(dynamics != "auto" || qd0.isZero(), "twist: dynamics='auto' answers from rest");
             require(model_tol > 0, "model_tol: expected a number > 0");
             PyTrajectory p{sc, {}, dynamics, std::nullopt};
-            py::gil_scoped_release free;
-            Scene run = sc;
-            std::string level = dynamics;
-            if (dynamics == "auto") {   // the command line's choice (experiments/hierarchy.hpp), decided up front
-                const ModelPick pick = pick_model(sc, q0, time, model_tol);
-                run = pick.scene;
-                level = pick.rung.dynamics == Dynamics::Full ? "full" : pick.rung.dynamics == Dynamics::U ? "u" : "field";
-                p.model = {pick.rung.name(), pick.predicted, pick.estimate.ok ? "" : pick.estimate.note};
-                p.dynamics = "auto: " + pick.rung.name();
-            }
-            if (level == "field") {
-                LimitCycleOptions lo;
-                lo.tol = tol;
-                p.tr = field_curve(run, q0, time, dt, lo);
-            } else {
+            p.tr = interruptible(py::none(), [&](Watch&) {
+                Scene run = sc;
+                std::string level = dynamics;
+                if (dynamics == "auto") {   // the command line's choice (experiments/hierarchy.hpp), decided up front
+                    const ModelPick pick = pick_model(sc, q0, time, model_tol);
+                    run = pick.scene;
+                    level = pick.rung.dynamics == Dynamics::Full ? "full" : pick.rung.dynamics == Dynamics::U ? "u" : "field";
+                    p.model = {pick.rung.name(), pick.predicted, pick.estimate.ok ? "" : pick.estimate.note};
+                    p.dynamics = "auto: " + pick.rung.name();
+                }
+                if (level == "field") {
+                    LimitCycleOptions lo;
+                    lo.tol = tol;
+                    return field_curve(run, q0, time, dt, lo);
+                }
                 IntegrationOptions io;
                 io.rtol = rtol;
                 io.max_steps = max_steps;
-                p.tr = level == "averaged" ? simulate_averaged(run, q0, qd0, time, dt, io)
+                return level == "averaged" ? simulate_averaged(run, q0, qd0, time, dt, io)
                                            : simulate(run, level == "full" ? Dynamics::Full : Dynamics::U, q0, qd0, time, dt, io);
-            }
+            });
             return p;
         },
         py::arg("scene"), py::arg("start"), py::arg("time"), py::kw_only(), py::arg("dynamics") = "full",

@@ -1,5 +1,6 @@
 // plate.twist: a limit cycle of the reduced U-dynamics and its asymptotic twist (plate.Cycle).
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include <algorithm>
 
@@ -121,8 +122,7 @@ void bind_twist(py::module_& m) {
             const std::vector<double> qd = renamed<std::vector<double>>(twist, start, "twist", "start", {});
             const Vec3 qd0 = twist || start ? config(sc, qd, "twist") : Vec3::Zero();
             const LimitCycleOptions o = cycle_options(tol, rtol, max_periods, solver, max_rhs);
-            py::gil_scoped_release free;
-            c.lc = limit_cycle(sc, c.at, o, qd0);
+            c.lc = interruptible(py::none(), [&](Watch&) { return limit_cycle(sc, c.at, o, qd0); });
             return c;
         },
         py::arg("scene"), py::arg("at"), py::kw_only(), py::arg("twist") = py::none(), py::arg("tol") = 1e-7,

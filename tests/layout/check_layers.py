@@ -33,7 +33,8 @@ SOURCES = (".cpp", ".hpp", ".h", ".cc", ".hh", ".hxx")
 # headers of its own level or of a lower one, never of a higher one.
 NUMERIC_LEVELS = [
     ("needs nothing of plate", ["include/plate/tasks.hpp", "src/tasks.cpp", "src/stepper.hpp", "src/events.hpp",
-                                "src/lsan_suppressions.cpp"]),
+                                "src/lsan_suppressions.cpp",
+                                "include/plate/progress.hpp", "src/progress.cpp"]),   # stop requests, progress
     ("model", ["include/plate/model.hpp", "src/model.cpp", "src/so3.hpp", "include/plate/scene_io.hpp",
                "src/scene_io.cpp", "src/input_reader.hpp", "include/plate/random_scene.hpp", "src/random_scene.cpp",
                "include/plate/friction.hpp", "include/plate/uncertainty.hpp", "src/uncertainty.cpp",

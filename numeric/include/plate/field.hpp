@@ -4,6 +4,7 @@
 #pragma once
 
 #include "plate/limit_cycle.hpp"
+#include "plate/progress.hpp"
 #include "plate/tasks.hpp"
 
 #include <functional>
@@ -54,6 +55,9 @@ struct FieldOptions {
     int threads = 0;                                     // 0: all cores
     bool warm_start = true;                              // start each theta from the previous theta's cycle
     std::function<void(int done, int total)> progress;   // called from worker threads, serialised
+    // Polled while the field runs (progress.hpp; nullptr: this thread's, if any): once set, the field
+    // throws Interrupted within a step of the integrator on every worker.
+    const StopRequest* stop = nullptr;
     // The field's work budget in right-hand sides (0: none). Once spent, the configurations not yet
     // started are left undefined with stop StepLimit and Field::budget_spent is set (which ones
     // depends on the threads' order: such a field is not a result, see the CLI); it is also set when
@@ -70,6 +74,23 @@ struct FieldOptions {
 };
 
 Field compute_field(const Scene& scene, GridSpec grid, const FieldOptions& opt = {});
+
+// Bounded work for a field (issue 18), judged here for the CLI and Python alike: five cycles from rest
+// (the grid's centre and four spread configurations) run first; the field costs about their mean per
+// configuration (warm starts save, sticking cycles cost more). (docs/decisions/cycles-and-fields.md,
+// A field's work is estimated up front and bounded)
+struct FieldWorkEstimate {
+    double per_configuration = 0;   // right-hand sides
+    double total = 0;               // right-hand sides, the whole grid
+    double seconds = 0;             // the whole grid on one core, timed from the five cycles
+};
+FieldWorkEstimate estimate_field_work(const Scene& scene, const GridSpec& grid, const LimitCycleOptions& cycle);
+// The default budget (right-hand sides): minutes on two cores.
+constexpr long kDefaultFieldWork = 2'000'000'000L;
+// Throws std::invalid_argument, with the estimate and how to raise the budget (`raise_with`: the CLI's
+// --max-work, Python's max_work=), when the field is estimated over `budget` (> 0).
+void require_field_work(const Scene& scene, const GridSpec& grid, const LimitCycleOptions& cycle, long budget,
+                        const std::string& raise_with);
 
 // One evaluation of the field with a warm start (updated in place). Throws FieldUndefined
 // where the asymptotic twist is undefined (contact lost, sticking, not converged).
@@ -115,6 +136,7 @@ struct FixedPointOptions {
     // are counted and the summary says so. (The scale: docs/decisions.md, Fixed-point refinement at a
     // tighter tolerance than the field.)
     long max_rhs_evaluations = 20'000'000;
+    const StopRequest* stop = nullptr;   // as FieldOptions::stop
 };
 
 struct FixedPoints {
