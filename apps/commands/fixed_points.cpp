@@ -17,7 +17,9 @@ struct FixedPointsArgs : Options {
     MeasuredArgs measured;
     long max_work = 2'000'000'000L;
     explicit FixedPointsArgs(CLI::App& app)
-        : Options(app, "fixed-points", "zeros of the field, refined and classified (stable, unstable, saddle, centre; lines); stuck regions; rotating attractors",
+        : Options(app, "fixed-points",
+                  "zeros of the field, refined and classified (stable, unstable, saddle, centre; lines); stuck regions; rotating "
+                  "attractors",
                   "Computes the field, finds cells where every component changes sign, refines the zeros\n"
                   "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
                   "and reports curves of zeros as lines. A centre: eigenvalues whose real parts are zero within\n"
