@@ -135,6 +135,7 @@ TEST_CASE("Fig. 1: lines of stable fixed points at (0, s_y, 0) and (0, s_y, pi),
     CHECK(stablepi == 1);
     CHECK(unstable == 2);
     CHECK(fp.lines.size() == 4u);
+    CHECK(fp.suggested_grid == 0);   // the default grid resolves the field: no warning (4 points do not)
 }
 
 TEST_CASE("Fig. 1(b): the point part's velocity field has a stable line of fixed points on s_x = 0", "[field][paper][point]") {
@@ -173,8 +174,8 @@ TEST_CASE("Fig. 4: stable fixed points near (0,0,0) and (0,0,pi), unstable near 
     CHECK(stable == 2);
     CHECK(unstable == 2);
     CHECK(fp.undefined_cells == 0);
-    CHECK(fp.cells == 6 * 6 * 7);   // 7x7 grid in (x, y), theta wrapping: 7 cells around
-    CHECK(fixed_points_sentence(fp) == "4 fixed points found");
+    CHECK(fp.cells == 6 * 6 * 7);                                 // 7x7 grid in (x, y), theta wrapping: 7 cells around
+    CHECK(fixed_points_sentence(fp) == "4 fixed points found");   // (no grid warning)
 
     // A datum made undefined (a corner with no cycle) is counted, not silently skipped: the cells
     // sharing that corner are undefined and the sentence says where nothing was searched.
@@ -424,7 +425,8 @@ TEST_CASE("fixed points: regions where the part is stuck all period are not refi
     const FixedPoints fp = find_fixed_points(hp, fh);
     CHECK(fp.stuck_cells > 0);
     CHECK(fp.stuck_cells <= 4 * stuck);   // each configuration is a corner of at most 4 cells
-    CHECK(fixed_points_sentence(fp).find("stuck all period") != std::string::npos);
+    CHECK(fixed_points_sentence(fp).find("a region where the part sticks") != std::string::npos);
+    CHECK(fp.stuck_regions.size() == 1u);
     // Bounded work: fig1's search needs ~1.4e6 right-hand sides; with 1e5 it stops, and says so.
     const Scene f1 = scene("fig1");
     const Field ff = compute_field(f1, GridSpec{});

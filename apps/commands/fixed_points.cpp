@@ -1,4 +1,5 @@
-// plate fixed-points: the zeros of the field, refined and classified (stable, unstable, saddle; lines).
+// plate fixed-points: the zeros of the field, refined and classified (stable, unstable, saddle, centre;
+// lines), the regions where the part sticks and the rotating attractors.
 #include "commands.hpp"
 
 #include "plate/output.hpp"
@@ -16,10 +17,17 @@ struct FixedPointsArgs : Options {
     MeasuredArgs measured;
     long max_work = kDefaultFieldWork;
     explicit FixedPointsArgs(CLI::App& app)
-        : Options(app, "fixed-points", "zeros of the field, refined and classified (stable, unstable, saddle; lines)",
+        : Options(app, "fixed-points",
+                  "zeros of the field, refined and classified (stable, unstable, saddle, centre; lines); stuck regions; rotating "
+                  "attractors",
                   "Computes the field, finds cells where every component changes sign, refines the zeros\n"
                   "by Gauss-Newton, classifies them by the Jacobian's eigenvalues (stable, unstable, saddle)\n"
-                  "and reports curves of zeros as lines. JSON to stdout or --out FILE. --max-work as for field;\n"
+                  "and reports curves of zeros as lines. A centre: eigenvalues whose real parts are zero within\n"
+                  "the difference Jacobian's own error (eigen_error, from two steps). Configurations where the part\n"
+                  "does not move are reported as stuck regions with their extent, not refined; orbits where the\n"
+                  "position returns while theta turns once (rigid parts) as rotating attractors with their rate\n"
+                  "[rad/s]. The summary warns when the grid may be too coarse, and names a finer one.\n"
+                  "JSON to stdout or --out FILE. --max-work as for field;\n"
                   "the refinement's own budget is the smaller of it and 2e7 right-hand sides.\n") {
         scene_file(scene);
         add_grid_options(*this, grid);

@@ -611,6 +611,8 @@ const char* stability_name(Stability s) {
             return "unstable";
         case Stability::Saddle:
             return "saddle";
+        case Stability::Centre:
+            return "centre";
     }
     return "?";
 }

@@ -1,5 +1,7 @@
 #include "plate/field.hpp"
 
+#include "fixed_regions.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -53,15 +55,16 @@ struct ScaledField {
     }
 };
 
-Stability classify(const Eigen::VectorXcd& ev, int skip) {
-    bool neg = true, pos = true;
-    for (int i = 0; i < ev.size(); ++i) {
-        if (i == skip) continue;
-        neg = neg && ev[i].real() < 0;
-        pos = pos && ev[i].real() > 0;
-    }
-    return neg ? Stability::Stable : pos ? Stability::Unstable : Stability::Saddle;
+// The error of the eigenvalues of a difference Jacobian, from the same Jacobian at twice the step:
+// the largest distance from each eigenvalue to the nearest of the other's. (The central difference's
+// truncation error grows 4x with the step, the field's noise halves: either way the difference of the
+// two is of the size of the error.)
+double eigen_error(const Eigen::VectorXcd& ev, const Eigen::VectorXcd& ev2) {
+    double err = 0;
+    for (int i = 0; i < ev.size(); ++i) err = std::max(err, (ev2.array() - ev[i]).abs().minCoeff());
+    return err;
 }
+
 
 // Gauss-Newton with SVD, the directions with singular values below `cut` * sigma_max left
 // alone (so that on a line of zeros it corrects only across the line). Backtracking on |F|.
@@ -103,15 +106,13 @@ bool newton(ScaledField& f, VecX& z, double ftol, int max_it, double max_step, d
 // order 1e-4 relative.
 constexpr double kCut = 1e-3;
 
-}   // namespace
+// A cell is searched unless a zero found lies in it or within half a cell of it: the reach of in_cell.
+constexpr double kInside = 1.0;
 
-// Stuck all period: every contact held the whole cycle, so the twist is exactly zero.
-static bool stuck_all_period(const FieldPoint& p, int dim) {
-    if (!p.converged || !p.twist.isZero(0)) return false;
-    for (int i = 0; i < (dim == 3 ? 3 : 1); ++i)
-        if (p.stick_fraction[i] < 1 - 1e-12) return false;
-    return true;
-}
+// Cells without a sign change searched by Newton at most (the rest are counted and make a warning).
+constexpr int kMaxNearZero = 16;
+
+}   // namespace
 
 namespace {
 
@@ -129,6 +130,10 @@ struct FixedPointSearch {
     double cell;
     double h;
     FixedPoints out;
+    std::vector<int> region;                                        // each grid point's stuck region (-1: none)
+    std::vector<std::pair<double, std::array<int, 3>>> near_zero;   // cells without a sign change whose
+                                                                    // field is near zero, with their score
+    bool from_near_zero = false;                                    // searching those now
 
     FixedPointSearch(const Scene& sc, const Field& field, const FixedPointOptions& opt)
         : field(field), opt(opt), g(field.grid), dim(sc.part.point ? 2 : 3), cycle(opt.cycle), f{sc, cycle, dim, sc.part.rho()} {
@@ -139,6 +144,8 @@ struct FixedPointSearch {
         cell = std::min(g.dx() > 0 ? g.dx() : 1.0, g.dy() > 0 ? g.dy() : 1.0);
         if (dim == 3) cell = std::min(cell, f.rho * g.dth());
         h = 5e-3 * cell;
+        out.point_part = dim == 2;
+        out.stuck_regions = stuck_regions(field, f.rho, ftol, &region);
     }
 
     bool inside(const VecX& z) const {
@@ -151,12 +158,19 @@ struct FixedPointSearch {
         if (dim == 3) d[2] = f.rho * wrap_angle((a[2] - b[2]) / f.rho);
         return d.norm();
     }
+    // The grid index of corner c (bits: +x, +y, +theta) of the cell at (i, j, k); theta wraps.
+    int corner(int i, int j, int k, int c) const {
+        return g.index(i + (c & 1), j + ((c >> 1) & 1), dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0);
+    }
     bool known(const VecX& z, double radius) const;
-    bool in_cell(const Vec3& qc) const;
+    bool in_cell(const Vec3& qc, double reach) const;
     bool candidate(int i, int j, int k);
     void search_cell(int i, int j, int k);
-    bool follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3, const VecX& v,
-                     const Vec3& q);
+    bool in_region(const Vec3& q) const;
+    bool resolved(int i, int j, int k, const VecX& centre) const;
+    bool refined_candidate(int i, int j, int k, const Vec3& qc);
+    bool follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3, double err,
+                     const VecX& v, const Vec3& q);
 };
 
 bool FixedPointSearch::known(const VecX& z, double radius) const {
@@ -168,11 +182,12 @@ bool FixedPointSearch::known(const VecX& z, double radius) const {
     return false;
 }
 
-// Is a known zero within the cell centred at qc, widened by half a cell each way?
-bool FixedPointSearch::in_cell(const Vec3& qc) const {
+// Is a known zero within `reach` cells of the centre qc along each axis (0.5: in the cell; 1: in the
+// cell widened by half a cell each way)?
+bool FixedPointSearch::in_cell(const Vec3& qc, double reach) const {
     auto near = [&](const Vec3& q) {
-        return std::abs(q[0] - qc[0]) <= g.dx() && std::abs(q[1] - qc[1]) <= g.dy() &&
-               (dim == 2 || std::abs(wrap_angle(q[2] - qc[2])) <= g.dth());
+        return std::abs(q[0] - qc[0]) <= reach * g.dx() && std::abs(q[1] - qc[1]) <= reach * g.dy() &&
+               (dim == 2 || std::abs(wrap_angle(q[2] - qc[2])) <= reach * g.dth());
     };
     for (const auto& p : out.points)
         if (near(p.q)) return true;
@@ -189,8 +204,8 @@ bool FixedPointSearch::candidate(int i, int j, int k) {
     Eigen::Vector3d lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
     bool ok = true;
     for (int c = 0; c < (dim == 3 ? 8 : 4); ++c) {
-        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
-        const FieldPoint& p = field.points[g.index(ii, jj, kk)];
+        const int at = corner(i, j, k, c);
+        const FieldPoint& p = field.points[at];
         if (!p.converged) {
             ok = false;
             break;
@@ -206,16 +221,24 @@ bool FixedPointSearch::candidate(int i, int j, int k) {
     }
     bool stuck = false;
     for (int c = 0; c < (dim == 3 ? 8 : 4) && !stuck; ++c) {
-        const int ii = i + (c & 1), jj = j + ((c >> 1) & 1), kk = dim == 3 ? (k + ((c >> 2) & 1)) % g.nth : 0;
-        stuck = stuck_all_period(field.points[g.index(ii, jj, kk)], dim);
+        const int at = corner(i, j, k, c);
+        stuck = region[at] >= 0;
     }
     if (stuck) {
         ++out.stuck_cells;
         return false;
     }
     bool cand = true;
-    for (int c = 0; c < dim; ++c) cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
-    if (!cand) return false;
+    double score = 0;   // how far, in cells, linearly, the farthest component's zero lies beyond the cell
+    for (int c = 0; c < dim; ++c) {
+        cand = cand && lo[c] <= ftol && hi[c] >= -ftol;
+        const double nearest = lo[c] > 0 ? lo[c] : hi[c] < 0 ? -hi[c] : 0;
+        score = std::max(score, nearest / std::max(hi[c] - lo[c], 1e-300));
+    }
+    if (!cand) {
+        if (score < 0.5) near_zero.push_back({score, {i, j, k}});
+        return false;
+    }
     ++out.candidates;
     return true;
 }
@@ -224,25 +247,27 @@ bool FixedPointSearch::candidate(int i, int j, int k) {
 void FixedPointSearch::search_cell(int i, int j, int k) {
     Vec3 qc = g.at(i, j, k) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
     VecX z = f.z_of(qc);
-    if (in_cell(qc)) return;   // a zero already found lies in (or next to) this cell
+    if (in_cell(qc, kInside)) return;   // a zero already found lies in (or next to) this cell
     f.warm.setZero();
     try {
+        if (!from_near_zero && !resolved(i, j, k, f.F(z))) ++out.unresolved_cells;
         if (!newton(f, z, ftol, opt.max_newton, cell, h, kCut)) return;
     } catch (const FieldUndefined&) {
         return;
     }
     if (!inside(z) || known(z, 0.5 * cell)) return;
-    if (f.F(z).isZero(0)) return;   // landed where the part is stuck all period (a region)
+    if (f.F(z).isZero(0) || in_region(f.q_of(z))) return;   // landed in a region where the part does not move
 
-    // Classify.
-    MatX Jm;
+    // Classify, with the eigenvalues' error from the Jacobian at twice the step.
+    MatX Jm, J2;
     try {
         Jm = f.J(z, h);
+        J2 = f.J(z, 2 * h);
     } catch (const FieldUndefined&) {
         return;
     }
-    Eigen::EigenSolver<MatX> es(Jm);
-    const Eigen::VectorXcd ev = es.eigenvalues();
+    const Eigen::VectorXcd ev = Eigen::EigenSolver<MatX>(Jm).eigenvalues();
+    const double err = eigen_error(ev, Eigen::EigenSolver<MatX>(J2).eigenvalues());
     Eigen::Vector3cd ev3 = Eigen::Vector3cd::Zero();
     ev3.head(dim) = ev;
     Eigen::JacobiSVD<MatX> svd(Jm, Eigen::ComputeFullV);
@@ -250,22 +275,72 @@ void FixedPointSearch::search_cell(int i, int j, int k) {
     const Vec3 q = f.q_of(z);
 
     bool is_line = false;
-    if (s[dim - 1] < opt.null_ratio * s[0]) is_line = follow_line(z, Jm, ev, ev3, svd.matrixV().col(dim - 1), q);
+    if (s[dim - 1] < opt.null_ratio * s[0]) is_line = follow_line(z, Jm, ev, ev3, err, svd.matrixV().col(dim - 1), q);
     if (!is_line) {
         FixedPoint fp;
         fp.q = q;
         fp.q[2] = dim == 3 ? wrap_angle(q[2]) : 0;
         fp.eigenvalues = ev3;
-        fp.stability = classify(ev, -1);
+        fp.eigen_error = err;
+        fp.stability = classify_eigenvalues(ev, err);
         fp.residual = f.F(z).norm();
         out.points.push_back(fp);
     }
+    if (from_near_zero) ++out.coarse_zeros;
+}
+
+// Do the cell's corners resolve the field inside it: is the field at its centre within the corners'
+// spread of their mean (the trilinear interpolant there), in every component?
+bool FixedPointSearch::resolved(int i, int j, int k, const VecX& centre) const {
+    const int corners = dim == 3 ? 8 : 4;
+    MatX v(dim, corners);
+    for (int c = 0; c < corners; ++c) {
+        const int at = corner(i, j, k, c);
+        v.col(c) = f.z_of(field.points[at].twist);   // (v_x, v_y, rho omega)
+    }
+    for (int c = 0; c < dim; ++c) {
+        const double spread = v.row(c).maxCoeff() - v.row(c).minCoeff();
+        if (std::abs(centre[c] - v.row(c).mean()) > std::max(spread, ftol)) return false;
+    }
+    return true;
+}
+
+// Does every component change sign among the cell's corners and the field at its centre qc?
+bool FixedPointSearch::refined_candidate(int i, int j, int k, const Vec3& qc) {
+    VecX fc;
+    try {
+        f.warm.setZero();
+        fc = f.F(f.z_of(qc));
+    } catch (const FieldUndefined&) {
+        return false;
+    }
+    for (int c = 0; c < dim; ++c) {
+        double lo = fc[c], hi = fc[c];
+        for (int n = 0; n < (dim == 3 ? 8 : 4); ++n) {
+            const int at = corner(i, j, k, n);
+            const double v = f.z_of(field.points[at].twist)[c];
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+        if (lo > ftol || hi < -ftol) return false;
+    }
+    return true;
+}
+
+// Does the grid cell holding q have a corner in a stuck region?
+bool FixedPointSearch::in_region(const Vec3& q) const {
+    const int i = std::clamp(static_cast<int>(std::floor((q[0] - g.x0) / g.dx())), 0, g.nx - 2);
+    const int j = std::clamp(static_cast<int>(std::floor((q[1] - g.y0) / g.dy())), 0, g.ny - 2);
+    const int k = dim == 3 ? static_cast<int>(std::floor(wrap_angle(q[2] - g.th0) / g.dth() + g.nth)) % g.nth : 0;
+    for (int c = 0; c < (dim == 3 ? 8 : 4); ++c)
+        if (region[corner(i, j, k, c)] >= 0) return true;
+    return false;
 }
 
 // Follows the null direction v of the zero z (at q; Jm its Jacobian, ev its eigenvalues) both ways;
 // kept as a line if it goes on for at least two points.
 bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::VectorXcd& ev, const Eigen::Vector3cd& ev3,
-                                   const VecX& v, const Vec3& q) {
+                                   double err, const VecX& v, const Vec3& q) {
     FixedLine line;
     std::vector<Vec3> fwd, bwd;
     for (int sgn : {1, -1}) {
@@ -296,7 +371,8 @@ bool FixedPointSearch::follow_line(const VecX& z, const MatX& Jm, const Eigen::V
     line.eigenvalues = ev3;
     int skip = 0;
     ev.cwiseAbs().minCoeff(&skip);
-    line.stability = classify(ev, skip);
+    line.stability = classify_eigenvalues(ev, err, skip);
+    line.eigen_error = err;
     for (std::size_t m = 1; m < line.points.size(); ++m) line.length += dist(f.z_of(line.points[m]), f.z_of(line.points[m - 1]));
     out.lines.push_back(line);
     return true;
@@ -311,6 +387,7 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
     const int dim = run.dim;
     const int nk = dim == 3 ? g.nth : 1;
     run.f.budget = opt.max_rhs_evaluations;
+    std::size_t next_near = 0;
     try {
         for (int i = 0; i + 1 < g.nx; ++i)
             for (int j = 0; j + 1 < g.ny; ++j)
@@ -318,15 +395,57 @@ FixedPoints find_fixed_points(const Scene& sc, const Field& field, const FixedPo
                     if (dim == 3 && g.nth < 2) break;
                     if (run.candidate(i, j, k)) run.search_cell(i, j, k);
                 }
+        // Then the cells the corners' signs cannot decide, nearest to a sign change first, unless a zero
+        // found lies next to them; at most kMaxNearZero.
+        run.from_near_zero = true;
+        std::stable_sort(run.near_zero.begin(), run.near_zero.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (; next_near < run.near_zero.size(); ++next_near) {
+            const auto& c = run.near_zero[next_near].second;
+            if (run.in_cell(g.at(c[0], c[1], c[2]) + 0.5 * Vec3(g.dx(), g.dy(), g.dth()), 1.0)) continue;
+            // Refined once: the field at the centre with the corners; searched when every component
+            // changes sign among those nine (or five) values.
+            const Vec3 qc = g.at(c[0], c[1], c[2]) + 0.5 * Vec3(g.dx(), g.dy(), g.dth());
+            if (!run.refined_candidate(c[0], c[1], c[2], qc)) continue;
+            if (run.out.near_zero_cells == kMaxNearZero) {
+                ++run.out.near_zero_unsearched;
+                continue;
+            }
+            ++run.out.near_zero_cells;
+            run.search_cell(c[0], c[1], c[2]);
+        }
     } catch (const BudgetSpent&) {
-        // The budget is spent: the cell in progress and every later one are counted as not searched.
-        const int total = (g.nx - 1) * (g.ny - 1) * (dim == 3 && g.nth >= 2 ? nk : dim == 3 ? 0 : 1);
-        run.out.unsearched_cells = total - run.out.cells + 1;
-        run.out.cells = total;
+        if (run.from_near_zero) {
+            run.out.near_zero_unsearched += static_cast<int>(run.near_zero.size() - next_near);
+        } else {
+            // The budget is spent: the cell in progress and every later one are counted as not searched.
+            const int total = (g.nx - 1) * (g.ny - 1) * (dim == 3 && g.nth >= 2 ? nk : dim == 3 ? 0 : 1);
+            run.out.unsearched_cells = total - run.out.cells + 1;
+            run.out.cells = total;
+        }
     }
+    if (run.out.coarse_zeros > 0 || run.out.near_zero_unsearched > 0 || run.out.unresolved_cells > 0)
+        run.out.suggested_grid = 2 * (std::max(g.nx, g.ny) - 1) + 1;
     run.out.evaluations = run.f.evals;
     run.out.rhs_evaluations = run.f.rhs_evals;
+    find_rotating_attractors(sc, field, opt, run.cycle, run.out);
     return run.out;
+}
+
+// Real parts within 3 x error of zero are zero as far as the Jacobian can tell; all of them so, with
+// a complex pair beyond it, make a centre.
+Stability classify_eigenvalues(const Eigen::VectorXcd& ev, double error, int skip) {
+    const double thr = 3 * error;
+    bool neg = true, pos = true, undecided = true, turning = false;
+    for (int i = 0; i < ev.size(); ++i) {
+        if (i == skip) continue;
+        neg = neg && ev[i].real() < 0;
+        pos = pos && ev[i].real() > 0;
+        undecided = undecided && std::abs(ev[i].real()) <= thr;
+        turning = turning || std::abs(ev[i].imag()) > thr;
+    }
+    if (undecided && turning) return Stability::Centre;
+    return neg ? Stability::Stable : pos ? Stability::Unstable : Stability::Saddle;
 }
 
 std::string fixed_points_sentence(const FixedPoints& fp) {
@@ -347,10 +466,27 @@ std::string fixed_points_sentence(const FixedPoints& fp) {
     if (fp.unsearched_cells > 0)
         s += " (the search stopped at its work budget, FixedPointOptions::max_rhs_evaluations: " +
              std::to_string(fp.unsearched_cells) + " of " + std::to_string(fp.cells) + " cells not searched)";
-    if (fp.stuck_cells > 0)
-        s += "; " + std::to_string(fp.stuck_cells) + " of " + std::to_string(fp.cells) +
-             " cells touch configurations where the part is stuck all period (it rides the plate: every such "
-             "configuration is fixed, a region rather than points)";
+    for (const StuckRegion& r : fp.stuck_regions) {
+        s += "; a region where the part sticks (" + stuck_region_words(r, fp.point_part) + ")";
+    }
+    if (!fp.stuck_regions.empty())
+        s += " (every configuration in it is fixed: a region rather than points; " + std::to_string(fp.stuck_cells) + " of " +
+             std::to_string(fp.cells) + " cells touch it and were not refined)";
+    for (const RotatingAttractor& r : fp.rotating) s += "; " + rotating_attractor_words(r);
+    if (fp.suggested_grid > 0) {
+        s += "; the grid may be too coarse: ";
+        if (fp.coarse_zeros > 0)
+            s += count(fp.coarse_zeros, "zero was", "zeros were") + " found only in cells without a sign change at their corners";
+        std::string sep = fp.coarse_zeros > 0 ? ", " : "";
+        if (fp.near_zero_unsearched > 0) {
+            s += sep + count(fp.near_zero_unsearched, "cell", "cells") + " with a near-zero field were not searched";
+            sep = ", ";
+        }
+        if (fp.unresolved_cells > 0)
+            s += sep + "at " + count(fp.unresolved_cells, "cell", "cells") +
+                 " the field at the centre is not what the corners say";
+        s += "; try --grid " + std::to_string(fp.suggested_grid);
+    }
     return s;
 }
 

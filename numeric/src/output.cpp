@@ -132,6 +132,7 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
         pts.push_back({{"at", vec(p.q, d)},
                        {"stability", stability_name(p.stability)},
                        {"eigenvalues", eig(p.eigenvalues, d)},
+                       {"eigen_error", num(p.eigen_error)},
                        {"residual", num(p.residual)}});
     json lines = json::array();
     for (const auto& l : fp.lines) {
@@ -143,15 +144,52 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
                          {"to", vec(l.points.back(), d)},
                          {"length", num(l.length)},
                          {"eigenvalues", eig(l.eigenvalues, d)},
+                         {"eigen_error", num(l.eigen_error)},
                          {"points", ps}});
     }
+    json regions = json::array();
+    for (const auto& r : fp.stuck_regions) {
+        json one = {{"x", {num(r.lo[0]), num(r.hi[0])}},
+                    {"y", {num(r.lo[1]), num(r.hi[1])}},
+                    {"grid_points", r.grid_points},
+                    {"touches_edge", r.touches_edge}};
+        if (d == 3) {
+            one["theta"] = {num(r.lo[2]), num(r.hi[2])};
+            one["all_theta"] = r.all_theta;
+        }
+        regions.push_back(one);
+    }
+    json rotating = json::array();
+    for (const auto& r : fp.rotating)
+        rotating.push_back({{"at", vec(r.q, 2)},
+                            {"theta_section", num(r.q[2])},
+                            {"rate", num(r.rate)},
+                            {"period", num(r.period)},
+                            {"stability", stability_name(r.stability)},
+                            {"multipliers", eig(Eigen::Vector3cd(r.multipliers[0], r.multipliers[1], 0), 2)},
+                            {"residual", num(r.residual)},
+                            {"wobble", num(r.wobble)}});
     j["points"] = pts;
     j["lines"] = lines;
     j["candidate_cells"] = fp.candidates;
     j["cells"] = fp.cells;
     j["undefined_cells"] = fp.undefined_cells;     // skipped: a corner has no cycle
     j["unsearched_cells"] = fp.unsearched_cells;   // left when the evaluation budget was spent
-    j["stuck_cells"] = fp.stuck_cells;             // skipped: a corner is stuck all period (fixed region)
+    j["stuck_cells"] = fp.stuck_cells;             // skipped: a corner is in a stuck region
+    j["stuck_regions"] = regions;
+    j["rotating_attractors"] = rotating;
+    j["near_zero_cells"] = fp.near_zero_cells;   // no sign change at the corners, field near zero: searched
+    j["near_zero_unsearched"] = fp.near_zero_unsearched;
+    j["coarse_zeros"] = fp.coarse_zeros;           // zeros found only from such cells
+    j["unresolved_cells"] = fp.unresolved_cells;   // candidates whose centre their corners do not predict
+    j["grid_too_coarse"] = fp.suggested_grid > 0;
+    if (fp.suggested_grid > 0) j["suggested_grid"] = fp.suggested_grid;
+    j["units"] = {{"at", d == 3 ? "m, m, rad" : "m, m"},
+                  {"eigenvalues", "1/s"},
+                  {"eigen_error", "1/s"},
+                  {"residual", "m/s (angular times rho)"},
+                  {"stuck_regions", "x, y: m; theta: rad"},
+                  {"rotating_attractors", "at: m; theta_section: rad; rate: rad/s; period: s; residual, wobble: m"}};
     j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
     j["rhs_evaluations"] = fp.rhs_evaluations;

@@ -129,10 +129,18 @@ void classify(const Scene& sc, const Vec3& target, const RobustnessOptions& opt,
             ++r.attractors;
             if (other.empty()) other = "a stable line of fixed points";
         }
-    if (fps.stuck_cells > 0) {
+    for (std::size_t k = 0; k < fps.stuck_regions.size(); ++k) {
         ++r.attractors;
-        if (other.empty()) other = std::to_string(fps.stuck_cells) + " cells where the part is stuck all period";
+        if (other.empty())
+            other = "a region where the part sticks (x in [" + std::to_string(fps.stuck_regions[k].lo[0]) + ", " +
+                    std::to_string(fps.stuck_regions[k].hi[0]) + "] m, y in [" + std::to_string(fps.stuck_regions[k].lo[1]) +
+                    ", " + std::to_string(fps.stuck_regions[k].hi[1]) + "] m)";
     }
+    for (const RotatingAttractor& ra : fps.rotating)
+        if (ra.stability == Stability::Stable) {
+            ++r.attractors;
+            if (other.empty()) other = "a rotating attractor";
+        }
     if (!r.matched) {
         r.outcome = Outcome::none;
         r.note = other.empty() ? "no stable fixed point" : "no stable fixed point at the target; " + other;

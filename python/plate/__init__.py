@@ -30,7 +30,7 @@ import json as _json
 from typing import Any, Dict
 
 from ._plate import (Camera, ControlEnv, ControlRun, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
-                     Progress, Robustness, Scene, Stop, Track, Trajectory, axis_peaks, check_track_scene, coning_rate, control, design, field,
+                     Progress, Robustness, RotatingAttractor, Scene, Stop, StuckRegion, Track, Trajectory, axis_peaks, check_track_scene, coning_rate, control, design, field,
                      fixed_points, frame_stamps, identify, load_camera, load_scene, observe, observe_at,
                      orientation_harmonics, parse_camera, parse_scene, proofs, random_scene, read_track_csv, robustness, scene_id,
                      simulate, sweep, twist, uncertain_parameters, write_track_csv)
@@ -38,7 +38,7 @@ from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
 __all__ = ["Camera", "ControlEnv", "ControlRun", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "Identification", "InputError",
-           "Progress", "Robustness", "Scene", "Stop", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "control", "design",
+           "Progress", "Robustness", "RotatingAttractor", "Scene", "Stop", "StuckRegion", "Track", "Trajectory", "axis_peaks", "check_track_scene", "coning_rate", "control", "design",
            "field", "fixed_points", "frame_stamps", "identify", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
            "parse_camera", "parse_scene", "proofs", "random_scene", "read_track_csv", "robustness", "scene_from_dict", "scene_id",
            "scene_to_dict", "simulate", "sweep", "twist", "uncertain_parameters", "write_track_csv"]

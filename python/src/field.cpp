@@ -193,9 +193,32 @@ void bind_fixed_points(py::module_& m) {
         .def_readonly("eigenvalues", &FixedPoint::eigenvalues, "of the field's Jacobian (point part: the first 2)")
         .def_property_readonly("stability", [](const FixedPoint& p) { return stability_name(p.stability); })
         .def_readonly("residual", &FixedPoint::residual)
+        .def_readonly("eigen_error", &FixedPoint::eigen_error, "estimated error of the eigenvalues' real parts [1/s]")
         .def("__repr__", [](const FixedPoint& p) {
             return "<plate.FixedPoint " + std::string(stability_name(p.stability)) + " at (" + std::to_string(p.q[0]) + ", " +
                    std::to_string(p.q[1]) + ", " + std::to_string(p.q[2]) + ")>";
+        });
+    py::class_<StuckRegion>(m, "StuckRegion", "configurations where the part does not move, connected on the grid")
+        .def_readonly("lo", &StuckRegion::lo, "lower bounds of (s_x, s_y, theta) [m, m, rad]")
+        .def_readonly("hi", &StuckRegion::hi, "upper bounds (theta from lo up to hi, possibly beyond pi)")
+        .def_readonly("all_theta", &StuckRegion::all_theta)
+        .def_readonly("grid_points", &StuckRegion::grid_points)
+        .def_readonly("touches_edge", &StuckRegion::touches_edge)
+        .def("__repr__", [](const StuckRegion& r) {
+            return "<plate.StuckRegion x in [" + num(r.lo[0]) + ", " + num(r.hi[0]) + "] m, y in [" + num(r.lo[1]) + ", " +
+                   num(r.hi[1]) + "] m, " + std::to_string(r.grid_points) + " grid points>";
+        });
+    py::class_<RotatingAttractor>(m, "RotatingAttractor", "position settled while theta turns at a steady mean rate")
+        .def_readonly("q", &RotatingAttractor::q, "(s_x, s_y) [m] on the section theta = q[2] [rad]")
+        .def_readonly("rate", &RotatingAttractor::rate, "mean dtheta/dt [rad/s]; +: counter-clockwise")
+        .def_readonly("period", &RotatingAttractor::period, "time for one turn [s]")
+        .def_readonly("multipliers", &RotatingAttractor::multipliers, "of the return map on the section")
+        .def_property_readonly("stability", [](const RotatingAttractor& r) { return stability_name(r.stability); })
+        .def_readonly("residual", &RotatingAttractor::residual, "|return(q) - q| [m]")
+        .def_readonly("wobble", &RotatingAttractor::wobble, "largest distance from q along the orbit [m]")
+        .def("__repr__", [](const RotatingAttractor& r) {
+            return "<plate.RotatingAttractor " + std::string(stability_name(r.stability)) + " at (" + num(r.q[0]) + ", " +
+                   num(r.q[1]) + ") m, " + num(r.rate) + " rad/s>";
         });
     py::class_<FixedLine>(m, "FixedLine")
         .def_property_readonly("points", [](const FixedLine& l) { return l.points; })
@@ -203,6 +226,7 @@ void bind_fixed_points(py::module_& m) {
         .def_property_readonly("stability", [](const FixedLine& l) { return stability_name(l.stability); })
         .def_readonly("eigenvalues", &FixedLine::eigenvalues)
         .def_readonly("length", &FixedLine::length)
+        .def_readonly("eigen_error", &FixedLine::eigen_error)
         .def("__repr__", [](const FixedLine& l) {
             return "<plate.FixedLine " + std::string(stability_name(l.stability)) + ", " + std::to_string(l.points.size()) +
                    " points, length " + num(l.length) + " m>";
@@ -213,6 +237,11 @@ void bind_fixed_points(py::module_& m) {
         .def_property_readonly("sentence", [](const PyFixedPoints& f) { return fixed_points_sentence(f.fp); })
         .def_property_readonly("undefined_cells", [](const PyFixedPoints& f) { return f.fp.undefined_cells; })
         .def_property_readonly("stuck_cells", [](const PyFixedPoints& f) { return f.fp.stuck_cells; })
+        .def_property_readonly("stuck_regions", [](const PyFixedPoints& f) { return f.fp.stuck_regions; })
+        .def_property_readonly("rotating", [](const PyFixedPoints& f) { return f.fp.rotating; })
+        .def_property_readonly(
+            "grid_too_coarse", [](const PyFixedPoints& f) { return f.fp.suggested_grid > 0; },
+            "zeros found only where the corners' signs did not change, or near-zero cells left unsearched")
         .def_property_readonly(
             "summary", [](const PyFixedPoints& f) { return json_to_python(to_json(f.scene, f.fp)); },
             "the command line's JSON (`plate fixed-points`) as a dict")

@@ -344,6 +344,23 @@ def test_a_scene_reads_like_its_file_compares_by_content_pickles_and_copies():
     assert s.friction == {"kinetic": [0.3], "static": [0.4]}
 
 
+def test_fixed_points_name_stuck_regions_and_rotating_orbits():
+    """A disk where the point part sticks is a region with its extent (it was 4 points and 2 lines), and a
+    symmetric part spun by heave and yaw turns at the field's omega on the axis (issue 54)."""
+    s = plate.load_scene(scene_path("heave_yaw_point"))
+    fp = plate.fixed_points(plate.field(s))
+    assert not fp.points and not fp.lines and not fp.grid_too_coarse
+    (r,) = fp.stuck_regions
+    assert abs(r.lo[0] + r.hi[0]) < 1e-12 and r.grid_points == 25 and not r.touches_edge
+    assert repr(r).startswith("<plate.StuckRegion x in [")
+    spin = plate.load_scene(os.path.join(SOURCE, "tests", "data", "fixed_points", "spin_symmetric.json"))
+    fs = plate.fixed_points(plate.field(spin))
+    (o,) = fs.rotating
+    assert abs(o.rate + 0.2197870) < 1e-5 and o.stability == "unstable"
+    assert repr(o).startswith("<plate.RotatingAttractor unstable at (")
+    assert fs.summary["rotating_attractors"][0]["rate"] == o.rate
+
+
 def test_every_result_says_what_it_is_when_printed():
     """No '<... object at 0x...>': each result's repr names its kind and its figures (seen failing before
     the reprs: Field, FixedPoints, FixedLine, Trajectory, Camera, Design and Robustness printed addresses)."""

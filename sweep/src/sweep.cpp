@@ -108,7 +108,7 @@ Row run_case(const Campaign& c, int index) {
                 fpo.cycle = c.cycle;
                 const FixedPoints fp = find_fixed_points(sc, f, fpo);
                 work += fp.rhs_evaluations;
-                int count[3] = {0, 0, 0};
+                int count[4] = {0, 0, 0, 0};
                 for (const FixedPoint& p : fp.points) ++count[static_cast<int>(p.stability)];
                 row["fp_stable"] = count[static_cast<int>(Stability::Stable)];
                 row["fp_saddle"] = count[static_cast<int>(Stability::Saddle)];

@@ -102,14 +102,21 @@ Vec3 field_at(const Scene& scene, const Vec3& q, const LimitCycleOptions& opt, V
               long* rhs_evals = nullptr);   // adds the work spent (right-hand sides) to *rhs_evals
 
 // --- fixed points ------------------------------------------------------------------------
-enum class Stability { Stable, Unstable, Saddle };
+// Centre: the Jacobian's eigenvalues are a complex pair whose real parts are zero within the finite-
+// difference Jacobian's own error (the linearisation cannot decide; the orbits around it are closed
+// to first order).
+enum class Stability { Stable, Unstable, Saddle, Centre };
 const char* stability_name(Stability s);
+// The stability the eigenvalues ev of a Jacobian say, their real parts taken as zero within
+// 3 x `error` (the Jacobian's own error, estimated); `skip`: an eigenvalue left out (along a line).
+Stability classify_eigenvalues(const Eigen::VectorXcd& ev, double error, int skip = -1);
 
 struct FixedPoint {
     Vec3 q = Vec3::Zero();                                     // theta in (-pi, pi]
     Eigen::Vector3cd eigenvalues = Eigen::Vector3cd::Zero();   // of the field's Jacobian (point part: 2 used)
     Stability stability = Stability::Saddle;
-    double residual = 0;   // |xi_a(q)| [m/s, angular times rho]
+    double residual = 0;      // |xi_a(q)| [m/s, angular times rho]
+    double eigen_error = 0;   // estimated error of the eigenvalues' real parts [1/s] (two difference steps)
 };
 
 // A curve of fixed points (Fig. 1): sampled points, its direction, and the stability given by
@@ -120,6 +127,30 @@ struct FixedLine {
     Stability stability = Stability::Saddle;
     Eigen::Vector3cd eigenvalues = Eigen::Vector3cd::Zero();   // at the first point; the one nearest 0 is along the line
     double length = 0;                                         // in (s_x, s_y, rho theta) [m]
+    double eigen_error = 0;                                    // as FixedPoint::eigen_error [1/s]
+};
+
+// A connected set of grid configurations where the part is stuck all period (twist exactly 0, every
+// contact held the whole cycle): every configuration in it is fixed, so it is a region, not points.
+// Its extent is that of its grid points (the region's true edge lies within a cell of it).
+struct StuckRegion {
+    Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();   // bounds of s_x, s_y [m] and theta [rad]; theta from lo
+                                                 // to hi going up, hi possibly beyond pi (wraps)
+    bool all_theta = false;                      // every theta of the grid (rigid parts)
+    int grid_points = 0;
+    bool touches_edge = false;   // reaches the grid's s_x or s_y edge: it may extend beyond the grid
+};
+
+// A periodic orbit of the field that turns once in theta while the position returns: the part's
+// position settles at `q` (s_x, s_y) while theta turns at a steady mean `rate` (rigid parts).
+struct RotatingAttractor {
+    Vec3 q = Vec3::Zero();   // (s_x, s_y) on the section theta = q[2]
+    double rate = 0;         // mean dtheta/dt over the orbit [rad/s]; sign: direction (+: counter-clockwise)
+    double period = 0;       // time for one turn [s]
+    Eigen::Vector2cd multipliers = Eigen::Vector2cd::Zero();   // of the return map's Jacobian on the section
+    Stability stability = Stability::Saddle;                   // |multipliers| < 1: Stable
+    double residual = 0;                                       // |return(q) - q| [m]
+    double wobble = 0;                                         // largest distance from q along the orbit [m]
 };
 
 struct FixedPointOptions {
@@ -136,10 +167,14 @@ struct FixedPointOptions {
     // are counted and the summary says so. (The scale: docs/decisions.md, Fixed-point refinement at a
     // tighter tolerance than the field.)
     long max_rhs_evaluations = 20'000'000;
+    // Rotating attractors: searched from the grid's (s_x, s_y) columns where omega keeps one sign over
+    // every theta, at most this many Newton starts on the return map (0: not searched).
+    int max_orbit_starts = 4;
     const StopRequest* stop = nullptr;   // as FieldOptions::stop
 };
 
 struct FixedPoints {
+    bool point_part = false;
     std::vector<FixedPoint> points;
     std::vector<FixedLine> lines;
     int candidates = 0;         // grid cells where every component changes sign
@@ -150,6 +185,23 @@ struct FixedPoints {
                                 // every configuration there is fixed; a region, not points to refine)
     long evaluations = 0;       // field evaluations spent refining
     long rhs_evaluations = 0;   // their cycles' right-hand-side evaluations
+    std::vector<StuckRegion> stuck_regions;
+    std::vector<RotatingAttractor> rotating;
+    // Cells without a sign change at their corners whose field is nevertheless near zero (each
+    // component's zero, extrapolated linearly, within half a cell of the cell) and not next to a zero
+    // found: the corners cannot say whether they hold a zero. Each is refined once, by the field at its
+    // centre; where every component then changes sign it is searched by Newton (near_zero_cells, at most
+    // 16; beyond, or when the budget is spent: near_zero_unsearched). `coarse_zeros` counts the zeros
+    // found only so (the grid missed them). Any of these counts but near_zero_cells, or
+    // unresolved_cells, makes the sentence warn that the grid may be too coarse.
+    int near_zero_cells = 0;
+    int near_zero_unsearched = 0;
+    int coarse_zeros = 0;
+    // Candidate cells whose field at the centre is farther from its corners' mean (the interpolant
+    // there) than the corners' whole spread, in some component: the corners do not resolve the field
+    // between them (fig1 on 4 points: omega is zero at every theta of the grid and largest between).
+    int unresolved_cells = 0;
+    int suggested_grid = 0;   // a finer grid to try when warning (0: no warning)
 };
 
 // Zeros of the field: candidate cells of `field` (every component changes sign), refined by
@@ -161,6 +213,8 @@ FixedPoints find_fixed_points(const Scene& scene, const Field& field, const Fixe
 // point", each followed, when some cells had an undefined corner, by "in the defined part (k of n
 // cells undefined)", and by the cells where the part is stuck all period.
 std::string fixed_points_sentence(const FixedPoints& fp);
+// "a stable rotating attractor at (x, y) m turning at r rad/s (one turn in T s)".
+std::string rotating_attractor_words(const RotatingAttractor& r);
 
 // --- integral curves -----------------------------------------------------------------------
 // q' = xi_a(q) from q0 (classical RK4, step h), sampled every sample_dt. Stops where the field
