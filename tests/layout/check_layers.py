@@ -50,8 +50,9 @@ NUMERIC_LEVELS = [
                 "include/plate/simulate.hpp"]),   # the options, stops and samples the engine fills
     ("simulate/limit_cycle", ["src/simulate.cpp", "include/plate/limit_cycle.hpp", "src/limit_cycle.cpp",
                               "src/cycle_solvers.hpp", "src/shooting_cycle.cpp"]),
-    ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp",
-                            "include/plate/output.hpp", "src/output.cpp"]),
+    ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp", "src/fixed_regions.hpp",
+                            "src/fixed_regions.cpp", "src/rotating_attractors.cpp", "include/plate/output.hpp",
+                            "src/output.cpp"]),
     ("observe", ["include/plate/observe.hpp", "src/observe.cpp",   # cameras filming simulations
                  "src/track_io.cpp"]),                             # and the track file
     ("robustness", ["include/plate/robustness.hpp", "src/robustness.cpp", "src/robustness_sensitivity.cpp",
