@@ -1,5 +1,7 @@
 #include "theorem1.hpp"
 
+#include "plate/progress.hpp"
+
 #include "plate/dynamics.hpp"
 #include "plate/random_scene.hpp"
 
@@ -8,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <exception>
 #include <chrono>
 #include <limits>
 #include <mutex>
@@ -294,14 +297,25 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
     std::vector<ContractionCase> cases(opt.cases);
     std::atomic<int> next{0}, done{0};
     std::mutex progress_mutex;
+    // Every worker polls the caller's stop request (progress.hpp); the first exception (Interrupted)
+    // stops the others taking cases and is rethrown once all have joined.
+    const StopRequest* const stop = current_stop_request();
+    std::exception_ptr failure;
     auto worker = [&] {
-        for (int k; (k = next.fetch_add(1)) < opt.cases;) {
-            cases[k] = contraction_random_case(opt, k);
-            const int d = ++done;
-            if (opt.progress) {
-                std::lock_guard<std::mutex> lock(progress_mutex);
-                opt.progress(d, opt.cases);
+        const StopScope scope(stop);
+        try {
+            for (int k; (k = next.fetch_add(1)) < opt.cases;) {
+                cases[k] = contraction_random_case(opt, k);
+                const int d = ++done;
+                if (opt.progress) {
+                    std::lock_guard<std::mutex> lock(progress_mutex);
+                    opt.progress(d, opt.cases);
+                }
             }
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            if (!failure) failure = std::current_exception();
+            next = opt.cases;
         }
     };
     int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency());
@@ -310,6 +324,7 @@ ContractionSummary check_contraction(const ContractionOptions& opt) {
     for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
     worker();
     for (auto& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
     return summarize_contraction(opt, std::move(cases),
                                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }

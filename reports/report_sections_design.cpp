@@ -38,7 +38,7 @@ std::string held_cell(Ctx& c, const std::string& target, double walked, double a
     const std::string v = fmt(1e3 * walked, 3);
     return "<td>" +
            c.verdict("released at rest on " + target + ", it stays within " + fmt(1e3 * allowed, 3) + " mm", !(walked > allowed),
-                     v, v) +
+                     v + " mm", v + " mm") +
            from + (stop.empty() ? "" : " (" + esc(stop) + ")") + "</td></tr>\n";
 }
 
@@ -74,7 +74,7 @@ void section_design(Ctx& c, const fs::path& src, const ReportOptions& opt) {
               "held; the part may turn on at the sink).</p>\n"
               "<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
               "<th>cycles</th><th>peaks over the period</th><th>worst end distance [mm]</th><th>seconds</th>"
-              "<th>coning [rad/s]</th><th>from the target, after the hold [mm]</th></tr>\n";
+              "<th>coning [rad/s]</th><th>from the target, after the hold</th></tr>\n";
     DesignSummary first;
     Vec2 first_at = Vec2::Zero();
     const Vec2 targets[] = {{0.02, -0.01}, {-0.025, 0.015}};
@@ -295,7 +295,7 @@ void section_fixed_point(Ctx& c, const fs::path& src, const ReportOptions& opt) 
     c.html << "</ul>\n<table><tr><th>target</th><th>verified</th><th>unique</th><th>rate [1/s]</th><th>evaluations</th>"
               "<th>cycles</th><th>peaks over the period</th><th>target's share of the runs</th><th>other stable fixed points "
               "(share)</th><th>seconds</th>"
-              "<th>from the target, after the hold [mm]</th></tr>\n"
+              "<th>from the target, after the hold</th></tr>\n"
            << design_cells(c, name, d) << "<td>" << fmt(d.basin_share, 3) << "</td><td>";
     for (const DesignSummary::Competitor& k : d.competitors)
         c.html << "(" << fmt(k.point.q[0], 4) << ", " << fmt(k.point.q[1], 4) << ", " << fmt(k.point.q[2], 4)

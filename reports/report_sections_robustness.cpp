@@ -135,8 +135,9 @@ void scatter_figures(Ctx& c, const std::string& n, const RobustnessSummary& s, c
     }
     const std::string marks = std::to_string(over) + " draws more than 30 % off their linear prediction (×)";
     c.html << "<p>" << marks << "; the robustness summary counts "
-           << c.verdict(n + ": the summary counts the draws off their linear prediction", over == s.nonlinear_draws, "the same",
-                        "FAIL: " + std::to_string(s.nonlinear_draws))
+           << c.verdict("scenes/designs/" + n.substr(std::string("robustness_").size()) +
+                            ".json: the summary counts the draws off their linear prediction",
+                        over == s.nonlinear_draws, "the same", "FAIL: " + std::to_string(s.nonlinear_draws))
            << ".</p>\n";
     const std::string common = "set key outside right\nset grid\n";
     const std::string pts = "'data/" + n + "_scatter_linear.dat' u %X:%Y w p pt 7 ps 0.6 lc rgb '#3050c0' t 'draw', 'data/" + n +

@@ -2,6 +2,7 @@
 // random scene (plate random-scene), a campaign (plate sweep) and Theorem 1's checks (plate proofs),
 // each with the command's options and its JSON.
 #include "bindings.hpp"
+#include "interrupt.hpp"
 
 #include "plate/random_scene.hpp"
 #include "plate/farm.hpp"
@@ -35,12 +36,10 @@ void bind_commands(py::module_& m) {
             require(threads >= 0, "threads: expected >= 0 (0: all cores)");
             sweep::SweepOptions o;
             o.out = out.string();
-            sweep::SweepSummary s;
-            {
-                py::gil_scoped_release free;
+            const sweep::SweepSummary s = interruptible(py::none(), [&](Watch&) {
                 const std::unique_ptr<sweep::Farm> farm = sweep::thread_farm(threads);
-                s = sweep::run_sweep(campaign.string(), o, *farm);
-            }
+                return sweep::run_sweep(campaign.string(), o, *farm);
+            });
             return json_to_python(sweep::sweep_summary_json(campaign.string(), out.string(), s));
         },
         py::arg("campaign"), py::arg("out"), py::kw_only(), py::arg("threads") = 0,
@@ -64,13 +63,11 @@ void bind_commands(py::module_& m) {
             } catch (const std::invalid_argument& e) {
                 require(false, std::string("wrong_model: ") + e.what());
             }
-            nlohmann::json j;
-            {
-                py::gil_scoped_release free;
+            const nlohmann::json j = interruptible(py::none(), [&](Watch&) {
                 nlohmann::json a = proofs::contraction_json(proofs::check_contraction(proofs::contraction_options(o, true)));
                 nlohmann::json b = proofs::contraction_json(proofs::check_contraction(proofs::contraction_options(o, false)));
-                j = proofs::proofs_json(o, std::move(a), std::move(b));
-            }
+                return proofs::proofs_json(o, std::move(a), std::move(b));
+            });
             return json_to_python(j);
         },
         py::kw_only(), py::arg("thin") = 10000, py::arg("thick") = 1000, py::arg("surfaces") = 200, py::arg("seed") = 1,

@@ -94,3 +94,23 @@ def test_a_field_over_the_command_lines_default_budget_is_refused_up_front_as_th
         cli = subprocess.run([EXE, "field", scene_path("fig6"), "--grid", "100"], capture_output=True, text=True)
         assert cli.returncode == 2 and "raise it with --max-work" in cli.stderr
         assert refusal_figures(cli.stderr) == refusal_figures(str(e.value))
+
+
+def test_ctrl_c_stops_proofs_and_a_campaign_and_the_campaign_resumes(tmp_path):
+    # Both share their cases over threads of their own (the proofs' pool, the campaign's farm): every
+    # thread polls the request, the first Interrupted stops the others and is raised once all joined.
+    # Measured here: proofs 0.02-0.05 s, campaign 0.03-0.1 s after the signal.
+    assert latency_of_ctrl_c(lambda: plate.proofs(thin=100000, thick=0, surfaces=0, threads=2)) < 0.5
+    import json
+    base = json.load(open(os.path.join(SOURCE, "campaigns", "heave_yaw_stick_slip.json")))
+    base["scene"] = scene_path("heave_yaw")
+    base["parameters"] = [{"name": "rz_amp", "pointer": "/plate/harmonics/1/amp", "from": 10, "to": 80, "count": 400}]
+    base["compute"] = {"twist_at": [[0.02, 0, 0]], "field": base["compute"]["field"]}
+    campaign = tmp_path / "c.json"
+    campaign.write_text(json.dumps(base))
+    out = tmp_path / "out"
+    assert latency_of_ctrl_c(lambda: plate.sweep(campaign, out, threads=2)) < 0.5
+    # No table after an interrupted run; the journal keeps the cases that finished, none failed by it.
+    assert not (out / "table.csv").exists()
+    journal = (out / "journal.jsonl").read_text().splitlines()[1:]
+    assert all(json.loads(line)["row"]["status"] != "failed" for line in journal)

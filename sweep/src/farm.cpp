@@ -1,6 +1,8 @@
 // The thread farm, and what the program needs to know about MPI whether or not it was built with it.
 #include "plate/farm.hpp"
 
+#include "plate/progress.hpp"
+
 #include <atomic>
 #include <cstdlib>
 #include <exception>
@@ -24,10 +26,22 @@ public:
              const std::function<void(int, const std::string&)>& done) override {
         std::atomic<std::size_t> next{0};
         std::mutex m;
-        std::exception_ptr failure;   // the first done() that threw (a journal that cannot be written)
+        // The first exception: a done() that threw (a journal that cannot be written) or a work() asked
+        // to stop (Interrupted: every thread polls the caller's stop request, progress.hpp).
+        std::exception_ptr failure;
+        const StopRequest* const stop = current_stop_request();
         auto worker = [&] {
+            const StopScope scope(stop);
             for (std::size_t k; (k = next.fetch_add(1)) < todo.size();) {
-                const std::string r = work(todo[k]);
+                std::string r;
+                try {
+                    r = work(todo[k]);
+                } catch (...) {
+                    std::lock_guard<std::mutex> lock(m);
+                    if (!failure) failure = std::current_exception();
+                    next = todo.size();
+                    return;
+                }
                 std::lock_guard<std::mutex> lock(m);
                 if (failure) return;
                 try {

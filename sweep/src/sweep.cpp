@@ -5,6 +5,7 @@
 
 #include "plate/farm.hpp"
 #include "plate/output.hpp"
+#include "plate/progress.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -146,6 +147,8 @@ Row run_case(const Campaign& c, int index) {
             row["design_evaluations"] = d.evaluations;
             if (!d.verified) reasons.push_back("design: " + d.failure);
         }
+    } catch (const Interrupted&) {   // (asked to stop: no row, the case stays out of the journal)
+        throw;
     } catch (const std::exception& e) {   // (the values make the scene invalid; a design's target)
         reasons.push_back(e.what());
     }
