@@ -2,6 +2,7 @@
 // period) and plate.ControlEnv (the same loop a step at a time, Gym-like): control/include/plate/control.hpp.
 #include "bindings.hpp"
 #include "interrupt.hpp"
+#include "pickling.hpp"
 
 #include "plate/control.hpp"
 #include "plate/observe.hpp"
@@ -152,6 +153,20 @@ struct PyControlRun {
     std::vector<std::string> motions;
 };
 
+}   // namespace
+
+// Each struct's members once (pickling.hpp).
+namespace pickling {
+void io(Archive& a, ControlRow& r) { a(r.t, r.observed, r.truth, r.motion, r.decision_seconds); }
+void io(Archive& a, ControlSummary& s) {
+    a(s.policy, s.periods, s.reached, s.time_to_goal, s.first_within, s.final_error, s.final_theta_error,
+      s.worst_overshoot, s.switches, s.decision_mean, s.decision_max, s.decision_p99, s.stop, s.interrupted, s.rows);
+}
+void io(Archive& a, PyControlRun& r) { a(r.s, r.summary, r.motions); }
+}   // namespace pickling
+
+namespace {
+
 py::array_t<double> rows_array(const ControlSummary& s, bool observed) {
     std::vector<double> d;
     for (const ControlRow& r : s.rows) {
@@ -174,6 +189,7 @@ struct PyControlEnv {
 
 void bind_control_run(py::module_& m) {
     py::class_<PyControlRun>(m, "ControlRun", "A closed-loop run (plate.control): one row per period start and the end.")
+        .def(pickling::pickle_as<PyControlRun>("plate.ControlRun"))
         .def_property_readonly("t",
                                [](const PyControlRun& r) {
                                    std::vector<double> t;

@@ -2,6 +2,7 @@
 // plate.coning_rate and plate.axis_peaks.
 #include "bindings.hpp"
 #include "interrupt.hpp"
+#include "pickling.hpp"
 
 #include <array>
 #include <cmath>
@@ -65,6 +66,19 @@ DesignTarget design_target_from_kwargs(const std::optional<std::pair<double, dou
 
 namespace {
 
+// plate.design's result: the library's summary and the command line's JSON of it.
+struct PyDesign : DesignSummary {
+    nlohmann::json summary;
+};
+
+}   // namespace
+
+namespace pickling {
+void io(Archive& a, PyDesign& d) { a(static_cast<DesignSummary&>(d), d.summary); }
+}   // namespace pickling
+
+namespace {
+
 // plate.design: the target and the options as keyword arguments, judged as the command line's.
 void bind_design_function(py::module_& m) {
     m.def(
@@ -104,7 +118,11 @@ void bind_design_function(py::module_& m) {
                 o.axes.push_back(static_cast<Axis>(k));
             }
             o.max_harmonic = renamed(harmonics, max_harmonic, "harmonics", "max_harmonic", 0);
-            return interruptible(py::none(), [&](Watch&) { return design(part, t, o); });   // (invalid_argument: ValueError)
+            PyDesign d{interruptible(py::none(), [&](Watch&) { return design(part, t, o); }),
+                       {}};   // (invalid_argument: ValueError)
+            d.summary = design_summary_json(d, part, t, o, "");
+            d.summary["scene"] = nullptr;   // (no file: the designed scene is .scene)
+            return d;
         },
         py::arg("part"), py::kw_only(), py::arg("sink") = py::none(), py::arg("transport") = py::none(),
         py::arg("fixed_point") = py::none(), py::arg("orient") = py::none(), py::arg("line_sink") = py::none(),
@@ -138,9 +156,13 @@ void bind_design_function(py::module_& m) {
 }   // namespace
 
 void bind_design(py::module_& m) {
-    py::class_<DesignSummary>(m, "Design", "A designed plate motion and its verification (plate.design).")
+    py::class_<PyDesign>(m, "Design", "A designed plate motion and its verification (plate.design).")
+        .def(pickling::pickle_as<PyDesign>("plate.Design"))
+        .def_property_readonly(
+            "summary", [](const PyDesign& d) { return json_to_python(d.summary); },
+            "the command line's JSON (`plate design`) as a dict ('scene': None, the designed scene being .scene)")
         .def("__repr__",
-             [](const DesignSummary& d) {
+             [](const PyDesign& d) {
                  return "<plate.Design '" + d.scene.name + "': " + (d.verified ? "verified" : "not verified") +
                         (d.unique ? ", unique" : "") + ", rate " + num(d.rate) + " 1/s" +
                         (d.failure.empty() ? "" : " (" + d.failure + ")") + ">";
@@ -164,7 +186,7 @@ void bind_design(py::module_& m) {
         .def_readonly("transport_spread", &DesignSummary::transport_spread)
         .def_property_readonly(
             "ring",
-            [](const DesignSummary& s) {
+            [](const PyDesign& s) {
                 std::vector<std::tuple<double, Vec3>> r;
                 for (std::size_t k = 0; k < s.ring_theta.size(); ++k) r.emplace_back(s.ring_theta[k], s.ring_twist[k]);
                 return r;
@@ -176,7 +198,7 @@ void bind_design(py::module_& m) {
                       "the largest share the design's symmetry allows (a half-turn pair: below 1)")
         .def_property_readonly(
             "competitors",
-            [](const DesignSummary& s) {
+            [](const PyDesign& s) {
                 std::vector<std::tuple<Vec3, double>> r;
                 for (const auto& c : s.competitors) r.emplace_back(c.point.q, c.basin_share);
                 return r;
@@ -184,14 +206,14 @@ void bind_design(py::module_& m) {
             "rigid parts: the other stable fixed points on the grid, (q, share of the runs ending there)")
         .def_property_readonly(
             "runs",
-            [](const DesignSummary& s) {
+            [](const PyDesign& s) {
                 std::vector<std::tuple<double, double, double, double>> r;
                 for (const DesignStartRun& x : s.runs) r.emplace_back(x.x, x.y, x.seconds, x.end_distance);
                 return r;
             },
             "(x, y, seconds, end distance) of each verification run")
         .def_property_readonly(
-            "held", [](const DesignSummary& s) { return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance); },
+            "held", [](const PyDesign& s) { return std::make_tuple(s.held.seconds, s.held.end, s.held.end_distance); },
             "sinks and fixed points: (seconds, end, distance) of the part released at rest at the target")
         .def_readonly("coning", &DesignSummary::coning, "the design's coning rate [rad/s] (plate.coning_rate)")
         .def_readonly("peaks", &DesignSummary::peaks,
@@ -199,7 +221,7 @@ void bind_design(py::module_& m) {
                       "(plate.axis_peaks): what limits bound")
         .def_property_readonly(
             "pulls",
-            [](const DesignSummary& s) {
+            [](const PyDesign& s) {
                 std::vector<std::tuple<double, Vec2, Eigen::Vector2cd>> r;
                 for (const auto& p : s.pulls) r.emplace_back(p.theta, p.zero, p.eigenvalues);
                 return r;

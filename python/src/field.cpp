@@ -1,6 +1,7 @@
 // plate.field (the asymptotic twist field on a grid, plate.Field) and plate.fixed_points (its zeros).
 #include "bindings.hpp"
 #include "interrupt.hpp"
+#include "pickling.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -13,6 +14,15 @@ struct PyFixedPoints {
     Scene scene;
     FixedPoints fp;
 };
+
+}   // namespace
+
+namespace pickling {
+void io(Archive& a, PyFixedPoints& p) { a(p.scene, p.fp); }
+}   // namespace pickling
+using pickling::pickle_as;
+
+namespace {
 
 // The field's arrays over its grid: shape (nx, ny, ntheta, 3) (point parts: ntheta = 1).
 py::array_t<double> field_array(const Field& f, int what) {
@@ -189,6 +199,7 @@ void bind_field(py::module_& m) {
 
 void bind_fixed_points(py::module_& m) {
     py::class_<FixedPoint>(m, "FixedPoint")
+        .def(pickle_as<FixedPoint>("plate.FixedPoint"))
         .def_readonly("q", &FixedPoint::q, "(s_x, s_y, theta), theta in (-pi, pi]")
         .def_readonly("eigenvalues", &FixedPoint::eigenvalues, "of the field's Jacobian (point part: the first 2)")
         .def_property_readonly("stability", [](const FixedPoint& p) { return stability_name(p.stability); })
@@ -199,6 +210,7 @@ void bind_fixed_points(py::module_& m) {
                    std::to_string(p.q[1]) + ", " + std::to_string(p.q[2]) + ")>";
         });
     py::class_<StuckRegion>(m, "StuckRegion", "configurations where the part does not move, connected on the grid")
+        .def(pickle_as<StuckRegion>("plate.StuckRegion"))
         .def_readonly("lo", &StuckRegion::lo, "lower bounds of (s_x, s_y, theta) [m, m, rad]")
         .def_readonly("hi", &StuckRegion::hi, "upper bounds (theta from lo up to hi, possibly beyond pi)")
         .def_readonly("all_theta", &StuckRegion::all_theta)
@@ -209,6 +221,7 @@ void bind_fixed_points(py::module_& m) {
                    num(r.hi[1]) + "] m, " + std::to_string(r.grid_points) + " grid points>";
         });
     py::class_<RotatingAttractor>(m, "RotatingAttractor", "position settled while theta turns at a steady mean rate")
+        .def(pickle_as<RotatingAttractor>("plate.RotatingAttractor"))
         .def_readonly("q", &RotatingAttractor::q, "(s_x, s_y) [m] on the section theta = q[2] [rad]")
         .def_readonly("rate", &RotatingAttractor::rate, "mean dtheta/dt [rad/s]; +: counter-clockwise")
         .def_readonly("period", &RotatingAttractor::period, "time for one turn [s]")
@@ -221,6 +234,7 @@ void bind_fixed_points(py::module_& m) {
                    num(r.q[1]) + ") m, " + num(r.rate) + " rad/s>";
         });
     py::class_<FixedLine>(m, "FixedLine")
+        .def(pickle_as<FixedLine>("plate.FixedLine"))
         .def_property_readonly("points", [](const FixedLine& l) { return l.points; })
         .def_readonly("direction", &FixedLine::direction)
         .def_property_readonly("stability", [](const FixedLine& l) { return stability_name(l.stability); })
@@ -232,6 +246,7 @@ void bind_fixed_points(py::module_& m) {
                    " points, length " + num(l.length) + " m>";
         });
     py::class_<PyFixedPoints>(m, "FixedPoints")
+        .def(pickle_as<PyFixedPoints>("plate.FixedPoints"))
         .def_property_readonly("points", [](const PyFixedPoints& f) { return f.fp.points; })
         .def_property_readonly("lines", [](const PyFixedPoints& f) { return f.fp.lines; })
         .def_property_readonly("sentence", [](const PyFixedPoints& f) { return fixed_points_sentence(f.fp); })

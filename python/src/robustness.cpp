@@ -2,6 +2,7 @@
 // spec: plate.Robustness) and plate.uncertain_parameters (the spec's parameters, in draw order).
 #include "bindings.hpp"
 #include "interrupt.hpp"
+#include "pickling.hpp"
 
 #include "plate/robustness.hpp"
 
@@ -18,6 +19,14 @@ struct PyRobustness {
     UncertaintySpec spec;
 };
 
+}   // namespace
+
+namespace pickling {
+void io(Archive& a, PyRobustness& r) { a(r.s, r.o, r.spec); }
+}   // namespace pickling
+
+namespace {
+
 // A spec from a path (str) or a dict in the file's form (checked as a file is: plate.InputError).
 UncertaintySpec spec_of(const py::object& u) {
     if (py::isinstance<py::str>(u)) return load_uncertainty(u.cast<std::string>());
@@ -33,6 +42,7 @@ void bind_robustness(py::module_& m) {
         m, "Robustness",
         "Where the part goes on the plates a real rig may be (plate robustness): per draw an outcome, the "
         "target's fixed point, arrival times; the spread and its first-order prediction.");
+    cls.def(pickling::pickle_as<PyRobustness>("plate.Robustness"));
     cls.def("__repr__", [](const PyRobustness& r) {
         const int n = static_cast<int>(r.s.draws.size());
         std::string shares;
