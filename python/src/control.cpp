@@ -159,8 +159,8 @@ struct PyControlRun {
 namespace pickling {
 void io(Archive& a, ControlRow& r) { a(r.t, r.observed, r.truth, r.motion, r.decision_seconds); }
 void io(Archive& a, ControlSummary& s) {
-    a(s.policy, s.periods, s.reached, s.time_to_goal, s.first_within, s.final_error, s.final_theta_error,
-      s.worst_overshoot, s.switches, s.decision_mean, s.decision_max, s.decision_p99, s.stop, s.interrupted, s.rows);
+    a(s.policy, s.periods, s.reached, s.time_to_goal, s.first_within, s.final_error, s.final_theta_error, s.worst_overshoot,
+      s.switches, s.decision_mean, s.decision_max, s.decision_p99, s.stop, s.interrupted, s.rows);
 }
 void io(Archive& a, PyControlRun& r) { a(r.s, r.summary, r.motions); }
 }   // namespace pickling

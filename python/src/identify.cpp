@@ -30,8 +30,8 @@ void io(Archive& a, FittedParameter& p) { a(p.name, p.unit, p.estimate, p.sd, p.
 void io(Archive& a, Unidentifiable& u) { a(u.combination, u.half_width); }
 void io(Archive& a, TrackFit& t) { a(t.source, t.frames, t.start, t.rms_xy_mm, t.rms_theta_mrad, t.chi2); }
 void io(Archive& a, IdentifySummary& s) {
-    a(s.params, s.covariance, s.unidentifiable, s.tracks, s.chi2, s.residuals, s.dof, s.reduced_chi2, s.starts_run,
-      s.best_start, s.held, s.iterations, s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
+    a(s.params, s.covariance, s.unidentifiable, s.tracks, s.chi2, s.residuals, s.dof, s.reduced_chi2, s.starts_run, s.best_start,
+      s.held, s.iterations, s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
 }
 void io(Archive& a, IdentifyOptions& o) {
     a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads, o.mu_min,
@@ -39,11 +39,13 @@ void io(Archive& a, IdentifyOptions& o) {
 }
 void io(Archive& a, ProfilePoint& p) { a(p.value, p.dchi2); }
 void io(Archive& a, ParameterProfile& p) {
-    a(p.name, p.unit, p.estimate, p.points, p.lo, p.hi, p.lo_end, p.hi_end, p.bound_lo, p.bound_hi, p.linear_lo,
-      p.linear_hi, p.interval_is_profile, p.identifiable, p.chi2_drop, p.verdict, p.simulations, p.seconds);
+    a(p.name, p.unit, p.estimate, p.points, p.lo, p.hi, p.lo_end, p.hi_end, p.bound_lo, p.bound_hi, p.linear_lo, p.linear_hi,
+      p.interval_is_profile, p.identifiable, p.chi2_drop, p.verdict, p.simulations, p.seconds);
 }
 void io(Archive& a, ProfileSummary& s) { a(s.profiles, s.chi2_min, s.simulations, s.seconds); }
-void io(Archive& a, ProfileOptions& o) { a(o.params, o.max_steps, o.max_iterations, o.max_simulations, o.time_limit, o.agreement); }
+void io(Archive& a, ProfileOptions& o) {
+    a(o.params, o.max_steps, o.max_iterations, o.max_simulations, o.time_limit, o.agreement);
+}
 void io(Archive& a, PyIdentification& r) { a(r.s, r.o, r.profiled, r.p, r.po); }
 }   // namespace pickling
 

@@ -82,9 +82,9 @@ void io(Archive& a, FixedLine& l) { a(l.points, l.direction, l.stability, l.eige
 void io(Archive& a, StuckRegion& r) { a(r.lo, r.hi, r.all_theta, r.grid_points, r.touches_edge); }
 void io(Archive& a, RotatingAttractor& r) { a(r.q, r.rate, r.period, r.multipliers, r.stability, r.residual, r.wobble); }
 void io(Archive& a, FixedPoints& f) {
-    a(f.point_part, f.points, f.lines, f.candidates, f.cells, f.undefined_cells, f.unsearched_cells, f.stuck_cells,
-      f.evaluations, f.rhs_evaluations, f.stuck_regions, f.rotating, f.near_zero_cells, f.near_zero_unsearched,
-      f.coarse_zeros, f.unresolved_cells, f.suggested_grid);
+    a(f.point_part, f.points, f.lines, f.candidates, f.cells, f.undefined_cells, f.unsearched_cells, f.stuck_cells, f.evaluations,
+      f.rhs_evaluations, f.stuck_regions, f.rotating, f.near_zero_cells, f.near_zero_unsearched, f.coarse_zeros,
+      f.unresolved_cells, f.suggested_grid);
 }
 
 void io(Archive& a, DesignStartRun& r) { a(r.x, r.y, r.theta, r.end, r.end_distance, r.seconds, r.from, r.at_from, r.stop); }
@@ -100,8 +100,8 @@ void io(Archive& a, DesignSummary& d) {
 
 void io(Archive& a, Spread& s) { a(s.spread, s.distribution); }
 void io(Archive& a, UncertaintySpec& u) {
-    a(u.source, u.seed, u.friction, u.mass, u.inertia, u.contacts_mm, u.com_offset_mm, u.amplitude, u.phase,
-      u.unmodelled_up_to, u.unmodelled_rms_fraction, u.period);
+    a(u.source, u.seed, u.friction, u.mass, u.inertia, u.contacts_mm, u.com_offset_mm, u.amplitude, u.phase, u.unmodelled_up_to,
+      u.unmodelled_rms_fraction, u.period);
 }
 void io(Archive& a, UncertainParameter& p) { a(p.name, p.unit, p.standard_deviation); }
 void io(Archive& a, Sensitivity& s) { a(s.parameter, s.dq, s.variance_share); }
@@ -109,13 +109,13 @@ void io(Archive& a, DrawResult& d) {
     a(d.index, d.outcome, d.note, d.matched, d.fixed_point, d.rate, d.attractors, d.p, d.arrival, d.arrival_full);
 }
 void io(Archive& a, RobustnessSummary& s) {
-    a(s.nominal, s.target, s.nominal_result, s.draws, s.starts, s.counts, s.mean_offset, s.radius95, s.angle95,
-      s.covariance, s.sensitivities, s.jacobian, s.predicted_covariance, s.predicted_radius95, s.predicted_angle95,
-      s.sensitivity_seconds, s.linear_error_median, s.linear_error_max, s.nonlinear_draws, s.notes, s.seconds);
+    a(s.nominal, s.target, s.nominal_result, s.draws, s.starts, s.counts, s.mean_offset, s.radius95, s.angle95, s.covariance,
+      s.sensitivities, s.jacobian, s.predicted_covariance, s.predicted_radius95, s.predicted_angle95, s.sensitivity_seconds,
+      s.linear_error_median, s.linear_error_max, s.nonlinear_draws, s.notes, s.seconds);
 }
 void io(Archive& a, RobustnessOptions& o) {
-    a(o.draws, o.target, o.grid, o.fixed, o.match_distance, o.match_angle, o.starts, o.arrive_distance, o.arrive_angle,
-      o.horizon, o.curve_step, o.full_draws, o.sensitivities, o.threads);
+    a(o.draws, o.target, o.grid, o.fixed, o.match_distance, o.match_angle, o.starts, o.arrive_distance, o.arrive_angle, o.horizon,
+      o.curve_step, o.full_draws, o.sensitivities, o.threads);
 }
 
 void heading(Archive& a, const char* kind) {
@@ -123,8 +123,8 @@ void heading(Archive& a, const char* kind) {
     std::string got = want;
     io(a, got);
     if (a.reading() && got != want)
-        throw std::invalid_argument(std::string(kind) + ": a pickled state of '" + got.substr(0, 60) + "', expected '" +
-                                    want + "' (pickles are read by the version of plate that wrote them)");
+        throw std::invalid_argument(std::string(kind) + ": a pickled state of '" + got.substr(0, 60) + "', expected '" + want +
+                                    "' (pickles are read by the version of plate that wrote them)");
 }
 
 void finished(const Archive& a, const char* kind) {

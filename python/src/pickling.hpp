@@ -28,7 +28,7 @@ namespace plate::python::pickling {
 
 class Archive {
 public:
-    Archive() = default;                                                       // to write
+    Archive() = default;                                                              // to write
     explicit Archive(std::string bytes) : reading_(true), buf_(std::move(bytes)) {}   // to read
     bool reading() const { return reading_; }
     // n bytes to or from p.
