@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -77,6 +78,9 @@ int cmd_robustness(const RobustnessArgs& a, Io& cio) {
     o.threads = a.grid.threads;
     if (a.has("--target")) o.target = config_arg(a, "--target", a.target, sc, true);
     if (cio.farm) o.tasks = sweep::farm_tasks(*cio.farm);
+    ProgressPrinter prog{"robustness draws"};
+    prog.to = &cio.err == &std::cerr && progress_wanted() && (!cio.farm || cio.farm->root()) ? &cio.err : nullptr;
+    o.progress = std::ref(prog);
     RobustnessSummary s;
     try {
         s = robustness(sc, spec, o);

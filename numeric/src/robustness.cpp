@@ -330,7 +330,10 @@ RobustnessSummary robustness(const Scene& nominal, const UncertaintySpec& spec, 
                 return to_text(r);
             }
         },
-        [&](int i, const std::string& text) { s.draws[i] = from_text(text); });
+        [&, done = 0](int i, const std::string& text) mutable {
+            s.draws[i] = from_text(text);
+            if (o.progress) o.progress(++done, o.draws);
+        });
     for (const DrawResult& r : s.draws) ++s.counts[static_cast<int>(r.outcome)];
     spread(s, reference);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

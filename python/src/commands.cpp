@@ -32,21 +32,23 @@ void bind_commands(py::module_& m) {
         "vertical acceleration below 0.6 g within 3 cm of the centre), as `plate random-scene --seed`.");
     m.def(
         "sweep",
-        [](const std::filesystem::path& campaign, const std::filesystem::path& out, int threads) {
+        [](const std::filesystem::path& campaign, const std::filesystem::path& out, int threads, const py::object& progress) {
             require(threads >= 0, "threads: expected >= 0 (0: all cores)");
             sweep::SweepOptions o;
             o.out = out.string();
-            const sweep::SweepSummary s = interruptible(py::none(), [&](Watch&) {
+            const sweep::SweepSummary s = interruptible(progress, [&](Watch& watch) {
+                o.progress = [&watch](int done, int total) { watch.report(done, total); };
                 const std::unique_ptr<sweep::Farm> farm = sweep::thread_farm(threads);
                 return sweep::run_sweep(campaign.string(), o, *farm);
             });
             return json_to_python(sweep::sweep_summary_json(campaign.string(), out.string(), s));
         },
-        py::arg("campaign"), py::arg("out"), py::kw_only(), py::arg("threads") = 0,
+        py::arg("campaign"), py::arg("out"), py::kw_only(), py::arg("threads") = 0, py::arg("progress") = py::none(),
         "A campaign (campaigns/*.json: a base scene, the parameters to vary, what to compute per case) run\n"
         "on `threads` threads into the folder `out`, as `plate sweep CAMPAIGN --out DIR`: each finished\n"
         "case is journaled, a rerun resumes, and when all are done out/table.csv and out/table.jsonl are\n"
-        "written. Returns the command's JSON summary as a dict. Paths may be str or os.PathLike.");
+        "written. Returns the command's JSON summary as a dict. Paths may be str or os.PathLike. progress: a\n"
+        "callable given a plate.Progress (cases done of those to compute) every 0.05 s while it changes.");
     m.def(
         "proofs",
         [](int thin, int thick, int surfaces, std::uint64_t seed, int threads, const std::string& wrong_model) {

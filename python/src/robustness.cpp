@@ -117,7 +117,7 @@ void bind_robustness(py::module_& m) {
         "robustness",
         [](const Scene& sc, const py::object& uncertainty, int draws, std::optional<std::vector<double>> target, int grid,
            int starts, double horizon, int full_draws, bool sensitivities, int threads, double tol, double rtol, int max_periods,
-           const std::string& solver, long max_rhs) {
+           const std::string& solver, long max_rhs, const py::object& progress) {
             require(draws >= 1 && starts >= 0 && full_draws >= 0, "draws >= 1, starts >= 0 and full_draws >= 0 expected");
             require(std::isfinite(horizon) && horizon > 0, "horizon: expected a positive number of seconds");
             require(grid >= 2 && grid <= 201, "grid: expected 2..201 points per axis");
@@ -134,16 +134,22 @@ void bind_robustness(py::module_& m) {
             r.o.sensitivities = sensitivities;
             r.o.threads = threads;
             r.o.fixed.cycle = cycle_options(tol, rtol, max_periods, solver, max_rhs);
-            r.s = interruptible(py::none(),
-                                [&](Watch&) { return robustness(sc, r.spec, r.o); });   // (invalid_argument: ValueError)
+            r.s = interruptible(progress, [&](Watch& watch) {
+                r.o.progress = [&watch](int done, int total) { watch.report(done, total); };
+                return robustness(sc, r.spec, r.o);   // (invalid_argument: ValueError)
+            });
+            r.o.progress = nullptr;
             return r;
         },
         py::arg("scene"), py::arg("uncertainty"), py::kw_only(), py::arg("draws") = 200, py::arg("target") = py::none(),
         py::arg("grid") = 7, py::arg("starts") = 8, py::arg("horizon") = 60.0, py::arg("full_draws") = 4,
         py::arg("sensitivities") = true, py::arg("threads") = 0, py::arg("tol") = 1e-7, py::arg("rtol") = 1e-8,
         py::arg("max_periods") = 400, py::arg("solver") = "shooting", py::arg("max_rhs") = 2'000'000L,
+        py::arg("progress") = py::none(),
         "The scene under an uncertainty spec (a file's path or a dict): outcome shares, the target's fixed point per draw, "
-        "its spread and first-order sensitivities, arrival times (plate robustness).");
+        "its spread and first-order sensitivities, arrival times (plate robustness). progress: a callable given a\n"
+        "plate.Progress (draws done of total, an estimate of the seconds left) every 0.05 s while it changes.\n"
+        "Ctrl-C stops it (KeyboardInterrupt, no result).");
     m.def(
         "uncertain_parameters",
         [](const Scene& sc, const py::object& uncertainty) {

@@ -81,8 +81,10 @@ def test_a_campaign_from_python_writes_the_programs_table(tmp_path):
     base["compute"] = {"twist_at": [[0.02, 0, 0]]}
     campaign = tmp_path / "c.json"
     campaign.write_text(json.dumps(base))
-    s = plate.sweep(campaign, tmp_path / "py", threads=1)
+    seen = []
+    s = plate.sweep(campaign, tmp_path / "py", threads=1, progress=seen.append)
     assert s["cases"] == 2 and s["computed"] == 2 and s["failed"] == 0
+    assert seen and seen[-1].done == seen[-1].total == 2
     subprocess.run([EXE, "sweep", str(campaign), "--out", str(tmp_path / "cli"), "--threads", "1"], check=True,
                    capture_output=True)
     assert (tmp_path / "py" / "table.csv").read_bytes() == (tmp_path / "cli" / "table.csv").read_bytes()

@@ -70,6 +70,17 @@ def test_progress_counts_configurations_and_estimates_the_time_left():
     assert max(left[-third:]) < min(left[:third]), left
 
 
+def test_robustness_reports_its_draws_done():
+    # designs/point_sink under the PPOD spec, 12 draws on one thread: about 0.5 s here.
+    seen = []
+    r = plate.robustness(plate.load_scene(scene_path("designs/point_sink")), scene_path("uncertainty/ppod"), draws=12,
+                         threads=1, progress=seen.append)
+    assert seen and all(p.total == 12 for p in seen)
+    done = [p.done for p in seen]
+    assert done == sorted(done) and done[-1] == 12 and len(r.outcome) == 12
+    assert seen[-1].seconds_left == 0 and seen[-1].seconds <= r.seconds + 0.1
+
+
 def test_an_exception_in_the_progress_callable_stops_the_call():
     def refuse(p):
         raise RuntimeError("stop here")

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,6 +60,8 @@ struct RobustnessOptions {
     bool sensitivities = true;
     int threads = 0;    // draws in parallel (0: all cores)
     TaskRunner tasks;   // (set: shares the draws instead of `threads`)
+    // Called as each draw is done (done of total), in the calling thread, one call at a time.
+    std::function<void(int done, int total)> progress;
 };
 
 struct DrawResult {
