@@ -1,4 +1,5 @@
 #include "plate/methods.hpp"
+#include "plate/progress.hpp"
 
 #include <boost/numeric/odeint.hpp>
 #include <boost/numeric/odeint/stepper/rosenbrock4.hpp>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,7 +66,12 @@ struct Counted {
         ++run.rhs_evals;
         sys.f(t, y, dy);
     }
-    bool over_budget() const { return run.rhs_evals > max_evals; }
+    // Past the evaluation budget; also where a run sees a request to stop (Ctrl-C: throws Interrupted),
+    // once a step, from C++ frames (never from within GSL's C code).
+    bool over_budget() const {
+        throw_if_stopped();
+        return run.rhs_evals > max_evals;
+    }
 };
 
 bool finite(const double* y, int n) {
@@ -301,6 +308,7 @@ bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const
     if (opt.fixed) {
         if (method_info(m).order == 0) throw std::invalid_argument(std::string(method_info(m).name) + " has no fixed-step form");
         gsl_odeiv2_step* st = gsl_odeiv2_step_alloc(type, sys.n);
+        const std::unique_ptr<gsl_odeiv2_step, void (*)(gsl_odeiv2_step*)> own_step(st, gsl_odeiv2_step_free);
         std::vector<double> err(sys.n);
         const bool ok = fixed_loop(
             [&](Vec& x, double tt, double hh) {
@@ -308,12 +316,12 @@ bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const
                 if (status != GSL_SUCCESS) x[0] = std::numeric_limits<double>::quiet_NaN();
             },
             t0, t1, y, opt, run, c);
-        gsl_odeiv2_step_free(st);
         return ok;
     }
     // The multistep steppers (msadams, msbdf) need their driver object: allocate through it.
     gsl_odeiv2_driver* d = gsl_odeiv2_driver_alloc_y_new(&s, type, h, opt.tol, opt.tol);
     if (!d) return fail(run, "GSL could not allocate the driver");
+    const std::unique_ptr<gsl_odeiv2_driver, void (*)(gsl_odeiv2_driver*)> own_driver(d, gsl_odeiv2_driver_free);
     const double h_min = opt.h_min > 0 ? opt.h_min : 1e-14 * (t1 - t0);
     bool ok = true;
     while (t < t1) {
@@ -342,7 +350,6 @@ bool run_gsl(Method m, const OdeSystem& sys, double t0, double t1, Vec& y, const
             break;
         }
     }
-    gsl_odeiv2_driver_free(d);
     return ok;
 }
 

@@ -1,6 +1,7 @@
 // The command line's remaining commands from Python (issue 54: every command reachable): a seeded
-// random scene (plate random-scene), a campaign (plate sweep) and Theorem 1's checks (plate proofs),
-// each with the command's options and its JSON.
+// random scene (plate random-scene), a campaign (plate sweep), Theorem 1's checks (plate proofs), the
+// verification report (plate report) and the speed-accuracy study (plate bench), each with the
+// command's options and its JSON or its page.
 #include "bindings.hpp"
 #include "interrupt.hpp"
 
@@ -8,6 +9,7 @@
 #include "plate/farm.hpp"
 #include "plate/sweep.hpp"
 #include "proofs_json.hpp"
+#include "report.hpp"
 
 #include <pybind11/stl/filesystem.h>
 
@@ -15,6 +17,72 @@
 #include <memory>
 
 namespace plate::python {
+
+namespace {
+
+// The project folder a report reads (scenes/, reports/generated/): `source`, else the one this module
+// was built from if it is still there (a pip-installed module carries no scenes).
+std::string project_folder(const std::optional<std::filesystem::path>& source) {
+    const std::filesystem::path root = source ? *source : std::filesystem::path(PLATE_SOURCE_DIR);
+    std::error_code ec;
+    require(std::filesystem::exists(root / "scenes", ec),
+            "source: " + root.string() +
+                " has no scenes/ (give source=, the project's folder: a checkout of plate, where scenes/ and reports/ are)");
+    return root.string();
+}
+
+void bind_report(py::module_& m) {
+    m.def(
+        "report",
+        [](const std::filesystem::path& out, bool quick, std::vector<std::string> sections, std::uint64_t seed, int threads,
+           const std::optional<std::filesystem::path>& source) {
+            require(threads >= 0, "threads: expected >= 0 (0: all cores)");
+            try {
+                report::check_sections(sections);
+            } catch (const std::invalid_argument& e) {
+                require(false, std::string("sections: ") + e.what());
+            }
+            report::ReportOptions o;
+            o.out = out.string();
+            o.source_dir = project_folder(source);
+            o.seed = seed;
+            o.quick = quick;
+            o.threads = threads;
+            o.sections = std::move(sections);
+            interruptible(py::none(), [&](Watch&) {
+                report::write_report(o);
+                return 0;
+            });
+            return (out / "index.html").string();
+        },
+        py::arg("out"), py::kw_only(), py::arg("quick") = false, py::arg("sections") = std::vector<std::string>{},
+        py::arg("seed") = 1, py::arg("threads") = 0, py::arg("source") = py::none(),
+        "The verification report, as `plate report --out DIR`: out/index.html and its SVG figures (gnuplot).\n"
+        "quick: small campaigns and grids; sections: only these (names as plate report --help lists them),\n"
+        "the page naming those left out. source: the project folder (scenes/, reports/generated/), default\n"
+        "the one this module was built from. Returns the page's path. Ctrl-C stops it (KeyboardInterrupt);\n"
+        "an interrupted report leaves no index.html.");
+    m.def(
+        "bench",
+        [](const std::filesystem::path& out, bool full, const std::optional<std::filesystem::path>& source) {
+            report::SpeedOptions o;
+            o.out = out.string();
+            o.source_dir = project_folder(source);
+            o.full = full;
+            interruptible(py::none(), [&](Watch&) {
+                report::write_speed_study(o);
+                return 0;
+            });
+            return (out / "index.html").string();
+        },
+        py::arg("out"), py::kw_only(), py::arg("full") = false, py::arg("source") = py::none(),
+        "The speed-accuracy study, as `plate bench --out DIR`: work-precision charts into out, its section\n"
+        "into out/index.html (the report's page if there is one). Minutes; full: the long campaign. (The\n"
+        "peer engines' study, `plate bench --peers`, is bench/peers/study.py.) Returns the page's path.\n"
+        "Ctrl-C stops it (KeyboardInterrupt).");
+}
+
+}   // namespace
 
 void bind_commands(py::module_& m) {
     m.def(
@@ -80,6 +148,7 @@ void bind_commands(py::module_& m) {
         "collinear contacts. Returns the command's JSON as a dict: 'passed', and 'failed' naming what did\n"
         "not. wrong_model='pushing-friction' or 'mu3' runs them on a deliberately wrong model, to see them\n"
         "fail.");
+    bind_report(m);
 }
 
 }   // namespace plate::python

@@ -5,6 +5,7 @@ import csv
 import json
 import os
 import pathlib
+import re
 import subprocess
 
 import numpy as np
@@ -111,6 +112,36 @@ def test_proofs_from_python_are_the_programs_and_fail_on_a_wrong_model(tmp_path)
     assert not wrong["passed"] and wrong["failed"] == ["thin"] and wrong["wrong_model"] == "pushing-friction"
     with pytest.raises(ValueError, match="wrong_model: expected none"):
         plate.proofs(thin=1, wrong_model="mu4")
+
+
+@needs_exe
+def test_the_report_from_python_is_the_programs(tmp_path):
+    # The same sections, seed and quick mode: the same figures and data files to the byte, and the same
+    # page but for the run's timings and its folder's name.
+    page = plate.report(tmp_path / "py", quick=True, sections=["fig3", "orient"])
+    assert page == str(tmp_path / "py" / "index.html")
+    subprocess.run([EXE, "report", "--quick", "--sections", "fig3", "orient", "--out", str(tmp_path / "cli")], check=True,
+                   capture_output=True)
+    py = sorted(p.relative_to(tmp_path / "py") for p in (tmp_path / "py").rglob("*") if p.is_file())
+    cli = sorted(p.relative_to(tmp_path / "cli") for p in (tmp_path / "cli").rglob("*") if p.is_file())
+    assert py == cli and len(py) > 10
+    for rel in py:
+        if rel.name != "index.html":
+            assert (tmp_path / "py" / rel).read_bytes() == (tmp_path / "cli" / rel).read_bytes(), rel
+
+    def page_of(folder):
+        # (the run's seconds: the total, the sections' timing rows, the orienter's last column)
+        text = (folder / "index.html").read_text().replace(str(folder), "OUT")
+        text = re.sub(r"total [0-9.e+-]+ s", "total T s", text)
+        text = re.sub(r"<td>[0-9.e+-]+</td></tr>", "<td>T</td></tr>", text)
+        return text
+    assert page_of(tmp_path / "py") == page_of(tmp_path / "cli")
+    assert "orient 2" in page_of(tmp_path / "py")
+    with pytest.raises(ValueError, match="sections: 'nope' is not a section"):
+        plate.report(tmp_path / "bad", sections=["nope"])
+    with pytest.raises(ValueError, match="has no scenes/"):
+        plate.report(tmp_path / "bad", source=tmp_path)
+    assert not (tmp_path / "bad").exists()
 
 
 def test_paths_may_be_pathlike():

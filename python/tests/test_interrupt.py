@@ -48,6 +48,22 @@ def test_ctrl_c_stops_a_long_field_within_half_a_second():
     assert latency_of_ctrl_c(lambda: plate.field(sc, grid=25, max_work=0)) < 0.5
 
 
+def test_ctrl_c_stops_a_report_within_half_a_second_and_leaves_no_page(tmp_path):
+    # The quick report's fields section takes about 10 s here; interrupted after 1 s it leaves no
+    # index.html (the page is written whole at the end, and an old one is removed at the start).
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "index.html").write_text("an older page")
+    assert latency_of_ctrl_c(lambda: plate.report(out, quick=True, sections=["fields"])) < 0.5
+    assert not (out / "index.html").exists()
+
+
+def test_ctrl_c_stops_the_speed_study_within_half_a_second(tmp_path):
+    # The quick speed study takes minutes; its integrations see the request at their next step.
+    assert latency_of_ctrl_c(lambda: plate.bench(tmp_path / "bench")) < 0.5
+    assert not (tmp_path / "bench" / "index.html").exists()
+
+
 def test_ctrl_c_stops_a_design_within_half_a_second():
     # A design whose search and verification take 48 s here; measured latency 0.06-0.11 s.
     part = plate.load_scene(scene_path("fig1_point"))
