@@ -106,39 +106,6 @@ Args parse(int argc, char** argv) {
     return a;
 }
 
-// The truth for start i: friction x scale, 3 % amplitude and 0.03 rad phase per period (spread).
-Truth truth_of(int i, double friction_scale, double spread) {
-    Truth truth;
-    truth.friction_scale = friction_scale;
-    UncertaintySpec spec;
-    spec.seed = 53;
-    spec.amplitude.spread = spread;
-    spec.phase.spread = spread;
-    truth.uncertainty = spec;
-    truth.draw = static_cast<std::uint64_t>(i);
-    return truth;
-}
-
-// A model of one motion that needs no field: what an open-loop run (one motion, never switched) reads.
-ControlModel open_loop_model(const Scene& nominal, const std::string& path) {
-    ControlModel m;
-    m.nominal = nominal;
-    m.library.source = path;
-    m.library.names = {"open_loop"};
-    m.library.motions = {load_scene(path).plate};
-    MotionField f;
-    f.uniform = true;
-    f.twist = {Vec3::Zero()};
-    m.fields = {f};
-    return m;
-}
-
-class Always : public Policy {
-public:
-    std::string name() const override { return "open_loop"; }
-    void reset(const ControlModel&, const Goal&) override {}
-    Decision decide(const Observation&, long) override { return {0, std::nullopt}; }
-};
 
 }   // namespace
 
@@ -180,7 +147,7 @@ int main(int argc, char** argv) try {
         Rng rng(1000 + static_cast<std::uint64_t>(i));
         Vec3 q0(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), 0);
         if (a.rigid) q0.z() = rng.uniform(-kPi, kPi);
-        const Truth truth = truth_of(i, a.friction_scale, a.spread);
+        const Truth truth = spread_truth(a.friction_scale, a.spread, static_cast<std::uint64_t>(i));
         Camera cam;
         cam.per_period = 1;
         cam.noise_xy_mm = 0.1;
@@ -204,14 +171,14 @@ int main(int argc, char** argv) try {
         if (s.stop.reason != StopReason::None) std::printf(" stopped: %s", s.stop.describe().c_str());
         if (!a.open_loop.empty()) {
             const ControlModel ol = open_loop_model(sc, a.open_loop);
-            Always always;
+            const std::unique_ptr<Policy> always = make_open_loop_policy();
             ControlOptions olo;
             olo.duration = a.open_loop_time;
             const auto t1 = std::chrono::steady_clock::now();
             Goal ol_goal = goal;
             ol_goal.tolerance = a.open_loop_tol;
             ol_goal.tolerance_theta = a.open_loop_tol_theta;
-            const ControlSummary o = run_control(ol, always, truth, std::nullopt, ol_goal, q0, olo);
+            const ControlSummary o = run_control(ol, *always, truth, std::nullopt, ol_goal, q0, olo);
             const double ol_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
             ol_reached += o.reached;
             ol_worst = std::max(ol_worst, o.reached ? o.time_to_goal : 1e300);

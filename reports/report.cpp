@@ -81,6 +81,7 @@ void write_report(const ReportOptions& opt) {
     if (wanted("fixed-point")) c.timed("rigid fixed point", [&] { section_fixed_point(c, src, opt); });
     if (wanted("robustness")) section_robustness(c, src, opt);
     if (wanted("identify")) c.timed("identification", [&] { section_identify(c, src, opt); });
+    if (wanted("control")) c.timed("closed loop", [&] { section_control(c, src, opt); });
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // KaTeX from Debian's libjs-katex, copied beside the report when present.
@@ -140,8 +141,8 @@ void write_report(const ReportOptions& opt) {
 }
 
 const std::vector<std::string>& report_section_names() {
-    static const std::vector<std::string> names = {"derivation", "kernels", "proofs",      "fig3",       "fields",
-                                                   "design",     "orient",  "fixed-point", "robustness", "identify"};
+    static const std::vector<std::string> names = {"derivation", "kernels",     "proofs",     "fig3",     "fields", "design",
+                                                   "orient",     "fixed-point", "robustness", "identify", "control"};
     return names;
 }
 

@@ -23,7 +23,7 @@ struct ReportOptions {
 };
 
 // The report's sections, in page order: derivation, kernels, proofs, fig3, fields, design, orient,
-// fixed-point, robustness, identify.
+// fixed-point, robustness, identify, control.
 const std::vector<std::string>& report_section_names();
 // Throws std::invalid_argument ("'NAME' is not a section (derivation, kernels, ...)") for the first
 // name in `sections` that is not one of them.

@@ -5,6 +5,7 @@
 //   report_sections_design.cpp  design, orient, fixed-point
 //   report_sections_robustness.cpp  robustness (the shipped designs under the PPOD spec)
 //   report_sections_identify.cpp  identify (a filmed track fitted, with profile likelihoods)
+//   report_sections_control.cpp  control (closed loop against the open-loop design)
 #pragma once
 
 #include "report.hpp"
@@ -25,5 +26,6 @@ void section_orient(html::Ctx& c, const std::filesystem::path& src, const Report
 void section_fixed_point(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_robustness(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 void section_identify(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
+void section_control(html::Ctx& c, const std::filesystem::path& src, const ReportOptions& opt);
 
 }   // namespace plate::report

@@ -535,12 +535,12 @@ TEST_CASE("plate report --sections computes only the named sections and says whi
     CHECK(html.find("Symbolic derivation") != std::string::npos);
     CHECK(html.find("fig3.svg") != std::string::npos);
     // Each left-out section's heading is absent (not computed, not only not named).
-    for (const char* h :
-         {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields", "\">Inverse design</h2>",
-          "Orienting a part", "Fixing a rigid part", "\">Robustness</h2>", "\">Identification: friction"})
+    for (const char* h : {"Generated kernels against", "Theorem 1: contraction", "Limit surfaces", "The paper's fields",
+                          "\">Inverse design</h2>", "Orienting a part", "Fixing a rigid part", "\">Robustness</h2>",
+                          "\">Identification: friction", "\">Closed loop against"})
         CHECK(html.find(h) == std::string::npos);
     CHECK(html.find("Sections left out of this run (--sections): kernels, proofs, fields, design, orient, fixed-point, "
-                    "robustness, identify.") != std::string::npos);
+                    "robustness, identify, control.") != std::string::npos);
     fs::remove_all(dir);
     r = run("report --quick --sections fig3 figure4 --out " + dir.string());
     CHECK(r.code == 2);

@@ -69,7 +69,7 @@ TEST_CASE("write_report rejects an unknown section before it touches the report'
     }
     CHECK(message ==
           "'figure4' is not a section (derivation, kernels, proofs, fig3, fields, design, orient, fixed-point, robustness, "
-          "identify)");
+          "identify, control)");
 }
 
 TEST_CASE("report: the captions that state a result follow this run's measurements", "[report][text]") {

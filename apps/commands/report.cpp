@@ -25,12 +25,13 @@ struct ReportArgs : Options {
                   "paper's fields with full-dynamics trajectories and fixed-point tables, the inverse designs, and\n"
                   "the robustness of each design in scenes/designs/ under scenes/uncertainty/ppod.json (200 draws;\n"
                   "--quick: 40), and an identification (fig1_point's part filmed at other friction, fitted, with profile\n"
-                  "likelihoods). ROOT: the project folder (scenes/, reports/generated/), default the one this\n"
+                  "likelihoods), and closed-loop control against the open-loop design on the same plates and starts.\n"
+                  "ROOT: the project folder (scenes/, reports/generated/), default the one this\n"
                   "program was built from. --sections computes only the named ones (derivation kernels proofs fig3\n"
-                  "fields design orient fixed-point robustness identify; the page names those left out).\n") {
+                  "fields design orient fixed-point robustness identify control; the page names those left out).\n") {
         text("--out", out, "DIR", "the report's folder; required");
         flag("--quick", quick, "small campaigns and grids");
-        words("--sections", sections, 1, 10, "NAME ...", "only these sections (default all)");
+        words("--sections", sections, 1, 11, "NAME ...", "only these sections (default all)");
         whole("--seed", seed, 0, 1L << 40, "the seed");
         whole("--threads", threads, 0, 256, "threads (0: all cores)");
         text("--source", source, "ROOT", "the project folder");

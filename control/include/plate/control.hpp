@@ -53,6 +53,11 @@ struct Truth {
 };
 inline constexpr double kMaxFrictionScale = 10;
 
+// The closed-loop issue's test plate: friction x friction_scale, every harmonic's amplitude off by a
+// relative `spread` and its phase by `spread` rad (normal draws, seed 53), drawn anew each period;
+// `draw` numbers the run (one per start).
+Truth spread_truth(double friction_scale, double spread, std::uint64_t draw);
+
 Truth load_truth(const std::string& path);                               // throws InputError
 Truth parse_truth(const std::string& text, const std::string& source);   // throws InputError
 
@@ -212,6 +217,12 @@ struct LibraryPolicyOptions {
 };
 inline constexpr int kMaxHorizon = 1000;
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
+
+// Open loop, for comparison: a model of one motion -- the plate of the scene file at `path`, kept all
+// run (its field is not needed: the model's one field is a zero placeholder) -- and the policy that
+// never switches from it. What an open-loop design does on the same truth and starts.
+ControlModel open_loop_model(const Scene& nominal, const std::string& path);   // throws InputError
+std::unique_ptr<Policy> make_open_loop_policy();
 
 // ---- the loop -----------------------------------------------------------------------------------
 
