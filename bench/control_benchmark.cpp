@@ -144,9 +144,7 @@ int main(int argc, char** argv) try {
     int met = 0, reached = 0, ol_reached = 0;
     double worst_time = 0, worst_decision = 0, ol_worst = 0;
     for (int i = a.first; i < a.first + a.starts; ++i) {
-        Rng rng(1000 + static_cast<std::uint64_t>(i));
-        Vec3 q0(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), 0);
-        if (a.rigid) q0.z() = rng.uniform(-kPi, kPi);
+        const Vec3 q0 = square_start(static_cast<std::uint64_t>(i), a.rigid);
         const Truth truth = spread_truth(a.friction_scale, a.spread, static_cast<std::uint64_t>(i));
         Camera cam;
         cam.per_period = 1;

@@ -8,7 +8,6 @@
 #include "report_sections.hpp"
 
 #include "plate/control.hpp"
-#include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
 
 #include <algorithm>
@@ -93,11 +92,8 @@ void section_control(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     const int starts = 20;   // (about 4 s: the same in quick and full runs)
     std::vector<Pair> runs;
     for (int i = 0; i < starts; ++i) {
-        Rng rng(1000 + static_cast<std::uint64_t>(i));   // (bench_control's starts)
         Pair p;
-        p.q0.x() = rng.uniform(-0.05, 0.05);
-        p.q0.y() = rng.uniform(-0.05, 0.05);
-        p.q0.z() = 0;
+        p.q0 = square_start(static_cast<std::uint64_t>(i), false);   // (bench_control's starts)
         const Truth truth = spread_truth(0.8, 0.03, static_cast<std::uint64_t>(i));
         Camera cam;
         cam.per_period = 1;

@@ -1,6 +1,7 @@
 // Open loop for comparison (control.hpp): one motion kept all run, the same loop and truth as the
 // closed-loop policies; and the test plate (spread_truth).
 #include "plate/control.hpp"
+#include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
 
 namespace plate {
@@ -15,6 +16,13 @@ Truth spread_truth(double friction_scale, double spread, std::uint64_t draw) {
     truth.uncertainty = spec;
     truth.draw = draw;
     return truth;
+}
+
+Vec3 square_start(std::uint64_t i, bool with_theta) {
+    Rng rng(1000 + i);
+    const double y = rng.uniform(-0.05, 0.05);   // (y first: the order bench_control's starts were measured in)
+    const double x = rng.uniform(-0.05, 0.05);
+    return Vec3(x, y, with_theta ? rng.uniform(-kPi, kPi) : 0.0);
 }
 
 ControlModel open_loop_model(const Scene& nominal, const std::string& path) {

@@ -57,6 +57,9 @@ inline constexpr double kMaxFrictionScale = 10;
 // relative `spread` and its phase by `spread` rad (normal draws, seed 53), drawn anew each period;
 // `draw` numbers the run (one per start).
 Truth spread_truth(double friction_scale, double spread, std::uint64_t draw);
+// Its starts: start i uniform over the square [-0.05, 0.05]^2 m (seed 1000 + i; y drawn first, then x),
+// and for a rigid part (with_theta) theta uniform over (-pi, pi], drawn third; else theta 0.
+Vec3 square_start(std::uint64_t i, bool with_theta);
 
 Truth load_truth(const std::string& path);                               // throws InputError
 Truth parse_truth(const std::string& text, const std::string& source);   // throws InputError
