@@ -57,10 +57,12 @@ void figures(Ctx& c, const std::vector<Pair>& runs, const Goal& goal) {
     c.plot("control_paths",
            "set xlabel 's_x (world) [mm]'\nset ylabel 's_y (world) [mm]'\nset size ratio -1\nset key outside right\nset grid\n"
            "set xrange [-55:55]\nset yrange [-55:55]\n"
-           "set object 1 circle at " + g + " size 1 fc rgb '#208020' fs solid\n"
-           "plot 'data/control_paths.dat' index 1 u 1:2 w l lw 1.5 lc rgb '#c03030' t 'open loop (designed sink)', "
-           "'' index 0 u 1:2 w l lw 1.5 lc rgb '#3050c0' t 'closed loop (library policy)', "
-           "NaN w p pt 7 lc rgb '#208020' t 'goal'\n",
+           "set object 1 circle at " +
+               g +
+               " size 1 fc rgb '#208020' fs solid\n"
+               "plot 'data/control_paths.dat' index 1 u 1:2 w l lw 1.5 lc rgb '#c03030' t 'open loop (designed sink)', "
+               "'' index 0 u 1:2 w l lw 1.5 lc rgb '#3050c0' t 'closed loop (library policy)', "
+               "NaN w p pt 7 lc rgb '#208020' t 'goal'\n",
            "The part's true paths, one point a period, from each start: closed loop (blue) and the open-loop "
            "design (red) on the same true plate.",
            "640,520");
@@ -129,8 +131,8 @@ void section_control(Ctx& c, const fs::path& src, const ReportOptions& opt) {
            << "films the world frame once a period with 0.1 mm noise, one period late. Beside it, on the same true "
            << "plates and starts, the open-loop design <code>scenes/designs/point_sink.json</code>, whose stable "
            << "fixed point on the nominal plate is the goal, kept for " << fmt(kOpenTime) << " s.</p>\n<p>"
-           << c.verdict("closed loop: every start within 1 mm and held within 10 s", closed_ok == starts && slowest <= kClosedTime,
-                        "pass", "FAIL")
+           << c.verdict("closed loop: every start within 1 mm and held within 10 s",
+                        closed_ok == starts && slowest <= kClosedTime, "pass", "FAIL")
            << " Closed loop: " << closed_ok << " of " << starts << " starts within 1 mm and held, the slowest after "
            << fmt(slowest, 3) << " s (the issue's target: 10 s); longest decision " << fmt(1e3 * decision, 3)
            << " ms. Open loop: " << open_ok << " of " << starts << " within 1 mm and held in " << fmt(kOpenTime)
