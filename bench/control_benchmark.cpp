@@ -1,6 +1,6 @@
 // Benchmark: closed-loop control (issue 53's targets). Not a test: nothing here passes or fails.
 // STARTS seeded starts at rest, uniform over the 0.1 m square [-0.05, 0.05]^2 (a rigid part: theta
-// uniform over a turn), to the goal within 1 mm (and 0.02 rad), by the `library` policy over LIBRARY
+// uniform over a turn), to the goal within 1 mm (and 0.02 rad), by the `library` policy (--mpc: `mpc`) over LIBRARY
 // against a truth with friction 20 % below the model's and 3 % amplitude / 0.03 rad phase tracking
 // errors drawn every period (draw = the start's index), filmed by a stroboscopic world-frame camera at
 // phase 0 with 0.1 mm (and 5 mrad) noise and one period of latency (seed = the start's index). Each run
@@ -10,7 +10,7 @@
 //   bench_control [--rigid] [--starts N] [--first SEED] [--duration S] [--scene SCENE] [--library LIB]
 //                 [--goal X Y [THETA]] [--horizon H] [--transitions 0|1] [--grid-transitions 0|1]
 //                 [--friction-scale F] [--spread S] [--single-phase] [--open-loop SCENE] [--open-loop-time S]
-//                 [--open-loop-tol MM RAD]
+//                 [--open-loop-tol MM RAD] [--mpc [--mpc-horizon H] [--mpc-no-correction]]
 // Defaults: the point-part target (scenes/fig1_point.json, scenes/control/fig1_point/library.json,
 // goal (0.02, -0.01), 15 s runs, target 10 s). --rigid: the rigid-part target (scenes/fig4.json,
 // scenes/control/fig4/library.json, goal (0.02, -0.01, 0.5), 40 s runs, target 30 s) and, beside each
@@ -44,6 +44,8 @@ struct Args {
     Vec3 goal = Vec3(0.02, -0.01, 0);
     bool rigid = false;
     LibraryPolicyOptions policy;
+    bool mpc = false;
+    MpcPolicyOptions mpc_options;
     bool transitions = true, grid_transitions = false;
 };
 
@@ -67,6 +69,18 @@ Args parse(int argc, char** argv) {
             return argv[++i];
         };
         if (o == "--rigid") continue;
+        if (o == "--mpc") {
+            a.mpc = true;
+            continue;
+        }
+        if (o == "--mpc-horizon") {
+            a.mpc_options.horizon = std::stoi(next());
+            continue;
+        }
+        if (o == "--mpc-no-correction") {
+            a.mpc_options.correct = false;
+            continue;
+        }
         if (o == "--starts")
             a.starts = std::stoi(next());
         else if (o == "--first")
@@ -155,7 +169,7 @@ int main(int argc, char** argv) try {
         cam.frame = CameraFrame::world;
         ControlOptions opt;
         opt.duration = a.duration;
-        auto policy = make_library_policy(a.policy);
+        auto policy = a.mpc ? make_mpc_policy(a.mpc_options) : make_library_policy(a.policy);
         const auto t0 = std::chrono::steady_clock::now();
         const ControlSummary s = run_control(model, *policy, truth, cam, goal, q0, opt);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -167,6 +181,11 @@ int main(int argc, char** argv) try {
                     s.time_to_goal, s.final_error * 1e3, s.final_theta_error, s.worst_overshoot * 1e3, s.switches,
                     s.decision_mean * 1e6, s.decision_p99 * 1e6, s.decision_max * 1e6, run_s);
         if (s.stop.reason != StopReason::None) std::printf(" stopped: %s", s.stop.describe().c_str());
+        if (a.mpc) {
+            const MpcEstimate e = mpc_estimate(*policy);
+            std::printf("  mpc gain %.3f drift (%.3g, %.3g) mm/period over %d frames", e.gain, 1e3 * e.drift.x(),
+                        1e3 * e.drift.y(), e.frames);
+        }
         if (!a.open_loop.empty()) {
             const ControlModel ol = open_loop_model(sc, a.open_loop);
             const std::unique_ptr<Policy> always = make_open_loop_policy();
@@ -186,8 +205,8 @@ int main(int argc, char** argv) try {
         std::printf("\n");
         std::fflush(stdout);
     }
-    std::printf("reached and held: %d/%d; within %g s: %d/%d; slowest %.3g s; largest decision %.3g ms (target 1 ms)\n", reached,
-                a.starts, a.target, met, a.starts, worst_time, worst_decision * 1e3);
+    std::printf("reached and held: %d/%d; within %g s: %d/%d; slowest %.3g s; largest decision %.3g ms (target %d ms)\n", reached,
+                a.starts, a.target, met, a.starts, worst_time, worst_decision * 1e3, a.mpc ? 10 : 1);
     if (!a.open_loop.empty())
         std::printf("open loop (%s): within %g mm and %g rad and held %d/%d within %g s; slowest %.3g s\n", a.open_loop.c_str(),
                     a.open_loop_tol * 1e3, a.open_loop_tol_theta, ol_reached, a.starts, a.open_loop_time, ol_worst);

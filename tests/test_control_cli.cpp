@@ -62,6 +62,22 @@ TEST_CASE("plate control: bad input files exit 2 naming the file and the field, 
         CHECK(r.code == 2);
         CHECK_THAT(r.err, Contains(c + ": stroboscopic.per_period"));
     }
+    SECTION("the mpc policy on a rigid part, a policy not known, the mpc's options on the library policy") {
+        Run r = run("control " PLATE_SOURCE_DIR
+                    "/scenes/fig4.json --goal 0.02 -0.01 0.5 --policy mpc --time 1 --library " PLATE_SOURCE_DIR
+                    "/scenes/control/fig4/library.json --out " +
+                    out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains("--policy mpc: the mpc policy steers point parts"));
+        std::string base = kBase;
+        base.replace(base.find("--policy library"), 16, "--policy greedy");
+        r = run(base + kLibrary + "--out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains("--policy: expected library or mpc"));
+        r = run(kBase + kLibrary + "--switch-cost 0.001 --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains("--switch-cost and --no-correction are the mpc policy's"));
+    }
     CHECK_FALSE(fs::exists(out));
 }
 

@@ -17,7 +17,9 @@ struct ControlArgs : Options {
     std::vector<double> goal, start;
     double time = 0, tol = Goal{}.tolerance, tol_theta = Goal{}.tolerance_theta, theta_weight = Goal{}.theta_weight;
     double stop_radius = LibraryPolicyOptions{}.stop_radius, hysteresis = LibraryPolicyOptions{}.hysteresis;
-    int horizon = LibraryPolicyOptions{}.horizon;
+    int horizon = 0;   // (0: the policy's default)
+    double switch_cost = MpcPolicyOptions{}.switch_cost;
+    bool no_correction = false;
     GridArgs grid = [] {
         GridArgs g;
         g.n = 13;
@@ -38,6 +40,12 @@ struct ControlArgs : Options {
                   "the --grid over --x, --y); the observation predicted forward over the camera's latency; inside\n"
                   "--stop-radius the still plate (its frames averaged), and a motion kept unless another does better\n"
                   "by --hysteresis. The library file: docs/guide.md, control.\n"
+                  "--policy mpc --library LIB.json (point parts): each period the sequence of --horizon motions\n"
+                  "(default 3; every one of motions^horizon searched, a switch allowed each period) whose predicted\n"
+                  "path stays nearest the goal on average, plus --switch-cost per switch; its first motion is applied.\n"
+                  "The prediction is corrected online: a gain on the model's steps and a drift per period, fitted to\n"
+                  "the frames by forgetting least squares (--no-correction: the nominal model). Stop radius and\n"
+                  "hysteresis as for library.\n"
                   "--out gets one row per period: t [s], the observed and the true configuration, the motion chosen\n"
                   "and the decision's time [s] (17 significant digits); the summary (time to goal: from when the part\n"
                   "stays within --tol to the end; final error, switches, worst overshoot, decision times) to stdout\n"
@@ -45,8 +53,8 @@ struct ControlArgs : Options {
         scene_file(scene);
         numbers("--goal", goal, 2, 3, "X Y [THETA]", "the goal (point parts: X Y); required");
         numbers("--start", start, 2, 3, "SX SY [THETA]", "the start, at rest on the plate");
-        text("--policy", policy, "library", "the policy; required");
-        text("--library", library, "LIB.json", "library: the motions");
+        text("--policy", policy, "library|mpc", "the policy; required");
+        text("--library", library, "LIB.json", "the motions (library and mpc)");
         text("--camera", camera, "CAMERA.json", "the camera (stroboscopic, one frame per period)");
         text("--truth", truth, "TRUTH.json", "the true plate and part");
         number("--time", time, "the run's duration [s]; required", "");
@@ -54,9 +62,14 @@ struct ControlArgs : Options {
         number("--tol", tol, "the goal's tolerance on the position [m]");
         number("--tol-theta", tol_theta, "the goal's tolerance on theta [rad] (rigid parts)");
         number("--theta-weight", theta_weight, "metres per radian in the distance to the goal");
-        number("--stop-radius", stop_radius, "library: hold the still plate within this distance [m]");
-        number("--hysteresis", hysteresis, "library: switch only for a step nearer by this [m]");
-        whole("--horizon", horizon, 1, kMaxHorizon, "library: periods a motion is judged kept for");
+        number("--stop-radius", stop_radius, "hold the still plate within this distance [m]");
+        number("--hysteresis", hysteresis,
+               "library: switch only for a step nearer by this; both: leave the still plate beyond "
+               "the stop radius plus this [m]");
+        whole("--horizon", horizon, 1, kMaxHorizon,
+              "periods: library, a motion judged kept for; mpc, the sequences' length (at most 8)", "2 for library, 3 for mpc");
+        number("--switch-cost", switch_cost, "mpc: the cost of a switch, in metres of distance");
+        flag("--no-correction", no_correction, "mpc: no online gain and drift (the nominal model)");
         add_grid_options(*this, grid);
     }
 };
@@ -72,9 +85,13 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     if (!(a.tol > 0) || !(a.tol_theta > 0) || !(a.theta_weight >= 0))
         throw UsageError("--tol and --tol-theta must be > 0, --theta-weight >= 0");
     const Vec3 q0 = config_arg(a, "--start", a.start, sc, false);
-    if (!a.has("--policy")) throw UsageError("missing --policy library");
-    if (a.policy != "library") throw UsageError("--policy: expected library (mpc and python are to come)");
-    if (!a.has("--library")) throw UsageError("--policy library needs --library LIB.json");
+    if (!a.has("--policy")) throw UsageError("missing --policy library|mpc");
+    if (a.policy != "library" && a.policy != "mpc")
+        throw UsageError("--policy: expected library or mpc (a Python callable: plate.control in Python), got '" + a.policy +
+                         "'");
+    if (!a.has("--library")) throw UsageError("--policy " + a.policy + " needs --library LIB.json");
+    if (a.policy == "library" && (a.has("--switch-cost") || a.has("--no-correction")))
+        throw UsageError("--switch-cost and --no-correction are the mpc policy's");
     if (!a.has("--time")) throw UsageError("missing --time T");
     if (!a.has("--out")) throw UsageError("missing --out RUN.csv");
     ControlOptions opt;
@@ -82,7 +99,13 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     LibraryPolicyOptions lo;
     lo.stop_radius = a.stop_radius;
     lo.hysteresis = a.hysteresis;
-    lo.horizon = a.horizon;
+    if (a.horizon > 0) lo.horizon = a.horizon;
+    MpcPolicyOptions mpo;
+    mpo.stop_radius = a.stop_radius;
+    mpo.hysteresis = a.hysteresis;
+    mpo.switch_cost = a.switch_cost;
+    mpo.correct = !a.no_correction;
+    if (a.horizon > 0) mpo.horizon = a.horizon;
     ControlModelOptions mo;
     mo.grid = grid_opts(a, a.grid);
     mo.field.threads = a.grid.threads;
@@ -90,9 +113,10 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     try {   // judged once, in the library; named here by their flags
         opt.validate();
         lo.validate();
+        mpo.validate();
         mo.validate();
     } catch (const std::invalid_argument& e) {
-        throw UsageError(std::string("--time, --stop-radius, --hysteresis or the grid: ") + e.what());
+        throw UsageError(std::string("--time, --stop-radius, --hysteresis, --horizon, --switch-cost or the grid: ") + e.what());
     }
     if (a.time / sc.plate.T > static_cast<double>(kMaxControlPeriods))
         throw UsageError("--time " + fmt(a.time) + " s is more than " + fmt(static_cast<double>(kMaxControlPeriods)) +
@@ -100,7 +124,13 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     const Truth truth = a.has("--truth") ? load_truth(a.truth) : Truth{};
     const std::optional<Camera> camera = a.has("--camera") ? std::optional<Camera>(load_camera(a.camera)) : std::nullopt;
     const ControlModel model = build_control_model(sc, load_motion_library(a.library, sc), mo);
-    auto policy = make_library_policy(lo);
+    std::unique_ptr<Policy> policy;
+    try {
+        policy = a.policy == "mpc" ? make_mpc_policy(mpo) : make_library_policy(lo);
+        policy->reset(model, goal);   // (what the policy cannot steer, refused before the run)
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("--policy ") + a.policy + ": " + e.what());
+    }
     const ControlSummary s = run_control(model, *policy, truth, camera, goal, q0, opt);
     write_file_atomic(a.out, [&](std::ostream& out) { write_control_csv(out, s, model, sc.part.point); });
     cio.out << control_summary_json(s, model, goal).dump(2) << "\n";

@@ -240,20 +240,24 @@ void bind_control(py::module_& m) {
         "control",
         [](const Scene& sc, const std::vector<double>& goal, const py::object& library, double time, const py::object& truth,
            const py::object& camera, const std::optional<std::vector<double>>& start, const py::object& policy, double tol,
-           std::optional<std::uint64_t> seed, int horizon, int grid) {
+           std::optional<std::uint64_t> seed, std::optional<int> horizon, int grid, double switch_cost, bool correction) {
             const Setup st = setup(sc, goal, library, truth, camera, start, time, tol, seed, grid);
             std::unique_ptr<Policy> p;
             if (py::isinstance<py::str>(policy)) {
-                require(policy.cast<std::string>() == "library",
-                        "policy: expected 'library' or a Python callable, got '" + policy.cast<std::string>() + "'");
+                const std::string name = policy.cast<std::string>();
+                require(name == "library" || name == "mpc",
+                        "policy: expected 'library', 'mpc' or a Python callable, got '" + name + "'");
                 LibraryPolicyOptions lo;
-                lo.horizon = horizon;
+                MpcPolicyOptions mo;
+                if (horizon) lo.horizon = mo.horizon = *horizon;
+                mo.switch_cost = switch_cost;
+                mo.correct = correction;
                 try {
-                    lo.validate();
+                    p = name == "mpc" ? make_mpc_policy(mo) : make_library_policy(lo);
+                    p->reset(st.model, st.goal);   // (what it cannot steer: refused before the run)
                 } catch (const std::invalid_argument& e) {
-                    require(false, std::string("horizon: ") + e.what());
+                    require(false, "policy '" + name + "': " + e.what());
                 }
-                p = make_library_policy(lo);
             } else {
                 require(PyCallable_Check(policy.ptr()) || py::hasattr(policy, "decide"),
                         "policy: expected 'library', a callable or an object with decide(observation)");
@@ -265,12 +269,14 @@ void bind_control(py::module_& m) {
         },
         py::arg("scene"), py::arg("goal"), py::kw_only(), py::arg("library"), py::arg("time"), py::arg("truth") = py::none(),
         py::arg("camera") = py::none(), py::arg("start") = py::none(), py::arg("policy") = "library",
-        py::arg("tol") = Goal{}.tolerance, py::arg("seed") = py::none(), py::arg("horizon") = LibraryPolicyOptions{}.horizon,
-        py::arg("grid") = 13,
+        py::arg("tol") = Goal{}.tolerance, py::arg("seed") = py::none(), py::arg("horizon") = py::none(), py::arg("grid") = 13,
+        py::arg("switch_cost") = MpcPolicyOptions{}.switch_cost, py::arg("correction") = true,
         "A closed-loop run (`plate control`): from `start` at rest, each plate period the policy chooses the next\n"
         "motion from the camera's newest frame; the true plate runs it through the full dynamics. library, truth,\n"
         "camera: a file's path or a dict in its form (camera also a plate.Camera; None: a perfect camera at phase 0,\n"
-        "the scene itself as truth). policy: 'library' (horizon periods), or a callable f(observation) -> motion\n"
+        "the scene itself as truth). policy: 'library' (a motion judged kept for horizon periods, default 2),\n"
+        "'mpc' (point parts: the best sequence of horizon motions, default 3, plus switch_cost [m] per switch, on\n"
+        "the model corrected online by a fitted gain and drift unless correction=False), or a callable f(observation) -> motion\n"
         "(observation: a dict period, t, seen, observed (s_x, s_y, theta) or None, state_time, motions; the motion:\n"
         "a library index, a motion's name, a plate.Scene of the same period or a list of harmonics dicts), or an\n"
         "object with decide(observation) (and reset(), called before the run). seed (if given): the truth's draw\n"

@@ -29,16 +29,18 @@ def scene():
 
 
 @pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
-def test_the_library_policy_gives_the_command_lines_run_to_the_bit(tmp_path):
+@pytest.mark.parametrize("policy", ["library", "mpc"])
+def test_the_library_and_mpc_policies_give_the_command_lines_run_to_the_bit(tmp_path, policy):
     (tmp_path / "truth.json").write_text(json.dumps(TRUTH))
     (tmp_path / "camera.json").write_text(json.dumps(CAMERA))
     out = tmp_path / "run.csv"
     cli = subprocess.run([EXE, "control", SCENE, "--goal", "0.02", "-0.01", "--start", "-0.04", "0.03", "--policy",
-                          "library", "--library", LIBRARY, "--camera", str(tmp_path / "camera.json"), "--truth",
+                          policy, "--library", LIBRARY, "--camera", str(tmp_path / "camera.json"), "--truth",
                           str(tmp_path / "truth.json"), "--time", "3", "--out", str(out)], capture_output=True, text=True)
     assert cli.returncode == 0, cli.stderr
     expected = json.loads(cli.stdout)
-    run = plate.control(scene(), GOAL, library=LIBRARY, truth=TRUTH, camera=CAMERA, start=(-0.04, 0.03), time=3.0)
+    run = plate.control(scene(), GOAL, library=LIBRARY, truth=TRUTH, camera=CAMERA, start=(-0.04, 0.03), time=3.0,
+                        policy=policy)
     wall = {"decision_mean_s", "decision_max_s", "decision_p99_s"}   # wall-clock times differ run to run
     assert {k: v for k, v in run.summary.items() if k not in wall} == {k: v for k, v in expected.items() if k not in wall}
     assert run.summary["reached"] and run.reached and run.summary["periods"] == 60
@@ -51,7 +53,11 @@ def test_the_library_policy_gives_the_command_lines_run_to_the_bit(tmp_path):
     assert np.array_equal(cells[:, 1:3], run.observed[:, :2], equal_nan=True)
     assert np.array_equal(cells[:, 3:5], run.truth[:, :2])
     assert [r[5] for r in rows[:-1]] == [run.motions[m] for m in run.motion[:-1]]
-    assert "plate.ControlRun policy library: 60 periods, goal reached" in repr(run)
+    assert f"plate.ControlRun policy {policy}: 60 periods, goal reached" in repr(run)
+    if policy == "mpc":   # the correction changes the run: without it the rows differ
+        plain = plate.control(scene(), GOAL, library=LIBRARY, truth=TRUTH, camera=CAMERA, start=(-0.04, 0.03), time=3.0,
+                              policy=policy, correction=False)
+        assert not np.array_equal(plain.truth, run.truth)
 
 
 def test_a_python_policy_on_the_still_plate_leaves_the_part_where_it_is():

@@ -221,6 +221,40 @@ struct LibraryPolicyOptions {
 inline constexpr int kMaxHorizon = 1000;
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
 
+// `mpc` (point parts): each period, the sequence of `horizon` library motions -- a switch allowed at
+// every period -- whose predicted path has the least cost, the mean weighted distance to the goal after
+// each period plus switch_cost per switch; its first motion is applied (receding horizon). The path is
+// the model's steps (ControlModel::step) corrected online: between consecutive frames the observed
+// displacement against the model's over the same stretch (the motions then chosen), fitted by
+// exponentially forgotten least squares (`forgetting` per frame) as
+//     dq_seen = gain dq_model + drift (dt / T),
+// a gain on the model's transport (friction changes the speeds) and a drift per period (tracking errors,
+// a tilt), with a prior (gain 1, drift 0) worth prior_travel of predicted travel and prior_frames frames.
+// Inside stop_radius the still plate, left only beyond stop_radius + hysteresis (the library policy's
+// rule). Every motions^horizon sequence is searched (a tree: the prefixes' steps shared).
+struct MpcPolicyOptions {
+    int horizon = 3;                // [periods], 1..kMaxMpcHorizon, motions^horizon <= kMaxMpcSequences
+    double switch_cost = 0.05e-3;   // [m] per switch
+    double forgetting = 0.9;        // per frame, in (0, 1]
+    bool correct = true;            // false: the nominal model, uncorrected
+    double prior_travel = 0.5e-3;   // [m]
+    double prior_frames = 1;
+    double stop_radius = 0.5e-3;   // [m]
+    double hysteresis = 0.1e-3;    // [m]
+    void validate() const;         // std::invalid_argument naming the option
+};
+inline constexpr int kMaxMpcHorizon = 8;
+inline constexpr long kMaxMpcSequences = 1'000'000;
+// The correction an mpc policy holds (its latest), for the run's summary and tests.
+struct MpcEstimate {
+    double gain = 1;
+    Vec2 drift = Vec2::Zero();   // [m per period]
+    int frames = 0;              // frame pairs fitted
+};
+std::unique_ptr<Policy> make_mpc_policy(const MpcPolicyOptions& opt = {});
+// The estimate of a policy made by make_mpc_policy (std::invalid_argument for another policy).
+MpcEstimate mpc_estimate(const Policy& mpc);
+
 // Open loop, for comparison: a model of one motion -- the plate of the scene file at `path`, kept all
 // run (its field is not needed: the model's one field is a zero placeholder) -- and the policy that
 // never switches from it. What an open-loop design does on the same truth and starts.

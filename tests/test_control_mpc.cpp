@@ -1,0 +1,138 @@
+// The `mpc` policy (control.hpp, issue 53): its online correction recovers a gain and a drift the model
+// does not have, exactly on exact data; on the issue's test plate it brings the point part in as the
+// target asks; what it cannot steer is refused by name.
+#include "plate/control.hpp"
+#include "plate/scene_io.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace plate;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
+
+namespace {
+
+const std::string kScenes = PLATE_SOURCE_DIR "/scenes/";
+
+// A model whose motions are uniform fields given by hand: the still plate and transports at 0.02 m/s
+// east, north and west (the plates themselves are not read by the policy).
+ControlModel hand_model() {
+    ControlModel m;
+    m.nominal = load_scene(kScenes + "fig1_point.json");
+    m.library.names = {"still", "east", "north", "west"};
+    m.library.motions.assign(4, m.nominal.plate);
+    m.library.still = 0;
+    for (const Vec3& xi : {Vec3(0, 0, 0), Vec3(0.02, 0, 0), Vec3(0, 0.02, 0), Vec3(-0.02, 0, 0)}) {
+        MotionField f;
+        f.uniform = true;
+        f.twist = {xi};
+        m.fields.push_back(f);
+    }
+    return m;
+}
+
+}   // namespace
+
+TEST_CASE("mpc: the online fit recovers the true gain and drift from exact frames", "[control][mpc]") {
+    // A synthetic plate: each period the part moves by gain * xi T + drift, seen without noise or latency.
+    // With priors far below the data (1e-9 m of travel, 1e-9 frames) the forgotten least squares solve an
+    // exact, consistent system once two motions have been seen: the estimate is the truth to rounding
+    // (measured: gain to 9e-13, drift to 3e-15 m). Seen failing: with the regressor taken from the
+    // corrected model (the gain fitted onto itself) the synthetic part is not in within 40 periods.
+    const ControlModel m = hand_model();
+    MpcPolicyOptions o;
+    o.prior_travel = 1e-9;
+    o.prior_frames = 1e-9;
+    auto p = make_mpc_policy(o);
+    Goal goal;
+    goal.q = Vec3(0.01, 0.006, 0);
+    p->reset(m, goal);
+    const double T = m.T(), gain = 0.8;
+    const Vec2 drift(1.5e-5, -2.5e-5);   // [m per period]
+    Vec3 q = Vec3::Zero();
+    bool used[4] = {false, false, false, false};
+    long k = 0;
+    for (; k < 40 && !goal.within(q); ++k) {
+        Observation obs;
+        obs.t = obs.stamp = obs.state_time = k * T;
+        obs.seen = true;
+        obs.q = q;
+        const Decision d = p->decide(obs, k);
+        REQUIRE((d.motion >= 0 && d.motion < 4));
+        used[d.motion] = true;
+        q += gain * m.fields[d.motion].twist[0] * T;
+        q.x() += drift.x();
+        q.y() += drift.y();
+    }
+    REQUIRE(goal.within(q));   // (the corrected model steers the synthetic part in)
+    REQUIRE((used[1] && used[2]));
+    const MpcEstimate e = mpc_estimate(*p);
+    CHECK(e.frames == k - 1);
+    CHECK_THAT(e.gain, WithinAbs(gain, 1e-9));
+    CHECK_THAT(e.drift.x(), WithinAbs(drift.x(), 1e-12));
+    CHECK_THAT(e.drift.y(), WithinAbs(drift.y(), 1e-12));
+    // Without the correction the estimate stays the nominal model's.
+    o.correct = false;
+    auto nominal = make_mpc_policy(o);
+    nominal->reset(m, goal);
+    Observation obs;
+    obs.seen = true;
+    for (long j = 0; j < 5; ++j) {
+        obs.stamp = obs.state_time = obs.t = j * T;
+        obs.q = Vec3(0.001 * j, 0, 0);
+        nominal->decide(obs, j);
+    }
+    CHECK(mpc_estimate(*nominal).frames == 0);
+    CHECK(mpc_estimate(*nominal).gain == 1);
+}
+
+TEST_CASE("mpc: on the issue's test plate the point part comes within 1 mm in 10 s and stays", "[control][mpc]") {
+    // fig1_point's library, the issue's truth (friction x0.8, 3 % / 0.03 rad per period), a world camera
+    // with 0.1 mm noise one period late; bench_control's first 3 starts (bench_control --mpc: 20 of 20,
+    // the slowest after 2.35 s).
+    const Scene sc = load_scene(kScenes + "fig1_point.json");
+    ControlModelOptions mo;
+    mo.field.threads = 1;
+    const ControlModel model = build_control_model(sc, load_motion_library(kScenes + "control/fig1_point/library.json", sc), mo);
+    Goal goal;
+    goal.q = Vec3(0.02, -0.01, 0);
+    for (std::uint64_t i = 0; i < 3; ++i) {
+        Camera cam;
+        cam.per_period = 1;
+        cam.noise_xy_mm = 0.1;
+        cam.latency = sc.plate.T;
+        cam.seed = i;
+        cam.frame = CameraFrame::world;
+        ControlOptions opt;
+        opt.duration = 10;
+        auto p = make_mpc_policy();
+        const ControlSummary s = run_control(model, *p, spread_truth(0.8, 0.03, i), cam, goal, square_start(i, false), opt);
+        INFO("start " << i);
+        CHECK(s.reached);
+        CHECK(s.final_error < 1e-3);
+        CHECK(s.policy == "mpc");
+    }
+}
+
+TEST_CASE("mpc: a rigid part, too many sequences and bad options are refused by name", "[control][mpc]") {
+    ControlModel m = hand_model();
+    m.nominal = load_scene(kScenes + "fig4.json");
+    auto p = make_mpc_policy();
+    CHECK_THROWS_WITH(p->reset(m, Goal{}), Contains("steers point parts"));
+    m = hand_model();
+    MpcPolicyOptions o;
+    o.horizon = 8;   // 4^8 = 65536 sequences: allowed
+    CHECK_NOTHROW(make_mpc_policy(o)->reset(m, Goal{}));
+    m.fields.resize(6, m.fields[0]);
+    m.library.names.resize(6, "more");
+    m.library.motions.resize(6, m.nominal.plate);   // 6^8 = 1679616 sequences
+    CHECK_THROWS_WITH(make_mpc_policy(o)->reset(m, Goal{}), Contains("shorten the horizon"));
+    o.horizon = 0;
+    CHECK_THROWS_WITH(make_mpc_policy(o), Contains("horizon: expected 1 to 8"));
+    o = {};
+    o.forgetting = 1.5;
+    CHECK_THROWS_WITH(make_mpc_policy(o), Contains("forgetting"));
+    CHECK_THROWS_WITH(mpc_estimate(*make_library_policy()), Contains("not an mpc policy"));
+}
