@@ -143,7 +143,8 @@ private:
         if (cost >= best_cost_) return;   // (costs only grow down the tree)
         for (int k = 0; k < model_->motions(); ++k) {
             const Vec3 next = q + step(previous, k, q);
-            const double c = cost + (goal_.distance(next) + (previous >= 0 && k != previous ? opt_.switch_cost : 0.0)) / opt_.horizon;
+            const double c =
+                cost + (goal_.distance(next) + (previous >= 0 && k != previous ? opt_.switch_cost : 0.0)) / opt_.horizon;
             descend(next, k, depth + 1, c, depth == 0 ? k : first);
         }
     }
