@@ -49,7 +49,8 @@ NUMERIC_LEVELS = [
                 "src/engine_modes.hxx", "src/engine_creep.hxx",
                 "include/plate/simulate.hpp"]),   # the options, stops and samples the engine fills
     ("simulate/limit_cycle", ["src/simulate.cpp", "include/plate/limit_cycle.hpp", "src/limit_cycle.cpp",
-                              "src/cycle_solvers.hpp", "src/shooting_cycle.cpp"]),
+                              "src/cycle_solvers.hpp", "src/shooting_cycle.cpp",
+                              "src/newton_cycle.cpp", "src/newton_cycle_web.cpp"]),
     ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp", "src/fixed_regions.hpp",
                             "src/fixed_regions.cpp", "src/rotating_attractors.cpp", "include/plate/output.hpp",
                             "src/output.cpp"]),
