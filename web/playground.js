@@ -22,7 +22,7 @@ const consoleError = console.error.bind(console);
 console.error = (...a) => { noteError(a.join(' ')); consoleError(...a); };
 
 // --- the worker and its requests --------------------------------------------------------------
-const playground = {scene: null, source: '', lastField: null, lastFixed: null, lastTrajectory: null, requests: 0};
+const playground = {scene: null, source: '', lastField: null, lastFixed: null, lastTrajectory: null, requests: 0, fieldsShown: 0};
 window.playground = playground;
 const worker = new Worker('worker.js');
 const lanes = {};   // kind -> {latest, inFlight, waiting}
@@ -165,6 +165,7 @@ function changed() {
   ask('field', Object.assign({op: 'field'}, request), answer => {
     if (!sceneAnswer(answer)) return;
     playground.lastField = answer.field;
+    playground.fieldsShown++;
     playground.lastFieldMilliseconds = answer.milliseconds;
     stopAnimation();
     const info = PlateDraw.field($('plot'), answer.field, null);

@@ -19,14 +19,20 @@ let failed = 0;
 const fail = msg => { console.log('FAIL: ' + msg); failed++; };
 const idle = "document.body.dataset.state === 'idle'";
 
-// Moves the slider `id` to value(old) through its input event; waits for the field it causes.
+// Moves the slider `id` through its input event three times in a row, as a dragging hand does, the last
+// time to value(old); waits for the field. Returns the value and how many fields the page drew meanwhile:
+// one, the last slider position's (the first request is in flight when the others come; the second is
+// replaced by the third before it is sent, and the first one's answer is stale, dropped).
 async function moveSlider(page, id, value) {
   return page.evaluate(`(async () => {
-    const s = document.getElementById(${JSON.stringify(id)}), before = playground.lastField;
-    s.value = (${value})(+s.value);
-    s.dispatchEvent(new Event('input', {bubbles: true}));
+    const s = document.getElementById(${JSON.stringify(id)}), before = playground.lastField, shown = playground.fieldsShown;
+    const last = (${value})(+s.value), first = +s.value;
+    for (const v of [first + 0.5 * (last - first), first + 0.75 * (last - first), last]) {
+      s.value = v;
+      s.dispatchEvent(new Event('input', {bubbles: true}));
+    }
     await ${until(`playground.lastField !== before && ${idle}`)};
-    return +s.value;
+    return {value: +s.value, drawn: playground.fieldsShown - shown};
   })()`);
 }
 
@@ -34,7 +40,8 @@ async function check(base, name, slider, value) {
   const page = await open(`${base}/index.html?scene=${name}`);
   try {
     await page.evaluate(until(`playground.lastField && ${idle}`));
-    const moved = await moveSlider(page, slider, value);
+    const {value: moved, drawn} = await moveSlider(page, slider, value);
+    if (drawn !== 1) fail(`${name}: ${drawn} fields drawn for three quick slider moves, not only the last one's`);
     const got = await page.evaluate(`({scene: JSON.stringify(playground.scene), field: playground.lastField,
                                        theta: +document.getElementById('theta').value})`);
     // the field is the slice the page's theta control shows (a point part's: theta 0)
@@ -57,7 +64,7 @@ async function check(base, name, slider, value) {
     if (native.points.length !== got.field.points.length || mismatched)
       fail(`${name}: ${mismatched} points differ in place or convergence (${got.field.points.length} vs ${native.points.length})`);
     if (!(worst <= TOL)) fail(`${name}: the page's field differs from plate field by ${worst}`);
-    console.log(`${name}: ${slider} moved to ${moved}; the page's ${got.field.points.length}-point field against plate field: ` +
+    console.log(`${name}: ${slider} moved (three quick moves, ${drawn} field drawn) to ${moved}; the page's ${got.field.points.length}-point field against plate field: ` +
                 `largest difference ${worst.toExponential(3)}`);
     // drop a part at (30 %, 30 %) of the plot and let the trajectory draw
     await page.evaluate(`(async () => {
