@@ -4,7 +4,8 @@
 // and fixed points are written by the program's own to_json.
 //
 //   request  {"op": "scene" | "field" | "fixed_points" | "trajectory", "scene": TEXT, "source": NAME, ...}
-//     field, fixed_points: "grid": {"nx", "ny", "x": [MIN, MAX], "y": [MIN, MAX], "theta": THETA}
+//     field, fixed_points: "grid": {"nx", "ny", "x": [MIN, MAX], "y": [MIN, MAX], "theta": THETA},
+//                          "max_work": right-hand sides (default a tenth of `plate field`'s)
 //                          (a rigid part's field is the slice at theta; a point part has no theta)
 //     trajectory:          "q0": [s_x, s_y(, theta)], "duration": s, "dt": s (full dynamics from rest)
 //   answer   {"ok": true, ...} or {"ok": false, "error": MESSAGE}
@@ -55,7 +56,13 @@ const Field& field_of(const Scene& sc, const json& rq) {
         last_key.clear();
         FieldOptions fo;
         fo.threads = 1;   // (no threads in the browser's module; the field is the same on any number)
+        // Bounded as `plate field` bounds it (field.hpp): refused up front when estimated over the
+        // budget, stopped (and refused) if it spends it anyway. A tenth of the program's default: tens
+        // of seconds in a page.
+        fo.max_rhs_evaluations = rq.value("max_work", kDefaultFieldWork / 10);
+        require_field_work(sc, grid, fo.cycle, fo.max_rhs_evaluations, "the request's max_work");
         last = compute_field(sc, grid, fo);
+        if (last.budget_spent) throw std::invalid_argument("the field spent its work budget (max_work) before it was complete");
         last_key = key;
     }
     return last;
@@ -93,6 +100,7 @@ json answer(const json& rq) {
         out["point_part"] = sc.part.point;
     } else if (op == "field") {
         out["field"] = to_json(sc, field_of(sc, rq));
+        out["warnings"] = scene_warnings(sc);
     } else if (op == "fixed_points") {
         const Field& f = field_of(sc, rq);
         out["field"] = to_json(sc, f);

@@ -141,6 +141,10 @@ function showScene() {
   $('theta-row').hidden = isPoint();
   changed();
 }
+// The program's warnings on the scene (outside the intended regime), listed under the scene's controls.
+function showWarnings(warnings) {
+  $('scene-warnings').replaceChildren(...warnings.map(w => Object.assign(document.createElement('li'), {textContent: w})));
+}
 // A scene file's text, read and judged by the module (the program's reader and messages): shown when
 // admissible, its message (and the current scene kept) when not; the program's warnings listed.
 function loadScene(text, source) {
@@ -148,7 +152,7 @@ function loadScene(text, source) {
     if (!sceneAnswer(answer)) return;
     playground.scene = answer.scene;
     playground.source = source;
-    $('scene-warnings').replaceChildren(...answer.warnings.map(w => Object.assign(document.createElement('li'), {textContent: w})));
+    showWarnings(answer.warnings);
     $('grid-n').value = isPoint() ? 25 : 13;   // (a rigid part's cycles cost more: a coarser slice)
     showScene();
   });
@@ -164,6 +168,7 @@ function changed() {
   const request = {scene: sceneText(), source: playground.source, grid: grid()};
   ask('field', Object.assign({op: 'field'}, request), answer => {
     if (!sceneAnswer(answer)) return;
+    showWarnings(answer.warnings);
     playground.lastField = answer.field;
     playground.fieldsShown++;
     playground.lastFieldMilliseconds = answer.milliseconds;

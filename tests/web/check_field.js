@@ -98,6 +98,17 @@ require(path.resolve(site, 'plate_web.js'))().then(M => {
   if (r.ok || !nativeError.includes(r.error)) fail(`bad scene: the module says '${r.error}', the program '${nativeError.trim()}'`);
   else console.log(`bad scene: both say '${r.error}'`);
   fs.rmSync(path.dirname(tmp), {recursive: true});
+  // A field over its work budget is refused up front, with the program's estimate.
+  {
+    const file = path.join(src, 'scenes/fig4.json');
+    let nativeError = '';
+    try { execFileSync(exe, ['field', file, '--grid', '41', '--ntheta', '1', '--max-work', '100000'], {stdio: 'pipe'}); } catch (e) { nativeError = String(e.stderr); }
+    const r = call({op: 'field', scene: fs.readFileSync(file, 'utf8'), grid: {nx: 41, ny: 41}, max_work: 100000});
+    const estimate = s => (/a 41x41x1 grid would take about \S+ right-hand sides/.exec(s) || ['(none)'])[0];
+    if (r.ok || estimate(r.error) === '(none)' || estimate(r.error) !== estimate(nativeError))
+      fail(`a field over its budget: the module says '${r.ok ? 'ok' : r.error}', the program '${nativeError.trim()}'`);
+    else console.log(`a field over its budget: both say '${estimate(r.error)}'`);
+  }
   console.log(failed ? `${failed} failure(s)` : 'web field matches the native program');
   process.exit(failed ? 1 : 0);
 });
