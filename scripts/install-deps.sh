@@ -12,7 +12,8 @@ pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-d
       ccache                  # (the mutation catalogue's scratch build reuses the build's objects)
       libopenmpi-dev openmpi-bin
       libbullet-dev libode-dev libmujoco-dev   # (these three: the peer engines, optional to the build)
-      libsiconos-numerics-dev)   # (the Moreau-Jean stick-slip reference, tests/test_siconos.cpp; optional)
+      libsiconos-numerics-dev   # (the Moreau-Jean stick-slip reference, tests/test_siconos.cpp; optional)
+      emscripten)   # (the playground in WebAssembly, web/: optional, the target `web` when found)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

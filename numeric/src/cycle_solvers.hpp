@@ -1,6 +1,6 @@
 // Internal: what the limit-cycle solvers share -- one period of the period map, the stick tests and
 // the stick bookkeeping of a period, the twist's scales -- and the shooting solver (shooting_cycle.cpp),
-// which limit_cycle() calls (limit_cycle.cpp: plain periods, Anderson, Newton).
+// which limit_cycle() calls (limit_cycle.cpp: plain periods and Anderson; newton_cycle.cpp: Newton).
 #pragma once
 
 #include "engine.hpp"
@@ -56,6 +56,10 @@ struct CycleRun {
     CycleRun(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt)
         : sc(sc), q0(q0), opt(opt), model(sc, q0), e(model, sc, opt.integration), T(sc.plate.T) {}
 };
+
+// Newton's method on the period map from qd0 with a finite-difference monodromy (newton_cycle.cpp,
+// GSL's gnewton; the web build, without GSL, refuses it: newton_cycle_web.cpp).
+LimitCycleSummary newton_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0);
 
 // Newton shooting from the warm start qd0 (shooting_cycle.cpp).
 LimitCycleSummary shooting_cycle(const Scene& sc, const Vec3& q0, const LimitCycleOptions& opt, const Vec3& qd0);

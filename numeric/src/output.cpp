@@ -203,8 +203,17 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
 std::string shortest(double x) {
     if (!std::isfinite(x)) return std::string();
     char buf[32];
+#if defined(__EMSCRIPTEN__)
+    // (Emscripten's libc++ has no floating-point to_chars: the fewest significant digits that read
+    // back to x, which are to_chars' digits, in printf's %g form)
+    for (int digits = 1;; ++digits) {
+        std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+        if (digits >= 17 || std::strtod(buf, nullptr) == x) return std::string(buf);
+    }
+#else
     const auto r = std::to_chars(buf, buf + sizeof buf, x);
     return std::string(buf, r.ptr);
+#endif
 }
 
 void write_field_csv(std::ostream& out, const Field& f) {

@@ -3,7 +3,7 @@
 includes a header of a layer above its own.
 
     symbolic  <  numeric  <  experiments, proofs, design, identify, control (siblings: none includes another)
-              <  reports, sweep  <  apps, python, bench  (tests may include anything)
+              <  reports, sweep  <  apps, python, bench, web  (tests may include anything)
 
 Every #include, quoted or <angled>, is resolved to the file it names (beside the includer, then in
 the layers' include folders; angled ones that resolve to no project file are system headers), and
@@ -22,7 +22,8 @@ import sys
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
 RANK = {"symbolic": 0, "numeric": 1, "experiments": 2, "proofs": 2, "design": 2, "identify": 2, "control": 2, "reports": 3, "sweep": 3, "apps": 4,
-        "python": 4, "bench": 4}
+        "python": 4, "bench": 4,
+        "web": 4}
 NOT_LAYERS = {"tests", "examples", "scripts", "cmake", "scenes", "campaigns", ".ci", ".git"}   # no library code
 INCLUDE_DIRS = ["symbolic", "numeric/include", "numeric/generated", "numeric/src", "experiments/include", "proofs",
                 "design/include", "identify/include", "control/include", "sweep/include", "reports", "reports/generated", "apps"]
@@ -49,7 +50,8 @@ NUMERIC_LEVELS = [
                 "src/engine_modes.hxx", "src/engine_creep.hxx",
                 "include/plate/simulate.hpp"]),   # the options, stops and samples the engine fills
     ("simulate/limit_cycle", ["src/simulate.cpp", "include/plate/limit_cycle.hpp", "src/limit_cycle.cpp",
-                              "src/cycle_solvers.hpp", "src/shooting_cycle.cpp"]),
+                              "src/cycle_solvers.hpp", "src/shooting_cycle.cpp",
+                              "src/newton_cycle.cpp", "src/newton_cycle_web.cpp"]),
     ("field/fixed_points", ["include/plate/field.hpp", "src/field.cpp", "src/fixed_points.cpp", "src/fixed_regions.hpp",
                             "src/fixed_regions.cpp", "src/rotating_attractors.cpp", "include/plate/output.hpp",
                             "src/output.cpp"]),
