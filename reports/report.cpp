@@ -52,6 +52,30 @@ std::string contents_and_verdicts(const Ctx& c) {
     return o.str();
 }
 
+// The playground (issue 55): the built site copied beside the page and linked, or how to build it.
+std::string playground_section(Ctx& c, const ReportOptions& opt) {
+    std::ostringstream o;
+    o << c.heading("Playground: the field in a browser", "playground");
+    std::error_code ec;
+    const fs::path site = opt.playground;
+    if (!opt.playground.empty() && fs::exists(site / "index.html", ec)) {
+        fs::remove_all(c.dir / "playground", ec);
+        fs::copy(site, c.dir / "playground", fs::copy_options::recursive);
+        o << "<p>The playground is beside this page: <a href=\"playground/index.html\">playground/index.html</a> -- the "
+             "numeric core in WebAssembly, the field recomputed as each harmonic's and the part's sliders move, a dropped "
+             "part's full-dynamics trajectory. A Web Worker does not start from a file: serve this folder over http, e.g. "
+             "<code>python3 -m http.server -d "
+          << esc(opt.out) << " 8000</code>, and open <code>http://localhost:8000/playground/</code> (its field equals "
+          << "<code>plate field</code>'s to 1e-9: ctest -R web_).</p>\n";
+    } else {
+        fs::remove_all(c.dir / "playground", ec);   // (an older run's copy is not this build's)
+        o << "<p>Not built. To add it: <code>cmake --build build --target web</code> (Debian's emscripten; "
+             "scripts/install-deps.sh installs it), then <code>plate report</code> again copies build/web/site here as "
+             "playground/ and links it (web/README.md).</p>\n";
+    }
+    return o.str();
+}
+
 }   // namespace
 
 void write_report(const ReportOptions& opt) {
@@ -118,6 +142,7 @@ void write_report(const ReportOptions& opt) {
             html << stub;
         html << end << "\n";
     };
+    html << playground_section(c, opt);
     study(kSpeedBegin, kSpeedEnd, "speed",   // plate bench
           "<h2>Speed and accuracy</h2><p>Not run yet. To fill it: <code>plate bench --out " + out +
               "</code> writes this section into this page (work-precision charts, failure maps, limit-cycle solvers, model "

@@ -20,6 +20,9 @@ struct ReportOptions {
     // The sections to compute (names from report_section_names()); empty: all of them. The page names
     // the ones left out.
     std::vector<std::string> sections;
+    // A built playground (the web target's site, build/web/site): copied into DIR/playground and linked
+    // from the page; empty or absent: the page says how to build it.
+    std::string playground;
 };
 
 // The report's sections, in page order: derivation, kernels, proofs, fig3, fields, design, orient,

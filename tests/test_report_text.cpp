@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <stdexcept>
 #include <vector>
 
@@ -152,4 +155,37 @@ TEST_CASE("report: the robustness sentence says where the response is linear fro
     CHECK(linearity_sentence(f).find("angle") == std::string::npos);   // (a point part has none)
     f.matched = 0;
     CHECK(linearity_sentence(f).find("nothing to compare") != std::string::npos);
+}
+
+TEST_CASE("the report copies a built playground beside its page and links it, or says how to build one", "[report][text]") {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "plate-report-playground";
+    const fs::path site = fs::temp_directory_path() / "plate-report-playground-site";
+    fs::remove_all(dir);
+    fs::remove_all(site);
+    fs::create_directories(site / "scenes");
+    std::ofstream(site / "index.html") << "<!DOCTYPE html><title>a playground</title>";
+    std::ofstream(site / "scenes" / "fig1_point.json") << "{}";
+    plate::report::ReportOptions o;
+    o.out = dir.string();
+    o.source_dir = PLATE_SOURCE_DIR;
+    o.sections = {"fig3"};
+    const auto page = [&] {
+        std::ifstream in(dir / "index.html");
+        return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    };
+    plate::report::write_report(o);   // no playground given
+    CHECK(page().find("Not built. To add it: <code>cmake --build build --target web</code>") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "playground"));
+    o.playground = site.string();
+    plate::report::write_report(o);
+    CHECK(page().find("<a href=\"playground/index.html\">") != std::string::npos);
+    CHECK(fs::exists(dir / "playground" / "index.html"));
+    CHECK(fs::exists(dir / "playground" / "scenes" / "fig1_point.json"));
+    o.playground = (site / "missing").string();   // a folder without a site: as none
+    plate::report::write_report(o);
+    CHECK(page().find("Not built.") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "playground"));   // (the older copy removed)
+    fs::remove_all(dir);
+    fs::remove_all(site);
 }

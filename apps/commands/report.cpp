@@ -3,6 +3,8 @@
 
 #include "report.hpp"
 
+#include <filesystem>
+
 #include <cstdint>
 #include <iostream>
 #include <stdexcept>
@@ -52,6 +54,11 @@ int cmd_report(const ReportArgs& a, Io& cio) {
         throw UsageError(std::string("--sections: ") + e.what());
     }
     o.sections = a.sections;
+    {   // the playground, when the web target was built beside this program (build/web/site)
+        std::error_code ec;
+        const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+        if (!ec) o.playground = (exe.parent_path() / "web" / "site").string();
+    }
     report::write_report(o);
     cio.err << "report: " << o.out << "/index.html" << std::endl;
     return 0;
