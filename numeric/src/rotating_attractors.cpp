@@ -209,7 +209,8 @@ void find_axis_rotations(const Scene& sc, const Field& field, const FixedPointOp
                 D = G.jacobian(b, gb, h);
                 closed = step.norm() < tol;
             }
-            if (!closed || omega == 0) continue;
+            // omega zero within the zero search's tolerance: a fixed point of the field, not a rotation.
+            if (!closed || sc.part.rho() * std::abs(omega) <= opt.ftol * sc.v_ref()) continue;
             bool dup = false;
             for (const auto& r : fp.rotating) dup = dup || (r.pivot - b).norm() < 0.1 * cell;
             if (dup) continue;
