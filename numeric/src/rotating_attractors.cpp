@@ -194,11 +194,13 @@ void find_axis_rotations(const Scene& sc, const Field& field, const FixedPointOp
     const double reach = Vec2(std::max(-g.x0, g.x1), std::max(-g.y0, g.y1)).norm() + cell;
     const long left = opt.max_rhs_evaluations > 0 ? std::max(1L, opt.max_rhs_evaluations - fp.rhs_evaluations) : 0;
     AxisField G{sc, cycle, g.th0, left};
-    try {
-        for (Vec2 b : axis_starts(field, sc.part.rho(), cell, kAxisStartsPerOrbitStart * opt.max_orbit_starts)) {
-            bool closed = false;
-            double omega = 0;
-            Vec2 gb = G(b, &omega);
+    for (Vec2 b : axis_starts(field, sc.part.rho(), cell, kAxisStartsPerOrbitStart * opt.max_orbit_starts)) {
+        bool closed = false;
+        double omega = 0;
+        Vec2 gb;
+        Eigen::Vector2cd ev, ev2;
+        try {
+            gb = G(b, &omega);
             Eigen::Matrix2d D = G.jacobian(b, gb, h);
             for (int it = 0; it < kMaxAxisNewton && !closed; ++it) {
                 Vec2 step = -D.fullPivLu().solve(gb);
@@ -210,30 +212,33 @@ void find_axis_rotations(const Scene& sc, const Field& field, const FixedPointOp
                 closed = step.norm() < tol;
             }
             // omega zero within the zero search's tolerance: a fixed point of the field, not a rotation.
-            if (!closed || sc.part.rho() * std::abs(omega) <= opt.ftol * sc.v_ref()) continue;
-            bool dup = false;
-            for (const auto& r : fp.rotating) dup = dup || (r.pivot - b).norm() < 0.1 * cell;
-            if (dup) continue;
-            const Eigen::Vector2cd ev = Eigen::EigenSolver<Eigen::Matrix2d>(G.jacobian(b, gb, h, true)).eigenvalues();
-            const Eigen::Vector2cd ev2 = Eigen::EigenSolver<Eigen::Matrix2d>(G.jacobian(b, gb, 2 * h, true)).eigenvalues();
-            RotatingAttractor ra;
-            const Vec2 s = G.s_of(b);
-            ra.q = Vec3(s[0], s[1], wrap_angle(g.th0));
-            ra.rate = omega;
-            ra.period = 2 * kPi / std::abs(omega);
-            ra.multipliers = (ev * ra.period).array().exp();
-            ra.stability = classify_eigenvalues(ev, real_part_error(ev, ev2));
-            ra.residual = gb.norm() * ra.period;
-            // Within the closing tolerance of the axis the position itself is settled there.
-            const bool settled = b.norm() < tol;
-            ra.centre = settled ? s : Vec2::Zero();
-            ra.radius = settled ? 0 : b.norm();
-            ra.wobble = 2 * ra.radius;
-            ra.pivot = settled ? Vec2::Zero() : b;
-            fp.rotating.push_back(ra);
+            closed = closed && sc.part.rho() * std::abs(omega) > opt.ftol * sc.v_ref();
+            for (const auto& r : fp.rotating) closed = closed && (r.pivot - b).norm() >= 0.1 * cell;
+            if (closed) {
+                ev = Eigen::EigenSolver<Eigen::Matrix2d>(G.jacobian(b, gb, h, true)).eigenvalues();
+                ev2 = Eigen::EigenSolver<Eigen::Matrix2d>(G.jacobian(b, gb, 2 * h, true)).eigenvalues();
+            }
+        } catch (const FieldUndefined&) {
+            closed = false;   // this start's Newton left the defined field; the next start goes on
+        } catch (const BudgetSpent&) {
+            break;
         }
-    } catch (const FieldUndefined&) {
-    } catch (const BudgetSpent&) {
+        if (!closed) continue;
+        RotatingAttractor ra;
+        const Vec2 s = G.s_of(b);
+        ra.q = Vec3(s[0], s[1], wrap_angle(g.th0));
+        ra.rate = omega;
+        ra.period = 2 * kPi / std::abs(omega);
+        ra.multipliers = (ev * ra.period).array().exp();
+        ra.stability = classify_eigenvalues(ev, real_part_error(ev, ev2));
+        ra.residual = gb.norm() * ra.period;
+        // Within the closing tolerance of the axis the position itself is settled there.
+        const bool settled = b.norm() < tol;
+        ra.centre = settled ? s : Vec2::Zero();
+        ra.radius = settled ? 0 : b.norm();
+        ra.wobble = 2 * ra.radius;
+        ra.pivot = settled ? Vec2::Zero() : b;
+        fp.rotating.push_back(ra);
     }
     fp.evaluations += G.evals;
     fp.rhs_evaluations += G.rhs_evals;
