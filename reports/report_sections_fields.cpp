@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,74 @@ struct QuiverScale {
     std::string arrow, caption;
 };
 QuiverScale quiver_scale(const GridSpec& g, double k, bool point);
+
+// Gnuplot objects for an s_x-s_y figure: each stuck region's extent (a shaded rectangle), each rotating
+// orbit's position on its section (a marker labelled with its rate and stability) and, where the
+// position circles, that circle (dashed); the ranges then hold them with the grid.
+std::string fixed_set_marks(const FixedPoints& fp, const GridSpec& g) {
+    std::string o;
+    double x0 = g.x0, x1 = g.x1, y0 = g.y0, y1 = g.y1;
+    int tag = 100;   // above the arrow scale's labels and arrows (90, 91)
+    for (const StuckRegion& r : fp.stuck_regions)
+        o += "set object " + std::to_string(tag++) + " rect from " + fmt(r.lo[0], 6) + "," + fmt(r.lo[1], 6) + " to " +
+             fmt(r.hi[0], 6) + "," + fmt(r.hi[1], 6) +
+             " fc rgb '#9999cc' fs transparent solid 0.3 border lc rgb '#333399' back\n";
+    for (const RotatingAttractor& r : fp.rotating) {
+        if (r.radius > 0) {
+            o += "set object " + std::to_string(tag++) + " ellipse at " + fmt(r.centre[0], 6) + "," + fmt(r.centre[1], 6) +
+                 " size " + fmt(2 * r.radius, 6) + "," + fmt(2 * r.radius, 6) +
+                 " units xy fs empty border lc rgb '#208020' dashtype 2 lw 1.5 front\n";
+            x0 = std::min(x0, r.centre[0] - r.radius);
+            x1 = std::max(x1, r.centre[0] + r.radius);
+            y0 = std::min(y0, r.centre[1] - r.radius);
+            y1 = std::max(y1, r.centre[1] + r.radius);
+        }
+        o += "set label " + std::to_string(tag++) + " 'ω " + fmt(r.rate, 3) + " rad/s, " + stability_name(r.stability) + "' at " +
+             fmt(r.q[0], 6) + "," + fmt(r.q[1], 6) +
+             " point pt 7 ps 1.5 lc rgb '#208020' offset 0.8,0.6 font ',10' textcolor rgb '#206020' front\n";
+    }
+    bool circles = false;
+    for (const RotatingAttractor& r : fp.rotating) circles = circles || r.radius > 0;
+    if (circles) o += "set size ratio -1\n";   // circles drawn round
+    if (x0 < g.x0 || x1 > g.x1 || y0 < g.y0 || y1 > g.y1) {
+        const double pad = 0.05 * std::max(x1 - x0, y1 - y0);
+        o += "set xrange [" + fmt(x0 - pad, 6) + ":" + fmt(x1 + pad, 6) + "]\nset yrange [" + fmt(y0 - pad, 6) + ":" +
+             fmt(y1 + pad, 6) + "]\n";
+    }
+    return o;
+}
+
+// The table's rows for what find_fixed_points found: points, lines, stuck regions (their extent) and
+// rotating orbits (rate, and the circle the position follows).
+void fixed_set_rows(std::ostream& html, const FixedPoints& fp, bool pt) {
+    for (const auto& p : fp.points) {
+        html << "<tr><td>point</td><td>(" << fmt(p.q[0], 3) << ", " << fmt(p.q[1], 3) << (pt ? "" : ", " + fmt(p.q[2], 4))
+             << ")</td><td>" << stability_name(p.stability) << "</td><td>";
+        for (int i = 0; i < (pt ? 2 : 3); ++i) html << fmt(p.eigenvalues[i].real(), 3) << " ";
+        html << "</td></tr>\n";
+    }
+    for (const auto& l : fp.lines) {
+        const Vec3 &a = l.points.front(), &b = l.points.back();
+        html << "<tr><td>line</td><td>(" << fmt(a[0], 3) << ", " << fmt(a[1], 3) << (pt ? "" : ", " + fmt(a[2], 3)) << ") … ("
+             << fmt(b[0], 3) << ", " << fmt(b[1], 3) << (pt ? "" : ", " + fmt(b[2], 3)) << ")</td><td>"
+             << stability_name(l.stability) << "</td><td>";
+        for (int i = 0; i < (pt ? 2 : 3); ++i) html << fmt(l.eigenvalues[i].real(), 3) << " ";
+        html << "</td></tr>\n";
+    }
+    for (const auto& r : fp.stuck_regions)
+        html << "<tr><td>stuck region (" << r.grid_points << " grid points)</td><td>x " << fmt(r.lo[0], 3) << " … "
+             << fmt(r.hi[0], 3) << ", y " << fmt(r.lo[1], 3) << " … " << fmt(r.hi[1], 3)
+             << (pt || r.all_theta ? "" : ", θ " + fmt(r.lo[2], 3) + " … " + fmt(r.hi[2], 3))
+             << "</td><td>fixed (sticks)</td><td>—</td></tr>\n";
+    for (const auto& r : fp.rotating) {
+        html << "<tr><td>rotating orbit, " << fmt(r.rate, 4) << " rad/s</td><td>(" << fmt(r.q[0], 3) << ", " << fmt(r.q[1], 3)
+             << ") at θ = " << fmt(r.q[2], 3);
+        if (r.radius > 0)
+            html << "; circling (" << fmt(r.centre[0], 3) << ", " << fmt(r.centre[1], 3) << ") at radius " << fmt(r.radius, 3);
+        html << "</td><td>" << stability_name(r.stability) << "</td><td>multipliers |μ| " << fmt(std::abs(r.multipliers[0]), 3)
+             << " " << fmt(std::abs(r.multipliers[1]), 3) << "</td></tr>\n";
+    }
+}
 
 // The quiver's scale: a reference arrow above a 2-D field plot, drawn in the axis it measures (`horizontal`:
 // along x, else along y), `length` [axis units] for `speed` [unit]; gnuplot commands.
@@ -222,10 +291,11 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const std::string kFieldSize = "800,640";   // field figures: large enough to read the arrows
         const QuiverScale qs = quiver_scale(g, k, pt);
         const std::string &scale = qs.arrow, &scale_y = qs.arrow, &scale_text = qs.caption;
+        const std::string marks = fixed_set_marks(fp, g);
         if (pt) {
             c.plot(n + "_xy",
-                   scale + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nplot " + F + " u 1:2:4:5" + arrows +
-                       ", " + T + " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
+                   scale + marks + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nset size ratio -1\nplot " + F + " u 1:2:4:5" +
+                       arrows + ", " + T + " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
                    std::string(f.what) + ": s_x–s_y." + scale_text, kFieldSize);
         } else {
             c.plot(n + "_3d",
@@ -233,7 +303,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                        " u 1:2:3:4:5:6" + arrows + ", " + T + " u 1:2:3 w l lw 2 lc rgb '#c02020' notitle\n",
                    std::string(f.what) + ": (s_x, s_y, θ). Arrows: the twist times " + fmt(k, 3) + " s.", kFieldSize);
             c.plot(n + "_xy",
-                   scale + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
+                   scale + marks + "set xlabel 's_x [m]'\nset ylabel 's_y [m]'\nplot " + F + " u 1:2:4:5" + arrows + ", " + T +
                        " u 1:2 w l lw 2 lc rgb '#c02020' notitle\n",
                    "s_x–s_y projection." + scale_text, kFieldSize);
             c.plot(n + "_xt",
@@ -270,22 +340,10 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                             SF + " u 1:2:3:7 w p pt 7 ps 1 palette notitle\n",
                    std::string(f.what) + ": fraction of the cycle a contact is held (largest of the contacts)", kFieldSize);
         }
-        c.html << "<table><tr><th>fixed point / line</th><th>at (from … to)</th><th>stability</th><th>eigenvalues (real "
+        c.html << "<table><tr><th>fixed point, line, stuck region or rotating orbit</th><th>at (from … "
+                  "to)</th><th>stability</th><th>eigenvalues (real "
                   "parts)</th></tr>\n";
-        for (const auto& p : fp.points) {
-            c.html << "<tr><td>point</td><td>(" << fmt(p.q[0], 3) << ", " << fmt(p.q[1], 3) << (pt ? "" : ", " + fmt(p.q[2], 4))
-                   << ")</td><td>" << stability_name(p.stability) << "</td><td>";
-            for (int i = 0; i < (pt ? 2 : 3); ++i) c.html << fmt(p.eigenvalues[i].real(), 3) << " ";
-            c.html << "</td></tr>\n";
-        }
-        for (const auto& l : fp.lines) {
-            const Vec3 &a = l.points.front(), &b = l.points.back();
-            c.html << "<tr><td>line</td><td>(" << fmt(a[0], 3) << ", " << fmt(a[1], 3) << (pt ? "" : ", " + fmt(a[2], 3))
-                   << ") … (" << fmt(b[0], 3) << ", " << fmt(b[1], 3) << (pt ? "" : ", " + fmt(b[2], 3)) << ")</td><td>"
-                   << stability_name(l.stability) << "</td><td>";
-            for (int i = 0; i < (pt ? 2 : 3); ++i) c.html << fmt(l.eigenvalues[i].real(), 3) << " ";
-            c.html << "</td></tr>\n";
-        }
+        fixed_set_rows(c.html, fp, pt);
         c.html << "</table>\n<p>" << esc(fixed_points_sentence(fp)) << ".</p>\n";
     }
     section_stick_reference(c, src, opt.quick);

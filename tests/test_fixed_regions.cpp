@@ -96,3 +96,49 @@ TEST_CASE("fixed points: fig1 on a 4-point grid warns that the grid may be too c
     CHECK(fixed_points_sentence(fp).find("the grid may be too coarse") != std::string::npos);
     CHECK(fixed_points_sentence(fp).find("try --grid 7") != std::string::npos);
 }
+
+TEST_CASE(
+    "fixed points: fig6's field turns the part about an end held at the plate's centre, at the rate its integral "
+    "curves turn",
+    "[field][rotating]") {
+    // The paper: "The field in Fig. 6 rotates the part. It has no fixed points." The plate only heaves and
+    // yaws, so the field is the same after any turn about the plate's z axis, and the part's rotations are
+    // relative equilibria: a point of the part stays on the axis while it turns about it at constant
+    // omega. Long field integral curves (docs/decisions/cycles-and-fields.md, Fixed-point outputs named
+    // right) end turning about an end: the tip contact (0, 0.052) or near the contact (0.01, -0.052).
+    const Scene sc = scene("fig6");
+    const Field f = compute_field(sc, GridSpec{});
+    const FixedPoints fp = find_fixed_points(sc, f);
+    INFO(fixed_points_sentence(fp));
+    CHECK(fp.points.empty());
+    // The 24-step return map spent 7.9e6 right-hand sides without finding it; the axis field 1.4e6.
+    CHECK(fp.rhs_evaluations < 3'000'000);
+    const RotatingAttractor* tip = nullptr;
+    const RotatingAttractor* end = nullptr;
+    for (const RotatingAttractor& r : fp.rotating) {
+        if ((r.pivot - Vec2(0, 0.052)).norm() < 1e-3) tip = &r;
+        if (r.stability == Stability::Stable) end = &r;
+    }
+    // The tip contact on the axis, where the plate does not move sideways: the part pivots about it
+    // exactly (the scene's contact, 1e-6 m: Newton closes to 1e-5 of a cell, 1.7e-7 m). Displacing the
+    // part moves the pivot with it, so the orbit is neutral to first order.
+    REQUIRE(tip);
+    CHECK((tip->pivot - Vec2(0, 0.052)).norm() < 1e-6);
+    CHECK(tip->centre.norm() == 0);
+    CHECK(tip->radius == Approx(0.052).epsilon(1e-4));
+    CHECK(tip->stability == Stability::Centre);
+    // The attractor: the rate against the mean dtheta/dt of the field's integral curve (RK4 in time in
+    // the plate's frame, no symmetry used) from 1 mm beside it, over its 20th to 60th second. Measured:
+    // -0.4707432 against -0.4707600 rad/s (1.7e-5: the curve's approach; its RK4 step 0.2 -> 0.05 s moves
+    // it 8e-7); tolerance 5e-5 rad/s.
+    REQUIRE(end);
+    CHECK(end->radius == Approx(0.052).epsilon(0.01));
+    CHECK(end->rate < 0);
+    const Vec2 s0 = end->q.head<2>() + Vec2(0.001, 0);
+    const Trajectory tr = field_curve(sc, Vec3(s0[0], s0[1], end->q[2]), 60, 1.0, LimitCycleOptions{}, 0.2);
+    REQUIRE(tr.samples.size() == 61u);
+    const Sample& a = tr.samples[20];
+    const Sample& b = tr.samples.back();
+    CHECK(end->rate == Approx((b.q[2] - a.q[2]) / (b.t - a.t)).margin(5e-5));
+    CHECK(end->period == Approx(2 * kPi / std::abs(end->rate)));
+}

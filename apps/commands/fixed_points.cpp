@@ -26,7 +26,9 @@ struct FixedPointsArgs : Options {
                   "the difference Jacobian's own error (eigen_error, from two steps). Configurations where the part\n"
                   "does not move are reported as stuck regions with their extent, not refined; orbits where the\n"
                   "position returns while theta turns once (rigid parts) as rotating attractors with their rate\n"
-                  "[rad/s]. The summary warns when the grid may be too coarse, and names a finer one.\n"
+                  "[rad/s]; on a plate motion that only heaves and yaws, the part turning about its point `pivot`\n"
+                  "held on the plate's axis, its position circling at `radius` (fig6: about its tip contact).\n"
+                  "The summary warns when the grid may be too coarse, and names a finer one.\n"
                   "JSON to stdout or --out FILE. --max-work as for field;\n"
                   "the refinement's own budget is the smaller of it and 2e7 right-hand sides.\n") {
         scene_file(scene);

@@ -55,16 +55,6 @@ struct ScaledField {
     }
 };
 
-// The error of the eigenvalues of a difference Jacobian, from the same Jacobian at twice the step:
-// the largest distance from each eigenvalue to the nearest of the other's. (The central difference's
-// truncation error grows 4x with the step, the field's noise halves: either way the difference of the
-// two is of the size of the error.)
-double eigen_error(const Eigen::VectorXcd& ev, const Eigen::VectorXcd& ev2) {
-    double err = 0;
-    for (int i = 0; i < ev.size(); ++i) err = std::max(err, (ev2.array() - ev[i]).abs().minCoeff());
-    return err;
-}
-
 
 // Gauss-Newton with SVD, the directions with singular values below `cut` * sigma_max left
 // alone (so that on a line of zeros it corrects only across the line). Backtracking on |F|.
@@ -113,6 +103,16 @@ constexpr double kInside = 1.0;
 constexpr int kMaxNearZero = 16;
 
 }   // namespace
+
+// The error of the eigenvalues of a difference Jacobian, from the same Jacobian at twice the step:
+// the largest distance from each eigenvalue to the nearest of the other's. (The central difference's
+// truncation error grows 4x with the step, the field's noise halves: either way the difference of the
+// two is of the size of the error.)
+double eigen_error(const Eigen::VectorXcd& ev, const Eigen::VectorXcd& ev2) {
+    double err = 0;
+    for (int i = 0; i < ev.size(); ++i) err = std::max(err, (ev2.array() - ev[i]).abs().minCoeff());
+    return err;
+}
 
 namespace {
 

@@ -19,6 +19,9 @@ bool at_rest(const FieldPoint& p, bool point_part, double rho, double ftol);
 std::vector<StuckRegion> stuck_regions(const Field& f, double rho, double ftol, std::vector<int>* member = nullptr);
 // "x in [a, b] m, y in [c, d] m, theta in [e, f] rad, n grid points[, reaching the grid's edge]".
 std::string stuck_region_words(const StuckRegion& r, bool point_part);
+// The error of a difference Jacobian's eigenvalues ev from the same Jacobian's at twice the step, ev2:
+// the largest distance from each eigenvalue to the nearest of the other's.
+double eigen_error(const Eigen::VectorXcd& ev, const Eigen::VectorXcd& ev2);
 // A number in 3 significant digits, for sentences.
 std::string short_num(double x);
 

@@ -168,7 +168,10 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
                             {"stability", stability_name(r.stability)},
                             {"multipliers", eig(Eigen::Vector3cd(r.multipliers[0], r.multipliers[1], 0), 2)},
                             {"residual", num(r.residual)},
-                            {"wobble", num(r.wobble)}});
+                            {"wobble", num(r.wobble)},
+                            {"centre", {num(r.centre[0]), num(r.centre[1])}},
+                            {"radius", num(r.radius)},
+                            {"pivot", {num(r.pivot[0]), num(r.pivot[1])}}});
     j["points"] = pts;
     j["lines"] = lines;
     j["candidate_cells"] = fp.candidates;
@@ -184,12 +187,13 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
     j["unresolved_cells"] = fp.unresolved_cells;   // candidates whose centre their corners do not predict
     j["grid_too_coarse"] = fp.suggested_grid > 0;
     if (fp.suggested_grid > 0) j["suggested_grid"] = fp.suggested_grid;
-    j["units"] = {{"at", d == 3 ? "m, m, rad" : "m, m"},
-                  {"eigenvalues", "1/s"},
-                  {"eigen_error", "1/s"},
-                  {"residual", "m/s (angular times rho)"},
-                  {"stuck_regions", "x, y: m; theta: rad"},
-                  {"rotating_attractors", "at: m; theta_section: rad; rate: rad/s; period: s; residual, wobble: m"}};
+    j["units"] = {
+        {"at", d == 3 ? "m, m, rad" : "m, m"},
+        {"eigenvalues", "1/s"},
+        {"eigen_error", "1/s"},
+        {"residual", "m/s (angular times rho)"},
+        {"stuck_regions", "x, y: m; theta: rad"},
+        {"rotating_attractors", "at, centre, pivot: m; theta_section: rad; rate: rad/s; period: s; residual, wobble, radius: m"}};
     j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
     j["rhs_evaluations"] = fp.rhs_evaluations;

@@ -229,6 +229,9 @@ void bind_fixed_points(py::module_& m) {
         .def_property_readonly("stability", [](const RotatingAttractor& r) { return stability_name(r.stability); })
         .def_readonly("residual", &RotatingAttractor::residual, "|return(q) - q| [m]")
         .def_readonly("wobble", &RotatingAttractor::wobble, "largest distance from q along the orbit [m]")
+        .def_readonly("centre", &RotatingAttractor::centre, "the point the position circles [m] (the position when settled)")
+        .def_readonly("radius", &RotatingAttractor::radius, "the position's distance from centre [m] (0: settled)")
+        .def_readonly("pivot", &RotatingAttractor::pivot, "the part's point held at centre, in the part's frame [m]")
         .def("__repr__", [](const RotatingAttractor& r) {
             return "<plate.RotatingAttractor " + std::string(stability_name(r.stability)) + " at (" + num(r.q[0]) + ", " +
                    num(r.q[1]) + ") m, " + num(r.rate) + " rad/s>";

@@ -355,10 +355,15 @@ def test_fixed_points_name_stuck_regions_and_rotating_orbits():
     assert repr(r).startswith("<plate.StuckRegion x in [")
     spin = plate.load_scene(os.path.join(SOURCE, "tests", "data", "fixed_points", "spin_symmetric.json"))
     fs = plate.fixed_points(plate.field(spin))
-    (o,) = fs.rotating
-    assert abs(o.rate + 0.2197870) < 1e-5 and o.stability == "unstable"
+    # The axis (settled: radius 0), then orbits about contacts held on the axis (neutral to first order).
+    o = fs.rotating[0]
+    assert abs(o.rate + 0.2197870) < 1e-5 and o.stability == "unstable" and o.radius == 0
     assert repr(o).startswith("<plate.RotatingAttractor unstable at (")
     assert fs.summary["rotating_attractors"][0]["rate"] == o.rate
+    contacts = [(0.0, 0.04), (-0.034641016151, -0.02), (0.034641016151, -0.02)]
+    for r in fs.rotating[1:]:
+        assert r.stability == "centre" and abs(r.radius - 0.04) < 1e-6 and list(r.centre) == [0, 0]
+        assert min(np.hypot(r.pivot[0] - cx, r.pivot[1] - cy) for cx, cy in contacts) < 1e-6
 
 
 def test_every_result_says_what_it_is_when_printed():

@@ -142,7 +142,10 @@ struct StuckRegion {
 };
 
 // A periodic orbit of the field that turns once in theta while the position returns: the part's
-// position settles at `q` (s_x, s_y) while theta turns at a steady mean `rate` (rigid parts).
+// position settles at `q` (s_x, s_y) while theta turns at a steady mean `rate` (rigid parts), or, on a
+// plate motion symmetric about the plate's z axis (heave and yaw only), the part turns rigidly about
+// the axis: the part's own point `pivot` stays at `centre` = (0, 0) while its position circles it at
+// `radius` (a relative equilibrium; fig6: the part turns about its tip contact).
 struct RotatingAttractor {
     Vec3 q = Vec3::Zero();   // (s_x, s_y) on the section theta = q[2]
     double rate = 0;         // mean dtheta/dt over the orbit [rad/s]; sign: direction (+: counter-clockwise)
@@ -151,6 +154,9 @@ struct RotatingAttractor {
     Stability stability = Stability::Saddle;                   // |multipliers| < 1: Stable
     double residual = 0;                                       // |return(q) - q| [m]
     double wobble = 0;                                         // largest distance from q along the orbit [m]
+    Vec2 centre = Vec2::Zero();   // the point the position circles [m] (the position itself when settled)
+    double radius = 0;            // the position's distance from `centre` [m] (0: settled)
+    Vec2 pivot = Vec2::Zero();    // the part's point held at `centre`, in the part's frame [m]
 };
 
 struct FixedPointOptions {
