@@ -187,20 +187,17 @@ json to_json(const Scene& sc, const FixedPoints& fp) {
     j["unresolved_cells"] = fp.unresolved_cells;   // candidates whose centre their corners do not predict
     j["grid_too_coarse"] = fp.suggested_grid > 0;
     if (fp.suggested_grid > 0) j["suggested_grid"] = fp.suggested_grid;
-    j["units"] = {
-        {"at", d == 3 ? "m, m, rad" : "m, m"},
-        {"eigenvalues", "1/s"},
-        {"eigen_error", "1/s"},
-        {"residual", "m/s (angular times rho)"},
-        {"stuck_regions", "x, y: m; theta: rad"},
-        {"rotating_attractors", "at, centre, pivot: m; theta_section: rad; rate: rad/s; period: s; residual, wobble, radius: m"}};
     j["summary"] = fixed_points_sentence(fp);
     j["field_evaluations"] = fp.evaluations;
     j["rhs_evaluations"] = fp.rhs_evaluations;
-    j["units"] = {{"at", d == 2 ? json{"m", "m"} : json{"m", "m", "rad"}},
-                  {"eigenvalues", "1/s (real, imaginary)"},
-                  {"residual", "m/s (|xi_a|, the angular part times rho)"},
-                  {"length", "m (in s_x, s_y, rho theta)"}};
+    j["units"] = {
+        {"at", d == 2 ? json{"m", "m"} : json{"m", "m", "rad"}},
+        {"eigenvalues", "1/s (real, imaginary)"},
+        {"eigen_error", "1/s"},
+        {"residual", "m/s (|xi_a|, the angular part times rho)"},
+        {"length", "m (in s_x, s_y, rho theta)"},
+        {"stuck_regions", "x, y: m; theta: rad"},
+        {"rotating_attractors", "at, centre, pivot: m; theta_section: rad; rate: rad/s; period: s; residual, wobble, radius: m"}};
     return j;
 }
 

@@ -35,7 +35,7 @@ void bind_report(py::module_& m) {
     m.def(
         "report",
         [](const std::filesystem::path& out, bool quick, std::vector<std::string> sections, std::uint64_t seed, int threads,
-           const std::optional<std::filesystem::path>& source) {
+           const std::optional<std::filesystem::path>& source, const std::optional<std::filesystem::path>& playground) {
             require(threads >= 0, "threads: expected >= 0 (0: all cores)");
             try {
                 report::check_sections(sections);
@@ -49,6 +49,7 @@ void bind_report(py::module_& m) {
             o.quick = quick;
             o.threads = threads;
             o.sections = std::move(sections);
+            o.playground = playground ? playground->string() : std::string(PLATE_BUILD_DIR) + "/web/site";
             interruptible(py::none(), [&](Watch&) {
                 report::write_report(o);
                 return 0;
@@ -56,11 +57,13 @@ void bind_report(py::module_& m) {
             return (out / "index.html").string();
         },
         py::arg("out"), py::kw_only(), py::arg("quick") = false, py::arg("sections") = std::vector<std::string>{},
-        py::arg("seed") = 1, py::arg("threads") = 0, py::arg("source") = py::none(),
+        py::arg("seed") = 1, py::arg("threads") = 0, py::arg("source") = py::none(), py::arg("playground") = py::none(),
         "The verification report, as `plate report --out DIR`: out/index.html and its SVG figures (gnuplot).\n"
         "quick: small campaigns and grids; sections: only these (names as plate report --help lists them),\n"
         "the page naming those left out. source: the project folder (scenes/, reports/generated/), default\n"
-        "the one this module was built from. Returns the page's path. Ctrl-C stops it (KeyboardInterrupt);\n"
+        "the one this module was built from. playground: a built playground site to copy beside the page and\n"
+        "link (default the build's web/site when there is one). Returns the page's path. Ctrl-C stops it\n"
+        "(KeyboardInterrupt);\n"
         "an interrupted report leaves no index.html.");
     m.def(
         "bench",

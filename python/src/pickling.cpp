@@ -80,7 +80,9 @@ void io(Archive& a, FixedPointOptions& o) {
 void io(Archive& a, FixedPoint& p) { a(p.q, p.eigenvalues, p.stability, p.residual, p.eigen_error); }
 void io(Archive& a, FixedLine& l) { a(l.points, l.direction, l.stability, l.eigenvalues, l.length, l.eigen_error); }
 void io(Archive& a, StuckRegion& r) { a(r.lo, r.hi, r.all_theta, r.grid_points, r.touches_edge); }
-void io(Archive& a, RotatingAttractor& r) { a(r.q, r.rate, r.period, r.multipliers, r.stability, r.residual, r.wobble); }
+void io(Archive& a, RotatingAttractor& r) {
+    a(r.q, r.rate, r.period, r.multipliers, r.stability, r.residual, r.wobble, r.centre, r.radius, r.pivot);
+}
 void io(Archive& a, FixedPoints& f) {
     a(f.point_part, f.points, f.lines, f.candidates, f.cells, f.undefined_cells, f.unsearched_cells, f.stuck_cells, f.evaluations,
       f.rhs_evaluations, f.stuck_regions, f.rotating, f.near_zero_cells, f.near_zero_unsearched, f.coarse_zeros,
