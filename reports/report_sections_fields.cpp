@@ -102,20 +102,18 @@ void fixed_set_rows(std::ostream& html, const FixedPoints& fp, bool pt) {
     }
 }
 
-// The quiver's scale: a reference arrow above a 2-D field plot, drawn in the axis it measures (`horizontal`:
-// along x, else along y), `length` [axis units] for `speed` [unit]; gnuplot commands.
-std::string scale_arrow(double length, double speed, const char* unit, bool horizontal) {
-    const std::string rto = horizontal ? "rto first " + fmt(length, 6) + ", first 0" : "rto first 0, first " + fmt(length, 6);
+// The quiver's scale: a reference arrow above a 2-D field plot, along its x axis (every such plot's x is a
+// position in m), `length` [m] for `speed` [unit]; gnuplot commands.
+std::string scale_arrow(double length, double speed, const char* unit) {
     return "set tmargin 4\nset label 90 'arrow scale: " + fmt(speed, 3) + " " + unit +
-           "' at graph 0, graph 1.06 left\nset arrow 90 from graph 0.3, graph 1.04 " + rto +
-           " lw 2 lc rgb '#000000' front nohead\nset arrow 91 from graph 0.3, graph 1.04 " + rto +
-           " lw 2 lc rgb '#000000' front head size 0.004,20\n";
+           "' at graph 0, graph 1.06 left\nset arrow 90 from graph 0.3, graph 1.04 rto first " + fmt(length, 6) +
+           ", first 0 lw 2 lc rgb '#000000' front head size 0.004,20\n";
 }
 
 QuiverScale quiver_scale(const GridSpec& g, double k, bool point) {
     if (!(k > 0) || !(g.dx() > 0)) return {};
     const double v = nice_floor(0.8 * g.dx() / k), w = nice_floor(0.8 * g.dth() / k);
-    return {scale_arrow(k * v, 1e3 * v, "mm/s", true),
+    return {scale_arrow(k * v, 1e3 * v, "mm/s"),
             " Arrows: the twist times " + fmt(k, 3) + " s; the black one above the plot is " + fmt(1e3 * v, 3) + " mm/s" +
                 (point ? "" : "; a θ-component of " + fmt(k * w, 3) + " rad is " + fmt(w, 3) + " rad/s") + "."};
 }
@@ -290,7 +288,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const std::string arrows = " w vec head size 0.004,20 lc rgb '#777777' notitle";
         const std::string kFieldSize = "800,640";   // field figures: large enough to read the arrows
         const QuiverScale qs = quiver_scale(g, k, pt);
-        const std::string &scale = qs.arrow, &scale_y = qs.arrow, &scale_text = qs.caption;
+        const std::string &scale = qs.arrow, &scale_text = qs.caption;
         const std::string marks = fixed_set_marks(fp, g);
         if (pt) {
             c.plot(n + "_xy",
@@ -311,7 +309,7 @@ void section_fields(Ctx& c, const fs::path& src, const ReportOptions& opt) {
                        " u 1:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
                    "s_x–θ projection." + scale_text, kFieldSize);
             c.plot(n + "_yt",
-                   scale_y + "set xlabel 's_y [m]'\nset ylabel 'θ [rad]'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T +
+                   scale + "set xlabel 's_y [m]'\nset ylabel 'θ [rad]'\nplot " + F + " u 2:3:5:6" + arrows + ", " + T +
                        " u 2:3 w p pt 7 ps 0.3 lc rgb '#c02020' notitle\n",
                    "s_y–θ projection." + scale_text, kFieldSize);
         }

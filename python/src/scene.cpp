@@ -9,6 +9,24 @@
 
 namespace plate::python {
 
+namespace {
+
+// Scene attributes are set through the file form: the value (numbers, lists, dicts as in a scene file;
+// numpy arrays as lists) replaces the field at `pointer`, and the whole scene is checked again as a file
+// is (plate.InputError naming the field; the scene unchanged then).
+void set_field(Scene& s, const char* pointer, py::object v) {
+    if (py::hasattr(v, "tolist")) v = v.attr("tolist")();
+    nlohmann::json j = scene_to_json(s);
+    j[nlohmann::json::json_pointer(pointer)] =
+        nlohmann::json::parse(py::module_::import("json").attr("dumps")(v).cast<std::string>());
+    const std::string source = s.source;
+    Scene changed = parse_scene(j.dump(), (source.empty() ? std::string("the scene") : source) + " (" + (pointer + 1) + " set)");
+    changed.source = source;
+    s = std::move(changed);
+}
+
+}   // namespace
+
 void bind_scene(py::module_& m) {
     py::class_<Scene>(m, "Scene", "A part and a periodic plate motion (a scene file's contents).")
         .def(py::init([](const py::dict& part, const py::dict& plate, const std::string& name, double gravity) {
@@ -24,22 +42,30 @@ void bind_scene(py::module_& m) {
              "A scene from its part and plate motion in the scene file's form, e.g. part={'mass': 0.02, 'friction': "
              "0.3},\nplate={'period': 0.05, 'harmonics': [{'axis': 'x', 'n': 1, 'amp': 20, 'phase': 0}]}; checked as a "
              "file is\n(raises plate.InputError naming the field).")
-        .def_readonly("name", &Scene::name)
+        .def_property(
+            "name", [](const Scene& s) { return s.name; }, [](Scene& s, py::object v) { set_field(s, "/name", std::move(v)); })
         .def_readonly("source", &Scene::source)
-        .def_readonly("gravity", &Scene::g)
+        .def_property(
+            "gravity", [](const Scene& s) { return s.g; }, [](Scene& s, py::object v) { set_field(s, "/gravity", std::move(v)); },
+            "[m/s^2]")
         .def_property_readonly("point_part", [](const Scene& s) { return s.part.point; })
         .def_property_readonly("thin", [](const Scene& s) { return !s.part.point && s.part.thin(); })
-        .def_property_readonly("mass", [](const Scene& s) { return s.part.m; })
+        .def_property(
+            "mass", [](const Scene& s) { return s.part.m; },
+            [](Scene& s, py::object v) { set_field(s, "/part/mass", std::move(v)); }, "[kg]")
         .def_property_readonly(
             "rho", [](const Scene& s) { return s.part.rho(); }, "radius of gyration sqrt(J_zz/m) [m] (1 for a point part)")
-        .def_property_readonly("period", [](const Scene& s) { return s.plate.T; })
+        .def_property(
+            "period", [](const Scene& s) { return s.plate.T; },
+            [](Scene& s, py::object v) { set_field(s, "/plate/period", std::move(v)); }, "[s]")
         .def_property_readonly("v_ref", &Scene::v_ref, "the slip-speed scale tolerances are relative to [m/s]")
         .def_property_readonly("warnings", &scene_warnings,
                                "admissible but outside the intended regime (the command line prints them)")
-        .def_property_readonly(
+        .def_property(
             "inertia", [](const Scene& s) -> py::object { return s.part.point ? py::object(py::none()) : py::cast(s.part.J); },
+            [](Scene& s, py::object v) { set_field(s, "/part/inertia", std::move(v)); },
             "J, the rotational inertia about the centre of mass in the part's frame S, (3, 3) [kg m^2]; None for a point part")
-        .def_property_readonly(
+        .def_property(
             "contacts",
             [](const Scene& s) -> py::object {
                 if (s.part.point) return py::none();
@@ -47,8 +73,9 @@ void bind_scene(py::module_& m) {
                 for (int i = 0; i < 3; ++i) c.row(i) = s.part.c[i].transpose();
                 return py::cast(c);
             },
+            [](Scene& s, py::object v) { set_field(s, "/part/contacts", std::move(v)); },
             "the contacts c_i in S, one per row, (3, 3) [m]; None for a point part")
-        .def_property_readonly(
+        .def_property(
             "friction",
             [](const Scene& s) {
                 const ContactFriction f = s.part.friction();
@@ -62,8 +89,9 @@ void bind_scene(py::module_& m) {
                 d["static"] = static_;
                 return d;
             },
+            [](Scene& s, py::object v) { set_field(s, "/part/friction", std::move(v)); },
             "{'kinetic': [mu_k per contact], 'static': [mu_s per contact]} (one each for a point part)")
-        .def_property_readonly(
+        .def_property(
             "harmonics",
             [](const Scene& s) {
                 py::list l;
@@ -72,6 +100,7 @@ void bind_scene(py::module_& m) {
                                       py::arg("phase") = h.phase));
                 return l;
             },
+            [](Scene& s, py::object v) { set_field(s, "/plate/harmonics", std::move(v)); },
             "the plate's u(t) = sum of amp sin(n 2 pi t / T + phase) per axis: [{'axis', 'n', 'amp' [m/s^2 or "
             "rad/s^2], 'phase' [rad]}]")
         .def(

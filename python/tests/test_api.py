@@ -389,3 +389,26 @@ def test_every_result_says_what_it_is_when_printed():
     for kind, (obj, says) in results.items():
         r = repr(obj)
         assert r.startswith("<plate." + kind) and "object at 0x" not in r and says in r, (kind, r)
+
+
+def test_a_scene_is_edited_by_attribute_and_checked_as_a_file_is():
+    """s.friction = ... (and mass, period, harmonics, ...) gives the scene a file with that field would give:
+    the same twist to the bit; a value a file may not hold is refused naming the field, the scene unchanged."""
+    s = plate.load_scene(scene_path("fig4"))
+    d = plate.scene_to_dict(s)
+    d["part"]["friction"] = [0.3, 0.35, 0.3]
+    d["part"]["mass"] = 0.03
+    from_file = plate.scene_from_dict(d)
+    s.friction = [0.3, 0.35, 0.3]
+    s.mass = 0.03
+    assert s == from_file and s.source.endswith("fig4.json")
+    at = (0.01, 0.02, 0.3)
+    assert np.array_equal(plate.twist(s, at=at).twist, plate.twist(from_file, at=at).twist)
+    assert not np.array_equal(plate.twist(s, at=at).twist, plate.twist(plate.load_scene(scene_path("fig4")), at=at).twist)
+    with pytest.raises(plate.InputError, match=r"part\.friction: expected friction coefficients >= 0, got -1"):
+        s.friction = [0.3, -1, 0.3]
+    assert s == from_file
+    s.harmonics = s.harmonics[:1]
+    assert len(s.harmonics) == 1 and s.period == 0.05
+    s.period = np.float64(0.04)
+    assert s.period == 0.04
