@@ -6,7 +6,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 using namespace plate;
 using Catch::Matchers::Contains;
@@ -88,6 +90,38 @@ TEST_CASE("mpc: the online fit recovers the true gain and drift from exact frame
     CHECK(mpc_estimate(*nominal).gain == 1);
 }
 
+TEST_CASE("mpc: frames one period late are carried forward along the motions chosen since", "[control][mpc]") {
+    // The hand model's east transport moves 1 mm a period (0.02 m/s x 0.05 s); the synthetic part moves
+    // exactly so, and each frame shows it one period late. Goal at 5.25 mm: the policy must see that the
+    // part is at 5 mm at the decision (the late frame's 4 mm advanced by the period on east) and stop
+    // there -- 5 mm is within the 0.5 mm stop radius, 6 mm would not be. Seen failing: deciding from the
+    // frame as it is (no advance), the part went on to 6 mm.
+    const ControlModel m = hand_model();
+    MpcPolicyOptions o;
+    o.correct = false;
+    auto p = make_mpc_policy(o);
+    Goal goal;
+    goal.q = Vec3(0.00525, 0, 0);
+    p->reset(m, goal);
+    const double T = m.T();
+    std::vector<Vec3> truth = {Vec3::Zero()};
+    for (long k = 0; k < 12; ++k) {
+        Observation obs;
+        obs.t = k * T;
+        obs.seen = k >= 1;
+        obs.stamp = k * T;
+        obs.state_time = (k - 1) * T;
+        obs.q = obs.seen ? truth[static_cast<std::size_t>(k - 1)] : Vec3::Zero();
+        const Decision d = p->decide(obs, k);
+        truth.push_back(truth.back() + m.fields[static_cast<std::size_t>(d.motion)].twist[0] * T);
+    }
+    double furthest = 0;
+    for (const Vec3& q : truth) furthest = std::max(furthest, q.x());
+    CHECK_THAT(furthest, WithinAbs(0.005, 1e-12));   // (never beyond: it stopped at 5 mm)
+    CHECK_THAT(truth.back().x(), WithinAbs(0.005, 1e-12));
+    CHECK_THAT(truth.back().y(), WithinAbs(0.0, 1e-12));
+}
+
 TEST_CASE("mpc: on the issue's test plate the point part comes within 1 mm in 10 s and stays", "[control][mpc]") {
     // fig1_point's library, the issue's truth (friction x0.8, 3 % / 0.03 rad per period), a world camera
     // with 0.1 mm noise one period late; bench_control's first 3 starts (bench_control --mpc: 20 of 20,
@@ -129,6 +163,16 @@ TEST_CASE("mpc: a rigid part, too many sequences and bad options are refused by 
     m.library.names.resize(6, "more");
     m.library.motions.resize(6, m.nominal.plate);   // 6^8 = 1679616 sequences
     CHECK_THROWS_WITH(make_mpc_policy(o)->reset(m, Goal{}), Contains("shorten the horizon"));
+    // The limit exactly: 1000 motions over 2 periods are 10^6 sequences (allowed), 1001 are not.
+    o.horizon = 2;
+    m.fields.resize(1000, m.fields[0]);
+    m.library.names.resize(1000, "more");
+    m.library.motions.resize(1000, m.nominal.plate);
+    CHECK_NOTHROW(make_mpc_policy(o)->reset(m, Goal{}));
+    m.fields.push_back(m.fields[0]);
+    m.library.names.push_back("more");
+    m.library.motions.push_back(m.nominal.plate);
+    CHECK_THROWS_WITH(make_mpc_policy(o)->reset(m, Goal{}), Contains("more than 1000000 sequences"));
     o.horizon = 0;
     CHECK_THROWS_WITH(make_mpc_policy(o), Contains("horizon: expected 1 to 8"));
     o = {};

@@ -247,6 +247,8 @@ void bind_control(py::module_& m) {
                 const std::string name = policy.cast<std::string>();
                 require(name == "library" || name == "mpc",
                         "policy: expected 'library', 'mpc' or a Python callable, got '" + name + "'");
+                require(name == "mpc" || (switch_cost == MpcPolicyOptions{}.switch_cost && correction),
+                        "switch_cost and correction are the mpc policy's");
                 LibraryPolicyOptions lo;
                 MpcPolicyOptions mo;
                 if (horizon) lo.horizon = mo.horizon = *horizon;
@@ -260,7 +262,7 @@ void bind_control(py::module_& m) {
                 }
             } else {
                 require(PyCallable_Check(policy.ptr()) || py::hasattr(policy, "decide"),
-                        "policy: expected 'library', a callable or an object with decide(observation)");
+                        "policy: expected 'library', 'mpc', a callable or an object with decide(observation)");
                 p = std::make_unique<PythonPolicy>(policy);
             }
             const ControlSummary s = interruptible(

@@ -3,6 +3,7 @@
 
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "plate/friction.hpp"
@@ -15,12 +16,18 @@ namespace {
 // numpy arrays as lists) replaces the field at `pointer`, and the whole scene is checked again as a file
 // is (plate.InputError naming the field; the scene unchanged then).
 void set_field(Scene& s, const char* pointer, py::object v) {
+    std::string field = pointer + 1;   // ("part/mass" -> "part.mass", as the file's messages name it)
+    std::replace(field.begin(), field.end(), '/', '.');
+    const std::string where = (s.source.empty() ? std::string("the scene") : s.source) + " (" + field + " set)";
+    if (s.part.point && (field == "part.contacts" || field == "part.inertia"))
+        throw InputError(where + ": " + field +
+                         ": a point part has no contacts or inertia (a rigid part: plate.Scene(part=...))");
     if (py::hasattr(v, "tolist")) v = v.attr("tolist")();
     nlohmann::json j = scene_to_json(s);
     j[nlohmann::json::json_pointer(pointer)] =
         nlohmann::json::parse(py::module_::import("json").attr("dumps")(v).cast<std::string>());
     const std::string source = s.source;
-    Scene changed = parse_scene(j.dump(), (source.empty() ? std::string("the scene") : source) + " (" + (pointer + 1) + " set)");
+    Scene changed = parse_scene(j.dump(), where);
     changed.source = source;
     s = std::move(changed);
 }

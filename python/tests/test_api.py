@@ -408,7 +408,19 @@ def test_a_scene_is_edited_by_attribute_and_checked_as_a_file_is():
     with pytest.raises(plate.InputError, match=r"part\.friction: expected friction coefficients >= 0, got -1"):
         s.friction = [0.3, -1, 0.3]
     assert s == from_file
-    s.harmonics = s.harmonics[:1]
-    assert len(s.harmonics) == 1 and s.period == 0.05
+    first = s.harmonics[:1]
+    s.harmonics = first
+    assert s.harmonics == first and s.period == 0.05
     s.period = np.float64(0.04)
     assert s.period == 0.04
+    # Every settable field, against the dict with the same change.
+    for attr, key, value in (("gravity", None, 9.0), ("name", None, "edited"), ("contacts", "part", [[0.01, -0.03, -0.002],
+                             [0.0, 0.031, -0.002], [-0.01, -0.03, -0.002]]),
+                             ("inertia", "part", [[2e-6, 0, 0], [0, 3e-6, 0], [0, 0, 4e-6]])):
+        d = plate.scene_to_dict(s)
+        (d if key is None else d[key])[attr] = value
+        setattr(s, attr, value)
+        assert s == plate.scene_from_dict(d), attr
+    point = plate.load_scene(scene_path("fig1_point"))
+    with pytest.raises(plate.InputError, match=r"\(part\.contacts set\): part\.contacts: a point part has no contacts"):
+        point.contacts = None

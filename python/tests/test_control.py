@@ -58,6 +58,9 @@ def test_the_library_and_mpc_policies_give_the_command_lines_run_to_the_bit(tmp_
         plain = plate.control(scene(), GOAL, library=LIBRARY, truth=TRUTH, camera=CAMERA, start=(-0.04, 0.03), time=3.0,
                               policy=policy, correction=False)
         assert not np.array_equal(plain.truth, run.truth)
+    else:   # (the mpc's options are refused on the library policy, as the command line refuses them)
+        with pytest.raises(ValueError, match="switch_cost and correction are the mpc policy's"):
+            plate.control(scene(), GOAL, library=LIBRARY, time=0.1, policy=policy, correction=False)
 
 
 def test_a_python_policy_on_the_still_plate_leaves_the_part_where_it_is():

@@ -79,13 +79,30 @@ def test_fixed_points_and_their_parts_come_back_to_the_bit():
         round_trips(part, type(part).__name__)
     complete = plate.fixed_points(plate.field(scene("fig4"), grid=5))
     assert complete.points
+    round_trips(complete, "FixedPoints")
     round_trips(complete.points[0], "FixedPoint")
+    # The counters: a grid too coarse (fig1 on 4 points: a finer grid suggested), a search cut short by its
+    # budget (cells left unsearched) -- each non-zero before the round trip.
+    coarse = plate.fixed_points(plate.field(scene("fig1"), grid=4))
+    assert coarse.grid_too_coarse and coarse.summary["suggested_grid"] > 0
+    round_trips(coarse, "FixedPoints")
+    cut = plate.fixed_points(plate.field(scene("fig4"), grid=5), max_rhs=1000)
+    assert cut.summary["unsearched_cells"] > 0
+    round_trips(cut, "FixedPoints")
 
 
 def test_a_design_a_robustness_study_and_an_identification_come_back_to_the_bit(tmp_path):
-    d = plate.design(scene("fig1_point"), sink=(0.02, -0.01), starts=1, evaluations=30, verify_starts=2, hold=0)
-    assert d.verified and d.summary
+    d = plate.design(scene("fig1_point"), sink=(0.02, -0.01), starts=1, evaluations=30, verify_starts=2, hold=1.0)
+    assert d.verified and d.summary and d.held[0] > 0
     round_trips(d, "Design")
+    # A rigid part's sink (pulls per orientation) and a transport (its mean and spread): members the point
+    # sink leaves at their defaults.
+    rigid = plate.design(scene("fig4"), sink=(0.02, -0.01), starts=1, evaluations=20, verify_starts=2, hold=0)
+    assert rigid.pulls
+    round_trips(rigid, "Design")
+    carry = plate.design(scene("fig1_point"), transport=(0.01, 0.0), starts=1, evaluations=20, verify_starts=2)
+    assert carry.transport_spread > 0 and carry.transport_mean[0] != 0
+    round_trips(carry, "Design")
     r = plate.robustness(scene("designs/point_sink"), os.path.join(SOURCE, "scenes", "uncertainty", "ppod.json"), draws=3)
     assert len(r.outcome) == 3
     round_trips(r, "Robustness")

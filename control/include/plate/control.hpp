@@ -222,8 +222,9 @@ inline constexpr int kMaxHorizon = 1000;
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
 
 // `mpc` (point parts): each period, the sequence of `horizon` library motions -- a switch allowed at
-// every period -- whose predicted path has the least cost, the mean weighted distance to the goal after
-// each period plus switch_cost per switch; its first motion is applied (receding horizon). The path is
+// every period -- whose predicted path has the least cost, the mean over the horizon of (the weighted
+// distance to the goal after the period, plus switch_cost if the period switched motion); its first motion
+// is applied (receding horizon). The path is
 // the model's steps (ControlModel::step) corrected online: between consecutive frames the observed
 // displacement against the model's over the same stretch (the motions then chosen), fitted by
 // exponentially forgotten least squares (`forgetting` per frame) as
