@@ -37,7 +37,7 @@ std::string contents_and_verdicts(const Ctx& c) {
         (k.paper ? printed : checks) += 1;
         (k.paper ? differ : failed) += !k.ok;
     }
-    o << "<h2 id=\"verdicts\">Verdicts</h2>\n<p>" << checks << " checks stated in this run: "
+    o << "<h2 id=\"verdicts\">Verdicts</h2>\n<p>" << checks << (checks == 1 ? " check" : " checks") << " stated in this run: "
       << (failed == 0 ? std::string("<span class=\"pass\">all pass</span>")
                       : "<span class=\"fail\">" + std::to_string(failed) + " failed</span>")
       << ". " << printed << " of the paper's printed equations compared with the derivation: " << differ
@@ -126,6 +126,7 @@ void write_report(const ReportOptions& opt) {
     html << "<p>Every number below was computed by this run. Seed " << opt.seed << (opt.quick ? " (quick mode)" : "")
          << "; machine: " << esc(machine_description()) << "; total " << fmt(total, 4) << " s."
          << (left_out.empty() ? "" : " Sections left out of this run (--sections): " + esc(left_out) + ".") << "</p>\n";
+    const std::string playground = playground_section(c, opt);   // (before the contents list, which lists it)
     html << contents_and_verdicts(c);
     html << "<h2 id=\"timings\">Time per part</h2>\n<table><tr><th>part</th><th>seconds</th></tr>\n";
     for (const auto& [w, s] : c.timings) html << "<tr><td>" << esc(w) << "</td><td>" << fmt(s, 4) << "</td></tr>\n";
@@ -142,7 +143,7 @@ void write_report(const ReportOptions& opt) {
             html << stub;
         html << end << "\n";
     };
-    html << playground_section(c, opt);
+    html << playground;
     study(kSpeedBegin, kSpeedEnd, "speed",   // plate bench
           "<h2>Speed and accuracy</h2><p>Not run yet. To fill it: <code>plate bench --out " + out +
               "</code> writes this section into this page (work-precision charts, failure maps, limit-cycle solvers, model "

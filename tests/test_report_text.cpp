@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <string>
 #include <stdexcept>
 #include <vector>
@@ -182,6 +183,19 @@ TEST_CASE("the report copies a built playground beside its page and links it, or
     CHECK(page().find("<a href=\"playground/index.html\">") != std::string::npos);
     CHECK(fs::exists(dir / "playground" / "index.html"));
     CHECK(fs::exists(dir / "playground" / "scenes" / "fig1_point.json"));
+    // Every section heading of the page is in its contents list (the playground's included), and the verdict
+    // line counts in English ("1 check", "2 checks").
+    const std::string text = page();
+    for (std::size_t at = text.find("<h2 id=\""); at != std::string::npos; at = text.find("<h2 id=\"", at + 1)) {
+        const std::size_t from = at + 8;
+        const std::string id = text.substr(from, text.find('"', from) - from);
+        if (id != "contents") CHECK(text.find("<li><a href=\"#" + id + "\">") != std::string::npos);
+    }
+    CHECK(text.find("<li><a href=\"#playground\">") != std::string::npos);
+    const std::regex count(R"((\d+) (checks?) stated in this run)");
+    std::smatch m;
+    REQUIRE(std::regex_search(text, m, count));
+    CHECK((m[1] == "1") == (m[2] == "check"));
     o.playground = (site / "missing").string();   // a folder without a site: as none
     plate::report::write_report(o);
     CHECK(page().find("Not built.") != std::string::npos);
