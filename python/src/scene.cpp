@@ -97,7 +97,8 @@ void bind_scene(py::module_& m) {
                 return d;
             },
             [](Scene& s, py::object v) { set_field(s, "/part/friction", std::move(v)); },
-            "{'kinetic': [mu_k per contact], 'static': [mu_s per contact]} (one each for a point part)")
+            "{'kinetic': [mu_k per contact], 'static': [mu_s per contact]} (one each for a point part); set as in a "
+            "scene file: a number or a list sets both static and kinetic to it (mu_s = mu_k)")
         .def_property(
             "harmonics",
             [](const Scene& s) {

@@ -408,6 +408,11 @@ def test_a_scene_is_edited_by_attribute_and_checked_as_a_file_is():
     with pytest.raises(plate.InputError, match=r"part\.friction: expected friction coefficients >= 0, got -1"):
         s.friction = [0.3, -1, 0.3]
     assert s == from_file
+    # Static and kinetic apart, then a plain list: as in a file, it means both (the static ones go too).
+    s.friction = {"static": [0.5, 0.5, 0.5], "kinetic": [0.3, 0.35, 0.3]}
+    assert s.friction == {"static": [0.5, 0.5, 0.5], "kinetic": [0.3, 0.35, 0.3]} and s != from_file
+    s.friction = [0.3, 0.35, 0.3]
+    assert s.friction == {"static": [0.3, 0.35, 0.3], "kinetic": [0.3, 0.35, 0.3]} and s == from_file
     first = s.harmonics[:1]
     s.harmonics = first
     assert s.harmonics == first and s.period == 0.05
