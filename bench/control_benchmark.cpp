@@ -9,7 +9,8 @@
 // then how many met the target time, and the machine.
 //   bench_control [--rigid] [--starts N] [--first SEED] [--duration S] [--scene SCENE] [--library LIB]
 //                 [--goal X Y [THETA]] [--horizon H] [--transitions 0|1] [--grid-transitions 0|1]
-//                 [--friction-scale F] [--spread S] [--single-phase] [--open-loop SCENE] [--open-loop-time S]
+//                 [--friction-scale F] [--spread S] [--contact-spread S] [--single-phase] [--open-loop SCENE]
+//                 [--open-loop-time S]
 //                 [--open-loop-tol MM RAD] [--mpc [--mpc-horizon H] [--mpc-no-correction]]
 // Defaults: the point-part target (scenes/fig1_point.json, scenes/control/fig1_point/library.json,
 // goal (0.02, -0.01), 15 s runs, target 10 s). --rigid: the rigid-part target (scenes/fig4.json,
@@ -18,8 +19,10 @@
 // from the same start (its time to goal, cap --open-loop-time, default 300 s; judged within --open-loop-tol,
 // default the goal's 1 mm and 0.02 rad). --single-phase: a rigid
 // part's one weighted distance (LibraryPolicyOptions::two_phase false, theta weighted by rho).
-// --spread: the tracking errors' (amplitude relative, phase rad; default 0.03); --grid-transitions 1: the
-// rigid part's transition table also for the turning motions (on the 3-D grid).
+// --spread: the tracking errors' (amplitude relative, phase rad; default 0.03); --contact-spread S: each
+// contact's true friction also off by its own uniform relative error in [-S, S] (drawn once per run, so a
+// rigid part's contacts differ); --grid-transitions 1: the rigid part's transition table also for the
+// turning motions (on the 3-D grid). --open-loop "": no open-loop run beside the closed loop.
 #include "machine.hpp"
 #include "plate/control.hpp"
 #include "plate/random_scene.hpp"
@@ -38,7 +41,7 @@ namespace {
 
 struct Args {
     int starts = 20, first = 0;
-    double duration = 15, target = 10, friction_scale = 0.8, open_loop_time = 300, spread = 0.03;
+    double duration = 15, target = 10, friction_scale = 0.8, open_loop_time = 300, spread = 0.03, contact_spread = 0;
     double open_loop_tol = 1e-3, open_loop_tol_theta = 0.02;
     std::string scene, library, open_loop;
     Vec3 goal = Vec3(0.02, -0.01, 0);
@@ -105,6 +108,8 @@ Args parse(int argc, char** argv) {
             a.friction_scale = std::stod(next());
         else if (o == "--spread")
             a.spread = std::stod(next());
+        else if (o == "--contact-spread")
+            a.contact_spread = std::stod(next());
         else if (o == "--single-phase")
             a.policy.two_phase = false;
         else if (o == "--open-loop")
@@ -149,9 +154,9 @@ int main(int argc, char** argv) try {
         sc.name.c_str(), a.starts, a.goal.x(), a.goal.y(), a.rigid ? (", " + std::to_string(a.goal.z())).c_str() : "",
         a.rigid ? " and 0.02 rad" : "", a.duration, model.motions(), model_s);
     std::printf(
-        "truth: friction x %g, amplitude %g %%, phase %g rad per period; camera: world, noise 0.1 mm%s, latency "
-        "one period (%g s)\n",
-        a.friction_scale, 100 * a.spread, a.spread, a.rigid ? " / 5 mrad" : "", sc.plate.T);
+        "truth: friction x %g, each contact's also x (1 + e), e uniform in +-%g %%; amplitude %g %%, phase %g rad per "
+        "period; camera: world, noise 0.1 mm%s, latency one period (%g s)\n",
+        a.friction_scale, 100 * a.contact_spread, 100 * a.spread, a.spread, a.rigid ? " / 5 mrad" : "", sc.plate.T);
     std::printf("%5s %8s %8s %7s %9s %9s %9s %9s %5s %8s %8s %8s %7s%s\n", "start", "x0 [m]", "y0 [m]", "th0", "goal [s]",
                 "err [mm]", "err [rad]", "overshoot", "sw", "dec mean", "dec p99", "dec max", "run [s]",
                 a.open_loop.empty() ? "" : "  open-loop goal [s], err [mm], err [rad], run [s]");
@@ -159,7 +164,9 @@ int main(int argc, char** argv) try {
     double worst_time = 0, worst_decision = 0, ol_worst = 0;
     for (int i = a.first; i < a.first + a.starts; ++i) {
         const Vec3 q0 = square_start(static_cast<std::uint64_t>(i), a.rigid);
-        const Truth truth = spread_truth(a.friction_scale, a.spread, static_cast<std::uint64_t>(i));
+        Truth truth = spread_truth(a.friction_scale, a.spread, static_cast<std::uint64_t>(i));
+        truth.uncertainty->friction = Spread{a.contact_spread, Distribution::uniform};
+        truth.validate();
         Camera cam;
         cam.per_period = 1;
         cam.noise_xy_mm = 0.1;
