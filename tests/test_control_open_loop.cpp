@@ -84,7 +84,8 @@ TEST_CASE("The control section's open loop is the designed sink's scene simulate
     std::filesystem::remove(flat_file);
 }
 
-TEST_CASE("The control loop does not carry the plate's coning: the shipped sink's drift from it is bounded by psi' t r", "[control][open-loop]") {
+TEST_CASE("The control loop does not carry the plate's coning: the shipped sink's drift from it is bounded by psi' t r",
+          "[control][open-loop]") {
     // The shipped point_sink tilts about x and y out of phase, so the unbroken simulation's plate yaws at
     // its coning rate psi' (coning_rate, a closed form) while the loop restarts it at phase 0 every period
     // (docs/decisions/control.md). Over 8 s the difference is then at most about |psi'| t times the part's
