@@ -30,8 +30,6 @@ public:
     std::string name() const override { return "mpc"; }
 
     void reset(const ControlModel& model, const Goal& goal) override {
-        if (!model.nominal.part.point)
-            throw std::invalid_argument("the mpc policy steers point parts (a rigid part: the library policy)");
         long sequences = 1;
         for (int h = 0; h < opt_.horizon; ++h) {
             sequences *= model.motions();
@@ -111,6 +109,12 @@ private:
                 Eigen::Vector3d phi(model[a], a == 0 ? periods : 0.0, a == 1 ? periods : 0.0);
                 normal_ += phi * phi.transpose();
                 rhs_ += phi * seen[a];
+            }
+            if (!model_->nominal.part.point) {   // a rigid part's turn: the same gain, in radians weighted to metres
+                const double w = goal_.theta_weight;
+                const Eigen::Vector3d phi(w * model[2], 0.0, 0.0);
+                normal_ += phi * phi.transpose();
+                rhs_ += phi * (w * wrap_angle(seen[2]));
             }
             ++estimate_.frames;
             const double pg = opt_.prior_travel * opt_.prior_travel, pd = opt_.prior_frames;

@@ -277,7 +277,7 @@ void bind_control(py::module_& m) {
         "motion from the camera's newest frame; the true plate runs it through the full dynamics. library, truth,\n"
         "camera: a file's path or a dict in its form (camera also a plate.Camera; None: a perfect camera at phase 0,\n"
         "the scene itself as truth). policy: 'library' (a motion judged kept for horizon periods, default 2),\n"
-        "'mpc' (point parts: the best sequence of horizon motions, default 3, plus switch_cost [m] per switch, on\n"
+        "'mpc' (the best sequence of horizon motions, default 3, plus switch_cost [m] per switch, on\n"
         "the model corrected online by a fitted gain and drift unless correction=False), or a callable f(observation) -> motion\n"
         "(observation: a dict period, t, seen, observed (s_x, s_y, theta) or None, state_time, motions; the motion:\n"
         "a library index, a motion's name, a plate.Scene of the same period or a list of harmonics dicts), or an\n"

@@ -221,7 +221,7 @@ struct LibraryPolicyOptions {
 inline constexpr int kMaxHorizon = 1000;
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {});
 
-// `mpc` (point parts): each period, the sequence of `horizon` library motions -- a switch allowed at
+// `mpc`: each period, the sequence of `horizon` library motions -- a switch allowed at
 // every period -- whose predicted path has the least cost, the mean over the horizon of (the weighted
 // distance to the goal after the period, plus switch_cost if the period switched motion); its first motion
 // is applied (receding horizon). The path is
@@ -231,6 +231,8 @@ std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt = {}
 //     dq_seen = gain dq_model + drift (dt / T),
 // a gain on the model's transport (friction changes the speeds) and a drift per period (tracking errors,
 // a tilt), with a prior (gain 1, drift 0) worth prior_travel of predicted travel and prior_frames frames.
+// A rigid part's angle enters the fit with the same gain (its steps' theta, weighted by the goal's
+// theta_weight) and no drift; its cost is the goal's weighted distance, in one phase (no turn-first rule).
 // Inside stop_radius the still plate, left only beyond stop_radius + hysteresis (the library policy's
 // rule). Every motions^horizon sequence is searched (a tree: the prefixes' steps shared).
 struct MpcPolicyOptions {
