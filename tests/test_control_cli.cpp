@@ -36,6 +36,37 @@ TEST_CASE("plate control: bad input files exit 2 naming the file and the field, 
         CHECK(r.code == 2);
         CHECK_THAT(r.err, Contains(t + ": tracking_error: unknown field"));
     }
+    SECTION("a truth's recorded cycles: a missing file, another period, a motion named twice, no harmonics") {
+        const std::string cycle = write("rec.csv",
+                                        "t [s],x [m/s^2],y [m/s^2],z [m/s^2],rx [rad/s^2],ry [rad/s^2],rz [rad/s^2]\n"
+                                        "0,1,0,0,0,0,0\n0.01,0,0,0,0,0,0\n0.02,-1,0,0,0,0,0\n0.03,0,0,0,0,0,0\n");
+        const std::string e_fast = kScenes + "control/fig1_point/e_fast.json";
+        const auto entry = [&](const std::string& cyc, const std::string& harmonics) {
+            return R"({"commanded": ")" + e_fast + R"(", "cycle": ")" + cyc + R"(", "harmonics": )" + harmonics + "}";
+        };
+        const std::pair<std::string, std::string> cases[] = {
+            {R"({"measured": [)" + entry(cycle + ".gone", "1") + "]}", ": measured[0].cycle: " + cycle + ".gone: cannot open"},
+            {R"({"measured": [)" + entry(cycle, "1") + "]}",
+             ": measured[0].cycle: " + cycle + ": period 0.04 s, not the commanded 0.05 s"},
+            {R"({"measured": [)" + entry(cycle, "0") + "]}", ": measured[0].harmonics: expected a whole number from 1 to 1000"},
+            {R"({"measured": [{"commanded": "e.json"}]})", ": measured[0].cycle: missing required field"},
+        };
+        for (const auto& [text, message] : cases) {
+            const std::string t = write("truth.json", text);
+            const Run r = run(kBase + kLibrary + "--truth " + t + " --out " + out);
+            CHECK(r.code == 2);
+            CHECK_THAT(r.err, Contains(t + message));
+            CHECK_FALSE(fs::exists(out));
+        }
+        // (the same commanded motion twice, each with a good cycle of its period)
+        std::string good = "t [s],x [m/s^2],y [m/s^2],z [m/s^2],rx [rad/s^2],ry [rad/s^2],rz [rad/s^2]\n";
+        for (int i = 0; i < 5; ++i) good += std::to_string(0.01 * i) + ",1,0,0,0,0,0\n";
+        const std::string g = write("good.csv", good);
+        const std::string t = write("truth.json", R"({"measured": [)" + entry(g, "1") + "," + entry(g, "1") + "]}");
+        const Run r = run(kBase + kLibrary + "--truth " + t + " --out " + out);
+        CHECK(r.code == 2);
+        CHECK_THAT(r.err, Contains(t + ": measured[1].commanded: " + e_fast + ": the same motion as " + e_fast));
+    }
     SECTION("a truth's uncertainty spec with a bad spread") {
         const std::string t = write("truth.json", R"({"uncertainty": {"seed": 1, "amplitude": {"spread": -1}}})");
         const Run r = run(kBase + kLibrary + "--truth " + t + " --out " + out);

@@ -2,16 +2,33 @@
 // boundary (carry_state).
 #include "plate/control.hpp"
 
+#include "plate/measured_cycle.hpp"
+#include "plate/scene_io.hpp"
+
 #include "input_reader.hpp"
 #include "so3.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 
 namespace plate {
 
 using detail::Reader;
 using nlohmann::json;
+
+namespace {
+
+bool same_motion(const PlateMotion& a, const PlateMotion& b) {
+    if (a.T != b.T || a.harmonics.size() != b.harmonics.size()) return false;
+    for (std::size_t i = 0; i < a.harmonics.size(); ++i) {
+        const Harmonic &x = a.harmonics[i], &y = b.harmonics[i];
+        if (x.axis != y.axis || x.n != y.n || x.amp != y.amp || x.phase != y.phase) return false;
+    }
+    return true;
+}
+
+}   // namespace
 
 void Truth::validate() const {
     const Reader r{source};
@@ -21,10 +38,10 @@ void Truth::validate() const {
     if (uncertainty) validate_uncertainty(*uncertainty);
 }
 
-Truth parse_truth(const std::string& text, const std::string& source) {
+Truth parse_truth(const std::string& text, const std::string& source, const std::string& dir) {
     const Reader r{source};
     const json doc = r.parse(text);
-    r.only_keys(doc, "", {"friction_scale", "uncertainty", "tracking", "draw"}, {});
+    r.only_keys(doc, "", {"friction_scale", "uncertainty", "tracking", "draw", "measured"}, {});
     Truth t;
     t.source = source;
     if (doc.contains("friction_scale")) t.friction_scale = r.number(doc["friction_scale"], "friction_scale");
@@ -42,11 +59,48 @@ Truth parse_truth(const std::string& text, const std::string& source) {
             r.fail("tracking", "expected \"per_period\" or \"per_run\"");
     }
     if (doc.contains("draw")) t.draw = r.seed(doc["draw"], "draw");
+    if (doc.contains("measured")) {
+        const json& M = doc["measured"];
+        if (!M.is_array()) r.fail("measured", "expected an array of {commanded, cycle, harmonics}");
+        for (std::size_t k = 0; k < M.size(); ++k) {
+            const std::string f = "measured[" + std::to_string(k) + "]";
+            r.only_keys(M[k], f, {"commanded", "cycle", "harmonics"}, {"commanded", "cycle", "harmonics"});
+            for (const char* key : {"commanded", "cycle"})
+                if (!M[k][key].is_string() || M[k][key].get<std::string>().empty())
+                    r.fail(f + "." + key, "expected a file's path");
+            const json& h = M[k]["harmonics"];
+            if (!h.is_number_integer() || h.get<long long>() < 1 || h.get<long long>() > 1000)
+                r.fail(f + ".harmonics", "expected a whole number from 1 to 1000");
+            MeasuredMotion m;
+            m.commanded_source = (std::filesystem::path(dir) / M[k]["commanded"].get<std::string>()).string();
+            m.cycle_source = (std::filesystem::path(dir) / M[k]["cycle"].get<std::string>()).string();
+            try {
+                m.commanded = load_scene(m.commanded_source).plate;
+            } catch (const InputError& e) {
+                r.fail(f + ".commanded", e.what());
+            }
+            try {
+                m.measured = read_measured_cycle(m.cycle_source, static_cast<int>(h.get<long long>())).plate;
+            } catch (const InputError& e) {
+                r.fail(f + ".cycle", e.what());
+            }
+            if (!(std::abs(m.measured.T - m.commanded.T) <= 1e-9 * m.commanded.T))
+                r.fail(f + ".cycle", m.cycle_source + ": period " + Reader::fmt(m.measured.T) + " s, not the commanded " +
+                                         Reader::fmt(m.commanded.T) + " s");
+            m.measured.T = m.commanded.T;
+            for (const MeasuredMotion& o : t.measured)
+                if (same_motion(o.commanded, m.commanded))
+                    r.fail(f + ".commanded", m.commanded_source + ": the same motion as " + o.commanded_source);
+            t.measured.push_back(std::move(m));
+        }
+    }
     t.validate();
     return t;
 }
 
-Truth load_truth(const std::string& path) { return parse_truth(detail::read_input_file(path, "truth file"), path); }
+Truth load_truth(const std::string& path) {
+    return parse_truth(detail::read_input_file(path, "truth file"), path, std::filesystem::path(path).parent_path().string());
+}
 
 namespace {
 
@@ -61,7 +115,13 @@ std::uint64_t draw_index(std::uint64_t run, std::uint64_t slot, std::uint64_t pe
 
 }   // namespace
 
-Scene true_scene(const Truth& truth, const Scene& commanded, int motion, long period) {
+Scene true_scene(const Truth& truth, const Scene& commanded_scene, int motion, long period) {
+    Scene commanded = commanded_scene;
+    for (const MeasuredMotion& m : truth.measured)
+        if (same_motion(m.commanded, commanded.plate)) {
+            commanded.plate = m.measured;
+            break;
+        }
     Scene s = commanded;
     if (truth.uncertainty) {
         const UncertaintySpec& spec = *truth.uncertainty;
@@ -80,20 +140,12 @@ Scene true_scene(const Truth& truth, const Scene& commanded, int motion, long pe
     }
     s.part.mu *= truth.friction_scale;
     if (s.part.mu_static) *s.part.mu_static *= truth.friction_scale;
-    s.name = commanded.name + "~truth";
+    s.name = commanded_scene.name + "~truth";
     return s;
 }
 
-namespace {
 
-bool same_motion(const PlateMotion& a, const PlateMotion& b) {
-    if (a.T != b.T || a.harmonics.size() != b.harmonics.size()) return false;
-    for (std::size_t i = 0; i < a.harmonics.size(); ++i) {
-        const Harmonic &x = a.harmonics[i], &y = b.harmonics[i];
-        if (x.axis != y.axis || x.n != y.n || x.amp != y.amp || x.phase != y.phase) return false;
-    }
-    return true;
-}
+namespace {
 
 // The heading about the world's z of R1 R_z(theta), taken within pi of theta.
 double heading(const Mat3& R1, double theta) {

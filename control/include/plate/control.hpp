@@ -33,7 +33,15 @@ namespace plate {
 //   { "friction_scale": 0.8,              // optional (1): every friction coefficient times this
 //     "uncertainty": { ...an uncertainty spec, inline (uncertainty.hpp)... },   // optional (none)
 //     "tracking": "per_period",            // optional ("per_period") | "per_run"
-//     "draw": 0 }                          // optional (0): which draw of the spec this run is
+//     "draw": 0,                           // optional (0): which draw of the spec this run is
+//     "measured": [                        // optional: what the real plate did when commanded a motion
+//       { "commanded": "e_fast.json",      //   a scene file whose plate motion the controller commands
+//         "cycle": "e_fast_recorded.csv",  //   one recorded period of the plate (measured_cycle.hpp)
+//         "harmonics": 5 } ] }             //   the highest harmonic kept of it
+//
+// Paths are relative to the truth file's folder. A commanded motion that equals an entry's (same
+// harmonics, to the bit) runs on the plate's recorded cycle instead, the cycle's period the commanded
+// one's (1e-9 relative); the spec's tracking errors, if any, are drawn on top of it.
 //
 // The part's deviations (friction, mass, inertia, contacts, centre of mass) and the period's are drawn
 // once per run: they are the part's and the drive's. The plate's tracking errors (amplitude, phase,
@@ -41,12 +49,19 @@ namespace plate {
 // vary cycle to cycle) or once per run for each motion ("per_run"). docs/decisions/control.md.
 enum class Tracking { per_period, per_run };
 
+// A plate motion as commanded and as a real plate ran it (a recorded cycle's harmonics).
+struct MeasuredMotion {
+    std::string commanded_source, cycle_source;   // files (for messages)
+    PlateMotion commanded, measured;
+};
+
 struct Truth {
     std::string source;   // file it was read from (for messages)
     double friction_scale = 1;
     std::optional<UncertaintySpec> uncertainty;
     Tracking tracking = Tracking::per_period;
     std::uint64_t draw = 0;
+    std::vector<MeasuredMotion> measured;
     // InputError naming source and the field unless friction_scale lies in (0, kMaxFrictionScale] and the
     // spec is admissible (validate_uncertainty).
     void validate() const;
@@ -61,10 +76,12 @@ Truth spread_truth(double friction_scale, double spread, std::uint64_t draw);
 // and for a rigid part (with_theta) theta uniform over (-pi, pi], drawn third; else theta 0.
 Vec3 square_start(std::uint64_t i, bool with_theta);
 
-Truth load_truth(const std::string& path);                               // throws InputError
-Truth parse_truth(const std::string& text, const std::string& source);   // throws InputError
+Truth load_truth(const std::string& path);   // throws InputError
+// dir: where the measured entries' relative paths start (load_truth: the file's folder).
+Truth parse_truth(const std::string& text, const std::string& source, const std::string& dir = "");   // throws InputError
 
-// The true scene of one period: `motion`'s plate with period `period`'s tracking errors (or the run's,
+// The true scene of one period: `motion`'s plate (its recorded cycle if the truth has one) with period
+// `period`'s tracking errors (or the run's,
 // per_run), on the run's true part and period. `motion` indexes the motions a loop was given (a
 // motion a policy made itself: index -1, always drawn per period). Without a spec: the nominal part
 // with its friction scaled, the motion as commanded. Deterministic in (spec seed, draw, motion, period).
