@@ -435,6 +435,53 @@ TEST_CASE("stick test: a point part at zero slip sticks exactly when |p''| <= mu
     CHECK_FALSE(stick_test(sc, Dynamics::U, 0, Vec3::Zero(), Vec3::Zero(), ps).sticks);
 }
 
+// A point part's creeping contact (StickSlipState::creep) slides along its consistent direction. For
+// one contact at s, s'' = -(mu N u + b_xy) / m with N = b_z whatever u (b of (33)), so s'' x u =
+// -(b_xy x u) / m: with no turn (rate 0) s'' is along u exactly where u is along -b_xy (the drive
+// past static friction, reversed); with the slip turning at rate w (counter-clockwise), u x s'' = |v| w
+// (modes.cpp) puts u at an angle delta from -b_xy with sin(delta) = -m |v| w / |b_xy|. Measured: the angle exact (0 rad; the
+// Newton's last step is below 1e-11 and its error then squared), allowed 1.5e-15 (3 ulp of an angle
+// near 2); s'' from that direction 2.2e-16 relative, allowed 7e-16. And the reduced U-dynamics' solve (the
+// engine's, modes.cpp's point_creep) gives the same direction as the U-dynamics' (the general path) at
+// the same instant, where the two coincide through different kernels: measured 0, allowed 1e-15.
+TEST_CASE("a point part's creeping contact slides along its consistent direction, turned by the slip's turn",
+          "[dynamics][creep]") {
+    Scene sc;
+    sc.part.point = true;
+    sc.part.m = 0.0216;
+    sc.part.mu.setConstant(0.3);
+    sc.plate.T = 0.05;
+    sc.plate.harmonics = {Harmonic{Axis::x, 1, 20, 0}, Harmonic{Axis::ry, 1, 100, 4.71238898038469},
+                          Harmonic{Axis::y, 2, 6, 0.4}};
+    const Vec3 q(0.01, -0.02, 0), qd(2e-9, -1e-9, 0);
+    const PlateState ps = plate_state(sc.plate, 0.3 * sc.plate.T, Dynamics::ReducedU);
+    const Vec6 b = rhs_b(sc, Dynamics::ReducedU, q, qd, ps);
+    REQUIRE(b.head<2>().norm() > 1.2 * sc.part.mu[0] * b[2]);   // beyond static friction: it slides
+    const double beta = std::atan2(-b[1], -b[0]);               // the direction of -b_xy
+    for (const double rate : {0.0, 3e4}) {
+        const double delta = -std::asin(sc.part.m * qd.norm() * rate / b.head<2>().norm());
+        Vec2 u[2];
+        for (int l = 0; l < 2; ++l) {
+            const Dynamics level = l == 0 ? Dynamics::ReducedU : Dynamics::U;
+            Workspace ws;
+            detail::StickSlipState& ss = detail::stick_slip(ws);
+            ss.use_hints = true;
+            ss.hint_speed = 1e-6;
+            ss.creep = 1;
+            ss.creep_rate[0] = rate;
+            ss.hint[0] = Vec2(std::cos(beta + 0.6), std::sin(beta + 0.6));   // 34 degrees off
+            mode_accelerations(sc, level, q, qd, ps, Mode{}, ws);
+            u[l] = ss.hint[0];
+            INFO("rate " << rate << ", " << dynamics_name(level) << ", delta " << delta);
+            CHECK(std::abs(std::remainder(std::atan2(u[l].y(), u[l].x()) - (beta + delta), 2 * kPi)) < 1.5e-15);
+            // (and s'' is the one of that direction)
+            const Vec2 sdd = (-sc.part.mu[0] * b[2] * u[l] - b.head<2>()) / sc.part.m;
+            CHECK((ws.qdd.head<2>() - sdd).norm() < 7e-16 * sdd.norm());
+        }
+        CHECK((u[0] - u[1]).norm() < 1e-15);
+    }
+}
+
 TEST_CASE("stick test: a rigid part held at one contact on a resting plate sticks", "[dynamics][stick]") {
     const Scene sc = resting(random_scene(4, RandomSceneOptions{true}));
     // Contact 0 at zero slip, others sliding slowly about it: friction needed is finite and the

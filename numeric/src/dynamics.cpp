@@ -218,6 +218,32 @@ inline void slip_directions(int nc, const Vec3& qd, Workspace& ws, double* ux, d
     for (int i = nc; i < 3; ++i) ws.slip[i].setZero();
 }
 
+// A point part's reduced U-dynamics (35) at the configuration whose slots are cached
+// (accelerations_reduced_U), with Jq as there.
+inline void reduced_U_point(const Vec3& qd, const PlateState& ps, Workspace& ws, Mat3* Jq) {
+    detail::KernelScratch& ks = detail::kernels(ws);
+    // The staged kernels read only the slip directions and u(t): those fields are written here.
+    gen::KernelInput& k = ks.staged;
+    set_plate_accelerations(ps, k);
+    double ux[1], uy[1];
+    slip_directions(1, qd, ws, ux, uy);
+    k.u1x = ux[0];
+    k.u1y = uy[0];
+    double z[3];
+    double dq[4];   // d s''_r / d u_j, row-major (2 x 2)
+    if (Jq)
+        gen::reduced_U_point_du(k, ks.C.data(), z, dq);
+    else
+        gen::reduced_U_point(k, ks.C.data(), z);
+    ws.qdd = Vec3(z[0], z[1], 0);
+    ws.n = Vec3(z[2], 0, 0);
+    if (Jq) {
+        Jq->setZero();
+        Jq->topLeftCorner<2, 2>() = Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(dq) *
+                                    direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
+    }
+}
+
 // Reduced U-dynamics (35) on the staged kernels: the slots of the frozen configuration once, then
 // per evaluation only the slip directions and u(t). Returns false when a thick part's reduced
 // system is near singular (the caller then takes the direct path with its pivoted LU). With Jq,
@@ -237,29 +263,15 @@ bool accelerations_reduced_U(const Part& P, const Vec3& q, const Vec3& qd, const
         else
             gen::reduced_U_thick_config(ks.in, ks.C.data());
     }
+    if (P.point) {
+        reduced_U_point(qd, ps, ws, Jq);
+        return true;
+    }
     // The staged kernels read only the slip directions and u(t): those fields are written here.
     gen::KernelInput& k = ks.staged;
     set_plate_accelerations(ps, k);
     double ux[3], uy[3];
-    double dq[18];   // d q''_r / d u_j, row-major (3 x 6; point part 2 x 2)
-    if (P.point) {
-        slip_directions(1, qd, ws, ux, uy);
-        k.u1x = ux[0];
-        k.u1y = uy[0];
-        double z[3];
-        if (Jq)
-            gen::reduced_U_point_du(k, ks.C.data(), z, dq);
-        else
-            gen::reduced_U_point(k, ks.C.data(), z);
-        ws.qdd = Vec3(z[0], z[1], 0);
-        ws.n = Vec3(z[2], 0, 0);
-        if (Jq) {
-            Jq->setZero();
-            Jq->topLeftCorner<2, 2>() = Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(dq) *
-                                        direction_derivative(ws.law, ws.law_eps, ws.slip[0]);
-        }
-        return true;
-    }
+    double dq[18];   // d q''_r / d u_j, row-major (3 x 6)
     slip_directions(3, qd, ws, ux, uy);
     k.u1x = ux[0];
     k.u1y = uy[0];
@@ -313,7 +325,12 @@ namespace detail {
 // the right-hand side)
 bool reduced_U_slide(const Scene& sc, const Vec3& q, const Vec3& qd, const PlateState& ps, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
-    if (ks.prepared != &sc || !accelerations_reduced_U(sc.part, q, qd, ps, ws)) return false;
+    if (ks.prepared != &sc) return false;
+    // (a point part at the configuration cached -- all period long -- straight to its branch)
+    if (sc.part.point && q[0] == ks.C_q[0] && q[1] == ks.C_q[1] && q[2] == ks.C_q[2])
+        reduced_U_point(qd, ps, ws, nullptr);
+    else if (!accelerations_reduced_U(sc.part, q, qd, ps, ws))
+        return false;
     ++ws.evals;
     return true;
 }

@@ -129,12 +129,15 @@ int Engine<Model>::first_event(double t1, const Guards& g1, double& t_ev, State&
     t_ev = std::numeric_limits<double>::infinity();
     for (int i = 0; i < kGuards; ++i) {
         double tb = t1, gb = g1[i];   // the bracket's right end: the step's end, or a dip's bottom
-        State yb = ys1_;
-        if (!crossed(i, g0_[i], gb) && !(i == 4 && turn_dip(t1, g1[i], tb, gb, yb)) &&
-            !((i < 3 || model_.mode.kind == ModeKind::Pivot) && stage_dip(i, t1, g1[i], tb, gb, yb)))
-            continue;
+        State yd;                     // (a dip's state; the step's end is not copied for each guard)
+        bool dip = false;
+        if (!crossed(i, g0_[i], gb)) {
+            dip = (i == 4 && turn_dip(t1, g1[i], tb, gb, yd)) ||
+                  ((i < 3 || model_.mode.kind == ModeKind::Pivot) && stage_dip(i, t1, g1[i], tb, gb, yd));
+            if (!dip) continue;
+        }
         State yr;
-        const double tr = locate(i, t1, tb, gb, yb, yr);
+        const double tr = locate(i, t1, tb, gb, dip ? yd : ys1_, yr);
         if (i >= 3 && model_.mode.kind == ModeKind::Slide && !slip_zero(i - 3, tr, yr)) {
             swing = true;   // the slip swung past zero without reaching it
             continue;

@@ -199,6 +199,50 @@ void twist_creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, c
     xi = at(a, b);
 }
 
+// creep_accelerations for a point part in the reduced U-dynamics, its one contact creeping, the
+// hints in use, after its first evaluation (ws holds it): the same Newton on the angle, with the same
+// operations in the same order, so the same bits. What an evaluation changes there is only the
+// direction: the configuration's slots are cached, u(t) and the slip are the first evaluation's (in
+// the staged inputs and ws.slip), and a creeping contact takes its hint as the direction -- so each
+// evaluation is the generated kernel on the new direction alone, without the slip's square root and
+// division whose result the hint replaces, and the slip's speed in the residual is taken once.
+// (docs/decisions/web.md, A point part's creep and slide without the general path)
+void point_creep(Workspace& ws) {
+    detail::KernelScratch& ks = detail::kernels(ws);
+    detail::StickSlipState& ss = detail::stick_slip(ws);
+    gen::KernelInput& k = ks.staged;
+    Vec2& u = ss.hint[0];
+    const double speed_turn = ws.slip[0].norm() * ss.creep_rate[0];
+    auto evaluate = [&] {   // (accelerations_reduced_U's point branch on the direction u)
+        ++ws.evals;
+        k.u1x = u.x();
+        k.u1y = u.y();
+        double z[3];
+        gen::reduced_U_point(k, ks.C.data(), z);
+        ws.qdd = Vec3(z[0], z[1], 0);
+        ws.n = Vec3(z[2], 0, 0);
+    };
+    auto residual = [&] { return ws.qdd[0] * u.y() - ws.qdd[1] * u.x() + speed_turn; };
+    double phi = std::atan2(u.y(), u.x());
+    double c = residual();
+    constexpr double dphi = 1e-7;
+    for (int it = 0; it < 8; ++it) {
+        const double p = phi + dphi;
+        u = Vec2(std::cos(p), std::sin(p));
+        evaluate();
+        const double J = (residual() - c) / dphi;
+        double step = -c / J;
+        if (!std::isfinite(step)) step = 0;
+        step = std::min(std::max(step, -0.5), 0.5);
+        phi += step;
+        u = Vec2(std::cos(phi), std::sin(phi));
+        evaluate();
+        ++ws.creep_iterations;
+        c = residual();
+        if (std::abs(step) < 1e-11) break;
+    }
+}
+
 // Slide with creeping contacts (StickSlipState::creep): the direction u_j = (cos phi_j, sin phi_j) of each
 // creeping contact j is the one along which it then accelerates, c_j = a_j x u_j = 0 (the consistent
 // slip direction at the rim of the friction disk; at a located break-away a_j = 0 and c_j vanishes to
@@ -219,6 +263,10 @@ void creep_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const V
     ws.creep_iterations = 0;
     accelerations(sc, level, q, qd, ps, ws);
     if (m == 0) return;
+    if (P.point && level == Dynamics::ReducedU && ss.use_hints) {
+        point_creep(ws);
+        return;
+    }
     // (a_j x u_j + |v_j| rate_j: the slip turns with its direction at the rate the engine measured,
     // d(v/|v|)/dt = (u x a) / |v|; with rate 0 the slip could not turn with a turning drive, and a
     // slide at the rim of the disk would stay at the zero threshold, far below the exact speed.)
