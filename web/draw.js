@@ -58,9 +58,9 @@ const PlateDraw = (() => {
     return `rgb(${c.map(k => Math.round(255 + (k - 255) * a)).join(',')})`;
   }
 
-  // The canvas under the SVG (its sibling, the same 640 x 640 frame), cleared and scaled to the screen's pixels.
-  function canvasUnder(svg) {
-    const c = svg.parentNode.querySelector('canvas'), ratio = window.devicePixelRatio || 1;
+  // The canvas `id` under the SVG (the same 640 x 640 frame), cleared and scaled to the screen's pixels.
+  function canvas(id) {
+    const c = document.getElementById(id), ratio = window.devicePixelRatio || 1;
     if (c.width !== SIZE * ratio) c.width = c.height = SIZE * ratio;
     const ctx = c.getContext('2d');
     ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
@@ -68,12 +68,12 @@ const PlateDraw = (() => {
     return ctx;
   }
   // The field (the program's JSON, output.cpp) with its fixed points (or null). Returns the frame. The
-  // many marks -- theta' cells and arrows, one per grid point -- go on the canvas under the SVG (625 SVG
-  // arrows cost the page about 8 ms a field: docs/decisions/web.md); axes, fixed points and trajectories,
-  // a few elements, stay SVG.
+  // many marks -- theta' cells and arrows, one per grid point -- go on two canvases under the SVG (625 SVG
+  // arrows cost the page about 8 ms a field: docs/decisions/web.md), the arrows on their own (transparent
+  // elsewhere: the page check reads their ink back); axes, fixed points and trajectories stay SVG.
   function field(svg, fld, fixed) {
     svg.replaceChildren();
-    const ctx = canvasUnder(svg);
+    let ctx = canvas('plot-cells');
     const grid = fld.grid, f = frame(grid), pts = fld.points;
     const nx = grid.nx, ny = grid.ny;
     const dx = nx > 1 ? (f.x1 - f.x0) / (nx - 1) : f.x1 - f.x0 || 1, dy = ny > 1 ? (f.y1 - f.y0) / (ny - 1) : f.y1 - f.y0 || 1;
@@ -90,6 +90,7 @@ const PlateDraw = (() => {
       }
     }
     axes(svg, f);
+    ctx = canvas('plot-arrows');
     const speeds = pts.filter(p => p.converged).map(p => Math.hypot(p.twist[0], p.twist[1]));
     const vmax = Math.max(1e-300, ...speeds);
     const cell = Math.min(W / Math.max(nx - 1, 1), H / Math.max(ny - 1, 1));
