@@ -55,6 +55,10 @@ const PlateDesign = (() => {
   function drop(why) {
     $('design-apply').hidden = true;
     if (!running) return;
+    // (ended while it loads the module, the worker reports its importScripts as failed: that report,
+    // about a worker the page no longer wants, is silenced)
+    worker.onmessage = null;
+    worker.onerror = e => e.preventDefault();
     worker.terminate();
     worker = null;
     running = 0;

@@ -1,8 +1,8 @@
 #!/usr/bin/env node
 // The playground designs a point part's sink as `plate design` does (issue 55): web/index.html on
 // fig1_point in headless Chromium; the design's inputs set and its button pressed through the page's own
-// controls; a slider moved while it runs (the stale design must be dropped: its worker ended, nothing
-// shown); designed again; the page's designed motion and summary against `plate design` on the scene the
+// controls; designs dropped as they start (no error), a slider moved while one runs (the stale design must
+// be dropped: its worker ended, nothing shown); designed again; the page's designed motion and summary against `plate design` on the scene the
 // page held, target and options the same; then "use the designed motion" and the page's field has its
 // stable fixed point where the design put it. A negative control: the program's design for a target
 // 1e-6 m away must differ from the page's by more than the tolerance.
@@ -74,6 +74,19 @@ async function check(base) {
       else console.log(`the module has no design; the page says so: '${why}'`);
       return 'unavailable';
     }
+    // designs dropped as soon as they start, 0-19 ms after the button (their workers ended while they load
+    // the module, which a worker then reports as a failed load): dropped, and no error stated
+    await page.evaluate(`(async () => {
+      for (let k = 0; k < 20; ++k) {
+        ${click('design-run')};
+        await new Promise(r => setTimeout(r, k));
+        ${type('design-x', TARGET[0])};
+      }
+      await new Promise(r => setTimeout(r, 200));
+    })()`);
+    const early = await page.evaluate('({dropped: playground.designsDropped, errors: document.body.dataset.errors})');
+    if (early.dropped !== 20 || early.errors !== 'none') fail(`20 designs dropped as they start: ${JSON.stringify(early)}`);
+    else console.log('20 designs dropped 0-19 ms after they started: all dropped, no error');
     // the inputs through the page's controls, the button, and at once a slider: the design is stale
     await page.evaluate(`${type('design-x', TARGET[0])}; ${type('design-y', TARGET[1])}; ${type('design-starts', STARTS)};
                          ${type('design-evaluations', EVALUATIONS)}; ${click('design-run')}`);
@@ -81,7 +94,7 @@ async function check(base) {
     await page.evaluate(`(async () => { const before = playground.lastField; ${type('h0-phase', 1.0)};
                                         await ${until(`playground.lastField !== before && ${idle}`)}; })()`);
     const dropped = await page.evaluate('({state: document.body.dataset.design, dropped: playground.designsDropped, shown: !!playground.lastDesign})');
-    if (dropped.state !== 'dropped' || dropped.dropped !== 1 || dropped.shown)
+    if (dropped.state !== 'dropped' || dropped.dropped !== 21 || dropped.shown)
       fail(`a slider moved while the design ran: the page says ${JSON.stringify(dropped)}, not one design dropped and none shown`);
     else console.log('a slider moved while the design ran: the stale design was dropped (its worker ended), none shown');
     // the design again, to its end
