@@ -13,7 +13,8 @@ pkgs=(g++ cmake make pkg-config libeigen3-dev libboost-dev libgsl-dev libginac-d
       libopenmpi-dev openmpi-bin
       libbullet-dev libode-dev libmujoco-dev   # (these three: the peer engines, optional to the build)
       libsiconos-numerics-dev   # (the Moreau-Jean stick-slip reference, tests/test_siconos.cpp; optional)
-      emscripten)   # (the playground in WebAssembly, web/: optional, the target `web` when found)
+      emscripten    # (the playground in WebAssembly, web/: optional, the target `web` when found)
+      dpkg-dev)     # (dpkg-source: the playground's NLopt from Debian's source package, web/fetch_nlopt.sh; optional)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

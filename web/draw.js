@@ -1,6 +1,6 @@
-// The playground's drawing (issue 55): the field as arrows on an SVG with axes in mm, a rigid part's
-// angular rate theta' as the colour under them, the fixed points and lines marked by their stability,
-// and a dropped part's trajectory coloured by its contact mode. No library: plain SVG elements.
+// The playground's drawing (issue 55): the field as arrows (on a canvas under the SVG) with axes in mm, a
+// rigid part's angular rate theta' as the colour under them, the fixed points and lines marked by their stability,
+// and a dropped part's trajectory coloured by its contact mode. No library: plain SVG elements and a canvas.
 'use strict';
 const PlateDraw = (() => {
   const NS = 'http://www.w3.org/2000/svg';
@@ -58,45 +58,70 @@ const PlateDraw = (() => {
     return `rgb(${c.map(k => Math.round(255 + (k - 255) * a)).join(',')})`;
   }
 
-  // The field (the program's JSON, output.cpp) with its fixed points (or null). Returns the frame.
+  // The canvas `id` under the SVG (the same 640 x 640 frame), cleared and scaled to the screen's pixels.
+  function canvas(id) {
+    const c = document.getElementById(id), ratio = window.devicePixelRatio || 1;
+    if (c.width !== SIZE * ratio) c.width = c.height = SIZE * ratio;
+    const ctx = c.getContext('2d');
+    ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+    ctx.clearRect(0, 0, SIZE, SIZE);
+    return ctx;
+  }
+  // The field (the program's JSON, output.cpp) with its fixed points (or null). Returns the frame. The
+  // many marks -- theta' cells and arrows, one per grid point -- go on two canvases under the SVG (625 SVG
+  // arrows cost the page about 8 ms a field: docs/decisions/web.md), the arrows on their own (transparent
+  // elsewhere: the page check reads their ink back); axes, fixed points and trajectories stay SVG.
   function field(svg, fld, fixed) {
     svg.replaceChildren();
+    let ctx = canvas('plot-cells');
     const grid = fld.grid, f = frame(grid), pts = fld.points;
     const nx = grid.nx, ny = grid.ny;
     const dx = nx > 1 ? (f.x1 - f.x0) / (nx - 1) : f.x1 - f.x0 || 1, dy = ny > 1 ? (f.y1 - f.y0) / (ny - 1) : f.y1 - f.y0 || 1;
     const rigid = pts.length && pts[0].twist && pts[0].twist.length === 3;
     const omegaMax = rigid ? Math.max(1e-12, ...pts.filter(p => p.converged).map(p => Math.abs(p.twist[2]))) : 0;
     if (rigid) {   // theta' as the colour of each point's cell
-      const g = el('g', {class: 'omega'}, svg);
       for (const p of pts) {
         if (!p.converged) continue;
         const [x, y] = p.at;
         const xa = f.px(Math.max(f.x0, x - dx / 2)), xb = f.px(Math.min(f.x1, x + dx / 2));
         const ya = f.py(Math.min(f.y1, y + dy / 2)), yb = f.py(Math.max(f.y0, y - dy / 2));
-        el('rect', {x: xa, y: ya, width: xb - xa, height: yb - ya, fill: diverging(p.twist[2] / omegaMax)}, g);
+        ctx.fillStyle = diverging(p.twist[2] / omegaMax);
+        ctx.fillRect(xa, ya, xb - xa, yb - ya);
       }
     }
     axes(svg, f);
+    ctx = canvas('plot-arrows');
     const speeds = pts.filter(p => p.converged).map(p => Math.hypot(p.twist[0], p.twist[1]));
     const vmax = Math.max(1e-300, ...speeds);
     const cell = Math.min(W / Math.max(nx - 1, 1), H / Math.max(ny - 1, 1));
-    const g = el('g', {class: 'arrows', stroke: '#222', fill: '#222'}, svg);
+    const lines = new Path2D(), heads = new Path2D();
+    ctx.font = '10px sans-serif';
+    ctx.textAlign = 'center';
+    ctx.fillStyle = '#999';
     for (const p of pts) {
       const x = f.px(p.at[0]), y = f.py(p.at[1]);
       if (!p.converged) {
-        el('text', {x, y: y + 4, 'text-anchor': 'middle', 'font-size': 10, fill: '#999', stroke: 'none'}, g).textContent = '×';
+        ctx.fillText('×', x, y + 4);
         continue;
       }
       const v = Math.hypot(p.twist[0], p.twist[1]), len = 0.85 * cell * v / vmax;
       if (len < 0.5) {
-        el('circle', {cx: x, cy: y, r: 1.2}, g);
+        heads.moveTo(x + 1.2, y);
+        heads.arc(x, y, 1.2, 0, 2 * Math.PI);
         continue;
       }
       const ux = p.twist[0] / v, uy = -p.twist[1] / v, hx = x + ux * len, hy = y + uy * len, h = Math.min(5, len / 2);
-      el('line', {x1: x, y1: y, x2: hx, y2: hy, 'stroke-width': 1.2}, g);
-      el('polygon', {points: `${hx},${hy} ${hx - ux * h - uy * h / 2},${hy - uy * h + ux * h / 2} ` +
-                             `${hx - ux * h + uy * h / 2},${hy - uy * h - ux * h / 2}`, stroke: 'none'}, g);
+      lines.moveTo(x, y);
+      lines.lineTo(hx, hy);
+      heads.moveTo(hx, hy);
+      heads.lineTo(hx - ux * h - uy * h / 2, hy - uy * h + ux * h / 2);
+      heads.lineTo(hx - ux * h + uy * h / 2, hy - uy * h - ux * h / 2);
+      heads.closePath();
     }
+    ctx.strokeStyle = ctx.fillStyle = '#222';
+    ctx.lineWidth = 1.2;
+    ctx.stroke(lines);
+    ctx.fill(heads);
     if (fixed) fixedPoints(svg, f, fixed);
     return {frame: f, vmax, omegaMax, rigid};
   }

@@ -3,12 +3,16 @@
 // by the same parse_scene as `plate field`, so a bad scene gets the program's own messages; the field
 // and fixed points are written by the program's own to_json.
 //
-//   request  {"op": "scene" | "field" | "fixed_points" | "trajectory", "scene": TEXT, "source": NAME, ...}
+//   request  {"op": "scene" | "field" | "fixed_points" | "trajectory" | "design", "scene": TEXT, "source": NAME, ...}
+//            or {"op": "about"} (whether this module designs: {"design": true} or {"design": false, "why": ...})
 //     field, fixed_points: "grid": {"nx", "ny", "x": [MIN, MAX], "y": [MIN, MAX], "theta": THETA},
 //                          "max_work": right-hand sides (default a tenth of `plate field`'s)
 //                          (a rigid part's field is the slice at theta; a point part has no theta)
 //     trajectory:          "q0": [s_x, s_y(, theta)], "duration": s, "dt": s (full dynamics from rest)
+//     design:              a point part's sink (plate_web_design.cpp)
 //   answer   {"ok": true, ...} or {"ok": false, "error": MESSAGE}
+#include "plate_web.hpp"
+
 #include "plate/field.hpp"
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
@@ -92,8 +96,14 @@ json trajectory_of(const Scene& sc, const json& rq) {
 
 json answer(const json& rq) {
     const std::string op = rq.at("op");
-    const Scene sc = scene_of(rq);
     json out = {{"ok", true}};
+    if (op == "about") {
+        std::string why;
+        out["design"] = design_available(why);
+        if (!why.empty()) out["why"] = why;
+        return out;
+    }
+    const Scene sc = scene_of(rq);
     if (op == "scene") {
         out["scene"] = scene_to_json(sc);
         out["warnings"] = scene_warnings(sc);
@@ -109,8 +119,10 @@ json answer(const json& rq) {
         out["fixed_points"] = to_json(sc, find_fixed_points(sc, f, fo));
     } else if (op == "trajectory") {
         out["trajectory"] = trajectory_of(sc, rq);
+    } else if (op == "design") {
+        out["design"] = design_answer(sc, rq);
     } else {
-        throw std::invalid_argument("unknown op '" + op + "' (expected scene, field, fixed_points or trajectory)");
+        throw std::invalid_argument("unknown op '" + op + "' (expected about, scene, field, fixed_points, trajectory or design)");
     }
     return out;
 }

@@ -54,6 +54,7 @@ function send(lane) {
 worker.onmessage = e => {
   if (e.data.ready) {
     playground.ready = true;
+    ask('about', {op: 'about'}, PlateDesign.about);   // (whether this module designs)
     Object.values(lanes).forEach(send);
     return;
   }
@@ -165,6 +166,7 @@ function grid() {
 }
 let stopAnimation = () => {};
 function changed() {
+  PlateDesign.sceneChanged(isPoint());   // (a design running for the old scene is dropped)
   const request = {scene: sceneText(), source: playground.source, grid: grid()};
   ask('field', Object.assign({op: 'field'}, request), answer => {
     if (!sceneAnswer(answer)) return;
@@ -234,5 +236,7 @@ $('plot').addEventListener('click', e => {
     $('timing').textContent = `trajectory of ${duration} s (full dynamics): ${answer.milliseconds.toFixed(0)} ms` + (stop ? `; stopped: ${stop}` : '');
   });
 });
+Object.assign(PlateDesign, {sceneText, noteError, useScene: sc => loadScene(JSON.stringify(sc, null, 1), 'the designed sink')});
+PlateDesign.init();
 setState('loading', 'loading the module...');
 pickScene(new URLSearchParams(location.search).get('scene') || SCENES[0]);

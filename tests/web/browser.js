@@ -62,6 +62,7 @@ async function open(url, {width = 1400, height = 1000} = {}) {
   await send('Runtime.enable');
   await send('Log.enable');
   await send('Page.enable');
+  await send('DOM.enable');
   await send('Page.navigate', {url});
   return {
     problems,
@@ -70,6 +71,16 @@ async function open(url, {width = 1400, height = 1000} = {}) {
       const r = await send('Runtime.evaluate', {expression, awaitPromise: true, returnByValue: true});
       if (r.exceptionDetails) throw new Error('in the page: ' + (r.exceptionDetails.exception || {}).description);
       return r.result.value;
+    },
+    // Chooses `files` in the page's file input `selector`, as a person does in the file dialog (the input's
+    // change event follows).
+    async chooseFiles(selector, files) {
+      const r = await send('Runtime.evaluate', {expression: `document.querySelector(${JSON.stringify(selector)})`});
+      await send('DOM.setFileInputFiles', {files, objectId: r.result.objectId});
+    },
+    // Downloads the page starts (a link's click) land in `dir`.
+    downloadTo(dir) {
+      return send('Browser.setDownloadBehavior', {behavior: 'allow', downloadPath: dir}, null);
     },
     async screenshot(file) {
       const r = await send('Page.captureScreenshot', {format: 'png', captureBeyondViewport: true});

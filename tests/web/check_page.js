@@ -5,6 +5,7 @@
 // no exception, console.error or failed load in the page; a part dropped on the field and its
 // trajectory drawn; screenshots kept in OUT_DIR. Two scenes: fig1_point (a point part; the first
 // harmonic's amplitude slider) and fig4 (a rigid part; the theta slider, so the slice at a new theta).
+// Then a scene file loaded and saved through the page's controls (loadAndSave).
 //   check_page.js PLATE_EXE SITE_DIR OUT_DIR
 'use strict';
 const {execFileSync} = require('child_process');
@@ -36,6 +37,33 @@ async function moveSlider(page, id, value) {
   })()`);
 }
 
+// The drawing read back: the field's arrows are painted on their own canvas under the plot (draw.js;
+// transparent elsewhere, so its alpha is ink). For the ten fastest points, the ink in a 5 x 5 pixel
+// window about the arrow's head (its centroid, 2/3 of the head's length back from the tip) against the
+// same window about the shaft's middle: a filled head of 5 px holds 12.5 px^2 of ink, the 1.2 px shaft
+// 6 px^2 in the window, so the head's window must hold at least 1.5 times the shaft's (measured: at least
+// 2.14 on fig1_point, 2.18 on fig4; arrows drawn backwards 0.42, without heads 0.91-1).
+// The arrow's length and head follow draw.js (0.85 of the cell at the fastest speed; head min(5, length / 2) px).
+const drawnHeads = `(() => {
+  const fld = playground.lastField, f = PlateDraw.frame(fld.grid), c = document.getElementById('plot-arrows');
+  const ctx = c.getContext('2d'), ratio = c.width / 640;
+  const ink = (x, y) => {
+    const d = ctx.getImageData(Math.round((x - 2.5) * ratio), Math.round((y - 2.5) * ratio), Math.round(5 * ratio), Math.round(5 * ratio)).data;
+    let sum = 0;
+    for (let k = 3; k < d.length; k += 4) sum += d[k] / 255;
+    return sum / (ratio * ratio);
+  };
+  const pts = fld.points.filter(p => p.converged).map(p => ({p, v: Math.hypot(p.twist[0], p.twist[1])})).sort((a, b) => b.v - a.v);
+  const cell = Math.min(550 / Math.max(fld.grid.nx - 1, 1), 560 / Math.max(fld.grid.ny - 1, 1)), vmax = pts[0].v;
+  let worst = Infinity;
+  for (const {p, v} of pts.slice(0, 10)) {
+    const len = 0.85 * cell * v / vmax, h = Math.min(5, len / 2), ux = p.twist[0] / v, uy = -p.twist[1] / v;
+    const x = f.px(p.at[0]), y = f.py(p.at[1]);
+    worst = Math.min(worst, ink(x + ux * (len - 2 * h / 3), y + uy * (len - 2 * h / 3)) / ink(x + ux * len / 2, y + uy * len / 2));
+  }
+  return worst;
+})()`;
+
 async function check(base, name, slider, value) {
   const page = await open(`${base}/index.html?scene=${name}`);
   try {
@@ -66,6 +94,9 @@ async function check(base, name, slider, value) {
     if (!(worst <= TOL)) fail(`${name}: the page's field differs from plate field by ${worst}`);
     console.log(`${name}: ${slider} moved (three quick moves, ${drawn} field drawn) to ${moved}; the page's ${got.field.points.length}-point field against plate field: ` +
                 `largest difference ${worst.toExponential(3)}`);
+    const heads = await page.evaluate(drawnHeads);
+    if (!(heads >= 1.5)) fail(`${name}: the 10 fastest arrows' heads hold only ${heads} times their shaft's ink on the canvas`);
+    else console.log(`${name}: the 10 fastest arrows drawn on the canvas, heads where the field points (ink ${heads.toFixed(2)} x the shaft's, at least)`);
     // drop a part at (30 %, 30 %) of the plot and let the trajectory draw
     await page.evaluate(`(async () => {
       const svg = document.getElementById('plot'), box = svg.getBoundingClientRect(), before = playground.lastTrajectory;
@@ -86,11 +117,61 @@ async function check(base, name, slider, value) {
   }
 }
 
+// The field `plate field` computes from a scene file on a small grid over (s_x, s_y, theta): what the
+// program makes of the file, to compare two files' meaning by.
+function meaning(file) {
+  const f = JSON.parse(execFileSync(exe, ['field', file, '--grid', '3', '--ntheta', '2', '--threads', '1'], {encoding: 'utf8'}));
+  return JSON.stringify(f.points);
+}
+
+// Load and save through the page's own controls: fig4's file chosen in the page's file input (the page
+// started on fig1_point), its controls then show fig4's part; "save scene JSON" downloads a file whose
+// meaning is the loaded file's -- `plate field` on both the same to the bit (the page holds the program's
+// reading of the file, and JSON carries doubles exactly) -- and whose name is the file's. A negative
+// control: the saved file with one friction coefficient changed by 1e-9 relative must differ.
+async function loadAndSave(base) {
+  const page = await open(`${base}/index.html?scene=fig1_point`);
+  const downloads = fs.mkdtempSync('/tmp/plate-save-');
+  try {
+    await page.evaluate(until(`playground.lastField && ${idle}`));
+    await page.downloadTo(downloads);
+    const file = path.resolve(site, 'scenes/fig4.json'), original = JSON.parse(fs.readFileSync(file, 'utf8'));
+    const before = await page.evaluate('playground.lastField');
+    await page.chooseFiles('#scene-load', [file]);
+    await page.evaluate(until(`playground.source === 'fig4.json' && playground.lastField && playground.lastField.points.length !== ${before.points.length} && ${idle}`));
+    const shown = await page.evaluate(`({contacts: document.querySelectorAll('#contacts tr').length - 1,
+                                         harmonics: document.querySelectorAll('#harmonics tbody tr').length, name: playground.scene.name})`);
+    if (shown.contacts !== original.part.contacts.length || shown.harmonics !== original.plate.harmonics.length)
+      fail(`loaded fig4.json: the page shows ${shown.contacts} contacts and ${shown.harmonics} harmonics, the file has ` +
+           `${original.part.contacts.length} and ${original.plate.harmonics.length}`);
+    await page.evaluate("document.getElementById('scene-save').click()");
+    const saved = path.join(downloads, `${shown.name}.json`);
+    for (let t = 0; t < 200 && !fs.existsSync(saved); ++t) await new Promise(r => setTimeout(r, 50));
+    if (!fs.existsSync(saved)) return fail(`saved: no ${path.basename(saved)} downloaded (${fs.readdirSync(downloads)})`);
+    const text = fs.readFileSync(saved, 'utf8'), copy = JSON.parse(text), failedBefore = failed;
+    if (copy.name !== original.name) fail(`saved: named '${copy.name}', the file '${original.name}'`);
+    if (meaning(saved) !== meaning(file)) fail("saved: plate field on the saved file differs from the loaded file's");
+    copy.part.friction = [].concat(copy.part.friction).map((mu, i) => (i === 0 ? mu * (1 + 1e-9) : mu));
+    const wrong = path.join(downloads, 'wrong.json');
+    fs.writeFileSync(wrong, JSON.stringify(copy));
+    if (meaning(wrong) === meaning(file)) fail('saved: the comparison did not see a friction coefficient changed by 1e-9');
+    if (failed === failedBefore) console.log(`load and save: fig4.json loaded through the page's file input (${shown.contacts} contacts, ${shown.harmonics} harmonics shown), ` +
+                `saved as ${path.basename(saved)}: plate field the same to the bit; with a friction coefficient x (1 + 1e-9), not`);
+    const errors = await page.evaluate('document.body.dataset.errors');
+    if (errors !== 'none') fail(`load and save: the page states errors: ${errors}`);
+    if (page.problems.length) fail(`load and save: errors in the page: ${page.problems.join(' | ')}`);
+  } finally {
+    await page.close();
+    fs.rmSync(downloads, {recursive: true, force: true});
+  }
+}
+
 serve(site).then(async server => {
   const base = `http://127.0.0.1:${server.address().port}`;
   try {
     await check(base, 'fig1_point', 'h0-amp', 'a => 0.9 * a');
     await check(base, 'fig4', 'theta', '() => 0.5');
+    await loadAndSave(base);
   } catch (e) {
     fail(String(e));
   }
