@@ -1,6 +1,6 @@
 // The `library` policy: each period the library motion that, kept, stays nearest the goal (a rigid part:
 // turn first, then steer the position with the motions that keep its orientation).
-#include "plate/control.hpp"
+#include "internal.hpp"
 
 #include <cmath>
 #include <limits>
@@ -69,23 +69,6 @@ public:
     }
 
 private:
-    // The observed configuration carried forward from the time it shows to the decision's, k T, along the
-    // model's field of the motion chosen for each period in between (one Euler step per period or part).
-    Vec3 predicted(const Observation& obs, long period) const {
-        const ControlModel& m = *model_;
-        const double T = m.T(), now = period * T;
-        Vec3 q = obs.q;
-        double t = obs.state_time;
-        while (t < now - 1e-9 * T) {
-            const long j = static_cast<long>(std::floor(t / T + 1e-9));
-            const double end = std::min((j + 1) * T, now);
-            if (j >= 0 && j < static_cast<long>(chosen_.size()))
-                q += m.step(j > 0 ? chosen_[j - 1] : -1, chosen_[j], q) * ((end - t) / T);
-            t = end;
-        }
-        return q;
-    }
-
     // Where the part is at the decision's time. On the still plate the part comes to rest within a period
     // and stays: from the second period on, the frames it shows are averaged (the camera's noise
     // shrinks as 1/sqrt(n), and a noisy frame alone does not start the plate again).
@@ -99,7 +82,7 @@ private:
             }
             return rest_sum_ / rest_frames_;
         }
-        return predicted(obs, period);
+        return detail::predict_forward(*model_, chosen_, obs, period);
     }
 
     // The mean distance to the goal over the next `horizon` periods on motion k kept, the first period
@@ -204,6 +187,20 @@ private:
 };
 
 }   // namespace
+
+Vec3 detail::predict_forward(const ControlModel& m, const std::vector<int>& chosen, const Observation& obs, long period) {
+    const double T = m.T(), now = period * T;
+    Vec3 q = obs.q;
+    double t = obs.state_time;
+    while (t < now - 1e-9 * T) {
+        const long j = static_cast<long>(std::floor(t / T + 1e-9));
+        const double end = std::min((j + 1) * T, now);
+        if (j >= 0 && j < static_cast<long>(chosen.size()))
+            q += m.step(j > 0 ? chosen[j - 1] : -1, chosen[j], q) * ((end - t) / T);
+        t = end;
+    }
+    return q;
+}
 
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt) { return std::make_unique<LibraryPolicy>(opt); }
 
