@@ -108,12 +108,7 @@ int main(int argc, char** argv) try {
         parts.parts = {{a.goal1, square_start(2 * static_cast<std::uint64_t>(i), false), 1},
                        {a.goal2, square_start(2 * static_cast<std::uint64_t>(i) + 1, false), 1}};
         const Truth truth = spread_truth(a.friction_scale, a.spread, static_cast<std::uint64_t>(i));
-        Camera cam;
-        cam.per_period = 1;
-        cam.noise_xy_mm = 0.1;
-        cam.latency = sc.plate.T;
-        cam.seed = static_cast<std::uint64_t>(i);
-        cam.frame = CameraFrame::world;
+        const Camera cam = issue_camera(sc.plate.T, static_cast<std::uint64_t>(i), false);
         ControlOptions opt;
         opt.duration = a.duration;
         auto policy = make_multi_library_policy(a.policy, a.aggregate);

@@ -61,4 +61,18 @@ inline Vec3 sink_point(const Scene& sc, Vec3 q) {
     return q;
 }
 
+// fig1_point's part (`part`) with e_fast, n_fast, w_fast, s_fast (2 mm per period) and the sink of
+// scenes/designs/point_sink.json (motion 4), its field on a 9 x 9 grid over [0, 0.04] x [-0.03, 0.01].
+inline ControlModel sink_model(const Scene& part) {
+    ControlModelOptions mo;
+    mo.grid.nx = mo.grid.ny = 9;
+    mo.grid.x0 = 0.0;
+    mo.grid.x1 = 0.04;
+    mo.grid.y0 = -0.03;
+    mo.grid.y1 = 0.01;
+    mo.field.threads = 1;
+    return build_control_model(
+        part, library_of(part, {"e_fast", "n_fast", "w_fast", "s_fast"}, kScenes + "designs/point_sink.json"), mo);
+}
+
 }   // namespace plate::test

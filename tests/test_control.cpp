@@ -58,15 +58,7 @@ TEST_CASE("a goal at one motion's fixed point: the controller settles on that mo
     const Scene sink = load_scene(kScenes + "designs/point_sink.json");
     const Vec3 fixed = sink_point(sink, Vec3(0.02, -0.01, 0));
     REQUIRE(field_at(sink, fixed, LimitCycleOptions{}).head<2>().norm() < 1e-7);
-    ControlModelOptions mo;
-    mo.grid.nx = mo.grid.ny = 9;
-    mo.grid.x0 = 0.0;
-    mo.grid.x1 = 0.04;
-    mo.grid.y0 = -0.03;
-    mo.grid.y1 = 0.01;
-    mo.field.threads = 1;
-    const ControlModel model = build_control_model(
-        part, library_of(part, {"e_fast", "n_fast", "w_fast", "s_fast"}, kScenes + "designs/point_sink.json"), mo);
+    const ControlModel model = sink_model(part);
     Goal goal;
     goal.q = fixed;
     auto policy = make_library_policy();

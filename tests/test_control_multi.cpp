@@ -21,16 +21,6 @@ MultiParts two_parts(const Vec3& goal1, const Vec3& start1, const Vec3& goal2, c
     return ps;
 }
 
-// The issue's camera: world frame, 0.1 mm noise, one period (0.05 s) late, seed 7.
-Camera issue_camera() {
-    Camera c;
-    c.per_period = 1;
-    c.noise_xy_mm = 0.1;
-    c.latency = 0.05;
-    c.frame = CameraFrame::world;
-    c.seed = 7;
-    return c;
-}
 
 }   // namespace
 
@@ -41,7 +31,7 @@ TEST_CASE("multi-part with one part is the single-part controller's run to the b
     const Scene part = load_scene(kScenes + "fig1_point.json");
     const ControlModel model = build_control_model(part, load_motion_library(kLib + "library.json", part));
     const Truth truth = spread_truth(0.8, 0.03, 3);
-    const Camera cam = issue_camera();
+    const Camera cam = issue_camera(0.05, 7, false);   // (world frame, 0.1 mm, one period late)
     ControlOptions opt;
     opt.duration = 3;
     Goal goal;
@@ -82,15 +72,7 @@ TEST_CASE("multi-part: both goals at a sink's fixed point -- the controller sett
     const Scene sink = load_scene(kScenes + "designs/point_sink.json");
     const Vec3 fixed = sink_point(sink, Vec3(0.02, -0.01, 0));
     REQUIRE(field_at(sink, fixed, LimitCycleOptions{}).head<2>().norm() < 1e-7);
-    ControlModelOptions mo;
-    mo.grid.nx = mo.grid.ny = 9;
-    mo.grid.x0 = 0.0;
-    mo.grid.x1 = 0.04;
-    mo.grid.y0 = -0.03;
-    mo.grid.y1 = 0.01;
-    mo.field.threads = 1;
-    const ControlModel model = build_control_model(
-        part, library_of(part, {"e_fast", "n_fast", "w_fast", "s_fast"}, kScenes + "designs/point_sink.json"), mo);
+    const ControlModel model = sink_model(part);
     const MultiParts parts = two_parts(fixed, Vec3(0.03, 0.0, 0), fixed, Vec3(0.01, -0.02, 0));
     auto policy = make_multi_library_policy();
     ControlOptions opt;
@@ -133,7 +115,8 @@ TEST_CASE(
     opt.duration = 8;
     SECTION("equal weights: the pair slides until the sum is the least the separation allows") {
         auto policy = make_multi_library_policy();
-        const MultiControlSummary s = run_multi_control(model, *policy, truth, issue_camera(), two_parts(A, s1, B, s2), opt);
+        const MultiControlSummary s =
+            run_multi_control(model, *policy, truth, issue_camera(0.05, 7, false), two_parts(A, s1, B, s2), opt);
         const auto &r1 = s.parts[0].rows, &r2 = s.parts[1].rows;
         const Vec3 d0 = r2[0].truth - r1[0].truth;
         double drift = 0;
@@ -149,7 +132,8 @@ TEST_CASE(
     }
     SECTION("weights 3 and 1: part 1 arrives, part 2 is left where the separation puts it") {
         auto policy = make_multi_library_policy();
-        const MultiControlSummary s = run_multi_control(model, *policy, truth, issue_camera(), two_parts(A, s1, B, s2, 3), opt);
+        const MultiControlSummary s =
+            run_multi_control(model, *policy, truth, issue_camera(0.05, 7, false), two_parts(A, s1, B, s2, 3), opt);
         CHECK(s.parts[0].reached);
         // Measured: 72.78 mm (part 1 0.2 mm from A along the separation).
         CHECK_THAT(s.parts[1].final_error, WithinAbs(least, 1e-3));

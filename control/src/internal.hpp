@@ -87,6 +87,32 @@ private:
     std::vector<Frame> frames_;
 };
 
+// One period of the true plate `tru` for one part: the full dynamics from its plate-frame (q, qd) at t = now
+// (period `first`: also the start's frame), the camera filming the frames due within it; (q, qd) become the
+// period's end (qd left as it was when the dynamics stopped). Returns the stop (its t within the period).
+StopEvent run_period(const Scene& tru, LoopCamera& cam, double now, double Tt, bool first, Vec3& q, Vec3& qd,
+                     const IntegrationOptions& integration);
+
+// A part's frames averaged while it rests on the still plate: from the still stretch's second period on the
+// part is at rest, and the camera's noise shrinks as 1/sqrt(n). (The last frame's stamp survives a restart.)
+struct RestAverage {
+    Vec3 sum = Vec3::Zero();
+    int frames = 0;
+    double last_stamp = -1;
+    void restart() {
+        sum.setZero();
+        frames = 0;
+    }
+    Vec3 add(const Observation& obs) {
+        if (obs.stamp != last_stamp) {
+            sum += obs.q;
+            ++frames;
+            last_stamp = obs.stamp;
+        }
+        return sum / frames;
+    }
+};
+
 // Time to goal, first entry, worst overshoot, switches and decision times of s.rows (ControlSummary).
 void summarise(ControlSummary& s, const Goal& goal);
 

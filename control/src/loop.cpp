@@ -117,23 +117,29 @@ void ControlLoop::step(const Decision& d, double decision_seconds) {
     row.motion = d.plate ? -1 : d.motion;
     row.decision_seconds = decision_seconds;
     S.rows.push_back(row);
-    std::vector<double> times = S.cam.due(now, k == 0);
-    const std::size_t frames = times.size();
-    times.push_back(S.Tt);
-    times.erase(std::unique(times.begin(), times.end()), times.end());
-    const Trajectory tr = simulate_at(tru, Dynamics::Full, S.q, S.qd, times, S.integration);
-    for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
-        if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) S.cam.film(tru, tr.samples[f].t, tr.samples[f].q);
-    S.q = tr.samples.back().q;
+    const StopEvent stop = detail::run_period(tru, S.cam, now, S.Tt, k == 0, S.q, S.qd, S.integration);
     S.last_truth = tru;
     ++S.k;
-    if (tr.stop.reason != StopReason::None) {
-        S.stop = tr.stop;
+    if (stop.reason != StopReason::None) {
+        S.stop = stop;
         S.stop.t += now;
         return;
     }
-    S.qd = tr.samples.back().qd;
     S.prev = tru.plate;
+}
+
+StopEvent detail::run_period(const Scene& tru, LoopCamera& cam, double now, double Tt, bool first, Vec3& q, Vec3& qd,
+                             const IntegrationOptions& integration) {
+    std::vector<double> times = cam.due(now, first);
+    const std::size_t frames = times.size();
+    times.push_back(Tt);
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    const Trajectory tr = simulate_at(tru, Dynamics::Full, q, qd, times, integration);
+    for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
+        if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) cam.film(tru, tr.samples[f].t, tr.samples[f].q);
+    q = tr.samples.back().q;
+    if (tr.stop.reason == StopReason::None) qd = tr.samples.back().qd;
+    return tr.stop;
 }
 
 ControlSummary ControlLoop::summary(const std::string& policy, bool interrupted) const {

@@ -132,20 +132,11 @@ MultiControlSummary run_multi_control(const ControlModel& model, MultiPolicy& po
             row.motion = d.plate ? -1 : d.motion;
             row.decision_seconds = spent;
             p.rows.push_back(row);
-            std::vector<double> times = p.cam.due(now, k == 0);
-            const std::size_t frames = times.size();
-            times.push_back(Tt);
-            times.erase(std::unique(times.begin(), times.end()), times.end());
-            const Trajectory tr = simulate_at(tru, Dynamics::Full, p.q, p.qd, times, opt.integration);
-            for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
-                if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size())
-                    p.cam.film(tru, tr.samples[f].t, tr.samples[f].q);
-            p.q = tr.samples.back().q;
-            if (tr.stop.reason != StopReason::None && out.stop.reason == StopReason::None) {
-                out.stop = tr.stop;
+            const StopEvent stop = detail::run_period(tru, p.cam, now, Tt, k == 0, p.q, p.qd, opt.integration);
+            if (stop.reason != StopReason::None && out.stop.reason == StopReason::None) {
+                out.stop = stop;
                 out.stop.t += now;
             }
-            p.qd = tr.samples.back().qd;
         }
         last_truth = tru;
         prev = tru.plate;

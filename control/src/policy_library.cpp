@@ -30,9 +30,7 @@ public:
         chosen_.clear();
         chosen_.reserve(1024);
         still_since_ = -1;
-        rest_sum_.setZero();
-        rest_frames_ = 0;
-        last_stamp_ = -1;
+        rest_ = detail::RestAverage{};
         keeps_.assign(model.motions(), false);
         bool turns = false, carries = false;   // some motion turns the part; some carries it without
         for (int k = 0; k < model.motions(); ++k) {
@@ -62,8 +60,7 @@ public:
             still_since_ = -1;
         } else if (still_since_ < 0) {
             still_since_ = period;
-            rest_sum_.setZero();
-            rest_frames_ = 0;
+            rest_.restart();
         }
         return {pick, std::nullopt};
     }
@@ -74,14 +71,7 @@ private:
     // shrinks as 1/sqrt(n), and a noisy frame alone does not start the plate again).
     Vec3 estimate(const Observation& obs, long period) {
         const double T = model_->T();
-        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) {
-            if (obs.stamp != last_stamp_) {
-                rest_sum_ += obs.q;
-                ++rest_frames_;
-                last_stamp_ = obs.stamp;
-            }
-            return rest_sum_ / rest_frames_;
-        }
+        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) return rest_.add(obs);
         return detail::predict_forward(*model_, chosen_, obs, period);
     }
 
@@ -170,11 +160,9 @@ private:
     LibraryPolicyOptions opt_;
     const ControlModel* model_ = nullptr;
     Goal goal_;
-    std::vector<int> chosen_;   // the motion chosen for each period so far
-    long still_since_ = -1;     // the period the current stretch on the still plate began (-1: moving)
-    Vec3 rest_sum_ = Vec3::Zero();
-    int rest_frames_ = 0;
-    double last_stamp_ = -1;
+    std::vector<int> chosen_;    // the motion chosen for each period so far
+    long still_since_ = -1;      // the period the current stretch on the still plate began (-1: moving)
+    detail::RestAverage rest_;   // the frames while the part rests on the still plate
     // Rigid parts, two phases: which motions keep the orientation, the phase, and the orientation's frames
     // since the turning ended (period keep_since_).
     std::vector<bool> keeps_;

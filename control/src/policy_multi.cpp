@@ -26,7 +26,7 @@ public:
         chosen_.clear();
         chosen_.reserve(1024);
         still_since_ = -1;
-        rest_.assign(parts.parts.size(), Rest{});
+        rest_.assign(parts.parts.size(), detail::RestAverage{});
         keeps_.assign(model.motions(), false);
         bool shapes = false, carries = false;   // some motion changes the parts' shape; some carries them without
         for (int k = 0; k < model.motions(); ++k) {
@@ -58,35 +58,17 @@ public:
             still_since_ = -1;
         } else if (still_since_ < 0) {
             still_since_ = period;
-            for (Rest& r : rest_) {   // (the last frame's stamp kept, as the single-part policy keeps it)
-                r.sum.setZero();
-                r.frames = 0;
-            }
+            for (detail::RestAverage& r : rest_) r.restart();
         }
         return {pick, std::nullopt};
     }
 
 private:
-    // A part's frames averaged while it rests on the still plate (the single-part policy's rule).
-    struct Rest {
-        Vec3 sum = Vec3::Zero();
-        int frames = 0;
-        double last_stamp = -1;
-    };
-
     // Where part i is at the decision's time: its frames averaged from the second still period on, else
     // its frame predicted forward over the latency.
     Vec3 estimate(std::size_t i, const Observation& obs, long period) {
         const double T = model_->T();
-        Rest& r = rest_[i];
-        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) {
-            if (obs.stamp != r.last_stamp) {
-                r.sum += obs.q;
-                ++r.frames;
-                r.last_stamp = obs.stamp;
-            }
-            return r.sum / r.frames;
-        }
+        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) return rest_[i].add(obs);
         return detail::predict_forward(*model_, chosen_, obs, period);
     }
 
@@ -187,7 +169,7 @@ private:
     std::vector<Goal> goals_;
     std::vector<int> chosen_;   // the motion chosen for each period so far
     long still_since_ = -1;     // the period the current stretch on the still plate began (-1: moving)
-    std::vector<Rest> rest_;
+    std::vector<detail::RestAverage> rest_;
     // Two phases: which motions keep the shape (uniform fields), whether they are used, the phase.
     std::vector<bool> keeps_;
     bool two_phase_ = false, shaping_ = false;
