@@ -91,7 +91,7 @@ TEST_CASE("plate control: a run writes a row per period with units and its summa
     CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 10 + 1);   // header, 10 periods, the end
 }
 
-TEST_CASE("plate control --parts: bad parts exit 2 naming the file and the field; a run writes each part's columns",
+TEST_CASE("plate control --parts: bad parts exit 2 naming the file and the field, and a run writes each part's columns",
           "[control][cli][multi]") {
     const std::string out = (tmpdir() / "multi.csv").string();
     fs::remove(out);
