@@ -109,12 +109,7 @@ void section_control(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         Pair p;
         p.q0 = square_start(static_cast<std::uint64_t>(i), false);   // (bench_control's starts)
         const Truth truth = spread_truth(0.8, 0.03, static_cast<std::uint64_t>(i));
-        Camera cam;
-        cam.per_period = 1;
-        cam.noise_xy_mm = 0.1;
-        cam.latency = sc.plate.T;
-        cam.seed = static_cast<std::uint64_t>(i);
-        cam.frame = CameraFrame::world;
+        const Camera cam = issue_camera(sc.plate.T, static_cast<std::uint64_t>(i), false);
         ControlOptions closed, open;
         closed.duration = kClosedTime;
         open.duration = kOpenTime;

@@ -2,49 +2,18 @@
 #include "plate/control.hpp"
 #include "plate/scene_io.hpp"
 
+#include "control_fixtures.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <unistd.h>
-
 
 using namespace plate;
+using namespace plate::test;
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
 
-namespace fs = std::filesystem;
-
 namespace {
-
-const std::string kScenes = PLATE_SOURCE_DIR "/scenes/";
-const std::string kLib = kScenes + "control/fig1_point/";
-const std::string kFig4 = kScenes + "control/fig4/";
-
-// A library of the given shipped motions of folder `from` (and the sink, when given), written beside the
-// shipped scenes' copies in the test's folder; "still" is the still plate.
-MotionLibrary library_of(const Scene& part, const std::vector<std::string>& names, const std::string& sink = "",
-                         const std::string& from = kLib) {
-    const fs::path dir = fs::temp_directory_path() / ("plate_control_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    std::string text = "{\"motions\": [";
-    for (const std::string& n : names) {
-        if (n == "still") {
-            text += "{\"name\": \"still\", \"still\": true},";
-            continue;
-        }
-        fs::copy_file(from + n + ".json", dir / (n + ".json"), fs::copy_options::overwrite_existing);
-        text += "{\"name\": \"" + n + "\", \"scene\": \"" + n + ".json\"},";
-    }
-    if (!sink.empty()) {
-        fs::copy_file(sink, dir / "sink.json", fs::copy_options::overwrite_existing);
-        text += "{\"name\": \"sink\", \"scene\": \"sink.json\"},";
-    }
-    text.back() = ']';
-    std::ofstream(dir / "library.json") << text << "}";
-    return load_motion_library((dir / "library.json").string(), part);
-}
 
 // A policy that always chooses one motion.
 class Always : public Policy {
@@ -57,24 +26,6 @@ public:
 private:
     int m_;
 };
-
-// The zero of the velocity field near q by Newton's method with a central-difference Jacobian.
-Vec3 sink_point(const Scene& sc, Vec3 q) {
-    LimitCycleOptions lo;
-    lo.tol = 1e-10;
-    for (int it = 0; it < 8; ++it) {
-        const Vec3 f = field_at(sc, q, lo);
-        Eigen::Matrix2d J;
-        const double h = 1e-4;
-        for (int c = 0; c < 2; ++c) {
-            Vec3 e = Vec3::Zero();
-            e[c] = h;
-            J.col(c) = (field_at(sc, q + e, lo) - field_at(sc, q - e, lo)).head<2>() / (2 * h);
-        }
-        q.head<2>() -= J.lu().solve(f.head<2>());
-    }
-    return q;
-}
 
 // Each motion of the model kept for 50 periods from rest at q0 on a perfect truth: the world displacement
 // over periods 5 to 45 (rows at phase 0 of the same motion, the part on its cycle) is 40 xi T to `tol`,
@@ -107,15 +58,7 @@ TEST_CASE("a goal at one motion's fixed point: the controller settles on that mo
     const Scene sink = load_scene(kScenes + "designs/point_sink.json");
     const Vec3 fixed = sink_point(sink, Vec3(0.02, -0.01, 0));
     REQUIRE(field_at(sink, fixed, LimitCycleOptions{}).head<2>().norm() < 1e-7);
-    ControlModelOptions mo;
-    mo.grid.nx = mo.grid.ny = 9;
-    mo.grid.x0 = 0.0;
-    mo.grid.x1 = 0.04;
-    mo.grid.y0 = -0.03;
-    mo.grid.y1 = 0.01;
-    mo.field.threads = 1;
-    const ControlModel model = build_control_model(
-        part, library_of(part, {"e_fast", "n_fast", "w_fast", "s_fast"}, kScenes + "designs/point_sink.json"), mo);
+    const ControlModel model = sink_model(part);
     Goal goal;
     goal.q = fixed;
     auto policy = make_library_policy();

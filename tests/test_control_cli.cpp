@@ -124,3 +124,31 @@ TEST_CASE("plate control: a run writes a row per period with units and its summa
     CHECK(csv.rfind("t [s],obs_s_x [m],obs_s_y [m],x [m],y [m],motion,decision [s]\n", 0) == 0);
     CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 10 + 1);   // header, 10 periods, the end
 }
+
+TEST_CASE("plate control --parts: bad parts exit 2 naming the file and the field, and a run writes each part's columns",
+          "[control][cli][multi]") {
+    const std::string out = (tmpdir() / "multi.csv").string();
+    fs::remove(out);
+    const std::string base = "control " + kScenes + "fig1_point.json --time 0.5 " + kLibrary;
+    const std::string bad = write("parts_bad.json", R"({"parts": [{"goal": [0.02, -0.01]}, {"goal": [0, 0], "weight": 0}]})");
+    Run r = run(base + "--policy library --parts " + bad + " --out " + out);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("parts_bad.json: parts[1].weight"));
+    const std::string parts =
+        write("parts.json", R"({"parts": [{"goal": [0.02, -0.01], "start": [0.019, -0.01]}, {"goal": [0, 0.0005]}]})");
+    r = run(base + "--policy library --parts " + parts + " --goal 0 0 --out " + out);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("--parts"));
+    r = run(base + "--parts " + parts + " --policy mpc --out " + out);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.err, Contains("--parts: the library policy"));
+    CHECK_FALSE(fs::exists(out));
+    r = run(base + "--policy library --parts " + parts + " --out " + out);
+    CHECK(r.code == 0);   // both start within 1 mm of their goals, on a still plate
+    CHECK_THAT(r.out, Contains("\"parts\": ["));
+    const std::string csv = slurp(out);
+    CHECK(csv.rfind("t [s],obs_s_x_1 [m],obs_s_y_1 [m],x_1 [m],y_1 [m],obs_s_x_2 [m],obs_s_y_2 [m],x_2 [m],y_2 [m],motion,"
+                    "decision [s]\n",
+                    0) == 0);
+    CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 10 + 1);
+}

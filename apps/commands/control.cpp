@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include "plate/control.hpp"
+#include "plate/control_multi.hpp"
 #include "plate/output.hpp"
 
 #include <iostream>
@@ -13,7 +14,7 @@ namespace plate::cli {
 namespace {
 
 struct ControlArgs : Options {
-    std::string scene, policy, library, camera, truth, out;
+    std::string scene, policy, library, camera, truth, out, parts;
     std::vector<double> goal, start;
     double time = 0, tol = Goal{}.tolerance, tol_theta = Goal{}.tolerance_theta, theta_weight = Goal{}.theta_weight;
     double stop_radius = LibraryPolicyOptions{}.stop_radius, hysteresis = LibraryPolicyOptions{}.hysteresis;
@@ -47,12 +48,19 @@ struct ControlArgs : Options {
                   "The prediction is corrected online: a gain on the model's steps and a drift per period, fitted to\n"
                   "the frames by forgetting least squares (--no-correction: the nominal model). Stop radius and\n"
                   "hysteresis as for library.\n"
+                  "--parts PARTS.json (point parts, --policy library): several parts on one plate, each to its own goal\n"
+                  "({\"parts\": [{\"goal\": [X, Y], \"start\": [X, Y], \"weight\": W}, ...]}, start and weight optional;\n"
+                  "instead of --goal and --start): each period the one motion whose predicted paths have the least sum\n"
+                  "of the parts' weighted distances to their goals; the camera films every part (part i's seed: the\n"
+                  "camera's + i); the parts do not interact. --out's columns per part (obs_s_x_1, ..., x_1, y_1, ...),\n"
+                  "the summary's per part under \"parts\"; exit 0 only when every part holds its goal at the end.\n"
                   "--out gets one row per period: t [s], the observed and the true configuration, the motion chosen\n"
                   "and the decision's time [s] (17 significant digits); the summary (time to goal: from when the part\n"
                   "stays within --tol to the end; final error, switches, worst overshoot, decision times) to stdout\n"
                   "as JSON. Exit 1 if the goal is not reached and held at the end, 3 if the true part loses contact.\n") {
         scene_file(scene);
-        numbers("--goal", goal, 2, 3, "X Y [THETA]", "the goal (point parts: X Y); required");
+        numbers("--goal", goal, 2, 3, "X Y [THETA]", "the goal (point parts: X Y); required unless --parts");
+        text("--parts", parts, "PARTS.json", "several point parts and their goals (instead of --goal, --start)");
         numbers("--start", start, 2, 3, "SX SY [THETA]", "the start, at rest on the plate");
         text("--policy", policy, "library|mpc", "the policy; required");
         text("--library", library, "LIB.json", "the motions (library and mpc)");
@@ -75,18 +83,44 @@ struct ControlArgs : Options {
     }
 };
 
+// Several parts (--parts): the multi-part loop, its CSV and its summary; exit 0 when every part holds its goal.
+int run_multi(const ControlArgs& a, const ControlModel& model, const LibraryPolicyOptions& lo, const Truth& truth,
+              const std::optional<Camera>& camera, const MultiParts& parts, const ControlOptions& opt, Io& cio) {
+    auto policy = make_multi_library_policy(lo);
+    const MultiControlSummary s = run_multi_control(model, *policy, truth, camera, parts, opt);
+    write_file_atomic(a.out, [&](std::ostream& out) { write_multi_control_csv(out, s, model); });
+    cio.out << multi_control_summary_json(s, model, parts).dump(2) << "\n";
+    if (s.stop.reason != StopReason::None) {
+        cio.err << "plate control: " << a.scene << ": a true part stopped: " << s.stop.describe() << std::endl;
+        return s.stop.reason == StopReason::ContactLost ? 3 : 1;
+    }
+    return s.reached ? 0 : 1;
+}
+
 int cmd_control(const ControlArgs& a, Io& cio) {
     const Scene sc = scene_arg(a.scene, cio);
-    Goal goal;
-    goal.q = config_arg(a, "--goal", a.goal, sc, true);
-    goal.point = sc.part.point;
-    goal.tolerance = a.tol;
-    goal.tolerance_theta = a.tol_theta;
-    goal.theta_weight = a.theta_weight;
     if (!(a.tol > 0) || !(a.tol_theta > 0) || !(a.theta_weight >= 0))
         throw UsageError("--tol and --tol-theta must be > 0, --theta-weight >= 0");
-    const Vec3 q0 = config_arg(a, "--start", a.start, sc, false);
+    const bool multi = a.has("--parts");
+    Goal goal;
+    Vec3 q0 = Vec3::Zero();
+    MultiParts parts;
+    if (multi) {
+        if (a.has("--goal") || a.has("--start"))
+            throw UsageError("--parts gives the parts' goals and starts: not with --goal or --start");
+        parts = load_parts(a.parts);
+        if (a.has("--tol")) parts.tolerance = a.tol;
+        parts.validate(sc);   // (an InputError naming the file and the field: exit 2)
+    } else {
+        goal.q = config_arg(a, "--goal", a.goal, sc, true);
+        goal.point = sc.part.point;
+        goal.tolerance = a.tol;
+        goal.tolerance_theta = a.tol_theta;
+        goal.theta_weight = a.theta_weight;
+        q0 = config_arg(a, "--start", a.start, sc, false);
+    }
     if (!a.has("--policy")) throw UsageError("missing --policy library|mpc");
+    if (multi && a.policy != "library") throw UsageError("--parts: the library policy steers several parts (--policy library)");
     if (a.policy != "library" && a.policy != "mpc")
         throw UsageError("--policy: expected library or mpc (a Python callable: plate.control in Python), got '" + a.policy +
                          "'");
@@ -125,6 +159,7 @@ int cmd_control(const ControlArgs& a, Io& cio) {
     const Truth truth = a.has("--truth") ? load_truth(a.truth) : Truth{};
     const std::optional<Camera> camera = a.has("--camera") ? std::optional<Camera>(load_camera(a.camera)) : std::nullopt;
     const ControlModel model = build_control_model(sc, load_motion_library(a.library, sc), mo);
+    if (multi) return run_multi(a, model, lo, truth, camera, parts, opt, cio);
     std::unique_ptr<Policy> policy;
     try {
         policy = a.policy == "mpc" ? make_mpc_policy(mpo) : make_library_policy(lo);

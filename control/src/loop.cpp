@@ -1,6 +1,6 @@
 // The loop: a period at a time, decide from the camera's newest frame, run the true plate through the
 // full dynamics from the carried state, film; then the summary, the CSV and the JSON.
-#include "plate/control.hpp"
+#include "internal.hpp"
 
 #include "plate/output.hpp"
 #include "plate/random_scene.hpp"
@@ -19,83 +19,7 @@ void ControlOptions::validate() const {
     if (!(duration > 0) || !std::isfinite(duration)) throw std::invalid_argument("duration: expected a number > 0");
 }
 
-namespace {
-
-// A frame the camera took: when it arrives (its stamp) and what it shows.
-struct Frame {
-    double stamp, state_time;
-    Vec3 q;
-};
-
-// The camera of the loop: one stroboscopic frame per period of the true plate (period Tt), drawing its
-// drop and noise per frame in the order observe.hpp's film() does.
-class LoopCamera {
-public:
-    LoopCamera(const std::optional<Camera>& cam, double Tt) : cam_(cam.value_or(Camera{})), Tt_(Tt), rng_(cam_.seed) {
-        if (!cam) {
-            cam_.per_period = 1;
-        } else {
-            cam_.validate();
-            if (!cam_.stroboscopic() || cam_.per_period != 1)
-                throw InputError(cam_.source + ": stroboscopic.per_period: the loop's camera takes one frame per plate period");
-        }
-        // The first frame whose state time is >= 0.
-        while (state_time(next_) < -1e-12 * Tt_) ++next_;
-    }
-    // The frames whose state times lie in (t0, t0 + Tt] (t0 = 0 also takes the start's), as times within
-    // the period.
-    std::vector<double> due(double t0, bool first) const {
-        std::vector<double> out;
-        for (long j = next_;; ++j) {
-            const double s = state_time(j) - t0;
-            if (s > Tt_ * (1 + 1e-12)) break;
-            if (s > 0 || (first && s >= -1e-12 * Tt_)) out.push_back(std::clamp(s, 0.0, Tt_));
-        }
-        return out;
-    }
-    // Films the next frame: the state q (plate frame) of `sc` at time tau within its period.
-    void film(const Scene& sc, double tau, const Vec3& q) {
-        const double stamp = stamp_of(next_++);
-        const bool dropped = rng_.uniform() < cam_.drop;
-        const double sd = cam_.noise_xy_mm * 1e-3, sdt = cam_.noise_theta_mrad * 1e-3;
-        const Vec3 e(standard_normal(rng_) * sd, standard_normal(rng_) * sd, standard_normal(rng_) * sdt);
-        if (dropped) return;
-        Vec3 x = q;
-        if (cam_.frame == CameraFrame::world) {
-            PlateOrientation R1(sc.plate);
-            x = world_pose(sc, tau, q, R1.at(tau));
-        }
-        x += e;
-        if (sc.part.point) x.z() = 0;
-        frames_.push_back({stamp, stamp - cam_.latency, x});
-    }
-    // The newest frame stamped at or before t.
-    Observation newest(double t) const {
-        Observation o;
-        o.t = t;
-        for (auto it = frames_.rbegin(); it != frames_.rend(); ++it)
-            if (it->stamp <= t + 1e-12 * Tt_) {
-                o.seen = true;
-                o.stamp = it->stamp;
-                o.state_time = it->state_time;
-                o.q = it->q;
-                break;
-            }
-        return o;
-    }
-
-private:
-    double stamp_of(long j) const { return (j + cam_.phase) * Tt_; }
-    double state_time(long j) const { return stamp_of(j) - cam_.latency; }
-    Camera cam_;
-    double Tt_;
-    Rng rng_;
-    long next_ = 0;
-    std::vector<Frame> frames_;
-};
-
-// Time to goal, first entry, worst overshoot, switches and decision times from the rows.
-void summarise(ControlSummary& s, const Goal& goal) {
+void detail::summarise(ControlSummary& s, const Goal& goal) {
     const auto& rows = s.rows;
     s.final_error = goal.error(rows.back().truth);
     s.final_theta_error = goal.theta_error(rows.back().truth);
@@ -129,7 +53,6 @@ void summarise(ControlSummary& s, const Goal& goal) {
     }
 }
 
-}   // namespace
 
 // The loop's state between periods: the commanded scene, the camera, the rows, the part's plate-frame
 // state (q, qd) on the last period's true plate `prev`/`last_truth`.
@@ -137,7 +60,7 @@ struct ControlLoop::State {
     Scene cmd;
     double Tt = 0;
     long periods = 0, k = 0;
-    LoopCamera cam;
+    detail::LoopCamera cam;
     IntegrationOptions integration;
     Truth truth;
     std::vector<ControlRow> rows;
@@ -194,23 +117,29 @@ void ControlLoop::step(const Decision& d, double decision_seconds) {
     row.motion = d.plate ? -1 : d.motion;
     row.decision_seconds = decision_seconds;
     S.rows.push_back(row);
-    std::vector<double> times = S.cam.due(now, k == 0);
-    const std::size_t frames = times.size();
-    times.push_back(S.Tt);
-    times.erase(std::unique(times.begin(), times.end()), times.end());
-    const Trajectory tr = simulate_at(tru, Dynamics::Full, S.q, S.qd, times, S.integration);
-    for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
-        if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) S.cam.film(tru, tr.samples[f].t, tr.samples[f].q);
-    S.q = tr.samples.back().q;
+    const StopEvent stop = detail::run_period(tru, S.cam, now, S.Tt, k == 0, S.q, S.qd, S.integration);
     S.last_truth = tru;
     ++S.k;
-    if (tr.stop.reason != StopReason::None) {
-        S.stop = tr.stop;
+    if (stop.reason != StopReason::None) {
+        S.stop = stop;
         S.stop.t += now;
         return;
     }
-    S.qd = tr.samples.back().qd;
     S.prev = tru.plate;
+}
+
+StopEvent detail::run_period(const Scene& tru, LoopCamera& cam, double now, double Tt, bool first, Vec3& q, Vec3& qd,
+                             const IntegrationOptions& integration) {
+    std::vector<double> times = cam.due(now, first);
+    const std::size_t frames = times.size();
+    times.push_back(Tt);
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    const Trajectory tr = simulate_at(tru, Dynamics::Full, q, qd, times, integration);
+    for (std::size_t f = 0; f < frames && f < tr.samples.size(); ++f)
+        if (tr.stop.reason == StopReason::None || f + 1 < tr.samples.size()) cam.film(tru, tr.samples[f].t, tr.samples[f].q);
+    q = tr.samples.back().q;
+    if (tr.stop.reason == StopReason::None) qd = tr.samples.back().qd;
+    return tr.stop;
 }
 
 ControlSummary ControlLoop::summary(const std::string& policy, bool interrupted) const {
@@ -224,7 +153,7 @@ ControlSummary ControlLoop::summary(const std::string& policy, bool interrupted)
     last.t = s.stop.reason != StopReason::None ? s.stop.t : s.periods * st_->Tt;
     last.truth = true_pose();   // (a stop's: at its time, taken at phase 0)
     s.rows.push_back(last);
-    summarise(s, goal_);
+    detail::summarise(s, goal_);
     return s;
 }
 

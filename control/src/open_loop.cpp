@@ -1,5 +1,5 @@
 // Open loop for comparison (control.hpp): one motion kept all run, the same loop and truth as the
-// closed-loop policies; and the issue's test plate (spread_truth).
+// closed-loop policies; and the issue's test plate, starts and camera (spread_truth, square_start, issue_camera).
 #include "plate/control.hpp"
 #include "plate/random_scene.hpp"
 #include "plate/scene_io.hpp"
@@ -23,6 +23,17 @@ Vec3 square_start(std::uint64_t i, bool with_theta) {
     const double y = rng.uniform(-0.05, 0.05);   // (y first: the order bench_control's starts were measured in)
     const double x = rng.uniform(-0.05, 0.05);
     return Vec3(x, y, with_theta ? rng.uniform(-kPi, kPi) : 0.0);
+}
+
+Camera issue_camera(double T, std::uint64_t seed, bool rigid) {
+    Camera cam;
+    cam.per_period = 1;
+    cam.noise_xy_mm = 0.1;
+    cam.noise_theta_mrad = rigid ? 5 : 0;
+    cam.latency = T;
+    cam.seed = seed;
+    cam.frame = CameraFrame::world;
+    return cam;
 }
 
 ControlModel open_loop_model(const Scene& nominal, const std::string& path) {

@@ -1,6 +1,6 @@
 // The `library` policy: each period the library motion that, kept, stays nearest the goal (a rigid part:
 // turn first, then steer the position with the motions that keep its orientation).
-#include "plate/control.hpp"
+#include "internal.hpp"
 
 #include <cmath>
 #include <limits>
@@ -30,9 +30,7 @@ public:
         chosen_.clear();
         chosen_.reserve(1024);
         still_since_ = -1;
-        rest_sum_.setZero();
-        rest_frames_ = 0;
-        last_stamp_ = -1;
+        rest_ = detail::RestAverage{};
         keeps_.assign(model.motions(), false);
         bool turns = false, carries = false;   // some motion turns the part; some carries it without
         for (int k = 0; k < model.motions(); ++k) {
@@ -62,44 +60,19 @@ public:
             still_since_ = -1;
         } else if (still_since_ < 0) {
             still_since_ = period;
-            rest_sum_.setZero();
-            rest_frames_ = 0;
+            rest_.restart();
         }
         return {pick, std::nullopt};
     }
 
 private:
-    // The observed configuration carried forward from the time it shows to the decision's, k T, along the
-    // model's field of the motion chosen for each period in between (one Euler step per period or part).
-    Vec3 predicted(const Observation& obs, long period) const {
-        const ControlModel& m = *model_;
-        const double T = m.T(), now = period * T;
-        Vec3 q = obs.q;
-        double t = obs.state_time;
-        while (t < now - 1e-9 * T) {
-            const long j = static_cast<long>(std::floor(t / T + 1e-9));
-            const double end = std::min((j + 1) * T, now);
-            if (j >= 0 && j < static_cast<long>(chosen_.size()))
-                q += m.step(j > 0 ? chosen_[j - 1] : -1, chosen_[j], q) * ((end - t) / T);
-            t = end;
-        }
-        return q;
-    }
-
     // Where the part is at the decision's time. On the still plate the part comes to rest within a period
     // and stays: from the second period on, the frames it shows are averaged (the camera's noise
     // shrinks as 1/sqrt(n), and a noisy frame alone does not start the plate again).
     Vec3 estimate(const Observation& obs, long period) {
         const double T = model_->T();
-        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) {
-            if (obs.stamp != last_stamp_) {
-                rest_sum_ += obs.q;
-                ++rest_frames_;
-                last_stamp_ = obs.stamp;
-            }
-            return rest_sum_ / rest_frames_;
-        }
-        return predicted(obs, period);
+        if (still_since_ >= 0 && obs.state_time >= (still_since_ + 1) * T - 1e-9 * T) return rest_.add(obs);
+        return detail::predict_forward(*model_, chosen_, obs, period);
     }
 
     // The mean distance to the goal over the next `horizon` periods on motion k kept, the first period
@@ -187,11 +160,9 @@ private:
     LibraryPolicyOptions opt_;
     const ControlModel* model_ = nullptr;
     Goal goal_;
-    std::vector<int> chosen_;   // the motion chosen for each period so far
-    long still_since_ = -1;     // the period the current stretch on the still plate began (-1: moving)
-    Vec3 rest_sum_ = Vec3::Zero();
-    int rest_frames_ = 0;
-    double last_stamp_ = -1;
+    std::vector<int> chosen_;    // the motion chosen for each period so far
+    long still_since_ = -1;      // the period the current stretch on the still plate began (-1: moving)
+    detail::RestAverage rest_;   // the frames while the part rests on the still plate
     // Rigid parts, two phases: which motions keep the orientation, the phase, and the orientation's frames
     // since the turning ended (period keep_since_).
     std::vector<bool> keeps_;
@@ -204,6 +175,20 @@ private:
 };
 
 }   // namespace
+
+Vec3 detail::predict_forward(const ControlModel& m, const std::vector<int>& chosen, const Observation& obs, long period) {
+    const double T = m.T(), now = period * T;
+    Vec3 q = obs.q;
+    double t = obs.state_time;
+    while (t < now - 1e-9 * T) {
+        const long j = static_cast<long>(std::floor(t / T + 1e-9));
+        const double end = std::min((j + 1) * T, now);
+        if (j >= 0 && j < static_cast<long>(chosen.size()))
+            q += m.step(j > 0 ? chosen[j - 1] : -1, chosen[j], q) * ((end - t) / T);
+        t = end;
+    }
+    return q;
+}
 
 std::unique_ptr<Policy> make_library_policy(const LibraryPolicyOptions& opt) { return std::make_unique<LibraryPolicy>(opt); }
 

@@ -19,6 +19,8 @@ program, from Python::
     run = plate.control(plate.load_scene("scenes/fig1_point.json"), (0.02, -0.01), library=lib, time=5.0,
                         start=(-0.04, 0.03), camera=cam)          # run.t, run.truth, run.motion, run.summary
     run = plate.control(..., policy=lambda obs: "e_fast")      # a Python policy: obs -> a motion, once a period
+    runs = plate.control_parts(scene, {"parts": [{"goal": [0.02, -0.01]}, {"goal": [-0.02, 0.01]}]},
+                               library="scenes/control/fig1_point/multi.json", time=30.0)   # one run per part
     env = plate.ControlEnv(plate.load_scene("scenes/fig1_point.json"), (0.02, -0.01), library=lib, time=5.0)
     obs = env.reset(seed=0); obs, reward, terminated, truncated, info = env.step("still")   # one plate period
 
@@ -30,7 +32,7 @@ import json as _json
 from typing import Any, Dict
 
 from ._plate import (Camera, ControlEnv, ControlRun, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
-                     Progress, Robustness, RotatingAttractor, Scene, Stop, StuckRegion, Track, Trajectory, axis_peaks, bench, check_track_scene, coning_rate, control, design, field,
+                     Progress, Robustness, RotatingAttractor, Scene, Stop, StuckRegion, Track, Trajectory, axis_peaks, bench, check_track_scene, coning_rate, control, control_parts, design, field,
                      fixed_points, frame_stamps, identify, load_camera, load_scene, observe, observe_at,
                      orientation_harmonics, parse_camera, parse_scene, proofs, random_scene, report, read_track_csv, robustness, scene_id,
                      simulate, sweep, twist, uncertain_parameters, write_track_csv)
@@ -38,7 +40,7 @@ from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
 __all__ = ["Camera", "ControlEnv", "ControlRun", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "Identification", "InputError",
-           "Progress", "Robustness", "RotatingAttractor", "Scene", "Stop", "StuckRegion", "Track", "Trajectory", "axis_peaks", "bench", "check_track_scene", "coning_rate", "control", "design",
+           "Progress", "Robustness", "RotatingAttractor", "Scene", "Stop", "StuckRegion", "Track", "Trajectory", "axis_peaks", "bench", "check_track_scene", "coning_rate", "control", "control_parts", "design",
            "field", "fixed_points", "frame_stamps", "identify", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
            "parse_camera", "parse_scene", "proofs", "random_scene", "read_track_csv", "report", "robustness", "scene_from_dict", "scene_id",
            "scene_to_dict", "simulate", "sweep", "twist", "uncertain_parameters", "write_track_csv"]

@@ -1,10 +1,12 @@
 // plate.control (a closed-loop run, plate.ControlRun), the `python` policy (a Python callable deciding each
-// period) and plate.ControlEnv (the same loop a step at a time, Gym-like): control/include/plate/control.hpp.
+// period), plate.ControlEnv (the same loop a step at a time, Gym-like): control/include/plate/control.hpp;
+// plate.control_parts (several point parts on one plate): control_multi.hpp.
 #include "bindings.hpp"
 #include "interrupt.hpp"
 #include "pickling.hpp"
 
 #include "plate/control.hpp"
+#include "plate/control_multi.hpp"
 #include "plate/observe.hpp"
 
 #include <chrono>
@@ -232,6 +234,50 @@ void bind_control_run(py::module_& m) {
         });
 }
 
+// plate.control_parts: several point parts on one plate, the multi-part library policy.
+void bind_control_parts(py::module_& m) {
+    m.def(
+        "control_parts",
+        [](const Scene& sc, const py::object& parts, const py::object& library, double time, const py::object& truth,
+           const py::object& camera, std::optional<double> tol, std::optional<std::uint64_t> seed, std::optional<int> horizon,
+           int grid) {
+            MultiParts ps;
+            if (const auto path = path_of(parts)) {
+                ps = load_parts(*path);
+            } else {
+                require(py::isinstance<py::dict>(parts), "parts: expected a parts file's path or a dict in its form");
+                ps = parse_parts(dumps(parts), "<dict>");
+            }
+            if (tol) ps.tolerance = *tol;
+            ps.validate(sc);
+            const Setup st = setup(sc, {0, 0}, library, truth, camera, std::nullopt, time, ps.tolerance, seed, grid);
+            LibraryPolicyOptions lo;
+            if (horizon) lo.horizon = *horizon;
+            std::unique_ptr<MultiPolicy> p;
+            try {
+                p = make_multi_library_policy(lo);
+            } catch (const std::invalid_argument& e) {
+                require(false, std::string("horizon: ") + e.what());
+            }
+            const MultiControlSummary s = interruptible(
+                py::none(), [&](Watch&) { return run_multi_control(st.model, *p, st.truth, st.camera, ps, st.opt); });
+            const nlohmann::json summary = multi_control_summary_json(s, st.model, ps);
+            std::vector<PyControlRun> runs;
+            for (const ControlSummary& part : s.parts) runs.push_back({part, summary, st.model.library.names});
+            return runs;
+        },
+        py::arg("scene"), py::arg("parts"), py::kw_only(), py::arg("library"), py::arg("time"), py::arg("truth") = py::none(),
+        py::arg("camera") = py::none(), py::arg("tol") = py::none(), py::arg("seed") = py::none(),
+        py::arg("horizon") = py::none(), py::arg("grid") = 13,
+        "Several point parts on one plate (`plate control --parts`): parts, a parts file's path or a dict in its\n"
+        "form ({'parts': [{'goal': [x, y], 'start': [x, y], 'weight': w}, ...]}); each plate period the library\n"
+        "policy chooses one motion for all of them (first the parts' shape, then carrying them in; the least sum of\n"
+        "weighted distances); each part follows it through the full dynamics, filmed by the camera (part i's seed:\n"
+        "the camera's + i). library, truth, camera, seed, horizon and grid as for plate.control; tol (if given)\n"
+        "replaces the file's tolerance. Returns a list of plate.ControlRun, one per part (its rows, reached, stop);\n"
+        "each one's summary is the whole run's (the command line's JSON, per part under 'parts').");
+}
+
 }   // namespace
 
 void bind_control(py::module_& m) {
@@ -340,6 +386,7 @@ void bind_control(py::module_& m) {
                 return make_run(e.loop->summary("env"), e.st);
             },
             "The episode so far as a plate.ControlRun (its rows and the current pose as the end row).");
+    bind_control_parts(m);
 }
 
 }   // namespace plate::python

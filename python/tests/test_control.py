@@ -162,3 +162,46 @@ def test_a_bad_answer_raises_ValueError_naming_it():
     env.reset()
     with pytest.raises(ValueError, match="'nowhere': not a motion"):
         env.step("nowhere")
+
+
+def test_control_parts_with_one_part_is_plate_controls_run_to_the_bit():
+    # One part of weight 1: its camera stream is the camera's seed and its cost the single part's distance.
+    one = plate.control_parts(scene(), {"parts": [{"goal": list(GOAL), "start": [-0.04, 0.03]}]}, library=LIBRARY,
+                              truth=TRUTH, camera=CAMERA, time=3.0)
+    run = plate.control(scene(), GOAL, library=LIBRARY, truth=TRUTH, camera=CAMERA, start=(-0.04, 0.03), time=3.0)
+    assert len(one) == 1 and run.reached
+    assert np.array_equal(one[0].truth, run.truth)
+    assert np.array_equal(one[0].observed, run.observed, equal_nan=True)
+    assert np.array_equal(one[0].motion, run.motion)
+    assert one[0].summary["parts"][0]["time_to_goal_s"] == run.summary["time_to_goal_s"]
+
+
+def test_control_parts_refuses_bad_parts_by_name():
+    with pytest.raises(plate.InputError, match=r"<dict>: parts\[1\]\.weight"):
+        plate.control_parts(scene(), {"parts": [{"goal": [0, 0]}, {"goal": [0, 0], "weight": -1}]}, library=LIBRARY,
+                            time=1.0)
+    with pytest.raises(ValueError, match="parts: expected a parts file's path or a dict"):
+        plate.control_parts(scene(), [[0, 0]], library=LIBRARY, time=1.0)
+
+
+@pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
+def test_control_parts_gives_the_command_lines_run(tmp_path):
+    parts = {"parts": [{"goal": [0.02, -0.01], "start": [0.0314, -0.0265]}, {"goal": [-0.02, 0.01], "start": [-0.027, -0.0175]}]}
+    (tmp_path / "parts.json").write_text(json.dumps(parts))
+    (tmp_path / "truth.json").write_text(json.dumps(TRUTH))
+    (tmp_path / "camera.json").write_text(json.dumps(CAMERA))
+    out = tmp_path / "run.csv"
+    cli = subprocess.run([EXE, "control", SCENE, "--parts", str(tmp_path / "parts.json"), "--policy", "library",
+                          "--library", LIBRARY, "--camera", str(tmp_path / "camera.json"), "--truth",
+                          str(tmp_path / "truth.json"), "--time", "2", "--out", str(out)], capture_output=True, text=True)
+    assert cli.returncode in (0, 1), cli.stderr
+    expected = json.loads(cli.stdout)
+    runs = plate.control_parts(scene(), parts, library=LIBRARY, truth=TRUTH, camera=CAMERA, time=2.0)
+    wall = {"decision_mean_s", "decision_max_s", "decision_p99_s"}
+    assert {k: v for k, v in runs[0].summary.items() if k not in wall} == {k: v for k, v in expected.items() if k not in wall}
+    with open(out) as f:
+        rows = list(csv.reader(f))[1:]
+    cells = np.array([[float(c) if c else math.nan for c in r[:9]] for r in rows])
+    for i, run in enumerate(runs):   # per part: obs_s_x_i, obs_s_y_i, x_i, y_i
+        assert np.array_equal(cells[:, 1 + 4 * i:3 + 4 * i], run.observed[:, :2], equal_nan=True)
+        assert np.array_equal(cells[:, 3 + 4 * i:5 + 4 * i], run.truth[:, :2])

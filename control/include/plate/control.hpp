@@ -75,6 +75,9 @@ Truth spread_truth(double friction_scale, double spread, std::uint64_t draw);
 // Its starts: start i uniform over the square [-0.05, 0.05]^2 m (seed 1000 + i; y drawn first, then x),
 // and for a rigid part (with_theta) theta uniform over (-pi, pi], drawn third; else theta 0.
 Vec3 square_start(std::uint64_t i, bool with_theta);
+// Its camera: stroboscopic, one frame per period of T, phase 0, world frame, 0.1 mm noise (a rigid part's
+// theta: 5 mrad), one period of latency (T), seed `seed`.
+Camera issue_camera(double T, std::uint64_t seed, bool rigid);
 
 Truth load_truth(const std::string& path);   // throws InputError
 // dir: where the measured entries' relative paths start (load_truth: the file's folder).
