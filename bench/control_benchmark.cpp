@@ -167,13 +167,7 @@ int main(int argc, char** argv) try {
         Truth truth = spread_truth(a.friction_scale, a.spread, static_cast<std::uint64_t>(i));
         truth.uncertainty->friction = Spread{a.contact_spread, Distribution::uniform};
         truth.validate();
-        Camera cam;
-        cam.per_period = 1;
-        cam.noise_xy_mm = 0.1;
-        cam.noise_theta_mrad = a.rigid ? 5 : 0;
-        cam.latency = sc.plate.T;
-        cam.seed = static_cast<std::uint64_t>(i);
-        cam.frame = CameraFrame::world;
+        const Camera cam = issue_camera(sc.plate.T, static_cast<std::uint64_t>(i), a.rigid);
         ControlOptions opt;
         opt.duration = a.duration;
         auto policy = a.mpc ? make_mpc_policy(a.mpc_options) : make_library_policy(a.policy);

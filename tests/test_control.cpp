@@ -141,12 +141,11 @@ TEST_CASE("fig4's part on a translating plate keeps its orientation and moves at
     check_transports(model, Vec3(-0.01, 0.01, 1.2), 2.5e-6);
 }
 
-TEST_CASE("the library policy turns fig4's part, then steers it to (0.02, -0.01, 0.5) and holds it there", "[control]") {
-    // Two phases (LibraryPolicyOptions::two_phase): the turning motions (a yawing plate: a vortex about
-    // its centre that turns the part) until the orientation is within tolerance, then the transports,
-    // which keep it. Perfect truth and camera. Measured: within 1 mm and 0.02 rad from 5.85 s on, held
-    // (52 switches); bound 10 s. One choice by the weighted distance alone (two_phase false): 10.4 s, 116
-    // switches. A model that put the transports on the grid (their theta' not known to be 0) never gets there.
+namespace {
+
+// fig4's part with 8 transports, 4 turning motions (tabulated on a 5 x 5 x 8 grid over +-0.04 m) and the
+// still plate; and its goal (0.02, -0.01, 0.5), theta weighted by rho.
+ControlModel fig4_turning_model() {
     const Scene part = load_scene(kScenes + "fig4.json");
     ControlModelOptions mo;
     mo.grid.nx = mo.grid.ny = 5;
@@ -154,17 +153,31 @@ TEST_CASE("the library policy turns fig4's part, then steers it to (0.02, -0.01,
     mo.grid.x0 = mo.grid.y0 = -0.04;
     mo.grid.x1 = mo.grid.y1 = 0.04;
     mo.field.threads = 1;
-    const ControlModel model =
-        build_control_model(part,
-                            library_of(part,
-                                       {"e_fast", "n_fast", "w_fast", "s_fast", "e_slow", "n_slow", "w_slow", "s_slow",
-                                        "turn_ccw_mid", "turn_cw_mid", "turn_ccw_slow", "turn_cw_slow", "still"},
-                                       "", kFig4),
-                            mo);
+    return build_control_model(part,
+                               library_of(part,
+                                          {"e_fast", "n_fast", "w_fast", "s_fast", "e_slow", "n_slow", "w_slow", "s_slow",
+                                           "turn_ccw_mid", "turn_cw_mid", "turn_ccw_slow", "turn_cw_slow", "still"},
+                                          "", kFig4),
+                               mo);
+}
+Goal fig4_goal(const Scene& part) {
     Goal goal;
     goal.q = Vec3(0.02, -0.01, 0.5);
     goal.point = false;
     goal.theta_weight = part.part.rho();
+    return goal;
+}
+
+}   // namespace
+
+TEST_CASE("the library policy turns fig4's part, then steers it to (0.02, -0.01, 0.5) and holds it there", "[control]") {
+    // Two phases (LibraryPolicyOptions::two_phase): the turning motions (a yawing plate: a vortex about
+    // its centre that turns the part) until the orientation is within tolerance, then the transports,
+    // which keep it. Perfect truth and camera. Measured: within 1 mm and 0.02 rad from 5.85 s on, held
+    // (52 switches); bound 10 s. One choice by the weighted distance alone (two_phase false): 10.4 s, 116
+    // switches. A model that put the transports on the grid (their theta' not known to be 0) never gets there.
+    const ControlModel model = fig4_turning_model();
+    const Goal goal = fig4_goal(model.nominal);
     auto policy = make_library_policy();
     ControlOptions opt;
     opt.duration = 12;
@@ -181,24 +194,8 @@ TEST_CASE("the mpc policy brings fig4's part to (0.02, -0.01, 0.5) by the weight
     // of 3 motions is judged by the weighted distance (theta weighted by rho). Measured: within 1 mm and
     // 0.02 rad from 8.75 s on, held (106 switches); bound 12 s. A policy that ignored the angle (the goal as
     // a point's) does not get there.
-    const Scene part = load_scene(kScenes + "fig4.json");
-    ControlModelOptions mo;
-    mo.grid.nx = mo.grid.ny = 5;
-    mo.grid.nth = 8;
-    mo.grid.x0 = mo.grid.y0 = -0.04;
-    mo.grid.x1 = mo.grid.y1 = 0.04;
-    mo.field.threads = 1;
-    const ControlModel model =
-        build_control_model(part,
-                            library_of(part,
-                                       {"e_fast", "n_fast", "w_fast", "s_fast", "e_slow", "n_slow", "w_slow", "s_slow",
-                                        "turn_ccw_mid", "turn_cw_mid", "turn_ccw_slow", "turn_cw_slow", "still"},
-                                       "", kFig4),
-                            mo);
-    Goal goal;
-    goal.q = Vec3(0.02, -0.01, 0.5);
-    goal.point = false;
-    goal.theta_weight = part.part.rho();
+    const ControlModel model = fig4_turning_model();
+    const Goal goal = fig4_goal(model.nominal);
     auto policy = make_mpc_policy();
     ControlOptions opt;
     opt.duration = 16;
