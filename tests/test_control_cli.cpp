@@ -58,14 +58,18 @@ TEST_CASE("plate control: bad input files exit 2 naming the file and the field, 
             CHECK_THAT(r.err, Contains(t + message));
             CHECK_FALSE(fs::exists(out));
         }
-        // (the same commanded motion twice, each with a good cycle of its period)
+        // (the same commanded motion twice -- the second a copy under another name: matched by its
+        // harmonics, not its file -- each with a good cycle of its period)
         std::string good = "t [s],x [m/s^2],y [m/s^2],z [m/s^2],rx [rad/s^2],ry [rad/s^2],rz [rad/s^2]\n";
         for (int i = 0; i < 5; ++i) good += std::to_string(0.01 * i) + ",1,0,0,0,0,0\n";
         const std::string g = write("good.csv", good);
-        const std::string t = write("truth.json", R"({"measured": [)" + entry(g, "1") + "," + entry(g, "1") + "]}");
+        const std::string copy = write("e_fast_copy.json", slurp(e_fast));
+        std::string twice = entry(g, "1");
+        twice.replace(twice.find(e_fast), e_fast.size(), copy);
+        const std::string t = write("truth.json", R"({"measured": [)" + entry(g, "1") + "," + twice + "]}");
         const Run r = run(kBase + kLibrary + "--truth " + t + " --out " + out);
         CHECK(r.code == 2);
-        CHECK_THAT(r.err, Contains(t + ": measured[1].commanded: " + e_fast + ": the same motion as " + e_fast));
+        CHECK_THAT(r.err, Contains(t + ": measured[1].commanded: " + copy + ": the same motion as " + e_fast));
     }
     SECTION("a truth's uncertainty spec with a bad spread") {
         const std::string t = write("truth.json", R"({"uncertainty": {"seed": 1, "amplitude": {"spread": -1}}})");

@@ -186,6 +186,23 @@ TEST_CASE("mpc: a rigid part's turn enters the fit: turning alone, the gain is r
     REQUIRE(goal.within(q));
     REQUIRE(turns >= 3);
     CHECK_THAT(mpc_estimate(*p).gain, WithinAbs(gain, 1e-9));
+    // The same across theta = pi: the camera gives angles in (-pi, pi], so a turn from 2.9 rad to the goal
+    // at -3.0 (3.28 unwrapped) shows a jump of -2 pi between two frames; the fit takes the wrapped change.
+    // Seen failing with the change taken unwrapped (the gain pulled far from 0.8).
+    Goal across = goal;
+    across.q.z() = -3.0;
+    p->reset(m, across);
+    q = Vec3(0.01, 0.006, 2.9);
+    for (k = 0; k < 60 && !across.within(q); ++k) {
+        Observation obs;
+        obs.t = obs.stamp = obs.state_time = k * T;
+        obs.seen = true;
+        obs.q = Vec3(q.x(), q.y(), wrap_angle(q.z()));
+        const Decision d = p->decide(obs, k);
+        q += gain * m.fields[d.motion].twist[0] * T;
+    }
+    CHECK(k < 60);
+    CHECK_THAT(mpc_estimate(*p).gain, WithinAbs(gain, 1e-9));
 }
 
 TEST_CASE("mpc: too many sequences and bad options are refused by name", "[control][mpc]") {
