@@ -125,9 +125,10 @@ function meaning(file) {
 }
 
 // Load and save through the page's own controls: fig4's file chosen in the page's file input (the page
-// started on fig1_point), its controls then show fig4's part; "save scene JSON" downloads a file whose
-// meaning is the loaded file's -- `plate field` on both the same to the bit (the page holds the program's
-// reading of the file, and JSON carries doubles exactly) -- and whose name is the file's. A negative
+// started on fig1_point), its controls then show fig4's part; an amplitude typed in; "save scene JSON"
+// downloads a file whose meaning is the loaded file's with that edit -- `plate field` on both the same to
+// the bit (the page holds the program's reading of the file, and JSON carries doubles exactly) -- and
+// whose name is the file's. A negative
 // control: the saved file with one friction coefficient changed by 1e-9 relative must differ.
 async function loadAndSave(base) {
   const page = await open(`${base}/index.html?scene=fig1_point`);
@@ -144,19 +145,31 @@ async function loadAndSave(base) {
     if (shown.contacts !== original.part.contacts.length || shown.harmonics !== original.plate.harmonics.length)
       fail(`loaded fig4.json: the page shows ${shown.contacts} contacts and ${shown.harmonics} harmonics, the file has ` +
            `${original.part.contacts.length} and ${original.plate.harmonics.length}`);
+    // An edit before the save, typed into the first harmonic's amplitude box (beside its slider): the
+    // saved file must carry it (a save that wrote back the loaded text would not).
+    const edited = 17.25;
+    const fieldBefore = await page.evaluate('playground.lastField');
+    await page.evaluate(`(() => { const n = document.getElementById('h0-amp').nextElementSibling;
+      n.value = '${edited}'; n.dispatchEvent(new Event('input', {bubbles: true})); })()`);
+    await page.evaluate(until(`JSON.stringify(playground.lastField.points) !== ${JSON.stringify(JSON.stringify(fieldBefore.points))} && ${idle}`));
+    const expected = path.join(downloads, 'expected.json');
+    const edit = JSON.parse(fs.readFileSync(file, 'utf8'));
+    edit.plate.harmonics[0].amp = edited;
+    fs.writeFileSync(expected, JSON.stringify(edit));
     await page.evaluate("document.getElementById('scene-save').click()");
     const saved = path.join(downloads, `${shown.name}.json`);
     for (let t = 0; t < 200 && !fs.existsSync(saved); ++t) await new Promise(r => setTimeout(r, 50));
     if (!fs.existsSync(saved)) return fail(`saved: no ${path.basename(saved)} downloaded (${fs.readdirSync(downloads)})`);
     const text = fs.readFileSync(saved, 'utf8'), copy = JSON.parse(text), failedBefore = failed;
     if (copy.name !== original.name) fail(`saved: named '${copy.name}', the file '${original.name}'`);
-    if (meaning(saved) !== meaning(file)) fail("saved: plate field on the saved file differs from the loaded file's");
+    if (meaning(saved) !== meaning(expected)) fail("saved: plate field on the saved file differs from the loaded file's with the typed edit");
+    if (meaning(saved) === meaning(file)) fail('saved: the typed edit is not in the saved file');
     copy.part.friction = [].concat(copy.part.friction).map((mu, i) => (i === 0 ? mu * (1 + 1e-9) : mu));
     const wrong = path.join(downloads, 'wrong.json');
     fs.writeFileSync(wrong, JSON.stringify(copy));
-    if (meaning(wrong) === meaning(file)) fail('saved: the comparison did not see a friction coefficient changed by 1e-9');
+    if (meaning(wrong) === meaning(expected)) fail('saved: the comparison did not see a friction coefficient changed by 1e-9');
     if (failed === failedBefore) console.log(`load and save: fig4.json loaded through the page's file input (${shown.contacts} contacts, ${shown.harmonics} harmonics shown), ` +
-                `saved as ${path.basename(saved)}: plate field the same to the bit; with a friction coefficient x (1 + 1e-9), not`);
+                `the first amplitude typed as ${edited}, saved as ${path.basename(saved)}: plate field the same to the bit as on the file with that edit; with a friction coefficient x (1 + 1e-9), not`);
     const errors = await page.evaluate('document.body.dataset.errors');
     if (errors !== 'none') fail(`load and save: the page states errors: ${errors}`);
     if (page.problems.length) fail(`load and save: errors in the page: ${page.problems.join(' | ')}`);
