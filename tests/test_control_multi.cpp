@@ -15,9 +15,9 @@ using Catch::Matchers::WithinAbs;
 
 namespace {
 
-MultiParts two_parts(const Vec3& goal1, const Vec3& start1, const Vec3& goal2, const Vec3& start2, double w1 = 1) {
+MultiParts two_parts(const Vec3& goal1, const Vec3& start1, const Vec3& goal2, const Vec3& start2, double w1 = 1, double w2 = 1) {
     MultiParts ps;
-    ps.parts = {{goal1, start1, w1}, {goal2, start2, 1}};
+    ps.parts = {{goal1, start1, w1}, {goal2, start2, w2}};
     return ps;
 }
 
@@ -137,6 +137,15 @@ TEST_CASE(
         CHECK(s.parts[0].reached);
         // Measured: 72.78 mm (part 1 0.2 mm from A along the separation).
         CHECK_THAT(s.parts[1].final_error, WithinAbs(least, 1e-3));
+        CHECK_FALSE(s.reached);
+    }
+    SECTION("weights 1 and 3: part 2 arrives, part 1 is left where the separation puts it") {
+        // The mirror of the section above (a cost that read only part 1's distance would bring part 1 in).
+        auto policy = make_multi_library_policy();
+        const MultiControlSummary s =
+            run_multi_control(model, *policy, truth, issue_camera(0.05, 7, false), two_parts(A, s1, B, s2, 1, 3), opt);
+        CHECK(s.parts[1].reached);
+        CHECK_THAT(s.parts[0].final_error, WithinAbs(least, 1e-3));
         CHECK_FALSE(s.reached);
     }
 }
