@@ -205,6 +205,58 @@ TEST_CASE("mpc: a rigid part's turn enters the fit: turning alone, the gain is r
     CHECK_THAT(mpc_estimate(*p).gain, WithinAbs(gain, 1e-9));
 }
 
+TEST_CASE("mpc: a rigid part's angle enters the fit weighted by the goal's theta_weight", "[control][mpc]") {
+    // Positions and angle disagree: the synthetic plate moves the part east at the model's speed (gain 1)
+    // and turns it at 0.8 of the model's rate. With no forgetting and negligible priors the fit is the
+    // least-squares solution over the frame pairs, worked out by hand: with N pairs, N_e of them east (a =
+    // 0.02 T per period), N_t turning (b = 0.5 T), the x rows give the drift d_x = N_e a (1 - g) / N and then
+    //     g = (E + 0.8 R) / (E + R),   E = N_e a^2 (1 - N_e / N),   R = N_t (w b)^2,
+    // w the goal's theta_weight (the y rows see nothing: d_y = 0). Measured: 0.90140845071 against
+    // 0.90140845070 (the priors' 1e-9), 28 pairs, 10 east, 18 turning. Seen failing with the angle's row
+    // weighted by 1 instead of w: 0.8001.
+    ControlModel m = hand_model();
+    m.nominal = load_scene(kScenes + "fig4.json");
+    m.library.names = {"still", "east", "turn"};
+    m.library.motions.resize(3);
+    m.fields.resize(3);
+    m.fields[2].twist = {Vec3(0, 0, 0.5)};
+    MpcPolicyOptions o;
+    o.prior_travel = 1e-9;
+    o.prior_frames = 1e-9;
+    o.forgetting = 1;
+    auto p = make_mpc_policy(o);
+    Goal goal;
+    goal.q = Vec3(0.01, 0.006, 0.4);
+    goal.point = false;
+    goal.theta_weight = m.nominal.part.rho();
+    p->reset(m, goal);
+    const double T = m.T();
+    Vec3 q(0, 0.006, 0);
+    std::vector<int> chosen;
+    for (long k = 0; k < 80 && !goal.within(q); ++k) {
+        Observation obs;
+        obs.t = obs.stamp = obs.state_time = k * T;
+        obs.seen = true;
+        obs.q = q;
+        const int d = p->decide(obs, k).motion;
+        chosen.push_back(d);
+        const Vec3 xi = m.fields[d].twist[0];
+        q += Vec3(xi.x(), xi.y(), 0.8 * xi.z()) * T;
+    }
+    REQUIRE(goal.within(q));
+    chosen.pop_back();   // (the last decision's period was not filmed)
+    const double N = static_cast<double>(chosen.size());
+    const double Ne = static_cast<double>(std::count(chosen.begin(), chosen.end(), 1));
+    const double Nt = static_cast<double>(std::count(chosen.begin(), chosen.end(), 2));
+    REQUIRE((Ne >= 2 && Nt >= 2));
+    const double a = 0.02 * T, b = 0.5 * T, w = goal.theta_weight;
+    const double E = Ne * a * a * (1 - Ne / N), R = Nt * (w * b) * (w * b);
+    const MpcEstimate e = mpc_estimate(*p);
+    CHECK(e.frames == static_cast<int>(N));
+    CHECK_THAT(e.gain, WithinAbs((E + 0.8 * R) / (E + R), 1e-9));
+    CHECK(std::abs(e.gain - 0.8) > 1e-3);   // (both kinds of rows count: not the angle's gain alone)
+}
+
 TEST_CASE("mpc: too many sequences and bad options are refused by name", "[control][mpc]") {
     ControlModel m = hand_model();
     MpcPolicyOptions o;
