@@ -176,6 +176,11 @@ TEST_CASE("A truth with a recorded cycle runs the commanded motion on the plate 
     scaled.friction_scale = 0.8;
     const Scene recorded_true = true_scene(scaled, flat, 0, 7);
     CHECK(recorded_true.part.mu.x() == flat.part.mu.x() * 0.8);
+    Scene holding = flat;   // (static above kinetic: both scaled)
+    holding.part.mu_static = holding.part.mu * 1.2;
+    const Scene holding_true = true_scene(scaled, holding, 0, 7);
+    REQUIRE(holding_true.part.mu_static);
+    CHECK(holding_true.part.mu_static->x() == holding.part.mu_static->x() * 0.8);
     REQUIRE(recorded_true.plate.harmonics.size() == recorded.plate.harmonics.size());
     for (const Harmonic& h : recorded.plate.harmonics) {
         const auto same = [&](const Harmonic& g) { return g.axis == h.axis && g.n == h.n; };
