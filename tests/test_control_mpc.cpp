@@ -35,6 +35,26 @@ ControlModel hand_model() {
     return m;
 }
 
+// fig4's part with hand-given uniform fields: the still plate, (with_east) a transport east at 0.02 m/s,
+// and a turn at 0.5 rad/s; and its goal (0.01, 0.006, 0.4), theta weighted by rho.
+ControlModel rigid_hand_model(bool with_east) {
+    ControlModel m = hand_model();
+    m.nominal = load_scene(kScenes + "fig4.json");
+    m.library.names = with_east ? std::vector<std::string>{"still", "east", "turn"} : std::vector<std::string>{"still", "turn"};
+    const std::size_t n = m.library.names.size();
+    m.library.motions.resize(n);
+    m.fields.resize(n);
+    m.fields[n - 1].twist = {Vec3(0, 0, 0.5)};
+    return m;
+}
+Goal rigid_goal(const ControlModel& m) {
+    Goal goal;
+    goal.q = Vec3(0.01, 0.006, 0.4);
+    goal.point = false;
+    goal.theta_weight = m.nominal.part.rho();
+    return goal;
+}
+
 }   // namespace
 
 TEST_CASE("mpc: the online fit recovers the true gain and drift from exact frames", "[control][mpc]") {
@@ -155,20 +175,12 @@ TEST_CASE("mpc: a rigid part's turn enters the fit: turning alone, the gain is r
     // 0.5 rad/s. The synthetic plate turns it at gain 0.8, exactly, so only the angle's frames carry the
     // gain (the positions never move): the estimate is 0.8 to rounding (measured 7e-14) once frames have
     // come. Seen failing with the angle's row left out of the fit (the gain stays at its prior, 1).
-    ControlModel m = hand_model();
-    m.nominal = load_scene(kScenes + "fig4.json");
-    m.library.names = {"still", "turn"};
-    m.library.motions.resize(2);
-    m.fields.resize(2);
-    m.fields[1].twist = {Vec3(0, 0, 0.5)};
+    const ControlModel m = rigid_hand_model(false);
     MpcPolicyOptions o;
     o.prior_travel = 1e-9;
     o.prior_frames = 1e-9;
     auto p = make_mpc_policy(o);
-    Goal goal;
-    goal.q = Vec3(0.01, 0.006, 0.4);
-    goal.point = false;
-    goal.theta_weight = m.nominal.part.rho();
+    const Goal goal = rigid_goal(m);
     p->reset(m, goal);
     const double T = m.T(), gain = 0.8;
     Vec3 q(0.01, 0.006, 0);
@@ -214,21 +226,13 @@ TEST_CASE("mpc: a rigid part's angle enters the fit weighted by the goal's theta
     // w the goal's theta_weight (the y rows see nothing: d_y = 0). Measured: 0.90140845071 against
     // 0.90140845070 (the priors' 1e-9), 28 pairs, 10 east, 18 turning. Seen failing with the angle's row
     // weighted by 1 instead of w: 0.8001.
-    ControlModel m = hand_model();
-    m.nominal = load_scene(kScenes + "fig4.json");
-    m.library.names = {"still", "east", "turn"};
-    m.library.motions.resize(3);
-    m.fields.resize(3);
-    m.fields[2].twist = {Vec3(0, 0, 0.5)};
+    const ControlModel m = rigid_hand_model(true);
     MpcPolicyOptions o;
     o.prior_travel = 1e-9;
     o.prior_frames = 1e-9;
     o.forgetting = 1;
     auto p = make_mpc_policy(o);
-    Goal goal;
-    goal.q = Vec3(0.01, 0.006, 0.4);
-    goal.point = false;
-    goal.theta_weight = m.nominal.part.rho();
+    const Goal goal = rigid_goal(m);
     p->reset(m, goal);
     const double T = m.T();
     Vec3 q(0, 0.006, 0);
