@@ -553,6 +553,10 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
                                       const Vec3& q0, const DesignTarget& target, const DesignOptions& opt,
                                       std::atomic<long>& cycles, Clock::time_point t0, bool pair = false, double run_seconds = 0,
                                       double theta_offset = 0);
+// theta' along the position's fixed points s*(theta) on n orientations theta_k = -pi + 2 pi k / n,
+// linearised about `base` (break_pair.cpp; bench_orientation_robustness reads it too). False where a
+// cycle did not converge.
+bool reduced_ring(const Scene& sc, const Vec2& base, int n, const LimitCycleOptions& cyc, long& own, double* w);
 // The half-turn pair broken by rz about its centre (break_pair.cpp).
 DesignSummary break_pair(const Scene& part_scene, const PlateMotion& pair_motion, const DesignTarget& target,
                          const DesignOptions& opt, double T, std::atomic<long>& cycles, Clock::time_point t0);
