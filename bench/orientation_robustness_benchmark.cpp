@@ -25,8 +25,9 @@
 // ring of 12 at the centre (every position is the centre of a shifted motion), maximising B_1, then the
 // held margin with friction's spread alone from the B_1 search's best; every start's whole-spec held
 // margin printed, and the best measured again on 24 orientations, over the spec's draws, with its fixed
-// point near the centre if any. Arguments: [--draws N] [--starts S] [--evaluations E] [--harmonics K]
-// [--tilt-drift] [DESIGN.json ...].
+// point near the centre if any. --aligned searches the motions without tilt drift and coning by
+// construction instead (Search::aligned). Arguments: [--draws N] [--starts S] [--evaluations E]
+// [--harmonics K] [--tilt-drift | --aligned] [DESIGN.json ...].
 #include "../design/src/internal.hpp"   // (design's internal header: reduced_ring, the placed constraints, the layout)
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
@@ -50,10 +51,10 @@ using namespace plate::design_detail;
 
 namespace {
 
-constexpr double kZ = 1.645;       // one-sided 95 %
-constexpr double kArrive = 60;     // [s] issue 51's arrival time
+constexpr double kZ = 1.645;     // one-sided 95 %
+constexpr double kArrive = 60;   // [s] issue 51's arrival time
 constexpr int kConstraints = kPeakConstraints + 3;
-using Ring = std::vector<double>;  // theta' on theta_k = -pi + 2 pi k / n [rad/s]
+using Ring = std::vector<double>;   // theta' on theta_k = -pi + 2 pi k / n [rad/s]
 
 // theta' at a fixed position, or along s* (reduced_ring: where the position's twist vanishes, linearised).
 Ring ring_at(const Scene& sc, const Vec2& s, int n, const LimitCycleOptions& cyc, bool along) {
@@ -127,7 +128,7 @@ struct RingSpread {
 };
 // `only`: the parameters whose name starts with it ("" every one).
 RingSpread spread_of(const Scene& sc, const UncertaintySpec& spec, const Vec2& s, int n, const LimitCycleOptions& cyc, bool along,
-                 const char* only) {
+                     const char* only) {
     RingSpread r;
     r.params = uncertain_parameters(sc, spec);
     r.dw.resize(r.params.size());
@@ -222,24 +223,28 @@ void print_ring_summary(const char* what, const Ring& w, const RingSpread& sp, c
     const Gap all = gap_of(w, sp), fr = gap_of(w, sp, "friction");
     std::printf("%s: M %+.4f B1 %.4f B2 %.4f B3 %.4f rad/s; stable zeros %d\n", what, coefficient(w, 0).real(), B(w, 1), B(w, 2),
                 B(w, 3), stable_zeros(w));
-    std::printf("  random B1 (RMS of the B_1 vector): friction %.4f, amplitude %.4f, phase %.4f, unmodelled %.4f, all %.4f rad/s; "
-                "friction: %.3f rad/s per mm of friction centroid\n",
-                sp.first("friction"), sp.first("amp"), sp.first("phase"), sp.first("unmodelled"), sp.first(), first_per_mm(sp, N, part, g));
+    std::printf(
+        "  random B1 (RMS of the B_1 vector): friction %.4f, amplitude %.4f, phase %.4f, unmodelled %.4f, all %.4f rad/s; "
+        "friction: %.3f rad/s per mm of friction centroid\n",
+        sp.first("friction"), sp.first("amp"), sp.first("phase"), sp.first("unmodelled"), sp.first(),
+        first_per_mm(sp, N, part, g));
     if (all.twin.k < 0) {
         std::printf("  one well only\n");
         return;
     }
     const int n = static_cast<int>(w.size());
     auto th = [&](int k) { return -kPi + 2 * kPi * k / n; };
-    std::printf("  wells: target theta %.2f at %+.4f, twin theta %.2f at %+.4f (curvature %.3f); sd target / twin: friction "
-                "%.4f / %.4f, amplitude %.4f / %.4f, phase %.4f / %.4f, unmodelled %.4f / %.4f, all %.4f / %.4f rad/s\n",
-                th(all.target.k), all.target.value, th(all.twin.k), all.twin.value, all.twin.kappa, sp.sd(all.target.k, "friction"),
-                sp.sd(all.twin.k, "friction"), sp.sd(all.target.k, "amp"), sp.sd(all.twin.k, "amp"), sp.sd(all.target.k, "phase"),
-                sp.sd(all.twin.k, "phase"), sp.sd(all.target.k, "unmodelled"), sp.sd(all.twin.k, "unmodelled"), all.sd_target,
-                all.sd_twin);
-    std::printf("  robust gap %.4f (friction alone %.4f) against %.4f needed for a %.0f s passage: margin %+.4f (friction alone "
-                "%+.4f) rad/s with M retuned; held margin (M as it is) %+.4f (friction alone %+.4f)\n  ring:",
-                all.gap, fr.gap, all.need, kArrive, all.margin(), fr.margin(), held_margin(w, sp), held_margin(w, sp, "friction"));
+    std::printf(
+        "  wells: target theta %.2f at %+.4f, twin theta %.2f at %+.4f (curvature %.3f); sd target / twin: friction "
+        "%.4f / %.4f, amplitude %.4f / %.4f, phase %.4f / %.4f, unmodelled %.4f / %.4f, all %.4f / %.4f rad/s\n",
+        th(all.target.k), all.target.value, th(all.twin.k), all.twin.value, all.twin.kappa, sp.sd(all.target.k, "friction"),
+        sp.sd(all.twin.k, "friction"), sp.sd(all.target.k, "amp"), sp.sd(all.twin.k, "amp"), sp.sd(all.target.k, "phase"),
+        sp.sd(all.twin.k, "phase"), sp.sd(all.target.k, "unmodelled"), sp.sd(all.twin.k, "unmodelled"), all.sd_target,
+        all.sd_twin);
+    std::printf(
+        "  robust gap %.4f (friction alone %.4f) against %.4f needed for a %.0f s passage: margin %+.4f (friction alone "
+        "%+.4f) rad/s with M retuned; held margin (M as it is) %+.4f (friction alone %+.4f)\n  ring:",
+        all.gap, fr.gap, all.need, kArrive, all.margin(), fr.margin(), held_margin(w, sp), held_margin(w, sp, "friction"));
     for (int k = 0; k < n; ++k) std::printf(" %+.3f", w[k]);
     std::printf("\n");
 }
@@ -282,11 +287,12 @@ PlateMotion shipped(const std::string& path, const UncertaintySpec& spec, int dr
         for (double x : v) s += (x - m) * (x - m);
         return std::sqrt(s / std::max<std::size_t>(v.size() - 1, 1));
     };
-    std::printf("  %d draws: one stable orientation on %d; theta' at the twin's well <= 0 on %d, at the target's >= 0 on %d; "
-                "sd of theta' at the twin's well %.4f (first order %.4f); B1 over the draws %.4f +- %.4f; %.1f s\n",
-                draws, one, twin_low, target_gone, sd_of(tw), nominal.sd_twin,
-                std::accumulate(first.begin(), first.end(), 0.0) / std::max<std::size_t>(first.size(), 1), sd_of(first),
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::printf(
+        "  %d draws: one stable orientation on %d; theta' at the twin's well <= 0 on %d, at the target's >= 0 on %d; "
+        "sd of theta' at the twin's well %.4f (first order %.4f); B1 over the draws %.4f +- %.4f; %.1f s\n",
+        draws, one, twin_low, target_gone, sd_of(tw), nominal.sd_twin,
+        std::accumulate(first.begin(), first.end(), 0.0) / std::max<std::size_t>(first.size(), 1), sd_of(first),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     return combined(shift_motion(sc.plate, -Vec2(q.head<2>())));
 }
 
@@ -300,7 +306,7 @@ struct Search {
     bool robust = false;   // the objective: the friction-only margin, else B_1
     long evaluations = 0;
     std::string lines;
-    std::vector<double> guess;   // start 0, where feasible (a shipped design's motion, centred)
+    std::vector<double> guess;      // start 0, where feasible (a shipped design's motion, centred)
     std::vector<double> best_all;   // the start whose whole-spec held margin is the best
     double best_all_score = -HUGE_VAL;
     // c_k <= 0: each axis' peak within its limit, the flight margin, coning either way (not the tilt
@@ -314,11 +320,32 @@ struct Search {
         c[k + 1] = -cone - 1;
         c[k + 2] = tilt_drift ? tilt_drift_rate(u).norm() / 2e-6 - 1 : -1;
     }
+    // ALIGNED (--aligned): per harmonic n, x, y, z as cosine and sine coefficients and rx, ry, rz as signed
+    // amplitudes on one line of phase psi_n, (c_x, s_x, c_y, s_y, c_z, s_z, psi_n, a_rx, a_ry, a_rz): the
+    // angular phasors parallel at each n, so no tilt drift and no coning by construction -- every motion
+    // the designs may use but those whose rz is zero at some n with rx and ry apart within the coning limit.
+    bool aligned = false;
     PlateMotion motion(const std::vector<double>& p) const {
-        return motion_from(p, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, harmonics, part.plate.T);
+        if (!aligned) return motion_from(p, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, harmonics, part.plate.T);
+        PlateMotion u;
+        u.T = part.plate.T;
+        for (std::size_t h = 0; h < harmonics.size(); ++h) {
+            const double* q = &p[10 * h];
+            const int n = harmonics[h];
+            for (int a = 0; a < 3; ++a)   // c cos + s sin = amp sin(. + atan2(c, s))
+                if (q[2 * a] != 0 || q[2 * a + 1] != 0)
+                    u.harmonics.push_back(
+                        {static_cast<Axis>(a), n, std::hypot(q[2 * a], q[2 * a + 1]), std::atan2(q[2 * a], q[2 * a + 1])});
+            for (int a = 0; a < 3; ++a)
+                if (q[7 + a] != 0) u.harmonics.push_back({static_cast<Axis>(3 + a), n, q[7 + a], q[6]});
+        }
+        return u;
     }
-    int params() const { return 12 * static_cast<int>(harmonics.size()); }
-    double limit(int i) const { return i / (2 * static_cast<int>(harmonics.size())) < 3 ? limits.lin_limit : limits.ang_limit; }
+    int params() const { return (aligned ? 10 : 12) * static_cast<int>(harmonics.size()); }
+    double limit(int i) const {
+        if (aligned) return i % 10 < 6 ? limits.lin_limit : i % 10 == 6 ? kPi : limits.ang_limit;
+        return i / (2 * static_cast<int>(harmonics.size())) < 3 ? limits.lin_limit : limits.ang_limit;
+    }
     // (score, the ring) of a motion: B_1 or the friction-only margin
     double score(const std::vector<double>& p, Ring* ring = nullptr, RingSpread* sp = nullptr) const {
         Scene sc = part;
@@ -408,11 +435,12 @@ void search(Search& s, int starts, int evaluations, std::uint64_t seed, std::vec
         const double held_all = whole.params.empty() ? -HUGE_VAL : held_margin(w, whole);
         if (held_all > s.best_all_score) s.best_all_score = held_all, s.best_all = ctx.kept;
         char buf[400];
-        std::snprintf(buf, sizeof buf,
-                      "%-6s %d %5d %+8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %+8.4f %+8.4f %+8.4f  %4.0f %4.0f %4.0f %4.0f %4.0f %4.0f\n",
-                      s.robust ? "held" : "B1", static_cast<int>(s.harmonics.size()), start, coefficient(w, 0).real(), B(w, 1),
-                      B(w, 2), sp.first("friction"), g.sd_twin, g.gap, g.need, g.margin(), margin, held_all, pk[0], pk[1], pk[2], pk[3], pk[4],
-                      pk[5]);
+        std::snprintf(
+            buf, sizeof buf,
+            "%-6s %d %5d %+8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %+8.4f %+8.4f %+8.4f  %4.0f %4.0f %4.0f %4.0f %4.0f %4.0f\n",
+            s.robust ? "held" : "B1", static_cast<int>(s.harmonics.size()), start, coefficient(w, 0).real(), B(w, 1), B(w, 2),
+            sp.first("friction"), g.sd_twin, g.gap, g.need, g.margin(), margin, held_all, pk[0], pk[1], pk[2], pk[3], pk[4],
+            pk[5]);
         s.lines += buf;
         const double got = s.robust ? margin : B(w, 1);
         if (got > best_score) best_score = got, best = ctx.kept;
@@ -423,19 +451,28 @@ void search(Search& s, int starts, int evaluations, std::uint64_t seed, std::vec
 
 int main(int argc, char** argv) {
     int draws = 200, starts = 4, evaluations = 600, top = 3;
-    bool tilt_drift = false;
+    bool tilt_drift = false, aligned = false;
     std::vector<std::string> designs;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        if (a == "--draws" && i + 1 < argc) draws = std::atoi(argv[++i]);
-        else if (a == "--starts" && i + 1 < argc) starts = std::atoi(argv[++i]);
-        else if (a == "--evaluations" && i + 1 < argc) evaluations = std::atoi(argv[++i]);
-        else if (a == "--harmonics" && i + 1 < argc) top = std::atoi(argv[++i]);
-        else if (a == "--tilt-drift") tilt_drift = true;
-        else designs.push_back(a);
+        if (a == "--draws" && i + 1 < argc)
+            draws = std::atoi(argv[++i]);
+        else if (a == "--starts" && i + 1 < argc)
+            starts = std::atoi(argv[++i]);
+        else if (a == "--evaluations" && i + 1 < argc)
+            evaluations = std::atoi(argv[++i]);
+        else if (a == "--harmonics" && i + 1 < argc)
+            top = std::atoi(argv[++i]);
+        else if (a == "--tilt-drift")
+            tilt_drift = true;
+        else if (a == "--aligned")
+            aligned = true;
+        else
+            designs.push_back(a);
     }
     if (designs.empty())
-        designs = {PLATE_SOURCE_DIR "/scenes/designs/fig4_fixed_point.json", PLATE_SOURCE_DIR "/scenes/designs/fig4_fixed_point_peak.json"};
+        designs = {PLATE_SOURCE_DIR "/scenes/designs/fig4_fixed_point.json",
+                   PLATE_SOURCE_DIR "/scenes/designs/fig4_fixed_point_peak.json"};
     const auto t_all = std::chrono::steady_clock::now();
     std::printf("machine: %s\n", machine_description().c_str());
     const Scene fig4 = load_scene(PLATE_SOURCE_DIR "/scenes/fig4.json");
@@ -443,19 +480,23 @@ int main(int argc, char** argv) {
     // Part A
     Vec3 N;
     const Vec2 fc = friction_centroid_sd(fig4.part, fig4.g, spec.friction.standard_deviation(), N);
-    std::printf("fig4's part at rest: loads %.3f %.3f %.3f of m g; friction +-%.0f %% per contact (sd %.4f) moves the friction "
-                "centroid by sd %.2f mm (x) and %.2f mm (y) [the nominal's: 0]\n",
-                N[0] / (fig4.part.m * fig4.g), N[1] / (fig4.part.m * fig4.g), N[2] / (fig4.part.m * fig4.g),
-                100 * spec.friction.spread, spec.friction.standard_deviation(), 1e3 * fc.x(), 1e3 * fc.y());
+    std::printf(
+        "fig4's part at rest: loads %.3f %.3f %.3f of m g; friction +-%.0f %% per contact (sd %.4f) moves the friction "
+        "centroid by sd %.2f mm (x) and %.2f mm (y) [the nominal's: 0]\n",
+        N[0] / (fig4.part.m * fig4.g), N[1] / (fig4.part.m * fig4.g), N[2] / (fig4.part.m * fig4.g), 100 * spec.friction.spread,
+        spec.friction.standard_deviation(), 1e3 * fc.x(), 1e3 * fc.y());
     std::printf("[rad/s throughout; z = %.3f; the need: 2 pi^2 / (kappa %.0f^2)]\n", kZ, kArrive);
     // Part B
     std::vector<PlateMotion> centred;
     for (const std::string& d : designs) centred.push_back(shipped(d, spec, draws, N));
     // Part C
-    std::printf("\nsearch: %d starts x %d evaluations per objective, harmonics 1..K on x..rz, peak limits 20 / 150, seed 1\n",
-                starts, evaluations);
-    std::printf("%-6s %s %5s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s  %4s %4s %4s %4s %4s %4s\n", "obj", "K", "start", "M", "B1", "B2",
-                "rB1_fr", "sd_tw_fr", "gap_fr", "need", "retuned", "held_fr", "held", "x", "y", "z", "rx", "ry", "rz");
+    std::printf("\nsearch: %d starts x %d evaluations per objective, harmonics 1..K on x..rz, peak limits 20 / 150, seed 1%s\n",
+                starts, evaluations,
+                aligned      ? "; aligned: rx, ry, rz on one line per n (no tilt drift, no coning)"
+                : tilt_drift ? "; tilt drift within 2e-6 rad/s"
+                             : "; tilt drift not limited");
+    std::printf("%-6s %s %5s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s  %4s %4s %4s %4s %4s %4s\n", "obj", "K", "start", "M", "B1",
+                "B2", "rB1_fr", "sd_tw_fr", "gap_fr", "need", "retuned", "held_fr", "held", "x", "y", "z", "rx", "ry", "rz");
     // Per K: B_1 first, then the held margin from the B_1 search's best (start 0); the drive with the
     // best whole-spec held margin of all starts measured again on 24 orientations.
     std::vector<double> best_all;
@@ -467,12 +508,14 @@ int main(int argc, char** argv) {
             Search s;
             s.part = fig4;
             s.spec = spec;
-            s.tilt_drift = tilt_drift;
+            s.tilt_drift = tilt_drift || aligned;
+            s.aligned = aligned;
             for (int k = 1; k <= K; ++k) s.harmonics.push_back(k);
             s.robust = robust;
             s.guess = guess;
             for (const PlateMotion& u : centred)
-                if (s.guess.empty()) s.guess = params_from(u, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, s.harmonics);
+                if (s.guess.empty() && !aligned)
+                    s.guess = params_from(u, {Axis::x, Axis::y, Axis::z, Axis::rx, Axis::ry, Axis::rz}, s.harmonics);
             std::vector<double> best;
             double best_score = -HUGE_VAL;
             search(s, starts, evaluations, 1, best, best_score);
@@ -487,6 +530,7 @@ int main(int argc, char** argv) {
         Search s;
         s.part = fig4;
         s.harmonics = best_all_harmonics;
+        s.aligned = aligned;
         Scene sc = fig4;
         sc.plate = s.motion(best_all);
         const Ring w = ring_at(sc, Vec2::Zero(), 24, s.cyc, false);
@@ -522,19 +566,23 @@ int main(int argc, char** argv) {
             }
             const Eigen::Vector3cd ev = J.eigenvalues();
             if (ok)
-                std::printf("  its fixed point (%.4f, %.4f, %.3f), eigenvalues %+.3f%+.3fi %+.3f%+.3fi %+.3f%+.3fi 1/s; tilt drift %.1e rad/s\n",
-                            q[0], q[1], q[2], ev[0].real(), ev[0].imag(), ev[1].real(), ev[1].imag(), ev[2].real(), ev[2].imag(),
-                            tilt_drift_rate(sc.plate).norm());
+                std::printf(
+                    "  its fixed point (%.4f, %.4f, %.3f), eigenvalues %+.3f%+.3fi %+.3f%+.3fi %+.3f%+.3fi 1/s; tilt drift %.1e "
+                    "rad/s\n",
+                    q[0], q[1], q[2], ev[0].real(), ev[0].imag(), ev[1].real(), ev[1].imag(), ev[2].real(), ev[2].imag(),
+                    tilt_drift_rate(sc.plate).norm());
             else
-                std::printf("  no fixed point found within 5 cm of the centre; tilt drift %.1e rad/s\n", tilt_drift_rate(sc.plate).norm());
+                std::printf("  no fixed point found within 5 cm of the centre; tilt drift %.1e rad/s\n",
+                            tilt_drift_rate(sc.plate).norm());
         }
         std::printf("  its motion:");
         for (const Harmonic& h : combined(sc.plate).harmonics)
             std::printf(" %s n=%d %.3f@%.3f;", axis_name(h.axis), h.n, h.amp, h.phase);
         std::printf("\n");
     }
-    std::printf("[obj: the search's objective; rB1_fr: RMS of the random B_1 from friction; sd_tw_fr, gap_fr: friction alone; "
-                "x..rz: the axis peaks]\nwall %.1f s on 1 thread\n",
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t_all).count());
+    std::printf(
+        "[obj: the search's objective; rB1_fr: RMS of the random B_1 from friction; sd_tw_fr, gap_fr: friction alone; "
+        "x..rz: the axis peaks]\nwall %.1f s on 1 thread\n",
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_all).count());
     return 0;
 }
