@@ -26,8 +26,10 @@
 // held margin with friction's spread alone from the B_1 search's best; every start's whole-spec held
 // margin printed, and the best measured again on 24 orientations, over the spec's draws, with its fixed
 // point near the centre if any. --aligned searches the motions without tilt drift and coning by
-// construction instead (Search::aligned). Arguments: [--draws N] [--starts S] [--evaluations E]
-// [--harmonics K] [--tilt-drift | --aligned] [DESIGN.json ...].
+// construction instead (Search::aligned); --fixed-point asks the held margin's search for the position's
+// fixed point and pull as well (Search::pull_score); --write PATH writes the best drive placed on the
+// target (0.02, -0.01, 0.5) as a scene, for plate robustness. Arguments: [--draws N] [--starts S]
+// [--evaluations E] [--harmonics K] [--tilt-drift | --aligned] [--fixed-point] [--write PATH] [DESIGN.json ...].
 #include "../design/src/internal.hpp"   // (design's internal header: reduced_ring, the placed constraints, the layout)
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
@@ -357,7 +359,33 @@ struct Search {
         const RingSpread s = spread_of(sc, spec, Vec2::Zero(), 12, cyc, false, "friction");
         if (s.params.empty()) return -1;
         if (sp) *sp = s;
-        return robust ? std::max(-1.0, held_margin(w, s, "friction")) : B(w, 1);
+        if (!robust) return B(w, 1);
+        const double held = std::max(-1.0, held_margin(w, s, "friction"));
+        return fixed_point ? held + pull_score(sc, w) : held;
+    }
+    // --fixed-point: the position too, at the ring's stable zero nearest the target's well, (0, 0,
+    // theta_0): the Newton step J^-1 xi there (over 1 cm and 0.1 rad; 0.01 rad/s per unit squared) and
+    // the slowest of J's three rates short of 0.05 1/s (0.1 rad/s per 1/s) taken off the held margin.
+    bool fixed_point = false;
+    double pull_score(const Scene& sc, const Ring& w) const {
+        const int n = static_cast<int>(w.size());
+        const int well = two_wells(w).first.k;
+        int at = -1;
+        for (int k = 0; k < n; ++k)
+            if (w[k] > 0 && w[(k + 1) % n] <= 0 &&
+                (at < 0 || std::abs(wrap_angle(2 * kPi * (k - well) / n)) < std::abs(wrap_angle(2 * kPi * (at - well) / n))))
+                at = k;
+        if (at < 0) return -1;
+        const Vec3 q0(0, 0, -kPi + 2 * kPi * (at + w[at] / (w[at] - w[(at + 1) % n])) / n);
+        Vec3 xi;
+        Mat3 J;
+        std::atomic<long> cycles{0};
+        if (!twist_and_jacobian(sc, q0, cyc, xi, J, cycles)) return -1;
+        const Vec3 step = J.fullPivLu().solve(xi);
+        const double off = step.allFinite() ? std::hypot(step.head<2>().norm() / 0.01, step[2] / 0.1) : 10.0;
+        const Eigen::Vector3cd ev = J.eigenvalues();
+        const double rate = -std::max({ev[0].real(), ev[1].real(), ev[2].real()});
+        return -0.01 * std::min(off * off, 100.0) + 0.1 * std::min(rate - 0.05, 0.0);
     }
 };
 
@@ -447,11 +475,49 @@ void search(Search& s, int starts, int evaluations, std::uint64_t seed, std::vec
     }
 }
 
+// A drive's fixed point near (0, 0, the target well's orientation), if any: what a design would also
+// need is the position pulled there. With `write`, the drive placed on the target, as a scene.
+void fixed_point_near(const Scene& sc, const Ring& w, const LimitCycleOptions& cyc, const std::string& write) {
+    Vec3 q(0, 0, -kPi + 2 * kPi * two_wells(w).first.k / 24.0), xi;
+    Mat3 J;
+    std::atomic<long> cycles{0};
+    bool ok = false;
+    for (int it = 0; it < 12 && twist_and_jacobian(sc, q, cyc, xi, J, cycles); ++it) {
+        const Vec3 step = J.fullPivLu().solve(xi);
+        if (!step.allFinite() || step.head<2>().norm() > 0.05) break;
+        q -= step;
+        if ((ok = step.head<2>().norm() < 1e-6 && std::abs(step[2]) < 1e-5)) break;
+    }
+    const Eigen::Vector3cd ev = J.eigenvalues();
+    if (ok && !write.empty()) {
+        Scene placed = sc;
+        placed.name = "fig4_robust_orientation";
+        placed.plate = placed_motion(sc.plate, q, Vec2(0.02, -0.01), 0.5);
+        double c[kPlacedConstraints];
+        placed_constraints(placed.plate, DesignOptions{}, placed, 1.0, c);
+        write_file_atomic(write, [&](std::ostream& out) { out << scene_to_json(placed).dump(2) << "\n"; });
+        std::printf(
+            "  placed on (0.02, -0.01, 0.5) and written to %s; its worst constraint %+.3f (<= 0: within the "
+            "limits, flight margin, coning and tilt drift)\n",
+            write.c_str(), *std::max_element(c, c + kPlacedConstraints));
+    }
+    if (ok)
+        std::printf(
+            "  its fixed point (%.4f, %.4f, %.3f), eigenvalues %+.3f%+.3fi %+.3f%+.3fi %+.3f%+.3fi 1/s; tilt drift %.1e "
+            "rad/s\n",
+            q[0], q[1], q[2], ev[0].real(), ev[0].imag(), ev[1].real(), ev[1].imag(), ev[2].real(), ev[2].imag(),
+            tilt_drift_rate(sc.plate).norm());
+    else
+        std::printf("  no fixed point found within 5 cm of the centre; tilt drift %.1e rad/s\n",
+                    tilt_drift_rate(sc.plate).norm());
+}
+
 }   // namespace
 
 int main(int argc, char** argv) {
     int draws = 200, starts = 4, evaluations = 600, top = 3;
-    bool tilt_drift = false, aligned = false;
+    bool tilt_drift = false, aligned = false, fixed_point = false;
+    std::string write;   // the best drive placed on the target (0.02, -0.01, 0.5), as a scene
     std::vector<std::string> designs;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -467,6 +533,10 @@ int main(int argc, char** argv) {
             tilt_drift = true;
         else if (a == "--aligned")
             aligned = true;
+        else if (a == "--fixed-point")
+            fixed_point = true;
+        else if (a == "--write" && i + 1 < argc)
+            write = argv[++i];
         else
             designs.push_back(a);
     }
@@ -510,6 +580,7 @@ int main(int argc, char** argv) {
             s.spec = spec;
             s.tilt_drift = tilt_drift || aligned;
             s.aligned = aligned;
+            s.fixed_point = fixed_point;
             for (int k = 1; k <= K; ++k) s.harmonics.push_back(k);
             s.robust = robust;
             s.guess = guess;
@@ -551,30 +622,7 @@ int main(int argc, char** argv) {
         }
         std::printf("  %d draws: one stable orientation on %d, held (one, and every other well above the passage's need) on %d\n",
                     done, one, held);
-        // Its fixed point near (0, 0, the target well's orientation), if any: what a design would also
-        // need is the position pulled there (this search never asked for it).
-        {
-            Vec3 q(0, 0, -kPi + 2 * kPi * two_wells(w).first.k / 24.0), xi;
-            Mat3 J;
-            std::atomic<long> cycles{0};
-            bool ok = false;
-            for (int it = 0; it < 12 && twist_and_jacobian(sc, q, s.cyc, xi, J, cycles); ++it) {
-                const Vec3 step = J.fullPivLu().solve(xi);
-                if (!step.allFinite() || step.head<2>().norm() > 0.05) break;
-                q -= step;
-                if ((ok = step.head<2>().norm() < 1e-6 && std::abs(step[2]) < 1e-5)) break;
-            }
-            const Eigen::Vector3cd ev = J.eigenvalues();
-            if (ok)
-                std::printf(
-                    "  its fixed point (%.4f, %.4f, %.3f), eigenvalues %+.3f%+.3fi %+.3f%+.3fi %+.3f%+.3fi 1/s; tilt drift %.1e "
-                    "rad/s\n",
-                    q[0], q[1], q[2], ev[0].real(), ev[0].imag(), ev[1].real(), ev[1].imag(), ev[2].real(), ev[2].imag(),
-                    tilt_drift_rate(sc.plate).norm());
-            else
-                std::printf("  no fixed point found within 5 cm of the centre; tilt drift %.1e rad/s\n",
-                            tilt_drift_rate(sc.plate).norm());
-        }
+        fixed_point_near(sc, w, s.cyc, write);
         std::printf("  its motion:");
         for (const Harmonic& h : combined(sc.plate).harmonics)
             std::printf(" %s n=%d %.3f@%.3f;", axis_name(h.axis), h.n, h.amp, h.phase);
