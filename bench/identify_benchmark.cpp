@@ -9,7 +9,11 @@
 // 20 % above its kinetic (the user's guess: that the part has some), and the fit starts from there.
 // TIME_LIMIT: each identification's (IdentifyOptions::time_limit, default 60 s). START "truth": the fit
 // starts from the truth (what the tracks can tell, apart from the search), else from the scene's values.
-//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START]]]]]]]]]]]
+// SEARCH: staged (IdentifyOptions' default: the tracks' starts first, then forward differences),
+// central (everything at once by central differences, the search before staging), or both (each
+// seed's tracks fitted twice, and the time ratio printed).
+//   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
+//   [SEARCH]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -64,6 +68,34 @@ void suggested(Scene& nominal, Scene& truth, const std::vector<std::string>& nam
     nominal.plate = truth.plate = s.suggested.plate;
 }
 
+// One way of searching (staged, IdentifyOptions' default; or everything at once by central
+// differences, as before staging) and its tally over the seeds.
+struct Variant {
+    const char* name;
+    bool central;
+    int within = 0, covered = 0, counted = 0, unid = 0;
+    double total_s = 0, worst_s = 0;
+
+    void tally(const IdentifySummary& s, const std::vector<std::string>& names, const std::vector<double>& truth) {
+        for (std::size_t j = 0; j < names.size(); ++j) {
+            const FittedParameter& p = s.params[j];
+            const double err = p.estimate - truth[j];
+            if (!p.identifiable) {
+                ++unid;
+                std::printf(" %s %+.4f [n/i]", names[j].c_str(), err);
+                continue;
+            }
+            const bool cov = p.lo <= truth[j] && truth[j] <= p.hi;
+            within += std::abs(err) <= 0.01;
+            covered += cov;
+            ++counted;
+            std::printf(" %s %+.4f(sd %.4f)%s", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]");
+        }
+        total_s += s.seconds;
+        worst_s = std::max(worst_s, s.seconds);
+    }
+};
+
 }   // namespace
 
 int main(int argc, char** argv) {
@@ -103,9 +135,12 @@ int main(int argc, char** argv) {
     o.rtol = rtol;
     if (argc > 10) o.time_limit = std::stod(argv[10]);
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
-    int within = 0, covered = 0, counted = 0, unid = 0;
-    double total_s = 0, worst_s = 0;
-    std::printf("seed  seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
+    const std::string diff = argc > 12 ? argv[12] : "staged";
+    std::vector<Variant> variants;
+    if (diff == "staged" || diff == "both") variants.push_back({"staged", false});
+    if (diff == "central" || diff == "both") variants.push_back({"central", true});
+    if (variants.empty()) throw std::invalid_argument("SEARCH: staged, central or both");
+    std::printf("seed  search   seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
     for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
         Rng rng(1000 + seed);
         std::vector<Track> tracks;
@@ -116,33 +151,26 @@ int main(int argc, char** argv) {
             tr.source = "seed" + std::to_string(seed) + "_track" + std::to_string(k);
             tracks.push_back(tr);
         }
-        const IdentifySummary s = identify(from_truth ? truth_scene : nominal, tracks, o);
-        std::printf("%4d  %7.2f  %8.3f  %5d  %5d ", seed, s.seconds, s.reduced_chi2, s.iterations, s.best_start);
-        for (std::size_t j = 0; j < names.size(); ++j) {
-            const FittedParameter& p = s.params[j];
-            const double err = p.estimate - truth[j];
-            if (!p.identifiable) {
-                ++unid;
-                std::printf(" %s %+.4f [n/i]", names[j].c_str(), err);
-                continue;
-            }
-            const bool cov = p.lo <= truth[j] && truth[j] <= p.hi;
-            within += std::abs(err) <= 0.01;
-            covered += cov;
-            ++counted;
-            std::printf(" %s %+.4f(sd %.4f)%s", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]");
+        for (Variant& v : variants) {
+            o.central_search = v.central;
+            o.fit_starts_first = !v.central;
+            const IdentifySummary s = identify(from_truth ? truth_scene : nominal, tracks, o);
+            std::printf("%4d  %-7s %7.2f  %8.3f  %5d  %5d ", seed, v.name, s.seconds, s.reduced_chi2, s.iterations, s.best_start);
+            v.tally(s, names, truth);
+            std::printf("  %s\n", s.termination.substr(0, 40).c_str());
+            if (s.reduced_chi2 > 1.5)   // (which track does not fit)
+                for (const TrackFit& f : s.tracks)
+                    std::printf("      %s: %d frames, rms %.3f mm %.2f mrad, chi2 %.1f\n", f.source.c_str(), f.frames,
+                                f.rms_xy_mm, f.rms_theta_mrad, f.chi2);
+            std::fflush(stdout);
         }
-        std::printf("  %s\n", s.termination.substr(0, 40).c_str());
-        if (s.reduced_chi2 > 1.5)   // (which track does not fit)
-            for (const TrackFit& f : s.tracks)
-                std::printf("      %s: %d frames, rms %.3f mm %.2f mrad, chi2 %.1f\n", f.source.c_str(), f.frames, f.rms_xy_mm,
-                            f.rms_theta_mrad, f.chi2);
-        std::fflush(stdout);
-        total_s += s.seconds;
-        worst_s = std::max(worst_s, s.seconds);
     }
-    std::printf(
-        "within 0.01: %d of %d; 95%% intervals covering: %d of %d (%.1f %%); not identifiable: %d; "
-        "seconds mean %.2f, largest %.2f\n",
-        within, counted, covered, counted, counted ? 100.0 * covered / counted : 0.0, unid, total_s / seeds, worst_s);
+    for (const Variant& v : variants)
+        std::printf(
+            "%s search: within 0.01: %d of %d; 95%% intervals covering: %d of %d (%.1f %%); not identifiable: %d; "
+            "seconds mean %.2f, largest %.2f\n",
+            v.name, v.within, v.counted, v.covered, v.counted, v.counted ? 100.0 * v.covered / v.counted : 0.0, v.unid,
+            v.total_s / seeds, v.worst_s);
+    if (variants.size() == 2 && variants[1].total_s > 0)
+        std::printf("time ratio, staged / central search (this run): %.3f\n", variants[0].total_s / variants[1].total_s);
 }

@@ -50,13 +50,14 @@ struct IdentifyArgs : Options {
                   "Exit 2 for a track of another scene, too few frames or a bad cell (file and line named), a name\n"
                   "that is no parameter or one the part has not (mu_k2, com_x for a point part).\n"
                   "--suggest: no fit; which plate motion to film so that the --params are identifiable. Candidate\n"
-                  "horizontal drives (x and its second harmonic; with a y second harmonic; with yaw for rigid parts)\n"
-                  "at 1.1-2 mu_s g of SCENE's part, within --limits LIN ANG (each axis' peak, as plate design's;\n"
+                  "horizontal drives (x and its second harmonic; with a y second harmonic; each with yaw for rigid\n"
+                  "parts) at 1.1-2 mu_s g of SCENE's part, within --limits LIN ANG (each axis' peak, as plate design's;\n"
                   "default 20 150), each weighed by the information --tracks-planned K tracks of --duration S s\n"
                   "(default 5 of 10 s, from seeded starts) filmed by --camera (default: stroboscopic at phase 0.25,\n"
-                  "0.1 mm and 5 mrad) would carry at SCENE's values; the one whose worst-determined combination is\n"
-                  "best determined wins. JSON: every candidate's motion, peaks, stick fraction, predicted sds and\n"
-                  "smallest eigenvalue, the winner; --scene-out FILE writes SCENE with the winner's plate motion\n"
+                  "0.1 mm and 5 mrad) would carry at SCENE's values, over --start-sets N sets of starts (default 3;\n"
+                  "judged by the worst); the one whose worst-determined combination is best determined wins. JSON:\n"
+                  "every candidate's motion, peaks, stick fraction, predicted sds and smallest eigenvalues, the winner; "
+                  "--scene-out FILE writes SCENE with the winner's plate motion\n"
                   "(film it: plate simulate FILE ... --observe CAMERA.json). Exit 4 if no candidate could be simulated.\n") {
         scene_file(scene);
         words("--tracks", tracks, 1, 1000, "T.csv ...", "the track files; required (but with --suggest)");
@@ -77,6 +78,7 @@ struct IdentifyArgs : Options {
         text("--camera", camera, "CAMERA.json", "--suggest: the camera that will film");
         numbers("--limits", limits, 2, 2, "LIN ANG", "--suggest: each axis' peak [m/s^2, rad/s^2]");
         whole("--tracks-planned", so.tracks, 1, 1000, "--suggest: tracks that will be filmed");
+        whole("--start-sets", so.start_sets, 1, 100, "--suggest: sets of their starts each motion is judged over (its worst)");
         number("--duration", so.duration, "--suggest: seconds of each");
         text("--scene-out", scene_out, "FILE", "--suggest: SCENE with the suggested plate motion");
     }

@@ -23,6 +23,7 @@ namespace {
 // coefficient of a part that hardly sticks: 1e-2-1e2, against 1e8 for a kinetic one) is then not
 // stepped across its whole range, into a regime it does not hold (docs/decisions/identification.md).
 constexpr double kMinLmDiagonal = 1e4;
+using Clock = std::chrono::steady_clock;
 constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // central-difference steps of a track's start
 
 // The starts: the scene's values (clamped into the bounds), then draws within them.
@@ -80,10 +81,29 @@ std::vector<int> unseen_parameters(const std::vector<std::unique_ptr<TrackCost>>
     return held;
 }
 
+// One start's search (IdentifyOptions::fit_starts_first): the tracks' starts alone, then everything; x
+// and q0 hold the result, the iterations summed over both.
+Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
+             const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, const IdentifyOptions& o,
+             Clock::time_point t0) {
+    const auto left = [&] { return std::max(o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count(), 1e-3); };
+    const int n = static_cast<int>(x.size());
+    int iterations = 0;
+    if (o.fit_starts_first) {
+        std::vector<int> all(n);
+        for (int j = 0; j < n; ++j) all[j] = j;
+        iterations = minimise(costs, x, q0, all, lo, hi, o.max_iterations, left(), o.threads).iterations;
+    }
+    Solve sol = minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads);
+    sol.iterations += iterations;
+    return sol;
+}
+
 }   // namespace
 
-TrackCost::TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o)
-    : scene_(scene), layout_(layout), track_(track), first_(first), o_(o) {
+TrackCost::TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
+                     bool central)
+    : scene_(scene), layout_(layout), track_(track), first_(first), o_(o), central_(central) {
     dim_ = track.point ? 2 : 3;
     mutable_parameter_block_sizes()->push_back(layout.size());
     mutable_parameter_block_sizes()->push_back(dim_);
@@ -152,8 +172,8 @@ bool TrackCost::Evaluate(double const* const* parameters, double* r, double** ja
             const double h = b == 0 ? layout_.step(j) : (j < 2 ? kStartStepMm : kStartStepRad);
             const double x0 = x[j];
             // One-sided at a bound (a static excess at 0: below it the part would have static < kinetic).
-            const bool down = b != 0 || x0 - h >= lo_[j];
             const bool up = b != 0 || x0 + h <= hi_[j];
+            const bool down = (central_ || !up) && (b != 0 || x0 - h >= lo_[j]);
             const double* blocks[2] = {parameters[0], parameters[1]};
             blocks[b] = x.data();
             x[j] = x0 + (up ? h : 0);
@@ -214,7 +234,7 @@ bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track
                     const std::vector<double>& x, const std::vector<double>& q0, Eigen::VectorXd& r, Eigen::MatrixXd& Jx,
                     Eigen::MatrixXd& Jq) {
     using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-    const TrackCost cost(scene, layout, track, first, o);
+    const TrackCost cost(scene, layout, track, first, o, true);
     const int m = cost.num_residuals(), n = layout.size(), d = track.point ? 2 : 3;
     std::vector<double> rr(m), j0(static_cast<std::size_t>(m) * n), j1(static_cast<std::size_t>(m) * d);
     const double* params[2] = {x.data(), q0.data()};
@@ -267,14 +287,16 @@ void check_tracks(const Scene& scene, const std::vector<Track>& tracks, const Id
 
 IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, const IdentifyOptions& o) {
     using namespace identify_detail;
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     o.validate();
     const Layout layout(scene, o.params);
     check_tracks(scene, tracks, o);
     const int n = layout.size(), nt = static_cast<int>(tracks.size()), d = scene.part.point ? 2 : 3;
+    std::vector<int> firsts;
+    for (const Track& tr : tracks) firsts.push_back(first_used_frame(tr, scene.plate.T, o.settle_periods));
     std::vector<std::unique_ptr<TrackCost>> costs;
-    for (const Track& tr : tracks)
-        costs.push_back(std::make_unique<TrackCost>(scene, layout, tr, first_used_frame(tr, scene.plate.T, o.settle_periods), o));
+    for (std::size_t t = 0; t < tracks.size(); ++t)
+        costs.push_back(std::make_unique<TrackCost>(scene, layout, tracks[t], firsts[t], o, o.central_search));
 
     IdentifySummary s;
     // A start whose chi-square lies within 3 sds of its mean at the truth (dof + 3 sqrt(2 dof)) fits as
@@ -296,11 +318,10 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         hi.push_back(layout.upper(j, o));
     }
     for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
-        const double left = o.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (left <= 0) break;
+        if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
         std::vector<double> x = xs[k];
         std::vector<std::vector<double>> q0 = first_frames(tracks, d);
-        const Solve sol = minimise(cost_ptrs, x, q0, held, lo, hi, o.max_iterations, left, o.threads);
+        const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0);
         ++s.starts_run;
         s.start_costs.push_back(sol.chi2);
         if (sol.usable && sol.chi2 < best_cost) {

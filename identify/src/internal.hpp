@@ -75,14 +75,15 @@ void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<dou
 
 // One track's residual block: parameter blocks (the named parameters, internal coordinates) and (the
 // track's start: s_x, s_y [mm], theta [rad]; a point part without theta). Its Jacobian by the fit's own
-// central differences, one-sided at a bound (docs/decisions/identification.md).
+// differences: central (`central`), else forward (backward at an upper bound); one-sided at a bound
+// (docs/decisions/identification.md).
 //
 // Profile mode (profile.cpp): block 0 holds z, the internal coordinates with the profiled parameter j's
 // own replaced by its value in scene units (held: its column is left zero), so that a static
 // coefficient stays at that value while its kinetic base moves; the differences stay within [lo, hi].
 class TrackCost final : public ceres::CostFunction {
 public:
-    TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o);
+    TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o, bool central);
     void profile(int j, const std::vector<double>& lo, const std::vector<double>& hi);
     // The internal coordinates x of block 0 (the identity outside profile mode); false if z puts a
     // static coefficient below its kinetic base.
@@ -97,6 +98,7 @@ private:
     const Track& track_;
     int first_, dim_;
     const IdentifyOptions& o_;
+    bool central_;
     IntegrationOptions opt_;
     int profiled_ = -1;
     std::vector<double> lo_, hi_;

@@ -35,9 +35,10 @@ double reach(const Part& p) {
     return r;
 }
 
-// The tracks' starts at rest: x, y in +-box, theta any; drawn in the same order for every candidate.
-std::vector<Vec3> planned_starts(const SuggestOptions& o) {
-    Rng rng(o.seed);
+// One set of the tracks' starts at rest: x, y in +-box, theta any; drawn in the same order for every
+// candidate.
+std::vector<Vec3> planned_starts(const SuggestOptions& o, std::uint64_t seed) {
+    Rng rng(seed);
     std::vector<Vec3> q0;
     for (int k = 0; k < o.tracks; ++k) {
         const double x = rng.uniform(-o.start_box, o.start_box), y = rng.uniform(-o.start_box, o.start_box);
@@ -85,6 +86,7 @@ void SuggestOptions::validate() const {
     if (!(lin_limit > 0 && lin_limit <= 1e4)) bad("lin_limit: in (0, 1e4] m/s^2");
     if (!(ang_limit > 0 && ang_limit <= 1e6)) bad("ang_limit: in (0, 1e6] rad/s^2");
     if (tracks < 1 || tracks > 1000) bad("tracks: from 1 to 1000");
+    if (start_sets < 1 || start_sets > 100) bad("start_sets: from 1 to 100");
     if (!(duration > 0 && duration <= 1e4)) bad("duration: in (0, 1e4] s");
     if (!(start_box >= 0 && start_box <= 1)) bad("start_box: in [0, 1] m");
     if (levels.empty() || levels.size() > 100) bad("levels: from 1 to 100 of them");
@@ -96,8 +98,8 @@ std::vector<MotionCandidate> candidate_motions(const Scene& scene, const Suggest
     o.validate();
     const double a_s = mean_static(scene.part) * scene.g, r = reach(scene.part);
     std::vector<MotionCandidate> out;
-    const char* shapes[3] = {"x+2x", "x+2x+2y", "x+2x+rz"};
-    for (int k = 0; k < (r > 0 ? 3 : 2); ++k)
+    const char* shapes[4] = {"x+2x", "x+2x+2y", "x+2x+rz", "x+2x+2y+rz"};
+    for (int k = 0; k < (r > 0 ? 4 : 2); ++k)
         for (double level : o.levels) {
             MotionCandidate c;
             std::ostringstream label;
@@ -106,12 +108,12 @@ std::vector<MotionCandidate> candidate_motions(const Scene& scene, const Suggest
             c.motion.T = scene.plate.T;
             c.motion.harmonics.push_back(Harmonic{Axis::x, 1, 1, 0});
             c.motion.harmonics.push_back(Harmonic{Axis::x, 2, 1.0 / 3, 0});
-            if (k == 1) c.motion.harmonics.push_back(Harmonic{Axis::y, 2, 1.0 / 3, kPi / 2});
+            if (k == 1 || k == 3) c.motion.harmonics.push_back(Harmonic{Axis::y, 2, 1.0 / 3, kPi / 2});
             const double A = level * a_s, scale = A / horizontal_peak(c.motion);
             for (Harmonic& h : c.motion.harmonics) h.amp *= scale;
             // yaw: the contacts' tangential acceleration from it half the drive's peak, a quarter period
             // after the drive
-            if (k == 2) c.motion.harmonics.push_back(Harmonic{Axis::rz, 1, 0.5 * A / r, kPi / 2});
+            if (k >= 2) c.motion.harmonics.push_back(Harmonic{Axis::rz, 1, 0.5 * A / r, kPi / 2});
             out.push_back(c);
         }
     return out;
@@ -132,39 +134,51 @@ void weigh_motion(const Scene& scene, const Camera& camera, const SuggestOptions
     Scene s = scene;
     s.plate = c.motion;
     const std::vector<double> x = layout.internal(layout.scene_values());
-    const std::vector<Vec3> q0 = planned_starts(o);
-    std::vector<PlannedTrack> planned(q0.size());
-    thread_tasks(std::max(1, std::min(o.fit.threads, o.tracks)))(
-        o.tracks,
-        [&](int k) {
-            planned[k] = plan_track(s, camera, o, layout, x, q0[k]);
+    const int sets = o.start_sets, nt = o.tracks, n = layout.size(), d = scene.part.point ? 2 : 3;
+    std::vector<std::vector<Vec3>> q0;
+    for (int k = 0; k < sets; ++k) q0.push_back(planned_starts(o, o.seed + static_cast<std::uint64_t>(k)));
+    std::vector<PlannedTrack> planned(static_cast<std::size_t>(sets) * nt);
+    thread_tasks(std::max(1, std::min(o.fit.threads, sets * nt)))(
+        sets * nt,
+        [&](int i) {
+            planned[i] = plan_track(s, camera, o, layout, x, q0[i / nt][i % nt]);
             return std::string();
         },
         [](int, const std::string&) {});
 
-    const int n = layout.size(), d = scene.part.point ? 2 : 3;
-    int rows = 0;
     c.simulated = true;
     double held = 0, time = 0;
     for (const PlannedTrack& p : planned) {
         c.simulated = c.simulated && p.ok;
-        rows += static_cast<int>(p.Jx.rows());
         held += p.held;
         time += p.time;
     }
     c.stick_fraction = time > 0 ? held / time : 0.0;
     if (!c.simulated) return;
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * o.tracks);
-    for (int t = 0, row = 0; t < o.tracks; ++t) {
-        const int m = static_cast<int>(planned[t].Jx.rows());
-        J.block(row, 0, m, n) = planned[t].Jx;
-        J.block(row, n + d * t, m, d) = planned[t].Jq;
-        row += m;
+    Eigen::MatrixXd worst;
+    for (int k = 0; k < sets; ++k) {
+        int rows = 0;
+        for (int t = 0; t < nt; ++t) rows += static_cast<int>(planned[k * nt + t].Jx.rows());
+        Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * nt);
+        for (int t = 0, row = 0; t < nt; ++t) {
+            const PlannedTrack& p = planned[k * nt + t];
+            const int m = static_cast<int>(p.Jx.rows());
+            J.block(row, 0, m, n) = p.Jx;
+            J.block(row, n + d * t, m, d) = p.Jq;
+            row += m;
+        }
+        const Eigen::MatrixXd info = scaled_information(layout, o.fit, J, d * nt);
+        const double eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(info, Eigen::EigenvaluesOnly).eigenvalues()[0];
+        c.set_min_eigenvalues.push_back(eig);
+        if (k == 0 || eig < c.min_eigenvalue) {
+            c.min_eigenvalue = eig;
+            c.information = info;
+            c.worst_set = k;
+            worst = J;
+        }
     }
-    c.information = scaled_information(layout, o.fit, J, d * o.tracks);
-    c.min_eigenvalue = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(c.information, Eigen::EigenvaluesOnly).eigenvalues()[0];
     IdentifySummary judged;
-    judge(layout, o.fit, x, J, d * o.tracks, judged);
+    judge(layout, o.fit, x, worst, d * nt, judged);
     c.predicted = judged.params;
     c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -202,6 +216,8 @@ nlohmann::json suggest_json(const SuggestSummary& s, const SuggestOptions& o) {
             j["simulated"] = c.simulated;
             j["stick_fraction"] = c.stick_fraction;
             j["min_eigenvalue"] = c.min_eigenvalue;
+            j["worst_set"] = c.worst_set;
+            j["set_min_eigenvalues"] = c.set_min_eigenvalues;
             json pred = json::array();
             for (const FittedParameter& p : c.predicted)
                 pred.push_back({{"name", p.name}, {"unit", p.unit}, {"nominal", p.estimate}, {"sd", num(p.sd)}});
@@ -215,7 +231,8 @@ nlohmann::json suggest_json(const SuggestSummary& s, const SuggestOptions& o) {
              {"tracks_planned", o.tracks},
              {"duration_s", o.duration},
              {"seed", o.seed},
-             {"criterion", "largest smallest eigenvalue of the range-scaled information (E-optimal)"},
+             {"start_sets", o.start_sets},
+             {"criterion", "largest smallest eigenvalue of the range-scaled information (E-optimal), of the worst set of starts"},
              {"candidates", cands},
              {"seconds", s.seconds}};
     out["best"] = s.best >= 0 ? json(s.candidates[s.best].label) : json(nullptr);

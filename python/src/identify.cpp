@@ -34,8 +34,8 @@ void io(Archive& a, IdentifySummary& s) {
       s.held, s.iterations, s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
 }
 void io(Archive& a, IdentifyOptions& o) {
-    a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads, o.mu_min,
-      o.mu_max, o.com_max);
+    a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads,
+      o.fit_starts_first, o.central_search, o.mu_min, o.mu_max, o.com_max);
 }
 void io(Archive& a, ProfilePoint& p) { a(p.value, p.dchi2); }
 void io(Archive& a, ParameterProfile& p) {

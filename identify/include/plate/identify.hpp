@@ -53,7 +53,13 @@ struct IdentifyOptions {
     // The simulation's tolerance (IntegrationOptions::rtol): 1e-7 keeps fig4's kinetic estimates within
     // their sd of those at 1e-8 at about a third of the time (docs/decisions/identification.md, Measured).
     double rtol = 1e-7;
-    int threads = 2;                      // tracks evaluated in parallel
+    int threads = 2;   // tracks evaluated in parallel
+    // The search (docs/decisions/identification.md, "A cheaper search"): each start first fits the tracks'
+    // starts alone (the named parameters held: three coordinates a track, cheap), then everything, its
+    // Jacobian by forward differences (one simulation a column) unless central_search (two). The
+    // covariance, the intervals and --suggest always use central differences.
+    bool fit_starts_first = true;
+    bool central_search = false;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;

@@ -10,16 +10,19 @@
 // second harmonic at a third of the first (asymmetric: the part drifts along x, so a stroboscope sees
 // it move; a symmetric drive brings it back to the same place every period), the same with a y second
 // harmonic at a third, a quarter of its period later (a drift along y too: two numbers a period, two
-// combinations of the coefficients), and the first with a yaw (rz) component (rigid parts only: the
-// plate turning under the contacts loads each differently, so their coefficients separate). A candidate whose axis peaks
-// (axis_peaks) exceed the limits is reported and not weighed.
+// combinations of the coefficients), and each of these two with a yaw (rz) component (rigid parts only:
+// the plate turning under the contacts loads each differently, so their coefficients separate). A
+// candidate whose axis peaks (axis_peaks) exceed the limits is reported and not weighed.
 //
 // The information of a candidate: the fit's own Jacobian (identify_detail::track_jacobian) of the
 // noise-scaled residuals of `tracks` tracks of `duration` s from seeded random starts at rest (x, y in
 // +-start_box, theta any), filmed by `camera` without drops at the scene's nominal parameters, the
-// tracks' starts eliminated (Schur complement), in range-scaled units. The winner maximises its
-// smallest eigenvalue (E-optimal: the worst-determined combination of the parameters is the best
-// determined). Deterministic: the starts are drawn from `seed`, the same for every candidate.
+// tracks' starts eliminated (Schur complement), in range-scaled units. Where the plate turns (a yaw),
+// what the tracks carry depends on where they start, so each candidate is weighed over `start_sets`
+// sets of starts and judged by its worst: the winner maximises the smallest eigenvalue of the worst
+// set's information (E-optimal, and max-min over the sets: the worst-determined combination of the
+// parameters is the best determined wherever the part is put down). Deterministic: the k-th set is
+// drawn from seed + k, the same for every candidate.
 #pragma once
 
 #include "plate/identify.hpp"
@@ -40,6 +43,7 @@ struct SuggestOptions {
     int tracks = 5;                                      // planned tracks per candidate
     double duration = 10;                                // [s] each
     std::uint64_t seed = 1;                              // of the tracks' starts
+    int start_sets = 3;                                  // sets of starts each candidate is weighed over
     double start_box = 0.05;                             // [m]: starts' |x|, |y| at most this
     std::vector<double> levels = {1.1, 1.4, 1.7, 2.0};   // horizontal peaks in units of mu_s g (nominal, mean)
     void validate() const;
@@ -54,10 +58,13 @@ struct MotionCandidate {
     bool simulated = false;      // every planned track ran to its end (no contact lost)
     // The contacts' mean share of the planned tracks' time at zero slip (Trajectory::held_time): 1 a part
     // that never slides, 0 one that never sticks.
-    double stick_fraction = 0;
-    std::vector<FittedParameter> predicted;   // the nominal values with their predicted sd (NaN: not identifiable)
-    Eigen::MatrixXd information;              // range-scaled, the starts eliminated (rows as params)
-    double min_eigenvalue = 0;                // of `information`
+    double stick_fraction = 0;   // (over every set)
+    // Of the worst set of starts (the smallest eigenvalue):
+    std::vector<FittedParameter> predicted;    // the nominal values with their predicted sd (NaN: not identifiable)
+    Eigen::MatrixXd information;               // range-scaled, the starts eliminated (rows as params)
+    double min_eigenvalue = 0;                 // of `information`
+    int worst_set = 0;                         // its index k (starts drawn from seed + k)
+    std::vector<double> set_min_eigenvalues;   // every set's smallest eigenvalue
     double seconds = 0;
 };
 
