@@ -1,6 +1,7 @@
 // The identification's search (identify.cpp, IdentifyOptions::fit_starts_first and central_search)
 // steps with forward differences; the covariance uses central ones. Where the part only slides the
-// residuals are smooth in the parameters and the two agree to O(h); where it sticks and slips they
+// residuals are smooth in the parameters and the two agree to O(h) (at one simulation a column against
+// two); where it sticks and slips they
 // have kinks (a contact's stick begins or ends at another step of the integration, or a period
 // earlier), across which one-sided quotients differ, so there they agree only roughly.
 #include "identify_fixtures.hpp"
@@ -34,6 +35,9 @@ std::vector<double> disagreement(const Scene& nominal, const std::vector<std::st
     double* jac_c[2] = {jc.data(), qc.data()};
     REQUIRE(forward.Evaluate(params, r.data(), jac_f));
     REQUIRE(central.Evaluate(params, r.data(), jac_c));
+    // One simulation a column forward (all inside their bounds here), two central; each and the residuals'.
+    CHECK(forward.simulations() == 1 + n + 3);
+    CHECK(central.simulations() == 1 + 2 * (n + 3));
     std::vector<double> out;
     const auto columns = [&](const std::vector<double>& a, const std::vector<double>& b, int cols) {
         for (int j = 0; j < cols; ++j) {
@@ -68,12 +72,11 @@ TEST_CASE("where the part only slides, the search's forward differences agree wi
 // fig4's part at kinetic (0.25, 0.30, 0.35), static 20 % above, under x with its second harmonic at
 // 1.4 mu_s g and a yaw a quarter period later (a suggestion's shape): it sticks and slips. Measured:
 // 0.2-6.5 % of each column (mu_k2's the most); bound 15 %, against 50 % for the wrong span.
-TEST_CASE("where the part sticks and slips, the search's forward differences agree with the central ones roughly",
-          "[identify]") {
+TEST_CASE("where the part sticks and slips, the search's forward differences agree with the central ones roughly", "[identify]") {
     Scene s = scene("fig4");
     s.plate.harmonics = {Harmonic{Axis::x, 1, 4.26, 0}, Harmonic{Axis::x, 2, 1.42, 0}, Harmonic{Axis::rz, 1, 78.2, kPi / 2}};
-    const std::vector<double> d = disagreement(s, {"mu_k1", "mu_k2", "mu_k3", "mu_s1", "mu_s2", "mu_s3"},
-                                               {0.25, 0.30, 0.35, 0.30, 0.36, 0.42});
+    const std::vector<double> d =
+        disagreement(s, {"mu_k1", "mu_k2", "mu_k3", "mu_s1", "mu_s2", "mu_s3"}, {0.25, 0.30, 0.35, 0.30, 0.36, 0.42});
     for (std::size_t j = 0; j < d.size(); ++j) {
         INFO("column " << j << ": " << d[j]);
         CHECK(d[j] < 0.15);

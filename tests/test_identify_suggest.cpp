@@ -218,6 +218,8 @@ TEST_CASE("a turning plate's candidate is judged by its worst set of starts", "[
         REQUIRE(c.simulated);
         alone.push_back(c.min_eigenvalue);
         CHECK(all.set_min_eigenvalues[k] == Approx(c.min_eigenvalue).epsilon(1e-9));
+        REQUIRE(c.set_min_eigenvalues.size() == 1u);
+        if (k == all.worst_set) CHECK(all.information.isApprox(c.information, 1e-9));
         if (k == all.worst_set)
             for (std::size_t j = 0; j < c.predicted.size(); ++j) {
                 const double a = all.predicted[j].sd, b = c.predicted[j].sd;   // (NaN: not identifiable)

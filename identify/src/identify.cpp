@@ -92,7 +92,9 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
     if (o.fit_starts_first) {
         std::vector<int> all(n);
         for (int j = 0; j < n; ++j) all[j] = j;
-        iterations = minimise(costs, x, q0, all, lo, hi, o.max_iterations, left(), o.threads).iterations;
+        Solve first = minimise(costs, x, q0, all, lo, hi, o.max_iterations, left(), o.threads);
+        if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) return first;   // (no time left)
+        iterations = first.iterations;
     }
     Solve sol = minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads);
     sol.iterations += iterations;

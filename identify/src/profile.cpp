@@ -225,8 +225,8 @@ ProfileSummary profile_likelihood(const Scene& scene, const std::vector<Track>& 
     std::vector<std::unique_ptr<TrackCost>> owned;
     std::vector<TrackCost*> costs;
     for (const Track& tr : tracks) {
-        owned.push_back(std::make_unique<TrackCost>(scene, layout, tr, first_used_frame(tr, scene.plate.T, o.settle_periods), o,
-                                                    o.central_search));
+        owned.push_back(
+            std::make_unique<TrackCost>(scene, layout, tr, first_used_frame(tr, scene.plate.T, o.settle_periods), o, true));
         costs.push_back(owned.back().get());
     }
     Budget budget(costs, po, t0);

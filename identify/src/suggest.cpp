@@ -128,6 +128,12 @@ void weigh_motion(const Scene& scene, const Camera& camera, const SuggestOptions
     if (!(camera.noise_xy_mm > 0) || (!scene.part.point && !(camera.noise_theta_mrad > 0)))
         throw InputError(camera.source +
                          ": the camera has no noise: the information weighs each frame by the noise's sd (give it)");
+    c.predicted.clear();   // (a candidate weighed again starts afresh)
+    c.information.resize(0, 0);
+    c.min_eigenvalue = c.stick_fraction = 0;
+    c.worst_set = 0;
+    c.set_min_eigenvalues.clear();
+    c.simulated = false;
     c.peaks = axis_peaks(c.motion);
     c.within_limits = c.peaks.head<3>().maxCoeff() <= o.lin_limit && c.peaks.tail<3>().maxCoeff() <= o.ang_limit;
     if (!c.within_limits) return;

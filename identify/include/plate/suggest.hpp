@@ -58,7 +58,7 @@ struct MotionCandidate {
     bool simulated = false;      // every planned track ran to its end (no contact lost)
     // The contacts' mean share of the planned tracks' time at zero slip (Trajectory::held_time): 1 a part
     // that never slides, 0 one that never sticks.
-    double stick_fraction = 0;   // (over every set)
+    double stick_fraction = 0;   // (pooled over every set)
     // Of the worst set of starts (the smallest eigenvalue):
     std::vector<FittedParameter> predicted;    // the nominal values with their predicted sd (NaN: not identifiable)
     Eigen::MatrixXd information;               // range-scaled, the starts eliminated (rows as params)
