@@ -9,9 +9,11 @@
 // 20 % above its kinetic (the user's guess: that the part has some), and the fit starts from there.
 // TIME_LIMIT: each identification's (IdentifyOptions::time_limit, default 60 s). START "truth": the fit
 // starts from the truth (what the tracks can tell, apart from the search), else from the scene's values.
-// SEARCH: staged (IdentifyOptions' default: the tracks' starts first, then forward differences),
-// central (everything at once by central differences, the search before staging), or both (each
-// seed's tracks fitted twice, and the time ratio printed).
+// SEARCH: a comma-separated list of searches, each seed's tracks fitted by each (the time ratio of the
+// first two printed): staged (the tracks' starts first, then forward differences), central
+// (everything at once by central differences, the search before staging), pieces[S] (staged, after a
+// first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
+// staged,central.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
 //   [SEARCH]]]]]]]]]]]]
 #include "plate/identify.hpp"
@@ -71,8 +73,9 @@ void suggested(Scene& nominal, Scene& truth, const std::vector<std::string>& nam
 // One way of searching (staged, IdentifyOptions' default; or everything at once by central
 // differences, as before staging) and its tally over the seeds.
 struct Variant {
-    const char* name;
+    std::string name;
     bool central;
+    double segment_seconds;
     int within = 0, covered = 0, counted = 0, unid = 0;
     double total_s = 0, worst_s = 0;
 
@@ -137,9 +140,15 @@ int main(int argc, char** argv) {
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;
-    if (diff == "staged" || diff == "both") variants.push_back({"staged", false});
-    if (diff == "central" || diff == "both") variants.push_back({"central", true});
-    if (variants.empty()) throw std::invalid_argument("SEARCH: staged, central or both");
+    std::stringstream vin(diff == "both" ? std::string("staged,central") : diff);
+    for (std::string w; std::getline(vin, w, ',');) {
+        if (w == "staged" || w == "central")
+            variants.push_back({w, w == "central", 0.0});
+        else if (w.rfind("pieces", 0) == 0)   // pieces (2 s) or piecesS (S s)
+            variants.push_back({w, false, w.size() > 6 ? std::stod(w.substr(6)) : 2.0});
+        else
+            throw std::invalid_argument("SEARCH: a comma-separated list of staged, central, pieces[S] (or both)");
+    }
     std::printf("seed  search   seconds  chi2/dof  iters  start  errors (estimate - truth) [covered?]\n");
     for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
         Rng rng(1000 + seed);
@@ -154,8 +163,11 @@ int main(int argc, char** argv) {
         for (Variant& v : variants) {
             o.central_search = v.central;
             o.fit_starts_first = !v.central;
+            o.segment_seconds = v.segment_seconds;
             const IdentifySummary s = identify(from_truth ? truth_scene : nominal, tracks, o);
-            std::printf("%4d  %-7s %7.2f  %8.3f  %5d  %5d ", seed, v.name, s.seconds, s.reduced_chi2, s.iterations, s.best_start);
+            std::printf("%4d  %-8s %7.2f  %8.3f  %5d  %5d ", seed, v.name.c_str(), s.seconds, s.reduced_chi2, s.iterations,
+                        s.best_start);
+            if (v.segment_seconds > 0) std::printf(" [pieces: %d iterations, %.1f s]", s.piece_iterations, s.piece_seconds);
             v.tally(s, names, truth);
             std::printf("  %s\n", s.termination.substr(0, 40).c_str());
             if (s.reduced_chi2 > 1.5)   // (which track does not fit)
@@ -169,8 +181,9 @@ int main(int argc, char** argv) {
         std::printf(
             "%s search: within 0.01: %d of %d; 95%% intervals covering: %d of %d (%.1f %%); not identifiable: %d; "
             "seconds mean %.2f, largest %.2f\n",
-            v.name, v.within, v.counted, v.covered, v.counted, v.counted ? 100.0 * v.covered / v.counted : 0.0, v.unid,
+            v.name.c_str(), v.within, v.counted, v.covered, v.counted, v.counted ? 100.0 * v.covered / v.counted : 0.0, v.unid,
             v.total_s / seeds, v.worst_s);
     if (variants.size() == 2 && variants[1].total_s > 0)
-        std::printf("time ratio, staged / central search (this run): %.3f\n", variants[0].total_s / variants[1].total_s);
+        std::printf("time ratio, %s / %s search (this run): %.3f\n", variants[0].name.c_str(), variants[1].name.c_str(),
+                    variants[0].total_s / variants[1].total_s);
 }

@@ -54,6 +54,7 @@ int main(int argc, char** argv) {
     o.tracks = tracks;
     o.duration = duration;
     o.start_box = box;
+    o.start_sets = 1;   // one set per weighing: the columns below are the sets one by one
     Camera cam;
     cam.per_period = 1;
     cam.phase = 0.25;

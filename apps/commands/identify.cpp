@@ -34,6 +34,9 @@ struct IdentifyArgs : Options {
                   "under SCENE, the camera's noise sds weighing the residuals). Each track's start (at rest at t = 0,\n"
                   "the configuration fitted) is fitted too; --settle N leaves out the frames of its first N periods\n"
                   "(default 0; for tracks filmed from an unknown start twist).\n"
+                  "Each start of the search first fits the tracks cut into pieces of --pieces S seconds (default 2;\n"
+                  "0: none), each from its own start at rest, its first 4 periods left out: short pieces keep the\n"
+                  "search out of the valleys a long track's chi-square has far from its minimum.\n"
                   "Levenberg-Marquardt (Ceres) over the full (or u) dynamics, from --starts starts (the scene's\n"
                   "values, then seeded draws), the best kept; each start at most --max-iterations, all within\n"
                   "--time-limit s. JSON: the estimates with their sd and 95 % intervals, the covariance, residual\n"
@@ -51,7 +54,8 @@ struct IdentifyArgs : Options {
                   "that is no parameter or one the part has not (mu_k2, com_x for a point part).\n"
                   "--suggest: no fit; which plate motion to film so that the --params are identifiable. Candidate\n"
                   "horizontal drives (x and its second harmonic; with a y second harmonic; each with yaw for rigid\n"
-                  "parts) at 1.1-2 mu_s g of SCENE's part, within --limits LIN ANG (each axis' peak, as plate design's;\n"
+                  "parts) at 1.1-2 mu_s g of SCENE's part, at SCENE's plate period and the multiples of it given by\n"
+                  "--period-factors (default 1 2), within --limits LIN ANG (each axis' peak, as plate design's;\n"
                   "default 20 150), each weighed by the information --tracks-planned K tracks of --duration S s\n"
                   "(default 5 of 10 s, from seeded starts) filmed by --camera (default: stroboscopic at phase 0.25,\n"
                   "0.1 mm and 5 mrad) would carry at SCENE's values, over --start-sets N sets of starts (default 3;\n"
@@ -70,6 +74,7 @@ struct IdentifyArgs : Options {
         number("--time-limit", o.time_limit, "seconds for the whole search");
         number("--settle", o.settle_periods, "plate periods of each track left out at its start");
         number("--rtol", o.rtol, "the simulation's tolerance");
+        number("--pieces", o.segment_seconds, "seconds of the pieces the search fits first (0: none)");
         whole("--threads", o.threads, 1, 1024, "tracks simulated in parallel");
         text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");
         whole("--profile-steps", po.max_steps, 1, 1000, "--profile: re-minimisations per side");
@@ -79,6 +84,8 @@ struct IdentifyArgs : Options {
         numbers("--limits", limits, 2, 2, "LIN ANG", "--suggest: each axis' peak [m/s^2, rad/s^2]");
         whole("--tracks-planned", so.tracks, 1, 1000, "--suggest: tracks that will be filmed");
         whole("--start-sets", so.start_sets, 1, 100, "--suggest: sets of their starts each motion is judged over (its worst)");
+        numbers("--period-factors", so.period_factors, 1, 100, "F ...",
+                "--suggest: the plate periods tried, in units of SCENE's (default 1 2)");
         number("--duration", so.duration, "--suggest: seconds of each");
         text("--scene-out", scene_out, "FILE", "--suggest: SCENE with the suggested plate motion");
     }
@@ -117,7 +124,8 @@ int cmd_suggest(const IdentifyArgs& a, const Scene& sc, const IdentifyOptions& o
         const std::pair<const char*, const char*> flags[] = {{"suggest: lin_limit", "--limits"},
                                                              {"suggest: ang_limit", "--limits"},
                                                              {"suggest: tracks", "--tracks-planned"},
-                                                             {"suggest: duration", "--duration"}};
+                                                             {"suggest: duration", "--duration"},
+                                                             {"suggest: period_factors", "--period-factors"}};
         for (const auto& [name, flag] : flags)
             if (m.rfind(name, 0) == 0) m = flag + m.substr(std::string(name).size());
         throw UsageError(m);
@@ -149,7 +157,8 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
         if (a.has("--tracks")) throw UsageError("--suggest plans tracks: give --tracks-planned, not --tracks");
         return cmd_suggest(a, sc, o, cio);
     }
-    for (const char* f : {"--camera", "--limits", "--tracks-planned", "--duration", "--scene-out"})
+    for (const char* f :
+         {"--camera", "--limits", "--tracks-planned", "--duration", "--scene-out", "--start-sets", "--period-factors"})
         if (a.has(f)) throw UsageError(std::string(f) + ": only with --suggest");
     std::vector<Track> tracks;
     for (const std::string& f : a.tracks) tracks.push_back(read_track_csv(f));

@@ -259,6 +259,8 @@ void IdentifyOptions::validate() const {
     if (!(time_limit > 0 && time_limit <= 1e6)) bad("time_limit: a positive number of seconds up to 1e6");
     if (!(settle_periods >= 0 && settle_periods <= 1e6)) bad("settle_periods: from 0 to 1e6");
     if (!(rtol > 0 && rtol <= 1e-3)) bad("rtol: in (0, 1e-3]");
+    if (!(segment_seconds >= 0 && segment_seconds <= 1e6)) bad("segment_seconds: from 0 (none) to 1e6 s");
+    if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
     if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");
     if (!(com_max > 0 && com_max <= 1)) bad("com_max: in (0, 1] m");
@@ -314,6 +316,27 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     s.held = static_cast<int>(held.size());
     std::vector<TrackCost*> cost_ptrs;
     for (const auto& c : costs) cost_ptrs.push_back(c.get());
+    // The pieces of the first stage (none if no track is longer than a piece).
+    // (A track's first piece starts where the track does; a later one from rest, its first periods left out.)
+    std::vector<double> shifts;
+    std::vector<Track> pieces;
+    std::vector<int> piece_firsts;
+    if (o.segment_seconds > 0) {
+        const std::vector<Track> cut = segments(tracks, scene.plate.T, o.segment_seconds, shifts);
+        for (std::size_t i = 0; cut.size() > tracks.size() && i < cut.size(); ++i) {
+            const int first =
+                first_used_frame(cut[i], scene.plate.T, shifts[i] > 0 ? o.segment_settle_periods : o.settle_periods);
+            if (static_cast<int>(cut[i].t.size()) - first < kMinTrackFrames) continue;
+            pieces.push_back(cut[i]);
+            piece_firsts.push_back(first);
+        }
+    }
+    std::vector<std::unique_ptr<TrackCost>> piece_costs;
+    std::vector<TrackCost*> piece_ptrs;
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+        piece_costs.push_back(std::make_unique<TrackCost>(scene, layout, pieces[i], piece_firsts[i], o, o.central_search));
+        piece_ptrs.push_back(piece_costs.back().get());
+    }
     std::vector<double> lo, hi;
     for (int j = 0; j < n; ++j) {
         lo.push_back(layout.lower(j, o));
@@ -322,6 +345,14 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
         if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
         std::vector<double> x = xs[k];
+        Solve on_pieces;
+        double piece_seconds = 0;
+        if (!piece_ptrs.empty()) {
+            const auto p_start = Clock::now();
+            std::vector<std::vector<double>> p0 = first_frames(pieces, d);
+            on_pieces = staged(piece_ptrs, x, p0, held, lo, hi, o, t0);
+            piece_seconds = std::chrono::duration<double>(Clock::now() - p_start).count();
+        }
         std::vector<std::vector<double>> q0 = first_frames(tracks, d);
         const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0);
         ++s.starts_run;
@@ -332,6 +363,8 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
             best_q0 = q0;
             s.best_start = k;
             s.iterations = sol.iterations;
+            s.piece_iterations = on_pieces.iterations;
+            s.piece_seconds = piece_seconds;
             s.termination = sol.termination;
             s.converged = sol.converged;
         }

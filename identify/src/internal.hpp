@@ -55,6 +55,13 @@ bool predict(const Scene& scene, const Track& track, Dynamics level, const Vec3&
 // The index of the first frame at or after settle_periods periods.
 int first_used_frame(const Track& track, double T, double settle_periods);
 
+// The tracks cut into pieces of `seconds` (rounded to whole plate periods; a track's last piece also
+// takes its remainder), each re-timed by a whole number of periods so that its camera stamps start
+// within its first period and the plate's phase is kept: the search's first stage fits them, each from
+// its own start at rest, its first frames left out (IdentifyOptions::segment_seconds). shifts: each
+// piece's re-timing [s] (0 for a track's first piece).
+std::vector<Track> segments(const std::vector<Track>& tracks, double T, double seconds, std::vector<double>& shifts);
+
 // A track's scaled residuals r (from frame `first` on) and their Jacobians by the named parameters at
 // internal coordinates x (Jx) and by the track's start q0 (mm, mm, rad; a point part without theta:
 // Jq), by the fit's own central differences (identify.cpp). False if a simulation stops.

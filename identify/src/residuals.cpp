@@ -1,7 +1,9 @@
 // A track's prediction and its scaled residuals.
 #include "internal.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace plate::identify_detail {
 
@@ -23,6 +25,40 @@ int first_used_frame(const Track& track, double T, double settle_periods) {
     int k = 0;
     while (k < static_cast<int>(track.t.size()) && track.t[k] - track.camera.latency < settle_periods * T) ++k;
     return k;
+}
+
+std::vector<Track> segments(const std::vector<Track>& tracks, double T, double seconds, std::vector<double>& shifts) {
+    shifts.clear();
+    const long P = std::max(1L, std::lround(seconds / T));   // whole periods a piece
+    const double span = static_cast<double>(P) * T;
+    std::vector<Track> out;
+    for (const Track& tr : tracks) {
+        if (tr.t.empty()) continue;
+        // K pieces of P periods, the last one taking the remainder too (it is never shorter than P periods).
+        const long K = std::max(1L, static_cast<long>(std::floor((tr.t.back() - tr.camera.latency) / span)));
+        std::size_t i = 0;
+        for (long k = 0; k < K; ++k) {
+            Track piece = tr;
+            piece.t.clear();
+            piece.q.clear();
+            piece.lines.clear();
+            const double shift = static_cast<double>(k) * span;
+            for (; i < tr.t.size() && (k == K - 1 || tr.t[i] - tr.camera.latency < shift + span); ++i) {
+                piece.t.push_back(tr.t[i] - shift);
+                piece.q.push_back(tr.q[i]);
+                if (i < tr.lines.size()) piece.lines.push_back(tr.lines[i]);
+            }
+            if (piece.t.empty()) continue;
+            if (k > 0) {
+                char from[48];
+                std::snprintf(from, sizeof from, " (from %g s)", shift);
+                piece.source += from;
+            }
+            out.push_back(std::move(piece));
+            shifts.push_back(shift);
+        }
+    }
+    return out;
 }
 
 }   // namespace plate::identify_detail

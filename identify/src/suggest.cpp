@@ -92,6 +92,9 @@ void SuggestOptions::validate() const {
     if (levels.empty() || levels.size() > 100) bad("levels: from 1 to 100 of them");
     for (double l : levels)
         if (!(l > 0 && l <= 100)) bad("levels: each in (0, 100] (units of mu_s g)");
+    if (period_factors.empty() || period_factors.size() > 100) bad("period_factors: from 1 to 100 of them");
+    for (double f : period_factors)
+        if (!(f >= 0.01 && f <= 100)) bad("period_factors: each in [0.01, 100] (units of the scene's period)");
 }
 
 std::vector<MotionCandidate> candidate_motions(const Scene& scene, const SuggestOptions& o) {
@@ -99,23 +102,25 @@ std::vector<MotionCandidate> candidate_motions(const Scene& scene, const Suggest
     const double a_s = mean_static(scene.part) * scene.g, r = reach(scene.part);
     std::vector<MotionCandidate> out;
     const char* shapes[4] = {"x+2x", "x+2x+2y", "x+2x+rz", "x+2x+2y+rz"};
-    for (int k = 0; k < (r > 0 ? 4 : 2); ++k)
-        for (double level : o.levels) {
-            MotionCandidate c;
-            std::ostringstream label;
-            label << shapes[k] << " @ " << level << " mu_s g";
-            c.label = label.str();
-            c.motion.T = scene.plate.T;
-            c.motion.harmonics.push_back(Harmonic{Axis::x, 1, 1, 0});
-            c.motion.harmonics.push_back(Harmonic{Axis::x, 2, 1.0 / 3, 0});
-            if (k == 1 || k == 3) c.motion.harmonics.push_back(Harmonic{Axis::y, 2, 1.0 / 3, kPi / 2});
-            const double A = level * a_s, scale = A / horizontal_peak(c.motion);
-            for (Harmonic& h : c.motion.harmonics) h.amp *= scale;
-            // yaw: the contacts' tangential acceleration from it half the drive's peak, a quarter period
-            // after the drive
-            if (k >= 2) c.motion.harmonics.push_back(Harmonic{Axis::rz, 1, 0.5 * A / r, kPi / 2});
-            out.push_back(c);
-        }
+    for (double factor : o.period_factors)
+        for (int k = 0; k < (r > 0 ? 4 : 2); ++k)
+            for (double level : o.levels) {
+                MotionCandidate c;
+                std::ostringstream label;
+                label << shapes[k] << " @ " << level << " mu_s g";
+                if (factor != 1) label << ", T = " << factor * scene.plate.T << " s";
+                c.label = label.str();
+                c.motion.T = factor * scene.plate.T;
+                c.motion.harmonics.push_back(Harmonic{Axis::x, 1, 1, 0});
+                c.motion.harmonics.push_back(Harmonic{Axis::x, 2, 1.0 / 3, 0});
+                if (k == 1 || k == 3) c.motion.harmonics.push_back(Harmonic{Axis::y, 2, 1.0 / 3, kPi / 2});
+                const double A = level * a_s, scale = A / horizontal_peak(c.motion);
+                for (Harmonic& h : c.motion.harmonics) h.amp *= scale;
+                // yaw: the contacts' tangential acceleration from it half the drive's peak, a quarter period
+                // after the drive
+                if (k >= 2) c.motion.harmonics.push_back(Harmonic{Axis::rz, 1, 0.5 * A / r, kPi / 2});
+                out.push_back(c);
+            }
     return out;
 }
 
@@ -238,6 +243,7 @@ nlohmann::json suggest_json(const SuggestSummary& s, const SuggestOptions& o) {
              {"duration_s", o.duration},
              {"seed", o.seed},
              {"start_sets", o.start_sets},
+             {"period_factors", o.period_factors},
              {"criterion", "largest smallest eigenvalue of the range-scaled information (E-optimal), of the worst set of starts"},
              {"candidates", cands},
              {"seconds", s.seconds}};

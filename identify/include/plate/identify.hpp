@@ -60,6 +60,12 @@ struct IdentifyOptions {
     // covariance, the intervals and --suggest always use central differences.
     bool fit_starts_first = true;
     bool central_search = false;
+    // The search's first stage ("Pieces first"): each start fits the tracks cut into pieces of
+    // segment_seconds (whole periods), each piece from its own start at rest with its first
+    // segment_settle_periods periods left out, then the whole tracks from there; 0, or no track as long
+    // as two pieces: no such stage.
+    double segment_seconds = 2;
+    double segment_settle_periods = 4;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
@@ -101,9 +107,11 @@ struct IdentifySummary {
     int residuals = 0, dof = 0;   // dof: residuals - fitted parameters (the starts' included)
     double reduced_chi2 = 0;      // chi2 / dof: near 1 when the model and the noise sds are right
     int starts_run = 0, best_start = 0;
-    int held = 0;              // named parameters no residual depended on at the first start: held there
-    int iterations = 0;        // of the best start
-    std::string termination;   // of the best start (Ceres' termination type and message)
+    int held = 0;               // named parameters no residual depended on at the first start: held there
+    int iterations = 0;         // of the best start
+    int piece_iterations = 0;   // of the best start's first stage on the pieces (segment_seconds)
+    double piece_seconds = 0;   // its time [s]
+    std::string termination;    // of the best start (Ceres' termination type and message)
     bool converged = false;
     double seconds = 0;
     std::vector<double> start_costs;   // each start's final chi2

@@ -12,7 +12,8 @@
 // harmonic at a third, a quarter of its period later (a drift along y too: two numbers a period, two
 // combinations of the coefficients), and each of these two with a yaw (rz) component (rigid parts only:
 // the plate turning under the contacts loads each differently, so their coefficients separate). A
-// candidate whose axis peaks (axis_peaks) exceed the limits is reported and not weighed.
+// candidate whose axis peaks (axis_peaks) exceed the limits is reported and not weighed. Each at the
+// scene's plate period and at the multiples of it in `period_factors`.
 //
 // The information of a candidate: the fit's own Jacobian (identify_detail::track_jacobian) of the
 // noise-scaled residuals of `tracks` tracks of `duration` s from seeded random starts at rest (x, y in
@@ -46,6 +47,10 @@ struct SuggestOptions {
     int start_sets = 3;                                  // sets of starts each candidate is weighed over
     double start_box = 0.05;                             // [m]: starts' |x|, |y| at most this
     std::vector<double> levels = {1.1, 1.4, 1.7, 2.0};   // horizontal peaks in units of mu_s g (nominal, mean)
+    // The plate's period in units of the scene's: each shape and level at each. A longer period at the
+    // same peaks moves the part further each period (more information a frame) and costs fewer periods
+    // to simulate (docs/decisions/identification.md, "A longer period").
+    std::vector<double> period_factors = {1, 2};
     void validate() const;
 };
 
