@@ -14,8 +14,9 @@
 // (everything at once by central differences, the search before staging), pieces[S] (staged, after a
 // first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
 // staged,central.
+// RADIUS: IdentifyOptions::initial_trust_radius.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH]]]]]]]]]]]]
+//   [SEARCH [RADIUS]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -137,6 +138,7 @@ int main(int argc, char** argv) {
     o.starts = 2;
     o.rtol = rtol;
     if (argc > 10) o.time_limit = std::stod(argv[10]);
+    if (argc > 13) o.initial_trust_radius = std::stod(argv[13]);
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;

@@ -7,6 +7,8 @@
 #include "identify_fixtures.hpp"
 #include "internal.hpp"
 
+#include "cli_run.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -152,4 +154,21 @@ TEST_CASE("a track cut into pieces keeps its frames and the plate's phase", "[id
     INFO("rms " << kept * 1e3 << " um, " << off * 1e3 << " um half a period off");
     CHECK(kept < 1.5 * cam.noise_xy_mm);
     CHECK(off > 3 * cam.noise_xy_mm);
+}
+
+// The search's options are checked once, naming the field.
+TEST_CASE("the search's pieces and first trust region are refused out of range, naming the field", "[identify]") {
+    IdentifyOptions o = options({"mu_k"});
+    REQUIRE_NOTHROW(o.validate());
+    o.segment_seconds = -1;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("segment_seconds"));
+    o = options({"mu_k"});
+    o.segment_settle_periods = std::nan("");
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("segment_settle_periods"));
+    o = options({"mu_k"});
+    o.initial_trust_radius = 0;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("initial_trust_radius"));
+    const Run cli = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --pieces -1");
+    CHECK(cli.code == 2);
+    CHECK(cli.err.find("--pieces: from 0 (none) to 1e6 s") != std::string::npos);
 }

@@ -151,7 +151,9 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
         o.validate();
         check_parameter_names(sc, o.params);
     } catch (const std::invalid_argument& e) {
-        throw UsageError(std::string("--params/options: ") + e.what());
+        const std::string m = e.what();
+        if (m.rfind("identify: segment_seconds", 0) == 0) throw UsageError("--pieces" + m.substr(25));
+        throw UsageError("--params/options: " + m);
     }
     if (a.suggest) {
         if (a.has("--tracks")) throw UsageError("--suggest plans tracks: give --tracks-planned, not --tracks");

@@ -92,11 +92,11 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
     if (o.fit_starts_first) {
         std::vector<int> all(n);
         for (int j = 0; j < n; ++j) all[j] = j;
-        Solve first = minimise(costs, x, q0, all, lo, hi, o.max_iterations, left(), o.threads);
+        Solve first = minimise(costs, x, q0, all, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
         if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) return first;   // (no time left)
         iterations = first.iterations;
     }
-    Solve sol = minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads);
+    Solve sol = minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
     sol.iterations += iterations;
     return sol;
 }
@@ -192,7 +192,7 @@ bool TrackCost::Evaluate(double const* const* parameters, double* r, double** ja
 
 Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
                const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
-               double seconds, int threads, ceres::IterationCallback* callback) {
+               double seconds, int threads, ceres::IterationCallback* callback, double initial_radius) {
     const int n = static_cast<int>(x.size());
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -211,6 +211,7 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
     so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     so.linear_solver_type = ceres::DENSE_QR;
     so.min_lm_diagonal = kMinLmDiagonal;
+    so.initial_trust_region_radius = initial_radius;
     so.max_num_iterations = max_iterations;
     so.max_solver_time_in_seconds = seconds;
     so.num_threads = threads;
@@ -260,6 +261,7 @@ void IdentifyOptions::validate() const {
     if (!(settle_periods >= 0 && settle_periods <= 1e6)) bad("settle_periods: from 0 to 1e6");
     if (!(rtol > 0 && rtol <= 1e-3)) bad("rtol: in (0, 1e-3]");
     if (!(segment_seconds >= 0 && segment_seconds <= 1e6)) bad("segment_seconds: from 0 (none) to 1e6 s");
+    if (!(initial_trust_radius >= 1 && initial_trust_radius <= 1e12)) bad("initial_trust_radius: from 1 to 1e12");
     if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
     if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");

@@ -114,7 +114,7 @@ private:
 
 // One Levenberg-Marquardt solve over block 0 (`x`, the coordinates in `held` kept) and the tracks'
 // starts q0, within [lo, hi], as the fit runs it; x and q0 hold the result. `callback` (may be null)
-// can end it early.
+// can end it early; initial_radius: IdentifyOptions::initial_trust_radius.
 struct Solve {
     double chi2 = 0;
     bool usable = false, converged = false;
@@ -123,6 +123,6 @@ struct Solve {
 };
 Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
                const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
-               double seconds, int threads, ceres::IterationCallback* callback = nullptr);
+               double seconds, int threads, ceres::IterationCallback* callback = nullptr, double initial_radius = 1e4);
 
 }   // namespace plate::identify_detail

@@ -81,8 +81,8 @@ struct Walk {
         hi[j] = v + 1;
         for (TrackCost* c : costs) c->profile(j, lo, hi);
         if (budget.spent()) return p;
-        const Solve s =
-            minimise(costs, p.z, p.q0, {j}, lo, hi, po.max_iterations, std::max(budget.left(), 1e-3), o.threads, &budget);
+        const Solve s = minimise(costs, p.z, p.q0, {j}, lo, hi, po.max_iterations, std::max(budget.left(), 1e-3), o.threads,
+                                 &budget, o.initial_trust_radius);
         p.ok = s.usable && std::isfinite(s.chi2);
         p.dchi2 = s.chi2 - chi2_min;
         return p;

@@ -66,6 +66,10 @@ struct IdentifyOptions {
     // as two pieces: no such stage.
     double segment_seconds = 2;
     double segment_settle_periods = 4;
+    // Levenberg-Marquardt's first trust-region radius (Ceres' initial_trust_region_radius): the damping
+    // starts at each parameter's floored information over it, and grows or shrinks from there
+    // (docs/decisions/identification.md, "The first trust region").
+    double initial_trust_radius = 1e4;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
