@@ -81,19 +81,19 @@ std::vector<int> unseen_parameters(const std::vector<std::unique_ptr<TrackCost>>
     return held;
 }
 
-// One start's search (IdentifyOptions::fit_starts_first): the tracks' starts alone, then everything; x
-// and q0 hold the result, the iterations summed over both.
+// One start's search (IdentifyOptions::fit_starts_first): the tracks' starts alone, then everything, by
+// `deadline` seconds after t0; x and q0 hold the result, the iterations summed over both.
 Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
              const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, const IdentifyOptions& o,
-             Clock::time_point t0) {
-    const auto left = [&] { return std::max(o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count(), 1e-3); };
+             Clock::time_point t0, double deadline) {
+    const auto left = [&] { return std::max(deadline - std::chrono::duration<double>(Clock::now() - t0).count(), 1e-3); };
     const int n = static_cast<int>(x.size());
     int iterations = 0;
     if (o.fit_starts_first) {
         std::vector<int> all(n);
         for (int j = 0; j < n; ++j) all[j] = j;
         Solve first = minimise(costs, x, q0, all, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
-        if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) return first;   // (no time left)
+        if (std::chrono::duration<double>(Clock::now() - t0).count() >= deadline) return first;   // (no time left)
         iterations = first.iterations;
     }
     Solve sol = minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
@@ -318,16 +318,28 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     s.held = static_cast<int>(held.size());
     std::vector<TrackCost*> cost_ptrs;
     for (const auto& c : costs) cost_ptrs.push_back(c.get());
-    // The pieces of the first stage (none if no track is longer than a piece).
-    // (A track's first piece starts where the track does; a later one from rest, its first periods left out.)
+    // The pieces of the first stage: none if no track is as long as two pieces, or if the plate turns about
+    // more than one axis (its orientation then drifts from period to period, coning: a piece re-timed by
+    // whole periods would start under another one). A track's first piece starts where the track does; a
+    // later one from rest, its first periods left out (and none the track's own settle leaves out).
+    int turning = 0;
+    for (int a = 3; a < 6; ++a) {
+        bool on = false;
+        for (const Harmonic& h : scene.plate.harmonics) on = on || (static_cast<int>(h.axis) == a && h.amp != 0);
+        turning += on;
+    }
     std::vector<double> shifts;
     std::vector<Track> pieces;
     std::vector<int> piece_firsts;
-    if (o.segment_seconds > 0) {
+    if (o.segment_seconds > 0 && std::max(1L, std::lround(o.segment_seconds / scene.plate.T)) <= o.segment_settle_periods)
+        throw std::invalid_argument("identify: segment_seconds: pieces of " + std::to_string(o.segment_seconds) +
+                                    " s are no longer than the periods each leaves out (segment_settle_periods)");
+    if (o.segment_seconds > 0 && turning <= 1) {
         const std::vector<Track> cut = segments(tracks, scene.plate.T, o.segment_seconds, shifts);
         for (std::size_t i = 0; cut.size() > tracks.size() && i < cut.size(); ++i) {
-            const int first =
-                first_used_frame(cut[i], scene.plate.T, shifts[i] > 0 ? o.segment_settle_periods : o.settle_periods);
+            const double settle = shifts[i] > 0 ? std::max(o.segment_settle_periods, o.settle_periods - shifts[i] / scene.plate.T)
+                                                : o.settle_periods;
+            const int first = first_used_frame(cut[i], scene.plate.T, settle);
             if (static_cast<int>(cut[i].t.size()) - first < kMinTrackFrames) continue;
             pieces.push_back(cut[i]);
             piece_firsts.push_back(first);
@@ -352,11 +364,13 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         if (!piece_ptrs.empty()) {
             const auto p_start = Clock::now();
             std::vector<std::vector<double>> p0 = first_frames(pieces, d);
-            on_pieces = staged(piece_ptrs, x, p0, held, lo, hi, o, t0);
+            // (at most half the time left: the whole tracks' stage decides the result)
+            const double now = std::chrono::duration<double>(p_start - t0).count();
+            on_pieces = staged(piece_ptrs, x, p0, held, lo, hi, o, t0, now + 0.5 * (o.time_limit - now));
             piece_seconds = std::chrono::duration<double>(Clock::now() - p_start).count();
         }
         std::vector<std::vector<double>> q0 = first_frames(tracks, d);
-        const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0);
+        const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0, o.time_limit);
         ++s.starts_run;
         s.start_costs.push_back(sol.chi2);
         if (sol.usable && sol.chi2 < best_cost) {
@@ -365,6 +379,7 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
             best_q0 = q0;
             s.best_start = k;
             s.iterations = sol.iterations;
+            s.pieces = static_cast<int>(pieces.size());
             s.piece_iterations = on_pieces.iterations;
             s.piece_seconds = piece_seconds;
             s.termination = sol.termination;

@@ -42,8 +42,11 @@ std::vector<Track> segments(const std::vector<Track>& tracks, double T, double s
             piece.t.clear();
             piece.q.clear();
             piece.lines.clear();
-            const double shift = static_cast<double>(k) * span;
-            for (; i < tr.t.size() && (k == K - 1 || tr.t[i] - tr.camera.latency < shift + span); ++i) {
+            // A frame stays in this piece while its state time re-timed for the next one, computed as the
+            // prediction will compute it there ((stamp - shift) - latency), is below 0: on a boundary it
+            // starts the next piece, never at a state time rounded below 0.
+            const double shift = static_cast<double>(k) * span, next = static_cast<double>(k + 1) * span;
+            for (; i < tr.t.size() && (k == K - 1 || (tr.t[i] - next) - tr.camera.latency < 0); ++i) {
                 piece.t.push_back(tr.t[i] - shift);
                 piece.q.push_back(tr.q[i]);
                 if (i < tr.lines.size()) piece.lines.push_back(tr.lines[i]);

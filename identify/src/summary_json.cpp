@@ -59,6 +59,8 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
               {"time_limit_s", o.time_limit},
               {"settle_periods", o.settle_periods},
               {"pieces_s", o.segment_seconds},
+              {"pieces_settle_periods", o.segment_settle_periods},
+              {"initial_trust_radius", o.initial_trust_radius},
               {"rtol", o.rtol}};
     return json{
         {"parameters", params},
@@ -72,6 +74,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         {"solver",
          {{"method", std::string("Ceres Levenberg-Marquardt; the search by ") + (o.central_search ? "central" : "forward") +
                          " differences of the simulation, the covariance by central ones"},
+          {"pieces", s.pieces},
           {"piece_iterations", s.piece_iterations},
           {"piece_seconds", s.piece_seconds},
           {"starts_run", s.starts_run},

@@ -62,8 +62,8 @@ struct IdentifyOptions {
     bool central_search = false;
     // The search's first stage ("Pieces first"): each start fits the tracks cut into pieces of
     // segment_seconds (whole periods), each piece from its own start at rest with its first
-    // segment_settle_periods periods left out, then the whole tracks from there; 0, or no track as long
-    // as two pieces: no such stage.
+    // segment_settle_periods periods left out, then the whole tracks from there; 0, no track as long as
+    // two pieces, or a plate turning about more than one axis (not periodic: coning): no such stage.
     double segment_seconds = 2;
     double segment_settle_periods = 4;
     // Levenberg-Marquardt's first trust-region radius (Ceres' initial_trust_region_radius): the damping
@@ -113,7 +113,8 @@ struct IdentifySummary {
     int starts_run = 0, best_start = 0;
     int held = 0;               // named parameters no residual depended on at the first start: held there
     int iterations = 0;         // of the best start
-    int piece_iterations = 0;   // of the best start's first stage on the pieces (segment_seconds)
+    int pieces = 0;             // fitted in the first stage (segment_seconds; 0: no such stage)
+    int piece_iterations = 0;   // of the best start's first stage on the pieces
     double piece_seconds = 0;   // its time [s]
     std::string termination;    // of the best start (Ceres' termination type and message)
     bool converged = false;
