@@ -176,6 +176,9 @@ TEST_CASE("the search's pieces and first trust region are refused out of range, 
     const Run cli = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --pieces -1");
     CHECK(cli.code == 2);
     CHECK(cli.err.find("--pieces: from 0 (none) to 1e6 s") != std::string::npos);
+    const Run short_pieces = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --pieces 0.2");
+    CHECK(short_pieces.code == 2);
+    CHECK(short_pieces.err.find("--pieces: pieces of 0.2 s are no longer than the 4 periods of 0.05 s") != std::string::npos);
 }
 
 // A frame whose state time falls on a piece's boundary goes to one piece or the other, every frame to

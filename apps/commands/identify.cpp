@@ -151,6 +151,7 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
     try {
         o.validate();
         check_parameter_names(sc, o.params);
+        check_pieces(sc, o);
     } catch (const std::invalid_argument& e) {
         const std::string m = e.what();
         if (m.rfind("identify: segment_seconds", 0) == 0) throw UsageError("--pieces" + m.substr(25));

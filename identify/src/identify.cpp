@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -291,12 +292,23 @@ void check_tracks(const Scene& scene, const std::vector<Track>& tracks, const Id
     }
 }
 
+void check_pieces(const Scene& scene, const IdentifyOptions& o) {
+    if (o.segment_seconds > 0 && std::max(1L, std::lround(o.segment_seconds / scene.plate.T)) <= o.segment_settle_periods) {
+        char m[200];
+        std::snprintf(m, sizeof m,
+                      "identify: segment_seconds: pieces of %g s are no longer than the %g periods of %g s each leaves out",
+                      o.segment_seconds, o.segment_settle_periods, scene.plate.T);
+        throw std::invalid_argument(m);
+    }
+}
+
 IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, const IdentifyOptions& o) {
     using namespace identify_detail;
     const auto t0 = Clock::now();
     o.validate();
     const Layout layout(scene, o.params);
     check_tracks(scene, tracks, o);
+    check_pieces(scene, o);
     const int n = layout.size(), nt = static_cast<int>(tracks.size()), d = scene.part.point ? 2 : 3;
     std::vector<int> firsts;
     for (const Track& tr : tracks) firsts.push_back(first_used_frame(tr, scene.plate.T, o.settle_periods));
@@ -331,9 +343,6 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     std::vector<double> shifts;
     std::vector<Track> pieces;
     std::vector<int> piece_firsts;
-    if (o.segment_seconds > 0 && std::max(1L, std::lround(o.segment_seconds / scene.plate.T)) <= o.segment_settle_periods)
-        throw std::invalid_argument("identify: segment_seconds: pieces of " + std::to_string(o.segment_seconds) +
-                                    " s are no longer than the periods each leaves out (segment_settle_periods)");
     if (o.segment_seconds > 0 && turning <= 1) {
         const std::vector<Track> cut = segments(tracks, scene.plate.T, o.segment_seconds, shifts);
         for (std::size_t i = 0; cut.size() > tracks.size() && i < cut.size(); ++i) {

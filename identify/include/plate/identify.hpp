@@ -132,6 +132,10 @@ void check_tracks(const Scene& scene, const std::vector<Track>& tracks, const Id
 // (mu_k2 for a point part, com_x for a point part: refused), no contact fitted by two names.
 void check_parameter_names(const Scene& scene, const std::vector<std::string>& names);
 
+// std::invalid_argument unless the pieces of the search's first stage (segment_seconds, in whole periods
+// of scene's plate) are longer than the periods each leaves out (segment_settle_periods); none asked: fine.
+void check_pieces(const Scene& scene, const IdentifyOptions& o);
+
 // The scene with the named parameters at `values` (scene units; static below kinetic refused with
 // std::invalid_argument). The one place a parameter reaches the part.
 Scene apply_parameters(const Scene& scene, const std::vector<std::string>& names, const std::vector<double>& values);
