@@ -14,7 +14,8 @@
 // (everything at once by central differences, the search before staging), pieces[S] (staged, after a
 // first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
 // staged,central.
-// RADIUS: IdentifyOptions::initial_trust_radius.
+// RADIUS: IdentifyOptions::initial_trust_radius. Each interval's check at its ends (the chi-square's rise
+// there, and the verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
 //   [SEARCH [RADIUS]]]]]]]]]]]]]
 #include "plate/identify.hpp"
@@ -78,6 +79,7 @@ struct Variant {
     bool central;
     double segment_seconds;
     int within = 0, covered = 0, counted = 0, unid = 0;
+    int checks[4] = {0, 0, 0, 0}, missed_flagged = 0;   // by Linearity; misses whose check did not hold
     double total_s = 0, worst_s = 0;
 
     void tally(const IdentifySummary& s, const std::vector<std::string>& names, const std::vector<double>& truth) {
@@ -93,7 +95,10 @@ struct Variant {
             within += std::abs(err) <= 0.01;
             covered += cov;
             ++counted;
-            std::printf(" %s %+.4f(sd %.4f)%s", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]");
+            std::printf(" %s %+.4f(sd %.4f)%s{%.1f,%.1f %s}", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]", p.dchi2_lo,
+                        p.dchi2_hi, to_string(p.linearity));
+            checks[static_cast<int>(p.linearity)] += 1;
+            missed_flagged += !cov && p.linearity != Linearity::Holds;
         }
         total_s += s.seconds;
         worst_s = std::max(worst_s, s.seconds);
@@ -185,6 +190,11 @@ int main(int argc, char** argv) {
             "seconds mean %.2f, largest %.2f\n",
             v.name.c_str(), v.within, v.counted, v.covered, v.counted, v.counted ? 100.0 * v.covered / v.counted : 0.0, v.unid,
             v.total_s / seeds, v.worst_s);
+    for (const Variant& v : variants)
+        std::printf(
+            "%s search: intervals checked at their ends: %d hold, %d too narrow, %d unconfirmed, %d not checked; "
+            "of the %d misses, %d not 'holds'\n",
+            v.name.c_str(), v.checks[0], v.checks[1], v.checks[2], v.checks[3], v.counted - v.covered, v.missed_flagged);
     if (variants.size() == 2 && variants[1].total_s > 0)
         std::printf("time ratio, %s / %s search (this run): %.3f\n", variants[0].name.c_str(), variants[1].name.c_str(),
                     variants[0].total_s / variants[1].total_s);

@@ -428,7 +428,8 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     s.residuals = rows;
     s.dof = rows - (n + d * nt);
     s.reduced_chi2 = s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
-    judge(layout, o, best, J, d * nt, s);
+    const Eigen::MatrixXd cov_internal = judge(layout, o, best, J, d * nt, s);
+    check_linearity(layout, o, cost_ptrs, best, best_q0, J, cov_internal, s);
     s.fitted = at(scene, layout, best);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return s;

@@ -75,10 +75,15 @@ bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track
 // the ranges (judge.cpp).
 Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size);
 
+// d(named values)/d(internal coordinates) at x (judge.cpp).
+Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>& x);
+
 // Covariance, intervals and identifiability at internal coordinates x from the whole Jacobian J (the
-// named parameters' columns, then the starts'), into s.params, s.covariance, s.unidentifiable (judge.cpp).
-void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
-           int starts_size, IdentifySummary& s);
+// named parameters' columns, then the starts'), into s.params, s.covariance, s.unidentifiable; returns
+// the named parameters' covariance in internal coordinates (none along the directions judged not
+// identifiable) (judge.cpp).
+Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
+                      int starts_size, IdentifySummary& s);
 
 // One track's residual block: parameter blocks (the named parameters, internal coordinates) and (the
 // track's start: s_x, s_y [mm], theta [rad]; a point part without theta). Its Jacobian by the fit's own
@@ -124,5 +129,13 @@ struct Solve {
 Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::vector<std::vector<double>>& q0,
                const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
                double seconds, int threads, ceres::IterationCallback* callback = nullptr, double initial_radius = 1e4);
+
+// The linearised intervals' check at their ends (FittedParameter::dchi2_lo, dchi2_hi, linearity): for
+// each identifiable parameter, the tracks' chi-square at x and q0 moved 1.96 linearised sds along the
+// quadratic model's profile path (cov_internal: judge()'s; the starts by their regression on the
+// parameters), less s.chi2; 2 predictions a track a parameter, on o.threads (judge.cpp).
+void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
+                     const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
+                     const Eigen::MatrixXd& cov_internal, IdentifySummary& s);
 
 }   // namespace plate::identify_detail

@@ -4,8 +4,12 @@
 // ranges, and the 95 % intervals of the rest.
 #include "internal.hpp"
 
+#include "plate/tasks.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace plate::identify_detail {
 
@@ -14,6 +18,22 @@ namespace plate::identify_detail {
 // parameter belongs to such a direction when its weight in it exceeds kLoading (its share of the
 // direction's variance above 1 %).
 constexpr double kZ95 = 1.959963984540054, kLoading = 0.1;
+constexpr double kChi2Q95 = kZ95 * kZ95;   // 3.84: the chi-square quantile of one degree of freedom at 95 %
+
+Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>& x) {
+    // The named values are linear in the internal coordinates wherever no two kinetic coefficients tie
+    // for a shared static's base: central differences are exact there.
+    const int n = layout.size();
+    Eigen::MatrixXd A(n, n);
+    for (int k = 0; k < n; ++k) {
+        std::vector<double> xp = x, xm = x;
+        xp[k] += 1e-6;
+        xm[k] -= 1e-6;
+        const std::vector<double> vp = layout.natural(xp), vm = layout.natural(xm);
+        for (int j = 0; j < n; ++j) A(j, k) = (vp[j] - vm[j]) / 2e-6;
+    }
+    return A;
+}
 
 Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size) {
     const int n = layout.size();
@@ -30,8 +50,8 @@ Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& 
     return 0.5 * (scaled + scaled.transpose());
 }
 
-void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
-           int starts_size, IdentifySummary& s) {
+Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
+                      int starts_size, IdentifySummary& s) {
     const int n = layout.size();
     const double nan = std::numeric_limits<double>::quiet_NaN();
     Eigen::VectorXd range(n);
@@ -56,17 +76,8 @@ void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<dou
         s.unidentifiable.push_back(u);
     }
     const Eigen::MatrixXd cov_internal = range.asDiagonal() * pinv * range.asDiagonal();
-    // The named values are linear in the internal coordinates wherever no two kinetic coefficients
-    // tie for a shared static's base: A by central differences is exact there.
     const std::vector<double> v0 = layout.natural(x);
-    Eigen::MatrixXd A(n, n);
-    for (int k = 0; k < n; ++k) {
-        std::vector<double> xp = x, xm = x;
-        xp[k] += 1e-6;
-        xm[k] -= 1e-6;
-        const std::vector<double> vp = layout.natural(xp), vm = layout.natural(xm);
-        for (int j = 0; j < n; ++j) A(j, k) = (vp[j] - vm[j]) / 2e-6;
-    }
+    const Eigen::MatrixXd A = natural_jacobian(layout, x);
     s.covariance = A * cov_internal * A.transpose();
     s.params.clear();
     for (int j = 0; j < n; ++j) {
@@ -87,6 +98,94 @@ void judge(const Layout& layout, const IdentifyOptions& o, const std::vector<dou
             s.covariance.row(j).setConstant(nan);
             s.covariance.col(j).setConstant(nan);
         }
+    return cov_internal;
+}
+
+void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
+                     const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
+                     const Eigen::MatrixXd& cov_internal, IdentifySummary& s) {
+    const int n = layout.size(), nt = static_cast<int>(costs.size()), ns = static_cast<int>(J.cols()) - n;
+    const int d = nt > 0 ? ns / nt : 0;
+    const Eigen::MatrixXd F = J.transpose() * J;
+    // The starts' regression on the named parameters: the quadratic model's minimum over the starts
+    // moves by -Fqq^+ Fqx dx when the parameters move by dx.
+    const Eigen::MatrixXd regress =
+        ns > 0 ? Eigen::MatrixXd(-F.bottomRightCorner(ns, ns).completeOrthogonalDecomposition().solve(F.bottomLeftCorner(ns, n)))
+               : Eigen::MatrixXd(0, n);
+    const Eigen::MatrixXd A = natural_jacobian(layout, x);
+    // Each identifiable parameter's path: per linearised sd of it, the internal coordinates move by
+    // C a^T / sqrt(a C a^T) (a its row of A), which the quadratic model climbs as the square.
+    std::vector<int> checked;
+    std::vector<Eigen::VectorXd> step;   // per checked parameter, over the named coordinates then the starts
+    for (int j = 0; j < n; ++j) {
+        FittedParameter& p = s.params[j];
+        const double var = A.row(j) * cov_internal * A.row(j).transpose();
+        if (!p.identifiable || !(var > 0)) continue;
+        Eigen::VectorXd v(n + ns);
+        v.head(n) = cov_internal * A.row(j).transpose() / std::sqrt(var);
+        v.tail(ns) = regress * v.head(n);
+        bool inside = true;
+        for (int k = 0; k < n; ++k)
+            for (const double sign : {-1.0, 1.0}) {
+                const double xe = x[k] + sign * kZ95 * v[k];
+                inside = inside && xe >= layout.lower(k, o) && xe <= layout.upper(k, o);
+            }
+        if (!inside) continue;
+        checked.push_back(j);
+        step.push_back(v);
+    }
+    // Every (parameter, end, track) prediction as a task; a stopped simulation gives NaN.
+    const int tasks = static_cast<int>(checked.size()) * 2 * nt;
+    std::vector<double> chi2(tasks, 0.0);
+    thread_tasks(std::max(1, std::min(o.threads, std::max(tasks, 1))))(
+        tasks,
+        [&](int i) {
+            const int c = i / (2 * nt), end = (i / nt) % 2, t = i % nt;
+            const Eigen::VectorXd& v = step[c];
+            const double sign = end == 0 ? -kZ95 : kZ95;
+            std::vector<double> xe(n), qe(d);
+            for (int k = 0; k < n; ++k) xe[k] = x[k] + sign * v[k];
+            for (int k = 0; k < d; ++k) qe[k] = q0[t][k] + sign * v[n + d * t + k];
+            std::vector<double> r(costs[t]->num_residuals());
+            if (!costs[t]->residuals(xe.data(), qe.data(), r.data())) {
+                chi2[i] = std::numeric_limits<double>::quiet_NaN();
+                return std::string();
+            }
+            for (double ri : r) chi2[i] += ri * ri;
+            return std::string();
+        },
+        [](int, const std::string&) {});
+    // A quadratic profile crossing within a fifth of the half-width of the ends (ProfileOptions' agreement).
+    const double low = kChi2Q95 / (1.2 * 1.2), high = kChi2Q95 / (0.8 * 0.8);
+    for (std::size_t c = 0; c < checked.size(); ++c) {
+        FittedParameter& p = s.params[checked[c]];
+        double ends[2] = {0, 0};
+        for (int end = 0; end < 2; ++end)
+            for (int t = 0; t < nt; ++t) ends[end] += chi2[(c * 2 + end) * nt + t];
+        if (!std::isfinite(ends[0]) || !std::isfinite(ends[1])) continue;
+        p.dchi2_lo = ends[0] - s.chi2;
+        p.dchi2_hi = ends[1] - s.chi2;
+        const double lo = std::min(p.dchi2_lo, p.dchi2_hi), hi = std::max(p.dchi2_lo, p.dchi2_hi);
+        p.linearity = lo < low ? Linearity::TooNarrow : hi > high ? Linearity::Unconfirmed : Linearity::Holds;
+    }
 }
 
 }   // namespace plate::identify_detail
+
+namespace plate {
+
+const char* to_string(Linearity l) {
+    switch (l) {
+        case Linearity::Holds:
+            return "holds";
+        case Linearity::TooNarrow:
+            return "too narrow";
+        case Linearity::Unconfirmed:
+            return "unconfirmed";
+        case Linearity::NotChecked:
+            break;
+    }
+    return "not checked";
+}
+
+}   // namespace plate

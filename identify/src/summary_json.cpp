@@ -21,6 +21,9 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         if (p.identifiable) {
             j["sd"] = num(p.sd);
             j["interval95"] = {num(p.lo), num(p.hi)};
+            j["interval95_check"] = {{"dchi2_at_ends", {num(p.dchi2_lo), num(p.dchi2_hi)}},
+                                     {"quadratic_dchi2", kProfileThreshold95},
+                                     {"verdict", to_string(p.linearity)}};
         } else {
             j["sd"] = nullptr;
             j["interval95"] = nullptr;

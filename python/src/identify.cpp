@@ -26,7 +26,9 @@ struct PyIdentification {
 
 // Each struct's members once (pickling.hpp).
 namespace pickling {
-void io(Archive& a, FittedParameter& p) { a(p.name, p.unit, p.estimate, p.sd, p.lo, p.hi, p.identifiable, p.at_bound); }
+void io(Archive& a, FittedParameter& p) {
+    a(p.name, p.unit, p.estimate, p.sd, p.lo, p.hi, p.identifiable, p.at_bound, p.dchi2_lo, p.dchi2_hi, p.linearity);
+}
 void io(Archive& a, Unidentifiable& u) { a(u.combination, u.half_width); }
 void io(Archive& a, TrackFit& t) { a(t.source, t.frames, t.start, t.rms_xy_mm, t.rms_theta_mrad, t.chi2); }
 void io(Archive& a, IdentifySummary& s) {
@@ -105,6 +107,22 @@ void bind_identify(py::module_& m) {
                 return v;
             },
             "per parameter: False where the tracks cannot place it within its physical range")
+        .def_property_readonly(
+            "interval_check",
+            [](const PyIdentification& r) {
+                py::list out;
+                for (const FittedParameter& p : r.s.params) {
+                    py::dict d;
+                    d["name"] = p.name;
+                    d["dchi2_at_ends"] = py::make_tuple(p.dchi2_lo, p.dchi2_hi);
+                    d["verdict"] = to_string(p.linearity);
+                    out.append(d);
+                }
+                return out;
+            },
+            "per parameter, the 95 % interval checked at its ends: a dict -- dchi2_at_ends (the chi-square's rise "
+            "there along the linearised profile's path; 3.84 where the chi-square is quadratic; NaN where not "
+            "checked), verdict ('holds', 'too narrow', 'unconfirmed' or 'not checked')")
         .def_property_readonly(
             "covariance", [](const PyIdentification& r) { return Eigen::MatrixXd(r.s.covariance); },
             "of the estimates, rows and columns as names (NaN where not identifiable)")

@@ -39,6 +39,9 @@ def test_a_point_parts_kinetic_friction_from_one_track(tmp_path):
     assert abs(r.estimates[0] - 0.27) < 0.005 and lo < 0.27 < hi
     assert 0.7 < r.reduced_chi2 < 1.3   # 199 degrees of freedom: chi2 / dof within ~3 sd of 1
     assert r.summary["parameters"][0]["estimate"] == r.estimates[0]
+    # The interval checked at its ends: the chi-square rises by 3.84 (+-5 %) there on this sliding part.
+    check = r.interval_check[0]
+    assert check["verdict"] == "holds" and all(abs(d - 3.84) < 0.2 for d in check["dchi2_at_ends"])
     assert r.fitted.to_dict()["part"]["friction"] == r.estimates[0]
     # A wrong noise model fails the chi-square check above: the same track declaring 0.01 mm of noise
     # (ten times too little) gives reduced chi2 near 100.

@@ -34,6 +34,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,19 @@ struct IdentifyOptions {
 };
 
 // One fitted parameter, in the scene's units.
+// The verdict of the interval's check at its ends (FittedParameter::dchi2_lo, dchi2_hi). A quadratic
+// profile crossing 3.84 within a fifth of the linearised half-width of the ends (ProfileOptions::agreement)
+// has 3.84 / 1.2^2 = 2.67 to 3.84 / 0.8^2 = 6.0 there; the path's rise bounds the profile's from above.
+enum class Linearity {
+    Holds,         // both ends' rise within [2.67, 6.0]
+    TooNarrow,     // an end's rise below 2.67 (or below 0: a better fit on the path): the profile, no higher,
+                   // crosses further out; the linearised interval is too narrow (--profile)
+    Unconfirmed,   // an end's rise above 6.0, none below 2.67: the path rises faster than a quadratic; the
+                   // profile, which may rise more slowly, decides (--profile)
+    NotChecked     // not identifiable, an end outside the physical bounds, or a simulation stopped on the path
+};
+const char* to_string(Linearity l);
+
 struct FittedParameter {
     std::string name, unit;   // unit "1" (friction) or "m"
     double estimate = 0;
@@ -83,6 +97,12 @@ struct FittedParameter {
     double lo = 0, hi = 0;      // 95 %: estimate -+ 1.96 sd; NaN where not identifiable
     bool identifiable = true;   // false: part of a combination the tracks cannot separate
     bool at_bound = false;      // the estimate lies on a physical bound (the interval is then one-sided at best)
+    // Is the chi-square quadratic over the interval? Its rise over the fit's at the interval's ends along
+    // the linearised profile's path (the other parameters and the tracks' starts moved by their regression
+    // on this one): 3.84 at both ends where it is (docs/decisions/identification.md, "Checked at its ends").
+    // NaN where not checked.
+    double dchi2_lo = std::numeric_limits<double>::quiet_NaN(), dchi2_hi = std::numeric_limits<double>::quiet_NaN();
+    Linearity linearity = Linearity::NotChecked;
 };
 
 // A combination of the parameters the tracks cannot place within the physical ranges: the singular
