@@ -14,10 +14,10 @@
 // (everything at once by central differences, the search before staging), pieces[S] (staged, after a
 // first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
 // staged,central.
-// RADIUS: IdentifyOptions::initial_trust_radius. Each interval's check at its ends (the chi-square's rise
-// there, and the verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
+// RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. Each interval's check at its ends (the
+// chi-square's rise there, and the verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -144,6 +144,7 @@ int main(int argc, char** argv) {
     o.rtol = rtol;
     if (argc > 10) o.time_limit = std::stod(argv[10]);
     if (argc > 13) o.initial_trust_radius = std::stod(argv[13]);
+    if (argc > 14) o.jacobian_reuse = std::stoi(argv[14]);
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;

@@ -108,6 +108,7 @@ TrackCost::TrackCost(const Scene& scene, const Layout& layout, const Track& trac
                      bool central)
     : scene_(scene), layout_(layout), track_(track), first_(first), o_(o), central_(central) {
     dim_ = track.point ? 2 : 3;
+    reuse_ = central ? 0 : o.jacobian_reuse;
     mutable_parameter_block_sizes()->push_back(layout.size());
     mutable_parameter_block_sizes()->push_back(dim_);
     set_num_residuals(dim_ * (static_cast<int>(track.t.size()) - first));
@@ -162,6 +163,12 @@ bool TrackCost::Evaluate(double const* const* parameters, double* r, double** ja
     if (!residuals(parameters[0], parameters[1], r)) return false;
     if (!jacobians) return true;
     const int m = num_residuals();
+    const bool whole = jacobians[0] && jacobians[1] && profiled_ < 0;   // what a chord step can reuse
+    if (whole && reused_ < reuse_) {
+        ++reused_;
+        for (int b = 0; b < 2; ++b) std::copy(kept_[b].begin(), kept_[b].end(), jacobians[b]);
+        return true;
+    }
     std::vector<double> plus(m), minus(m);
     for (int b = 0; b < 2; ++b) {
         if (!jacobians[b]) continue;
@@ -188,6 +195,11 @@ bool TrackCost::Evaluate(double const* const* parameters, double* r, double** ja
             for (int i = 0; i < m; ++i) jacobians[b][i * n + j] = ((up ? plus[i] : r[i]) - (down ? minus[i] : r[i])) / span;
         }
     }
+    if (whole && reuse_ > 0) {
+        reused_ = 0;
+        kept_[0].assign(jacobians[0], jacobians[0] + static_cast<std::size_t>(m) * layout_.size());
+        kept_[1].assign(jacobians[1], jacobians[1] + static_cast<std::size_t>(m) * dim_);
+    }
     return true;
 }
 
@@ -198,7 +210,10 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem problem(po);
-    for (std::size_t t = 0; t < costs.size(); ++t) problem.AddResidualBlock(costs[t], nullptr, x.data(), q0[t].data());
+    for (std::size_t t = 0; t < costs.size(); ++t) {
+        costs[t]->fresh_jacobian();
+        problem.AddResidualBlock(costs[t], nullptr, x.data(), q0[t].data());
+    }
     if (static_cast<int>(held.size()) == n)
         problem.SetParameterBlockConstant(x.data());
     else if (!held.empty())
@@ -263,6 +278,7 @@ void IdentifyOptions::validate() const {
     if (!(rtol > 0 && rtol <= 1e-3)) bad("rtol: in (0, 1e-3]");
     if (!(segment_seconds >= 0 && segment_seconds <= 1e6)) bad("segment_seconds: from 0 (none) to 1e6 s");
     if (!(initial_trust_radius >= 1 && initial_trust_radius <= 1e12)) bad("initial_trust_radius: from 1 to 1e12");
+    if (jacobian_reuse < 0 || jacobian_reuse > 100) bad("jacobian_reuse: from 0 to 100");
     if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
     if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");

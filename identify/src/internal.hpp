@@ -103,6 +103,9 @@ public:
     bool residuals(const double* z, const double* q0, double* r) const;
     bool Evaluate(double const* const* parameters, double* r, double** jacobians) const override;
     long simulations() const { return sims_; }   // predictions run so far
+    // Chord steps (IdentifyOptions::jacobian_reuse; the search's forward differences only): the next
+    // Evaluate that asks for Jacobians computes them anew; those after it reuse them up to that many times.
+    void fresh_jacobian() const { reused_ = kFresh; }
 
 private:
     const Scene& scene_;
@@ -115,6 +118,10 @@ private:
     int profiled_ = -1;
     std::vector<double> lo_, hi_;
     mutable std::atomic<long> sims_{0};
+    static constexpr int kFresh = 1 << 30;
+    int reuse_ = 0;                         // 0: a Jacobian computed at every Evaluate that asks
+    mutable int reused_ = kFresh;           // times the kept Jacobians were reused since computed
+    mutable std::vector<double> kept_[2];   // the last computed Jacobians, blocks 0 and 1
 };
 
 // One Levenberg-Marquardt solve over block 0 (`x`, the coordinates in `held` kept) and the tracks'

@@ -64,6 +64,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
               {"pieces_s", o.segment_seconds},
               {"pieces_settle_periods", o.segment_settle_periods},
               {"initial_trust_radius", o.initial_trust_radius},
+              {"jacobian_reuse", o.jacobian_reuse},
               {"rtol", o.rtol}};
     return json{
         {"parameters", params},

@@ -71,6 +71,11 @@ struct IdentifyOptions {
     // starts at each parameter's floored information over it, and grows or shrinks from there
     // (docs/decisions/identification.md, "The first trust region").
     double initial_trust_radius = 1e4;
+    // Chord steps ("Chord steps: a track's Jacobian reused"): after the search computes a track's Jacobian
+    // by forward differences, the next jacobian_reuse points it accepts reuse it (only their residuals are
+    // simulated, 1 prediction instead of 1 + parameters + start's); then it is computed anew. 0: at every
+    // accepted point. The covariance, the check, the profiles and --suggest always compute theirs.
+    int jacobian_reuse = 2;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
