@@ -14,10 +14,11 @@
 // (everything at once by central differences, the search before staging), pieces[S] (staged, after a
 // first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
 // staged,central.
-// RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. Each interval's check at its ends (the
-// chi-square's rise there, and the verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
+// RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. Each
+// interval's check at its ends (the chi-square's rise there, and the verdict: FittedParameter::linearity) is printed in braces,
+// and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS [REUSE]]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE [HOPS]]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -145,6 +146,7 @@ int main(int argc, char** argv) {
     if (argc > 10) o.time_limit = std::stod(argv[10]);
     if (argc > 13) o.initial_trust_radius = std::stod(argv[13]);
     if (argc > 14) o.jacobian_reuse = std::stoi(argv[14]);
+    if (argc > 15) o.hops = std::stoi(argv[15]);
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;
@@ -176,6 +178,7 @@ int main(int argc, char** argv) {
             std::printf("%4d  %-8s %7.2f  %8.3f  %5d  %5d ", seed, v.name.c_str(), s.seconds, s.reduced_chi2, s.iterations,
                         s.best_start);
             if (v.segment_seconds > 0) std::printf(" [pieces: %d iterations, %.1f s]", s.piece_iterations, s.piece_seconds);
+            if (s.hops > 0) std::printf(" [hops: %d]", s.hops);
             v.tally(s, names, truth);
             std::printf("  %s\n", s.termination.substr(0, 40).c_str());
             if (s.reduced_chi2 > 1.5)   // (which track does not fit)

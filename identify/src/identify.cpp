@@ -102,6 +102,50 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
     return sol;
 }
 
+// What the fit says at internal coordinates x and starts q0: each track's fit and the chi-square, the
+// covariance and intervals from the whole Jacobian (central differences; the tracks' starts beside the
+// named parameters), and each interval's check, with the best end of its paths in `better`.
+void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
+              const std::vector<TrackCost*>& costs, const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
+              IdentifySummary& s, PathEnd& better) {
+    const int n = layout.size(), nt = static_cast<int>(tracks.size()), d = scene.part.point ? 2 : 3;
+    int rows = 0;
+    for (const TrackCost* c : costs) rows += c->num_residuals();
+    s.tracks.clear();
+    s.unidentifiable.clear();
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * nt);
+    s.chi2 = 0;
+    for (int t = 0, row = 0; t < nt; ++t) {
+        Eigen::VectorXd r;
+        Eigen::MatrixXd Jx, Jq;
+        if (!track_jacobian(scene, layout, tracks[t], first_used_frame(tracks[t], scene.plate.T, o.settle_periods), o, x, q0[t],
+                            r, Jx, Jq))
+            throw std::runtime_error("identify: the optimum's simulation stopped");
+        const int m = static_cast<int>(r.size());
+        J.block(row, 0, m, n) = Jx;
+        J.block(row, n + d * t, m, d) = Jq;
+        TrackFit f;
+        f.source = tracks[t].source;
+        f.frames = m / d;
+        f.start = Vec3(q0[t][0] * 1e-3, q0[t][1] * 1e-3, d == 3 ? q0[t][2] : 0.0);
+        double sxy = 0, sth = 0;
+        for (int i = 0; i < m; ++i) {
+            f.chi2 += r[i] * r[i];
+            (i % d < 2 ? sxy : sth) += r[i] * r[i];
+        }
+        f.rms_xy_mm = std::sqrt(sxy / (2.0 * f.frames)) * tracks[t].camera.noise_xy_mm;
+        f.rms_theta_mrad = d == 3 ? std::sqrt(sth / f.frames) * tracks[t].camera.noise_theta_mrad : 0.0;
+        s.chi2 += f.chi2;
+        s.tracks.push_back(f);
+        row += m;
+    }
+    s.residuals = rows;
+    s.dof = rows - (n + d * nt);
+    s.reduced_chi2 = s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
+    const Eigen::MatrixXd cov_internal = judge(layout, o, x, J, d * nt, s);
+    check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);
+}
+
 }   // namespace
 
 TrackCost::TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
@@ -279,6 +323,7 @@ void IdentifyOptions::validate() const {
     if (!(segment_seconds >= 0 && segment_seconds <= 1e6)) bad("segment_seconds: from 0 (none) to 1e6 s");
     if (!(initial_trust_radius >= 1 && initial_trust_radius <= 1e12)) bad("initial_trust_radius: from 1 to 1e12");
     if (jacobian_reuse < 0 || jacobian_reuse > 100) bad("jacobian_reuse: from 0 to 100");
+    if (hops < 0 || hops > 100) bad("hops: from 0 to 100");
     if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
     if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");
@@ -414,38 +459,25 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     }
     if (best.empty()) throw std::runtime_error("identify: no start gave a usable fit (every simulation stopped?)");
 
-    // The whole Jacobian at the optimum (the tracks' starts beside the named parameters), and the fits.
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * nt);
-    s.chi2 = 0;
-    for (int t = 0, row = 0; t < nt; ++t) {
-        Eigen::VectorXd r;
-        Eigen::MatrixXd Jx, Jq;
-        if (!track_jacobian(scene, layout, tracks[t], first_used_frame(tracks[t], scene.plate.T, o.settle_periods), o, best,
-                            best_q0[t], r, Jx, Jq))
-            throw std::runtime_error("identify: the optimum's simulation stopped");
-        const int m = static_cast<int>(r.size());
-        J.block(row, 0, m, n) = Jx;
-        J.block(row, n + d * t, m, d) = Jq;
-        TrackFit f;
-        f.source = tracks[t].source;
-        f.frames = m / d;
-        f.start = Vec3(best_q0[t][0] * 1e-3, best_q0[t][1] * 1e-3, d == 3 ? best_q0[t][2] : 0.0);
-        double sxy = 0, sth = 0;
-        for (int i = 0; i < m; ++i) {
-            f.chi2 += r[i] * r[i];
-            (i % d < 2 ? sxy : sth) += r[i] * r[i];
-        }
-        f.rms_xy_mm = std::sqrt(sxy / (2.0 * f.frames)) * tracks[t].camera.noise_xy_mm;
-        f.rms_theta_mrad = d == 3 ? std::sqrt(sth / f.frames) * tracks[t].camera.noise_theta_mrad : 0.0;
-        s.chi2 += f.chi2;
-        s.tracks.push_back(f);
-        row += m;
+    // The fit's verdict at the best start's optimum; then, while the interval check finds a fit better by
+    // more than one chi-square unit at an end of its paths (the search stopped in a cell of the chi-square
+    // that a step of 1.96 sd leaves: docs/decisions/identification.md, "Hops"), the search goes on from there.
+    PathEnd better;
+    conclude(scene, layout, tracks, o, cost_ptrs, best, best_q0, s, better);
+    for (int hop = 0; hop < o.hops && better.chi2 < s.chi2 - 1; ++hop) {
+        if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
+        std::vector<double> x = better.x;
+        std::vector<std::vector<double>> q0 = better.q0;
+        const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0, o.time_limit);
+        if (!sol.usable || !(sol.chi2 < s.chi2)) break;
+        best = x;
+        best_q0 = q0;
+        ++s.hops;
+        s.iterations += sol.iterations;
+        s.termination = sol.termination;
+        s.converged = sol.converged;
+        conclude(scene, layout, tracks, o, cost_ptrs, best, best_q0, s, better);
     }
-    s.residuals = rows;
-    s.dof = rows - (n + d * nt);
-    s.reduced_chi2 = s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
-    const Eigen::MatrixXd cov_internal = judge(layout, o, best, J, d * nt, s);
-    check_linearity(layout, o, cost_ptrs, best, best_q0, J, cov_internal, s);
     s.fitted = at(scene, layout, best);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return s;

@@ -8,6 +8,7 @@
 #include <ceres/ceres.h>
 
 #include <atomic>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -137,12 +138,20 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
                const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
                double seconds, int threads, ceres::IterationCallback* callback = nullptr, double initial_radius = 1e4);
 
+// A point of the search's space (internal coordinates, the tracks' starts) and the tracks' chi-square there.
+struct PathEnd {
+    double chi2 = std::numeric_limits<double>::infinity();
+    std::vector<double> x;
+    std::vector<std::vector<double>> q0;
+};
+
 // The linearised intervals' check at their ends (FittedParameter::dchi2_lo, dchi2_hi, linearity): for
 // each identifiable parameter, the tracks' chi-square at x and q0 moved 1.96 linearised sds along the
 // quadratic model's profile path (cov_internal: judge()'s; the starts by their regression on the
-// parameters), less s.chi2; 2 predictions a track a parameter, on o.threads (judge.cpp).
+// parameters), less s.chi2; 2 predictions a track a parameter, on o.threads. `better`: the end with the
+// lowest chi-square (chi2 infinite if none was checked) (judge.cpp).
 void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                      const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
-                     const Eigen::MatrixXd& cov_internal, IdentifySummary& s);
+                     const Eigen::MatrixXd& cov_internal, IdentifySummary& s, PathEnd& better);
 
 }   // namespace plate::identify_detail

@@ -103,7 +103,8 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
 
 void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                      const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
-                     const Eigen::MatrixXd& cov_internal, IdentifySummary& s) {
+                     const Eigen::MatrixXd& cov_internal, IdentifySummary& s, PathEnd& better) {
+    better = PathEnd{};
     const int n = layout.size(), nt = static_cast<int>(costs.size()), ns = static_cast<int>(J.cols()) - n;
     const int d = nt > 0 ? ns / nt : 0;
     const Eigen::MatrixXd F = J.transpose() * J;
@@ -134,6 +135,12 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
         checked.push_back(j);
         step.push_back(v);
     }
+    // An end of a path: the named coordinates and track t's start.
+    const auto end_point = [&](const Eigen::VectorXd& v, int end, std::vector<double>& xe, std::vector<double>& qe, int t) {
+        const double sign = end == 0 ? -kZ95 : kZ95;
+        for (int k = 0; k < n; ++k) xe[k] = x[k] + sign * v[k];
+        for (int k = 0; k < d; ++k) qe[k] = q0[t][k] + sign * v[n + d * t + k];
+    };
     // Every (parameter, end, track) prediction as a task; a stopped simulation gives NaN.
     const int tasks = static_cast<int>(checked.size()) * 2 * nt;
     std::vector<double> chi2(tasks, 0.0);
@@ -141,11 +148,8 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
         tasks,
         [&](int i) {
             const int c = i / (2 * nt), end = (i / nt) % 2, t = i % nt;
-            const Eigen::VectorXd& v = step[c];
-            const double sign = end == 0 ? -kZ95 : kZ95;
             std::vector<double> xe(n), qe(d);
-            for (int k = 0; k < n; ++k) xe[k] = x[k] + sign * v[k];
-            for (int k = 0; k < d; ++k) qe[k] = q0[t][k] + sign * v[n + d * t + k];
+            end_point(step[c], end, xe, qe, t);
             std::vector<double> r(costs[t]->num_residuals());
             if (!costs[t]->residuals(xe.data(), qe.data(), r.data())) {
                 chi2[i] = std::numeric_limits<double>::quiet_NaN();
@@ -163,6 +167,13 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
         for (int end = 0; end < 2; ++end)
             for (int t = 0; t < nt; ++t) ends[end] += chi2[(c * 2 + end) * nt + t];
         if (!std::isfinite(ends[0]) || !std::isfinite(ends[1])) continue;
+        for (int end = 0; end < 2; ++end) {
+            if (!(ends[end] < better.chi2)) continue;
+            better.chi2 = ends[end];
+            better.x.assign(n, 0.0);
+            better.q0.assign(nt, std::vector<double>(d));
+            for (int t = 0; t < nt; ++t) end_point(step[c], end, better.x, better.q0[t], t);
+        }
         p.dchi2_lo = ends[0] - s.chi2;
         p.dchi2_hi = ends[1] - s.chi2;
         const double lo = std::min(p.dchi2_lo, p.dchi2_hi), hi = std::max(p.dchi2_lo, p.dchi2_hi);

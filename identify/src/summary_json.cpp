@@ -65,6 +65,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
               {"pieces_settle_periods", o.segment_settle_periods},
               {"initial_trust_radius", o.initial_trust_radius},
               {"jacobian_reuse", o.jacobian_reuse},
+              {"hops", o.hops},
               {"rtol", o.rtol}};
     return json{
         {"parameters", params},
@@ -80,6 +81,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
                          " differences of the simulation, the covariance by central ones"},
           {"pieces", s.pieces},
           {"piece_iterations", s.piece_iterations},
+          {"hops", s.hops},
           {"piece_seconds", s.piece_seconds},
           {"starts_run", s.starts_run},
           {"best_start", s.best_start},

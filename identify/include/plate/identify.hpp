@@ -76,6 +76,10 @@ struct IdentifyOptions {
     // simulated, 1 prediction instead of 1 + parameters + start's); then it is computed anew. 0: at every
     // accepted point. The covariance, the check, the profiles and --suggest always compute theirs.
     int jacobian_reuse = 2;
+    // Hops ("Hops: the search goes on from a better end"): after the fit, while the interval check finds a
+    // chi-square lower by more than 1 at an end of its paths, the search goes on from there, at most this
+    // many times within time_limit. 0: never.
+    int hops = 4;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
@@ -140,6 +144,7 @@ struct IdentifySummary {
     int iterations = 0;         // of the best start
     int pieces = 0;             // fitted in the first stage (segment_seconds; 0: no such stage)
     int piece_iterations = 0;   // of the best start's first stage on the pieces
+    int hops = 0;               // times the search went on from a better end of the interval check's paths
     double piece_seconds = 0;   // its time [s]
     std::string termination;    // of the best start (Ceres' termination type and message)
     bool converged = false;
