@@ -207,7 +207,8 @@ TEST_CASE("a track cut into pieces keeps its frames and the plate's phase", "[id
 }
 
 // The search's options are checked once, naming the field.
-TEST_CASE("the search's pieces, first trust region and chord steps are refused out of range, naming the field", "[identify]") {
+TEST_CASE("the search's pieces, first trust region, chord steps and hops are refused out of range, naming the field",
+          "[identify]") {
     IdentifyOptions o = options({"mu_k"});
     REQUIRE_NOTHROW(o.validate());
     o.segment_seconds = -1;
@@ -221,6 +222,9 @@ TEST_CASE("the search's pieces, first trust region and chord steps are refused o
     o = options({"mu_k"});
     o.jacobian_reuse = -1;
     CHECK_THROWS_WITH(o.validate(), Catch::Contains("jacobian_reuse"));
+    o = options({"mu_k"});
+    o.hops = 101;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("hops"));
     o = options({"mu_k"});
     o.segment_seconds = 0.2;   // 4 periods of fig1_point's 0.05 s: every frame of a later piece left out
     const Scene point = scene("fig1_point");

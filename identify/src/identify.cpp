@@ -99,6 +99,16 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
     }
     Solve sol = minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
     sol.iterations += iterations;
+    // A solve with chord steps may converge on its stale Jacobian (rejected steps shrinking the trust region
+    // to the tolerance): only a solve whose every Jacobian is computed anew confirms it.
+    if (o.jacobian_reuse > 0 && sol.converged && std::chrono::duration<double>(Clock::now() - t0).count() < deadline) {
+        for (TrackCost* c : costs) c->reuse(0);
+        Solve confirm =
+            minimise(costs, x, q0, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
+        for (TrackCost* c : costs) c->reuse(o.jacobian_reuse);
+        confirm.iterations += sol.iterations;
+        sol = confirm;
+    }
     return sol;
 }
 
@@ -271,6 +281,9 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
     so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     so.linear_solver_type = ceres::DENSE_QR;
     so.min_lm_diagonal = kMinLmDiagonal;
+    // With bounds Ceres follows each step with a line search; cubic interpolation asks for the gradient,
+    // so for every track's Jacobian, at every trial point: quadratic needs only the residuals there.
+    so.line_search_interpolation_type = ceres::QUADRATIC;
     so.initial_trust_region_radius = initial_radius;
     so.max_num_iterations = max_iterations;
     so.max_solver_time_in_seconds = seconds;
@@ -470,13 +483,19 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         std::vector<std::vector<double>> q0 = better.q0;
         const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0, o.time_limit);
         if (!sol.usable || !(sol.chi2 < s.chi2)) break;
+        IdentifySummary hopped = s;
+        ++hopped.hops;
+        hopped.iterations += sol.iterations;
+        hopped.termination = sol.termination;
+        hopped.converged = sol.converged;
+        try {
+            conclude(scene, layout, tracks, o, cost_ptrs, x, q0, hopped, better);
+        } catch (const std::runtime_error&) {   // (a simulation at the hop's optimum stopped: the fit before it stands)
+            break;
+        }
+        s = hopped;
         best = x;
         best_q0 = q0;
-        ++s.hops;
-        s.iterations += sol.iterations;
-        s.termination = sol.termination;
-        s.converged = sol.converged;
-        conclude(scene, layout, tracks, o, cost_ptrs, best, best_q0, s, better);
     }
     s.fitted = at(scene, layout, best);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -107,6 +107,7 @@ public:
     // Chord steps (IdentifyOptions::jacobian_reuse; the search's forward differences only): the next
     // Evaluate that asks for Jacobians computes them anew; those after it reuse them up to that many times.
     void fresh_jacobian() const { reused_ = kFresh; }
+    void reuse(int times) { reuse_ = central_ ? 0 : times; }
 
 private:
     const Scene& scene_;

@@ -39,7 +39,7 @@ void io(Archive& a, IdentifySummary& s) {
 void io(Archive& a, IdentifyOptions& o) {
     a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads,
       o.fit_starts_first, o.central_search, o.segment_seconds, o.segment_settle_periods, o.initial_trust_radius, o.jacobian_reuse,
-      o.mu_min, o.mu_max, o.com_max);
+      o.hops, o.mu_min, o.mu_max, o.com_max);
 }
 void io(Archive& a, ProfilePoint& p) { a(p.value, p.dchi2); }
 void io(Archive& a, ParameterProfile& p) {

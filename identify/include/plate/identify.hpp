@@ -71,11 +71,12 @@ struct IdentifyOptions {
     // starts at each parameter's floored information over it, and grows or shrinks from there
     // (docs/decisions/identification.md, "The first trust region").
     double initial_trust_radius = 1e4;
-    // Chord steps ("Chord steps: a track's Jacobian reused"): after the search computes a track's Jacobian
-    // by forward differences, the next jacobian_reuse points it accepts reuse it (only their residuals are
-    // simulated, 1 prediction instead of 1 + parameters + start's); then it is computed anew. 0: at every
-    // accepted point. The covariance, the check, the profiles and --suggest always compute theirs.
-    int jacobian_reuse = 2;
+    // Chord steps ("Chord steps: a track's Jacobian reused -- measured, not the default"): after the search
+    // computes a track's Jacobian by forward differences, the next jacobian_reuse evaluations that ask for
+    // it get it back (only their residuals simulated, 1 prediction instead of 1 + parameters + start's);
+    // a solve that converged so is confirmed by one without reuse. 0: computed at every evaluation. The
+    // covariance, the check, the profiles and --suggest always compute theirs.
+    int jacobian_reuse = 0;
     // Hops ("Hops: the search goes on from a better end"): after the fit, while the interval check finds a
     // chi-square lower by more than 1 at an end of its paths, the search goes on from there, at most this
     // many times within time_limit. 0: never.
@@ -141,7 +142,7 @@ struct IdentifySummary {
     double reduced_chi2 = 0;      // chi2 / dof: near 1 when the model and the noise sds are right
     int starts_run = 0, best_start = 0;
     int held = 0;               // named parameters no residual depended on at the first start: held there
-    int iterations = 0;         // of the best start
+    int iterations = 0;         // of the best start, its hops' included
     int pieces = 0;             // fitted in the first stage (segment_seconds; 0: no such stage)
     int piece_iterations = 0;   // of the best start's first stage on the pieces
     int hops = 0;               // times the search went on from a better end of the interval check's paths
