@@ -20,8 +20,22 @@ def scene_path(name):
     return os.path.join(SOURCE, "scenes", name + ".json")
 
 
-def latency_of_ctrl_c(call, after=1.0):
-    """Seconds from a SIGINT sent to this process `after` s into call() to the KeyboardInterrupt."""
+def latency_of_ctrl_c(call, after=1.0, tries=2):
+    """Seconds from a SIGINT sent to this process `after` s into call() to the KeyboardInterrupt: the best of
+    `tries` calls. What the 0.5 s bound guards is the calls' polling (a missing poll waits for the whole call,
+    seconds every time); one sample under a parallel ctest also measures the scheduler. With three busy
+    loops beside it on this 2-core machine the report's fields section measured 0.41-0.61 s at 1 s in, and
+    0.013-0.04 s alone; so the best of two."""
+    best = None
+    for _ in range(tries):
+        t = _latency_once(call, after)
+        best = t if best is None else min(best, t)
+        if best < 0.5:
+            break
+    return best
+
+
+def _latency_once(call, after):
     sent = {}
 
     def interrupt():
