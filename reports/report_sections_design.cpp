@@ -19,13 +19,15 @@ using namespace html;
 // Inverse design (design.hpp): point-part sinks designed, verified, and shown -- the signal, the field
 // with its fixed point, and full-dynamics runs from the verification's random starts.
 // A design table row's first cells: the target, the verdict (with why it failed), unique, the rate,
-// evaluations, cycles and the designed signal's peaks (the axes that move).
+// evaluations, cycles and the designed signal's peaks (the axes that move), and its corners'.
 std::string design_cells(Ctx& c, const std::string& target, const DesignSummary& d) {
     std::string peaks;
     for (int a = 0; a < 6; ++a)
         if (d.peaks[a] > 0)
             peaks += (peaks.empty() ? "" : ", ") + std::string(axis_name(static_cast<Axis>(a))) + " " + fmt(d.peaks[a], 3) +
                      (a < 3 ? " m/s²" : " rad/s²");
+    peaks += "; corners at ±(" + fmt(1e3 * d.corner_half_size.x(), 3) + ", " + fmt(1e3 * d.corner_half_size.y(), 3) +
+             ") mm: " + fmt(1e3 * d.corner_peaks.displacement, 3) + " mm, " + fmt(d.corner_peaks.velocity, 3) + " m/s";
     return "<tr><td>" + target + "</td><td>" + c.verdict("design verified: " + target, d.verified) +
            (d.verified ? "" : " " + esc(d.failure)) + "</td><td>" + (d.unique ? "yes" : "no") + "</td><td>" + fmt(d.rate, 3) +
            "</td><td>" + std::to_string(d.evaluations) + "</td><td>" + std::to_string(d.cycles) + "</td><td>" + peaks + "</td>";

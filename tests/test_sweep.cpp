@@ -149,6 +149,29 @@ TEST_CASE("bad campaign files are refused with the file and the field named", "[
             "parameters[1].name: 'a' named twice");
 }
 
+TEST_CASE("a design campaign takes plate design's corner limits and the plate's half size", "[sweep][input]") {
+    TempDir d;
+    write(d / "block.json", kShakenBlock);
+    const auto campaign = [&](const std::string& design) {
+        return write(d / "c.json", R"({"name": "x", "scene": "block.json", "parameters": [{"name": "mu", "pointer":
+          "/part/friction", "values": [0.2]}], "compute": {"design": {"target": ["sink", 0.02, -0.01], )" +
+                                       design + "}}}");
+    };
+    const Campaign c = load_campaign(campaign(R"("corner_limits": [0.0005, 0.07], "plate_half_size": [0.1, 0.08])"));
+    CHECK(c.design_options.corner_displacement_limit == 0.0005);
+    CHECK(c.design_options.corner_velocity_limit == 0.07);
+    CHECK(c.design_options.plate_half_size == Vec2(0.1, 0.08));
+    const Campaign plain = load_campaign(campaign(R"("seed": 3)"));
+    CHECK(plain.design_options.corner_displacement_limit == 0);
+    CHECK(plain.design_options.plate_half_size == Vec2::Zero());
+    for (const auto& [bad, expected] : {std::pair<std::string, std::string>{R"("corner_limits": [-1, 0])", "corner_limits"},
+                                        {R"("corner_limits": [0.001])", "compute.design.corner_limits"},
+                                        {R"("plate_half_size": [0.1, 0])", "plate_half_size"}}) {
+        INFO(bad);
+        CHECK_THROWS_WITH(load_campaign(campaign(bad)), Catch::Contains(expected));
+    }
+}
+
 TEST_CASE("a case's row is the direct computation's, and the stick threshold mu = A/g is where the closed form puts it",
           "[sweep]") {
     TempDir d;

@@ -19,7 +19,7 @@ namespace {
 struct DesignArgs : Options {
     std::string scene, out;
     std::vector<std::string> target;
-    std::vector<double> limits;
+    std::vector<double> limits, corner_limits, plate_half_size;
     double period = 0, hold = DesignOptions{}.hold, max_coning = DesignOptions{}.max_coning;
     std::uint64_t seed = 1;
     int threads = 0, starts = DesignOptions{}.starts, evaluations = DesignOptions{}.local_evaluations, harmonics = 0;
@@ -45,7 +45,11 @@ struct DesignArgs : Options {
                   "--limits LIN ANG: the peak over the period of each axis' summed signal |u_a(t)|, what actuators\n"
                   "saturate on: LIN for x, y, z [m/s^2], ANG for rx, ry, rz [rad/s^2] (default 20, 150), on the motion\n"
                   "as designed (shifted, turned, rz added; the summary's \"peaks\"); not each harmonic's amplitude,\n"
-                  "which may exceed it where the others flatten the crest. g plus the\n"
+                  "which may exceed it where the others flatten the crest. --corner-limits DISP VEL [m, m/s] (optional)\n"
+                  "bound what the plate's stops and its actuators' speed see: the peak length of the displacement and\n"
+                  "of the velocity of the plate's corners at (+-HX, +-HY) of --plate-half-size (default: the flight\n"
+                  "check's square, the region widened by the part's reach), to first order in the plate's rotation;\n"
+                  "0 leaves one free. The summary's \"corner_peaks\" say where the design ends up. g plus the\n"
                   "vertical acceleration stays above 0.2 g over the plate (a constraint). NLopt COBYLA from --starts\n"
                   "seeded feasible motions (default 4 for sinks and line sinks, 16 otherwise),\n"
                   "--evaluations each (default 400). Verification: the field's fixed points on a 7x7 grid and full\n"
@@ -67,6 +71,10 @@ struct DesignArgs : Options {
         text("--out", out, "SCENE.json", "the designed scene; required");
         numbers("--limits", limits, 2, 2, "LIN ANG",
                 "each axis' peak acceleration over the period, linear and angular (default 20 m/s^2, 150 rad/s^2)");
+        numbers("--corner-limits", corner_limits, 2, 2, "DISP VEL",
+                "the peak displacement [m] and velocity [m/s] of the plate's corners (0: none; default none)");
+        numbers("--plate-half-size", plate_half_size, 2, 2, "HX HY",
+                "the plate's corners at (+-HX, +-HY) [m] for --corner-limits (default: the flight check's square)");
         number("--period", period, "the plate's period [s]", "the part scene's");
         whole("--seed", seed, 0, 1L << 40, "the seed");
         whole("--threads", threads, 0, 256, "threads (0: all cores)");
@@ -105,8 +113,9 @@ void judge_options(const DesignOptions& o) {
     } catch (const std::invalid_argument& e) {
         std::string m = e.what();
         const std::pair<const char*, const char*> flags[] = {
-            {"local_evaluations:", "evaluations:"}, {"max_harmonic:", "harmonics:"},    {"max_coning:", "max-coning:"},
-            {"robust_radius:", "robust-radius:"},   {"robust_share:", "robust-share:"}, {"robust_draws:", "robust-draws:"}};
+            {"local_evaluations:", "evaluations:"}, {"max_harmonic:", "harmonics:"},         {"max_coning:", "max-coning:"},
+            {"robust_radius:", "robust-radius:"},   {"robust_share:", "robust-share:"},      {"robust_draws:", "robust-draws:"},
+            {"corner_limits:", "corner-limits:"},   {"plate_half_size:", "plate-half-size:"}};
         for (const auto& [name, flag] : flags)
             if (m.rfind(name, 0) == 0) m = flag + m.substr(std::string(name).size());
         throw UsageError("--" + m);
@@ -120,6 +129,11 @@ DesignOptions design_options(const DesignArgs& a) {
         o.lin_limit = a.limits[0];
         o.ang_limit = a.limits[1];
     }
+    if (a.has("--corner-limits")) {
+        o.corner_displacement_limit = a.corner_limits[0];
+        o.corner_velocity_limit = a.corner_limits[1];
+    }
+    if (a.has("--plate-half-size")) o.plate_half_size = Vec2(a.plate_half_size[0], a.plate_half_size[1]);
     o.period = a.period;   // (the ranges are judged by the library, as for campaigns and Python)
     o.hold = a.hold;
     o.max_coning = a.max_coning;   // (any finite number: negative asks for the hold's limit)

@@ -169,9 +169,9 @@ struct PairBreaker {
     // The motion with fixed point q, placed as place_and_verify_rigid will place it: within the limits,
     // the flight margin, and the coning and tilt-drift limits.
     bool fits(const PlateMotion& u, const Vec3& q) const {
-        double con[kPlacedConstraints];
+        double con[kPlacedConstraints + kCornerConstraints];
         placed_constraints(placed_motion(u, q, target.at, target.theta), opt, part_scene, 1.0, con);
-        return *std::max_element(con, con + kPlacedConstraints) <= 0;
+        return *std::max_element(con, con + kPlacedConstraints + corner_count(opt)) <= 0;
     }
     // A ring of n values of theta' with exactly one stable zero: its fixed point by Newton from q (not
     // finite: the middle of the zero's cell at the centre), stable and within `reach` of the centre

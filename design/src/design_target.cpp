@@ -138,6 +138,12 @@ void validate_design_options(const DesignOptions& o) {
     };
     require(o.lin_limit >= 0 && o.ang_limit >= 0 && o.lin_limit <= kMaxAmplitude && o.ang_limit <= kMaxAmplitude,
             "limits: expected amplitudes from 0 to " + number_text(kMaxAmplitude));
+    require(o.corner_displacement_limit >= 0 && o.corner_displacement_limit <= 1 && o.corner_velocity_limit >= 0 &&
+                o.corner_velocity_limit <= 100,
+            "corner_limits: expected a displacement from 0 to 1 m and a velocity from 0 to 100 m/s (0: none)");
+    require(o.plate_half_size.x() >= 0 && o.plate_half_size.y() >= 0 && o.plate_half_size.x() <= 10 &&
+                o.plate_half_size.y() <= 10 && (o.plate_half_size.x() > 0) == (o.plate_half_size.y() > 0),
+            "plate_half_size: expected both zero (the flight check's square) or both from 0 to 10 m");
     require(o.period == 0 || (o.period >= kPeriodRange[0] && o.period <= kPeriodRange[1]),
             "period: expected 0 (the part scene's) or " + number_text(kPeriodRange[0]) + " to " + number_text(kPeriodRange[1]) +
                 " s");

@@ -45,9 +45,18 @@ double cycle_noise(const LimitCycleOptions& o);
 // The option's task runner, else its threads.
 TaskRunner runner(const DesignOptions& opt);
 // c_a <= 0 for each axis' peak of `fin` (axis_peaks) within `room` times the axis' limit (6 entries),
-// then c <= 0 for no flight over the region; returns the entries written (kPeakConstraints).
+// then c <= 0 for no flight over the region, then corner_constraints' entries; returns the entries
+// written (kPeakConstraints + corner_count(opt)).
 constexpr int kPeakConstraints = 7;
 int peak_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c);
+// The corner limits' constraints: none where neither limit is set (a search without them is unchanged),
+// else c <= 0 for the corners' peak displacement and velocity within `room` times their limits (an
+// unset one: -1). Arrays of constraints leave room for kCornerConstraints more than their own.
+constexpr int kCornerConstraints = 2;
+int corner_count(const DesignOptions& opt);
+int corner_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c);
+// The plate's corners the limits apply at: plate_half_size, or the flight check's square.
+Vec2 corner_half_size(const Scene& part, const DesignOptions& opt);
 
 // --- peaks (plate/peaks.hpp, numeric) ------------------------------------------------------------------
 using plate::horizontal_peak;
@@ -79,10 +88,12 @@ struct Problem {
         if (opt.max_harmonic > 0 && harmonics[static_cast<std::size_t>((i / 2) % H)] > opt.max_harmonic) return false;
         return opt.axes.empty() || std::find(opt.axes.begin(), opt.axes.end(), a) != opt.axes.end();
     }
+    // Derived's constraints and the corner limits' (corner_count).
+    int constraint_count() const { return Derived::kConstraints + corner_count(opt); }
     bool feasible(const std::vector<double>& p) const {
-        double c[Derived::kConstraints];
+        double c[Derived::kConstraints + kCornerConstraints];
         self().constraints(p, c);
-        return std::all_of(c, c + Derived::kConstraints, [](double x) { return x <= 0; });
+        return std::all_of(c, c + constraint_count(), [](double x) { return x <= 0; });
     }
     double objective(const std::vector<double>& p) {
         const double f = static_cast<Derived&>(*this).evaluate(p);
@@ -215,17 +226,17 @@ std::vector<double> multistart(const DesignOptions& opt, double stopval, Make&& 
                     Reduced& r = *static_cast<Reduced*>(d);
                     r.prob->constraints(r.place(xr), c);
                     if (!grad) return;
-                    double cp[P::kConstraints];
+                    double cp[P::kConstraints + kCornerConstraints];
                     std::vector<double> xp(xr, xr + mr);
                     for (unsigned j = 0; j < mr; ++j) {   // grad[k m + j] = d c_k / d x_j
                         const double h = 1e-3 * r.prob->limit((*r.idx)[j]);
                         xp[j] += h;
                         r.prob->constraints(r.place(xp.data()), cp);
                         xp[j] = xr[j];
-                        for (int k = 0; k < P::kConstraints; ++k) grad[k * mr + j] = (cp[k] - c[k]) / h;
+                        for (int k = 0; k < r.prob->constraint_count(); ++k) grad[k * mr + j] = (cp[k] - c[k]) / h;
                     }
                 },
-                &red, std::vector<double>(P::kConstraints, 1e-9));
+                &red, std::vector<double>(static_cast<std::size_t>(prob.constraint_count()), 1e-9));
             double f = 0;
             try {
                 local.optimize(x, f);
@@ -432,7 +443,7 @@ struct SinkProblem : Problem<SinkProblem> {
         // (orient: 3 % of each limit and 0.02 g of the flight margin kept in hand for the placement's
         // small turn and shift onto the fixed point found)
         const int k = peak_constraints(fin, opt, part, orient ? 0.97 : 1.0, c);
-        if (orient) c[k - 1] += 0.02;
+        if (orient) c[kPeakConstraints - 1] += 0.02;   // (the flight margin's entry)
         const double psi = coning_rate(fin);
         const double cone = !std::isfinite(cone_limit) ? 0.0
                             : cone_limit > 0           ? psi / cone_limit
@@ -538,7 +549,7 @@ PlateMotion transport_motion(const std::vector<double>& p, double T);
 // What the rigid fixed point (rigid_fixed_point.cpp) and its broken pair (break_pair.cpp) share.
 // Constraints c_k <= 0 on a motion as placed: each axis' peak within its limit times `room`, no
 // flight, no coning beyond kConingLimit either way and no tilt drift beyond kTiltDriftLimit
-// (kPlacedConstraints entries).
+// (kPlacedConstraints entries, and corner_count(opt) more).
 constexpr int kPlacedConstraints = kPeakConstraints + 3;
 void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c);
 // The field xi_a at q and its Jacobian by central differences (steps 3 mm and 0.1 rad), warm-started

@@ -74,6 +74,7 @@ struct OrientProblem : Problem<OrientProblem> {
         c[0] = (horizontal_peak(u) - opt.lin_limit) / L;
         c[1] = (axis_peaks(u)[2] - opt.lin_limit) / L;
         c[2] = opt.flight_margin - vertical_margin(u, part.g, opt.region);
+        corner_constraints(u, opt, part, 1.0, c + 3);   // (x, y, z alone: the same at every turn)
     }
     // One stable orientation on the ring: minus its rate [1/s]; else the number of stable ones less
     // one, or 1 for none (a part that does not turn).
@@ -180,10 +181,11 @@ DesignSummary design_orient(const Scene& part_scene, const DesignTarget& target,
     sum.eigenvalues3 = Eigen::Vector3cd(0, 0, -sum.rate);   // positions are neutral: the field is theta's alone
     sum.scene.plate = combined(rotate_motion(centred.plate, target.theta - theta_s));
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
-    double c[OrientProblem::kConstraints];
-    OrientProblem(part_scene, opt, T, &cycles).constraints(params_from(sum.scene.plate, kTranslationAxes, {1, 2}), c);
-    if (*std::max_element(c, c + OrientProblem::kConstraints) > 1e-9) {
-        sum.failure = "the turned motion exceeds the peak limits or the flight margin";
+    double c[OrientProblem::kConstraints + kCornerConstraints];
+    const OrientProblem check(part_scene, opt, T, &cycles);
+    check.constraints(params_from(sum.scene.plate, kTranslationAxes, {1, 2}), c);
+    if (*std::max_element(c, c + check.constraint_count()) > 1e-9) {
+        sum.failure = "the turned motion exceeds the peak limits, the corner limits or the flight margin";
         return finished(sum, cycles, t0);
     }
 

@@ -273,10 +273,12 @@ DesignSummary& place_and_verify_rigid(DesignSummary& sum, const Scene& part_scen
     const Vec2 s_turned = Eigen::Rotation2Dd(target.theta - theta_offset - q[2]) * Vec2(q.head<2>());
     sum.scene.plate = placed_motion(centred.plate, q, at, target.theta, theta_offset);
     sum.min_vertical_margin = vertical_margin(sum.scene.plate, sum.scene.g, flight_region(sum.scene, opt));
-    double c[kPlacedConstraints];
+    double c[kPlacedConstraints + kCornerConstraints];
     placed_constraints(sum.scene.plate, opt, sum.scene, 1.0, c);
-    if (*std::max_element(c, c + kPlacedConstraints) > 1e-9) {
-        sum.failure = "the placed motion exceeds the peak limits, the flight margin or the coning (or tilt drift) limit";
+    if (*std::max_element(c, c + kPlacedConstraints + corner_count(opt)) > 1e-9) {
+        sum.failure =
+            "the placed motion exceeds the peak limits, the corner limits, the flight margin or the coning (or tilt drift) "
+            "limit";
         return finished(sum, cycles, t0);
     }
     const Vec3 goal(at.x(), at.y(), wrap_angle(target.theta));

@@ -96,7 +96,26 @@ int peak_constraints(const PlateMotion& fin, const DesignOptions& opt, const Sce
         c[axis] = (peak[axis] - room * lim) / std::max(lim, 1e-12);
     }
     c[6] = opt.flight_margin - vertical_margin(fin, part.g, flight_region(part, opt));
-    return kPeakConstraints;
+    return kPeakConstraints + corner_constraints(fin, opt, part, room, c + kPeakConstraints);
+}
+
+int corner_count(const DesignOptions& opt) {
+    return opt.corner_displacement_limit > 0 || opt.corner_velocity_limit > 0 ? kCornerConstraints : 0;
+}
+
+int corner_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
+    if (corner_count(opt) == 0) return 0;
+    const CornerPeaks p = corner_peaks(fin, corner_half_size(part, opt));
+    const auto bound = [&](double peak, double lim) { return lim > 0 ? (peak - room * lim) / lim : -1.0; };
+    c[0] = bound(p.displacement, opt.corner_displacement_limit);
+    c[1] = bound(p.velocity, opt.corner_velocity_limit);
+    return kCornerConstraints;
+}
+
+Vec2 corner_half_size(const Scene& part, const DesignOptions& opt) {
+    if (opt.plate_half_size.x() > 0) return opt.plate_half_size;
+    const double h = flight_region(part, opt);
+    return Vec2(h, h);
 }
 
 

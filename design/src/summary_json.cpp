@@ -109,6 +109,11 @@ nlohmann::json design_summary_json(const DesignSummary& d, const Scene& part_sce
     // The designed signal's peak per axis over the period (axis_peaks): what the limits bound.
     j["peaks"] = {{"x_m_per_s2", d.peaks[0]},    {"y_m_per_s2", d.peaks[1]},    {"z_m_per_s2", d.peaks[2]},
                   {"rx_rad_per_s2", d.peaks[3]}, {"ry_rad_per_s2", d.peaks[4]}, {"rz_rad_per_s2", d.peaks[5]}};
+    // The plate's corners (corner_peaks): the limits asked (0: none) and the designed motion's peaks.
+    j["corner_limits"] = {{"displacement_m", opt.corner_displacement_limit}, {"velocity_m_per_s", opt.corner_velocity_limit}};
+    j["corner_peaks"] = {{"half_size_m", {d.corner_half_size.x(), d.corner_half_size.y()}},
+                         {"displacement_m", d.corner_peaks.displacement},
+                         {"velocity_m_per_s", d.corner_peaks.velocity}};
     j["starts"] = d.starts;
     j["evaluations"] = d.evaluations;
     j["limit_cycles"] = d.cycles;

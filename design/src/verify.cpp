@@ -117,10 +117,13 @@ bool position_pull(const Scene& sc, const Vec2& s, double theta, const LimitCycl
 
 
 // The designed motion's peaks against the limits, for every target (design() judges what each designer
-// returns, a registered kind's too): sum.peaks set, and a verified design with an axis' peak beyond its
-// limit (by more than 1e-9 relative: the searches' constraints hold to roundoff) fails, naming the axis.
+// returns, a registered kind's too): sum.peaks and sum.corner_peaks set, and a verified design with an
+// axis' peak or a set corner limit exceeded (by more than 1e-9 relative: the searches' constraints hold
+// to roundoff) fails, naming the axis or the corner's quantity.
 void judge_peaks(DesignSummary& sum, const DesignOptions& opt) {
     sum.peaks = axis_peaks(sum.scene.plate);
+    sum.corner_half_size = corner_half_size(sum.scene, opt);
+    sum.corner_peaks = corner_peaks(sum.scene.plate, sum.corner_half_size);
     for (int a = 0; a < 6 && sum.verified; ++a) {
         const double lim = a < 3 ? opt.lin_limit : opt.ang_limit;
         if (sum.peaks[a] <= lim * (1 + 1e-9)) continue;
@@ -129,6 +132,22 @@ void judge_peaks(DesignSummary& sum, const DesignOptions& opt) {
         const char* unit = a < 3 ? " m/s^2" : " rad/s^2";
         why << "the designed motion's peak on " << axis_name(static_cast<Axis>(a)) << " is " << sum.peaks[a] << unit
             << ", above the limit " << lim << unit << " (the peak of the axis' summed signal over the period)";
+        sum.verified = false;
+        sum.failure = why.str();
+    }
+    // (the corners' displacement in mm, their velocity in m/s)
+    const struct {
+        double peak, limit, scale;
+        const char *what, *unit;
+    } corners[] = {{sum.corner_peaks.displacement, opt.corner_displacement_limit, 1e3, "displacement", " mm"},
+                   {sum.corner_peaks.velocity, opt.corner_velocity_limit, 1, "velocity", " m/s"}};
+    for (const auto& k : corners) {
+        if (!sum.verified || !(k.limit > 0) || k.peak <= k.limit * (1 + 1e-9)) continue;
+        std::ostringstream why;
+        why.precision(4);
+        why << "the designed motion's corner " << k.what << " peaks at " << k.scale * k.peak << k.unit << ", above the limit "
+            << k.scale * k.limit << k.unit << " (the plate's corners at +-(" << sum.corner_half_size.x() << ", "
+            << sum.corner_half_size.y() << ") m)";
         sum.verified = false;
         sum.failure = why.str();
     }

@@ -4,7 +4,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <utility>
 
 namespace plate {
 
@@ -78,11 +81,12 @@ std::vector<std::complex<double>> coefficients(const PlateMotion& u, int axis) {
 }
 }   // namespace
 
-// (peaks.hpp) max_t |(u_x, u_y)|: the peak of x^2 + y^2, whose coefficients are the
-// self-convolutions of x's and y's (two-sided, length 2 N + 1; the product has degree 2 N).
-double horizontal_peak(const PlateMotion& u) {
-    const std::vector<std::complex<double>> X = coefficients(u, 0), Y = coefficients(u, 1);
-    const int N = static_cast<int>(std::max(X.size(), Y.size())) - 1;
+// max_t |(f_1(t), ..., f_m(t))|: the peak of sum_j f_j^2, whose coefficients are the
+// self-convolutions of each f_j's (two-sided, length 2 N + 1; the product has degree 2 N).
+double norm_peak(const std::vector<std::vector<std::complex<double>>>& f) {
+    std::size_t size = 1;
+    for (const auto& A : f) size = std::max(size, A.size());
+    const int N = static_cast<int>(size) - 1;
     const auto two_sided = [&](const std::vector<std::complex<double>>& A, int k) -> std::complex<double> {
         const int a = std::abs(k);
         if (a >= static_cast<int>(A.size())) return 0.0;
@@ -90,9 +94,54 @@ double horizontal_peak(const PlateMotion& u) {
     };
     std::vector<std::complex<double>> G(static_cast<std::size_t>(2 * N) + 1, 0.0);
     for (int m = 0; m <= 2 * N; ++m)
-        for (int k = m - N; k <= N; ++k)
-            G[static_cast<std::size_t>(m)] += two_sided(X, k) * two_sided(X, m - k) + two_sided(Y, k) * two_sided(Y, m - k);
+        for (int k = m - N; k <= N; ++k) {
+            std::complex<double> s = 0.0;
+            for (const auto& A : f) s += two_sided(A, k) * two_sided(A, m - k);
+            G[static_cast<std::size_t>(m)] += s;
+        }
     return std::sqrt(trig_peak(G));
+}
+
+// (peaks.hpp) max_t |(u_x, u_y)|.
+double horizontal_peak(const PlateMotion& u) { return norm_peak({coefficients(u, 0), coefficients(u, 1)}); }
+
+// (peaks.hpp) A corner r = (x, y, 0) moves by d = p + phi x r = (p_x - y phi_z, p_y + x phi_z, p_z + y phi_x -
+// x phi_y), and v likewise from p' and omega. In the coefficients F_n of u (theta = w t), integration in t
+// divides F_n by i n w: the velocity's F_n / (i n w), the displacement's -F_n / (n w)^2, both zero-mean as
+// PlateMotion::velocity and ::displacement.
+CornerPeaks corner_peaks(const PlateMotion& u, const Vec2& half_size) {
+    using Coeffs = std::vector<std::complex<double>>;
+    const double w = u.omega();
+    Coeffs V[6], D[6];
+    for (int a = 0; a < 6; ++a) {
+        V[a] = D[a] = coefficients(u, a);
+        for (std::size_t n = 1; n < V[a].size(); ++n) {
+            const double k = static_cast<double>(n) * w;
+            V[a][n] /= std::complex<double>(0, k);
+            D[a][n] /= -(k * k);
+        }
+    }
+    // sum_j w_j L_j for (axis, w) terms
+    const auto combine = [](const Coeffs* L, std::initializer_list<std::pair<int, double>> terms) {
+        Coeffs r(1, 0.0);
+        for (const auto& [a, wt] : terms) {
+            r.resize(std::max(r.size(), L[a].size()), 0.0);
+            for (std::size_t n = 0; n < L[a].size(); ++n) r[n] += wt * L[a][n];
+        }
+        return r;
+    };
+    const auto peak_at = [&](const Coeffs* L, double x, double y) {   // L: x, y, z, rx, ry, rz's coefficients
+        return norm_peak(
+            {combine(L, {{0, 1.0}, {5, -y}}), combine(L, {{1, 1.0}, {5, x}}), combine(L, {{2, 1.0}, {3, y}, {4, -x}})});
+    };
+    CornerPeaks p;
+    for (double sx : {-1.0, 1.0})
+        for (double sy : {-1.0, 1.0}) {
+            const double x = sx * half_size.x(), y = sy * half_size.y();
+            p.displacement = std::max(p.displacement, peak_at(D, x, y));
+            p.velocity = std::max(p.velocity, peak_at(V, x, y));
+        }
+    return p;
 }
 
 Vec6 axis_peaks(const PlateMotion& u) {

@@ -32,7 +32,7 @@ import json as _json
 from typing import Any, Dict
 
 from ._plate import (Camera, ControlEnv, ControlRun, Cycle, Design, Field, FixedLine, FixedPoint, FixedPoints, Identification, InputError,
-                     Progress, Robustness, RotatingAttractor, Scene, Stop, StuckRegion, Track, Trajectory, axis_peaks, bench, check_track_scene, coning_rate, control, control_parts, design, field,
+                     Progress, Robustness, RotatingAttractor, Scene, Stop, StuckRegion, Track, Trajectory, axis_peaks, bench, check_track_scene, coning_rate, control, control_parts, corner_peaks, design, field,
                      fixed_points, frame_stamps, identify, load_camera, load_scene, observe, observe_at,
                      orientation_harmonics, parse_camera, parse_scene, proofs, random_scene, report, read_track_csv, robustness, scene_id,
                      simulate, sweep, twist, uncertain_parameters, write_track_csv)
@@ -40,7 +40,7 @@ from ._plate import __version__ as _compiled_version
 
 __version__ = _compiled_version
 __all__ = ["Camera", "ControlEnv", "ControlRun", "Cycle", "Design", "Field", "FixedLine", "FixedPoint", "FixedPoints", "Identification", "InputError",
-           "Progress", "Robustness", "RotatingAttractor", "Scene", "Stop", "StuckRegion", "Track", "Trajectory", "axis_peaks", "bench", "check_track_scene", "coning_rate", "control", "control_parts", "design",
+           "Progress", "Robustness", "RotatingAttractor", "Scene", "Stop", "StuckRegion", "Track", "Trajectory", "axis_peaks", "bench", "check_track_scene", "coning_rate", "control", "control_parts", "corner_peaks", "design",
            "field", "fixed_points", "frame_stamps", "identify", "load_camera", "load_scene", "observe", "observe_at", "orientation_harmonics",
            "parse_camera", "parse_scene", "proofs", "random_scene", "read_track_csv", "report", "robustness", "scene_from_dict", "scene_id",
            "scene_to_dict", "simulate", "sweep", "twist", "uncertain_parameters", "write_track_csv"]

@@ -89,7 +89,8 @@ void bind_design_function(py::module_& m) {
            double period, std::uint64_t seed, int starts, std::optional<int> evaluations, int verify_starts, int threads,
            double hold, double max_coning, std::vector<std::string> axes, std::optional<int> harmonics,
            std::optional<std::string> target, std::optional<double> lin_limit, std::optional<double> ang_limit,
-           std::optional<int> local_evaluations, std::optional<int> max_harmonic) {
+           std::optional<int> local_evaluations, std::optional<int> max_harmonic,
+           std::optional<std::pair<double, double>> corner_limits, std::optional<std::pair<double, double>> plate_half_size) {
             const DesignTarget t =
                 design_target_from_kwargs(sink, transport, fixed_point, orient, line_sink, target, part.part.point);
             DesignOptions o;   // (judged in the library: validate_design_options, as for the CLI and campaigns)
@@ -102,6 +103,8 @@ void bind_design_function(py::module_& m) {
                 renamed(limits, old_limits, "limits", lin_limit ? "lin_limit" : "ang_limit", std::pair(o.lin_limit, o.ang_limit));
             o.lin_limit = lin;
             o.ang_limit = ang;
+            if (corner_limits) std::tie(o.corner_displacement_limit, o.corner_velocity_limit) = *corner_limits;
+            if (plate_half_size) o.plate_half_size = Vec2(plate_half_size->first, plate_half_size->second);
             o.period = period;
             o.seed = seed;
             o.starts = starts;
@@ -130,10 +133,13 @@ void bind_design_function(py::module_& m) {
         py::arg("evaluations") = py::none(), py::arg("verify_starts") = 20, py::arg("threads") = 0, py::arg("hold") = 120.0,
         py::arg("max_coning") = -1.0, py::arg("axes") = std::vector<std::string>{}, py::arg("harmonics") = py::none(),
         py::arg("target") = py::none(), py::arg("lin_limit") = py::none(), py::arg("ang_limit") = py::none(),
-        py::arg("local_evaluations") = py::none(), py::arg("max_harmonic") = py::none(),
+        py::arg("local_evaluations") = py::none(), py::arg("max_harmonic") = py::none(), py::arg("corner_limits") = py::none(),
+        py::arg("plate_half_size") = py::none(),
         "Designs a plate motion within the peak limits (limits=(LIN, ANG), default (20, 150): LIN [m/s^2]\n"
         "for x, y, z and ANG [rad/s^2] for rx, ry, rz bound the peak over the period of each axis' summed\n"
-        "signal; `peaks`; the command line's --limits) and without\n"
+        "signal; `peaks`; the command line's --limits), optionally within corner_limits=(DISP, VEL) [m, m/s]\n"
+        "on the peak displacement and velocity of the plate's corners at +-plate_half_size [m] (default the\n"
+        "flight check's square; `corner_peaks`; --corner-limits, --plate-half-size), and without\n"
         "flight, and verifies it (grid and\n"
         "full dynamics; sinks and fixed points also by a part released at the target staying within 5 mm\n"
         "for `hold` seconds, which limits a sink's coning unless max_coning >= 0 sets it [rad/s]).\n"
@@ -220,6 +226,12 @@ void bind_design(py::module_& m) {
                       "the designed motion's peak per axis over the period, x y z [m/s^2], rx ry rz [rad/s^2] "
                       "(plate.axis_peaks): what limits bound")
         .def_property_readonly(
+            "corner_peaks",
+            [](const PyDesign& s) { return std::make_tuple(s.corner_peaks.displacement, s.corner_peaks.velocity); },
+            "the designed motion's corners (at +-corner_half_size): (peak displacement [m], peak velocity [m/s]) "
+            "(plate.corner_peaks): what corner_limits bound")
+        .def_readonly("corner_half_size", &DesignSummary::corner_half_size, "the plate's corners the corner peaks are at [m]")
+        .def_property_readonly(
             "pulls",
             [](const PyDesign& s) {
                 std::vector<std::tuple<double, Vec2, Eigen::Vector2cd>> r;
@@ -256,6 +268,19 @@ void bind_design(py::module_& m) {
         "axis_peaks", [](const Scene& sc) { return axis_peaks(sc.plate); }, py::arg("scene"),
         "The peak over the period of each axis' summed plate acceleration |u_a(t)|, x y z [m/s^2], rx ry rz\n"
         "[rad/s^2]: what actuators saturate on, and what plate.design's limits bound.");
+    m.def(
+        "corner_peaks",
+        [](const Scene& sc, const std::pair<double, double>& half_size) {
+            require(half_size.first >= 0 && half_size.second >= 0 && std::isfinite(half_size.first) &&
+                        std::isfinite(half_size.second),
+                    "corner_peaks: half_size: expected two finite lengths >= 0 [m]");
+            const CornerPeaks p = corner_peaks(sc.plate, Vec2(half_size.first, half_size.second));
+            return std::make_tuple(p.displacement, p.velocity);
+        },
+        py::arg("scene"), py::arg("half_size"),
+        "(peak displacement [m], peak velocity [m/s]) over the period of the plate's corners at\n"
+        "(+-half_size[0], +-half_size[1]) [m], to first order in the plate's rotation: what plate.design's\n"
+        "corner_limits bound.");
 }
 
 }   // namespace plate::python

@@ -95,9 +95,9 @@ void io(Archive& a, DesignSummary::OrientationPull& p) { a(p.theta, p.zero, p.ei
 void io(Archive& a, DesignSummary& d) {
     a(d.verified, d.unique, d.failure, d.scene, d.rate, d.eigenvalues, d.eigenvalues3, d.starts, d.evaluations, d.cycles,
       d.fixed_points, d.fixed_point, d.fixed_point_eigenvalues, d.basin_share, d.basin_share_bound, d.competitors, d.runs,
-      d.worst_end_distance, d.held, d.coning, d.peaks, d.min_vertical_margin, d.pulls, d.ring_theta, d.ring_twist,
-      d.transport_mean, d.transport_turn, d.transport_spread, d.transport_tolerance, d.seconds, d.predicted_radius95,
-      d.robustness, d.notes);
+      d.worst_end_distance, d.held, d.coning, d.peaks, d.corner_peaks.displacement, d.corner_peaks.velocity, d.corner_half_size,
+      d.min_vertical_margin, d.pulls, d.ring_theta, d.ring_twist, d.transport_mean, d.transport_turn, d.transport_spread,
+      d.transport_tolerance, d.seconds, d.predicted_radius95, d.robustness, d.notes);
 }
 
 void io(Archive& a, Spread& s) { a(s.spread, s.distribution); }

@@ -315,6 +315,41 @@ def test_a_designed_sink_gathers_parts_released_anywhere_on_the_plate():
     assert np.hypot(*(tr.q[-1, :2] - end[:2])) < 1e-4     # the design's own hold, at rtol 1e-7
 
 
+def test_a_sink_designed_under_corner_limits_keeps_the_plate_corners_within_them():
+    # The plate's corners at +-(0.05, 0.05) m (the flight check's square), sampled here at 2 10^4 points
+    # from the scene's harmonics: displacement p + phi x r and velocity p' + omega x r, to first order in
+    # the rotation (the sampling is never above the true peak, and within 1e-6 of it for n <= 3).
+    part = plate.load_scene(scene_path("fig1_point"))
+    d = plate.design(part, sink=(0.02, -0.01), corner_limits=(0.0005, 0.07), starts=4, evaluations=400)
+    assert d.verified, d.failure
+    assert tuple(d.corner_half_size) == (0.05, 0.05)
+    m = d.scene.to_dict()["plate"]
+    T = m["period"]
+    t = np.linspace(0, T, 20000, endpoint=False)
+    disp = {a: np.zeros_like(t) for a in ("x", "y", "z", "rx", "ry", "rz")}
+    vel = {a: np.zeros_like(t) for a in disp}
+    for h in m["harmonics"]:
+        k = h["n"] * 2 * np.pi / T
+        disp[h["axis"]] += -h["amp"] / k**2 * np.sin(k * t + h["phase"])
+        vel[h["axis"]] += -h["amp"] / k * np.cos(k * t + h["phase"])
+    peaks = []
+    for s in (disp, vel):
+        worst = 0.0
+        for x in (-0.05, 0.05):
+            for y in (-0.05, 0.05):
+                p = np.stack([s["x"], s["y"], s["z"]]) + np.cross(np.stack([s["rx"], s["ry"], s["rz"]]).T, [x, y, 0]).T
+                worst = max(worst, float(np.max(np.linalg.norm(p, axis=0))))
+        peaks.append(worst)
+    assert peaks[0] <= 0.0005 * (1 + 1e-9) and peaks[1] <= 0.07 * (1 + 1e-9)
+    assert d.corner_peaks == pytest.approx(peaks, rel=1e-6)
+    assert plate.corner_peaks(d.scene, (0.05, 0.05)) == d.corner_peaks
+    # Unlimited, the same sink moves its corners by 1.1 mm at 0.14 m/s: the limits bound the design.
+    free = plate.design(part, sink=(0.02, -0.01), starts=4, evaluations=400)
+    assert free.corner_peaks[0] > 0.001 and free.corner_peaks[1] > 0.1
+    with pytest.raises(ValueError, match="corner_limits"):
+        plate.design(part, sink=(0.02, -0.01), corner_limits=(-1, 0))
+
+
 def test_coning_turns_the_part_at_the_closed_form_rate():
     # fig4: rx, ry 100 rad/s^2 a quarter period apart turn the plate about z at -1e4 / (2 (40 pi)^3)
     # rad/s; the part, at the field's stable fixed point (0, 0, 0), turns with it in the full dynamics.

@@ -206,7 +206,7 @@ void read_field(const Reader& r, const json& f, std::size_t d, const Scene& base
 
 // "compute": {"design": {...}}: the target and the search, judged by the library on the base scene.
 void read_design(const Reader& r, const json& g, const Scene& base, Campaign& c) {
-    r.only(g, "compute.design", {"target", "limits", "starts", "evaluations", "seed"});
+    r.only(g, "compute.design", {"target", "limits", "corner_limits", "plate_half_size", "starts", "evaluations", "seed"});
     // [KIND, numbers...]: the library's parser and judgement, as the CLI's --target and Python's target=
     const json& t = r.need(g, "compute.design", "target");
     if (!t.is_array() || t.empty() || t.size() > 100 || !t[0].is_string())   // (the count: the parser's)
@@ -223,6 +223,15 @@ void read_design(const Reader& r, const json& g, const Scene& base, Campaign& c)
         const auto l = r.numbers(g["limits"], "compute.design.limits", 2, 2);
         c.design_options.lin_limit = l[0];
         c.design_options.ang_limit = l[1];
+    }
+    if (g.contains("corner_limits")) {
+        const auto l = r.numbers(g["corner_limits"], "compute.design.corner_limits", 2, 2);
+        c.design_options.corner_displacement_limit = l[0];
+        c.design_options.corner_velocity_limit = l[1];
+    }
+    if (g.contains("plate_half_size")) {
+        const auto h = r.numbers(g["plate_half_size"], "compute.design.plate_half_size", 2, 2);
+        c.design_options.plate_half_size = Vec2(h[0], h[1]);
     }
     if (g.contains("starts")) c.design_options.starts = static_cast<int>(r.whole(g["starts"], "compute.design.starts", 1, 10000));
     if (g.contains("evaluations"))

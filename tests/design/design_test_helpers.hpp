@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <initializer_list>
 #include <string>
 
 namespace design_tests {
@@ -64,6 +65,14 @@ inline DesignSummary verified_transport(const Scene& part, const Vec2& velocity,
     INFO(s.failure);
     REQUIRE(s.verified);
     return s;
+}
+
+// A plate motion of the given harmonics and period T [s].
+inline PlateMotion harmonic_motion(std::initializer_list<Harmonic> h, double T = 0.05) {
+    PlateMotion u;
+    u.T = T;
+    u.harmonics = h;
+    return u;
 }
 
 // max over N equally spaced samples of |u_a(t)| per axis (the acceleration as the model evaluates it):

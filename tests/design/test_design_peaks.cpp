@@ -13,24 +13,13 @@
 using namespace plate;
 using namespace design_tests;
 
-namespace {
-
-PlateMotion motion(std::initializer_list<Harmonic> h, double T = 0.05) {
-    PlateMotion u;
-    u.T = T;
-    u.harmonics = h;
-    return u;
-}
-
-}   // namespace
-
 TEST_CASE("one harmonic peaks at its amplitude, whatever its phase, order, sign or axis", "[design][peaks]") {
     // (measured: within 2e-16 of |amp|; a sampling of 32 points per period alone misses by up to 5e-3)
     for (int a = 0; a < 6; ++a)
         for (int n : {1, 2, 5})
             for (double amp : {1.0, -7.5, 130.0})
                 for (double phase : {0.0, 0.3, -2.9}) {
-                    const Vec6 p = axis_peaks(motion({{static_cast<Axis>(a), n, amp, phase}}));
+                    const Vec6 p = axis_peaks(harmonic_motion({{static_cast<Axis>(a), n, amp, phase}}));
                     for (int b = 0; b < 6; ++b) CHECK(p[b] == Approx(b == a ? std::abs(amp) : 0.0).epsilon(1e-12).margin(1e-300));
                 }
 }
@@ -47,16 +36,17 @@ TEST_CASE("sin t + a sin 3t: the crest at pi/2 for a <= 1/9, the interior maximu
     for (double a : {-2.0, -0.5, -1.0 / 3, -0.1, 0.0, 0.05, 1.0 / 9, 0.125, 1.0 / 6, 0.3, 1.0, 4.0}) {
         INFO("a = " << a);
         const double T = 0.037;
-        const Vec6 p = axis_peaks(motion({{Axis::ry, 1, 12.0, 0}, {Axis::ry, 3, 12.0 * a, 0}}, T));
+        const Vec6 p = axis_peaks(harmonic_motion({{Axis::ry, 1, 12.0, 0}, {Axis::ry, 3, 12.0 * a, 0}}, T));
         CHECK(p[4] == Approx(12.0 * closed(a)).epsilon(1e-12));
     }
 }
 
 TEST_CASE("entries of one axis and harmonic add as phasors, a negative amplitude a half period", "[design][peaks]") {
     // (a sum of amplitudes gives 2, 3.5 and 2)
-    CHECK(axis_peaks(motion({{Axis::x, 1, 1.0, 0}, {Axis::x, 1, 1.0, kPi / 2}}))[0] == Approx(std::sqrt(2.0)).epsilon(1e-12));
-    CHECK(axis_peaks(motion({{Axis::x, 1, 2.0, 0.4}, {Axis::x, 1, -1.5, 0.4}}))[0] == Approx(0.5).epsilon(1e-12));
-    CHECK(axis_peaks(motion({{Axis::rz, 2, 1.0, 0.7}, {Axis::rz, 2, 1.0, 0.7 + kPi}}))[5] < 1e-15);
+    CHECK(axis_peaks(harmonic_motion({{Axis::x, 1, 1.0, 0}, {Axis::x, 1, 1.0, kPi / 2}}))[0] ==
+          Approx(std::sqrt(2.0)).epsilon(1e-12));
+    CHECK(axis_peaks(harmonic_motion({{Axis::x, 1, 2.0, 0.4}, {Axis::x, 1, -1.5, 0.4}}))[0] == Approx(0.5).epsilon(1e-12));
+    CHECK(axis_peaks(harmonic_motion({{Axis::rz, 2, 1.0, 0.7}, {Axis::rz, 2, 1.0, 0.7 + kPi}}))[5] < 1e-15);
 }
 
 TEST_CASE("the peaks match an independent sampling at 10^6 points and do not move with a time shift", "[design][peaks]") {
@@ -103,10 +93,11 @@ TEST_CASE("the horizontal peak bounds x's and y's peaks at every turn of the mot
     // random motion against 10^5 samples of |(x, y)| (below the peak by at most 2e-9 of it), the same
     // after any turn, and at least the x peak of 72 turns. (measured: the closed forms exactly)
     using design_detail::horizontal_peak;
-    CHECK(horizontal_peak(motion({{Axis::x, 1, 3.0, kPi / 2}, {Axis::y, 1, 3.0, 0}})) == Approx(3.0).epsilon(1e-12));
-    CHECK(horizontal_peak(motion({{Axis::x, 2, 1.0, 0.3}, {Axis::y, 2, 1.0, 0.3}})) == Approx(std::sqrt(2.0)).epsilon(1e-12));
+    CHECK(horizontal_peak(harmonic_motion({{Axis::x, 1, 3.0, kPi / 2}, {Axis::y, 1, 3.0, 0}})) == Approx(3.0).epsilon(1e-12));
+    CHECK(horizontal_peak(harmonic_motion({{Axis::x, 2, 1.0, 0.3}, {Axis::y, 2, 1.0, 0.3}})) ==
+          Approx(std::sqrt(2.0)).epsilon(1e-12));
     const PlateMotion u =
-        motion({{Axis::x, 1, 7.0, 0.4}, {Axis::x, 2, 3.0, -1.1}, {Axis::y, 1, 5.0, 2.0}, {Axis::y, 2, 4.0, 0.2}});
+        harmonic_motion({{Axis::x, 1, 7.0, 0.4}, {Axis::x, 2, 3.0, -1.1}, {Axis::y, 1, 5.0, 2.0}, {Axis::y, 2, 4.0, 0.2}});
     const double h = horizontal_peak(u);
     double sampled = 0;
     for (int k = 0; k < 100'000; ++k) {
@@ -138,7 +129,7 @@ TEST_CASE("a design whose motion exceeds a peak limit fails verification, naming
     type.design = [](const Scene& p, const DesignTarget&, const DesignOptions&, double T) {
         DesignSummary s;
         s.scene = p;
-        s.scene.plate = motion({{Axis::rx, 1, 60.0, 0.2}, {Axis::rx, 3, -20.0, 0.6}}, T);
+        s.scene.plate = harmonic_motion({{Axis::rx, 1, 60.0, 0.2}, {Axis::rx, 3, -20.0, 0.6}}, T);
         s.verified = true;
         return s;
     };

@@ -100,8 +100,17 @@ struct DesignOptions {
     // motions with a coefficient between 1 and 4 / pi of the limit; docs/decisions: why not wider).
     double lin_limit = 20;    // the peak of each linear axis' acceleration, x, y, z [m/s^2]
     double ang_limit = 150;   // the peak of each angular axis' acceleration, rx, ry, rz [rad/s^2]
-    double period = 0;        // plate period T [s]; 0: the part scene's
-    double region = 0.05;     // the plate region |s_x|, |s_y| <= region [m]
+    // Corner limits (0: none): what the plate's stops and its actuators' speed bound. The plate's
+    // corners at (+-plate_half_size) keep the peak length of their displacement within
+    // corner_displacement_limit [m] and of their velocity within corner_velocity_limit [m/s]
+    // (corner_peaks, plate/peaks.hpp) -- a constraint of every search when either is set, and checked
+    // by design() on the motion it returns, as the peaks are. plate_half_size zero: the corners of the
+    // flight check's square (the region widened by a rigid part's reach).
+    double corner_displacement_limit = 0;
+    double corner_velocity_limit = 0;
+    Vec2 plate_half_size = Vec2::Zero();   // [m]
+    double period = 0;                     // plate period T [s]; 0: the part scene's
+    double region = 0.05;                  // the plate region |s_x|, |s_y| <= region [m]
     // No flight: g + the vertical acceleration of every plate point in the region (for a rigid part
     // widened by its contacts' reach from its centre of mass) stays at or above this fraction of g,
     // all period long (a constraint of the search, never a penalty).
@@ -235,9 +244,11 @@ struct DesignSummary {
     // Hold (sinks and fixed points): released at rest at the target, where the part is after
     // DesignOptions::hold seconds of full dynamics and how far that is (measured as end_distance).
     DesignStartRun held;
-    double coning = 0;                // the design's coning rate psi' [rad/s] (coning_rate)
-    Vec6 peaks = Vec6::Zero();        // the designed motion's axis_peaks [m/s^2 x y z, rad/s^2 rx ry rz]
-    double min_vertical_margin = 0;   // min over the period and the flight check's square of (g + a_z) / g
+    double coning = 0;                      // the design's coning rate psi' [rad/s] (coning_rate)
+    Vec6 peaks = Vec6::Zero();              // the designed motion's axis_peaks [m/s^2 x y z, rad/s^2 rx ry rz]
+    CornerPeaks corner_peaks;               // ... and its corners' (at corner_half_size), whether limited or not
+    Vec2 corner_half_size = Vec2::Zero();   // [m]
+    double min_vertical_margin = 0;         // min over the period and the flight check's square of (g + a_z) / g
     // A rigid part's sink (position only: the part may turn as it pleases): at the target, per
     // orientation of the verification grid, where the position's velocity field vanishes and its
     // Jacobian's eigenvalues there.

@@ -23,5 +23,18 @@ Vec6 axis_peaks(const PlateMotion& u);
 double trig_peak(const std::vector<std::complex<double>>& F);
 // max over t of |(u_x(t), u_y(t))|: the largest peak of x (or y) over every turn of the motion about z.
 double horizontal_peak(const PlateMotion& u);
+// max_t |(f_1(t), ..., f_m(t))| for real trigonometric polynomials given as trig_peak's F_k.
+double norm_peak(const std::vector<std::vector<std::complex<double>>>& f);
+
+// What a plate's stops and its actuators' speed bound: the plate's corners at (+-half_size.x,
+// +-half_size.y) in the plate frame [m], and over the period and the four corners the peak length of
+// a corner's displacement from its mean position [m] and of its velocity [m/s]. To first order in the
+// plate's rotation, which is milliradians (d = p + phi x r with phi the zero-mean integral of omega, as
+// PlateMotion::displacement; v = p' + omega x r). Exact to roundoff as the peaks above.
+struct CornerPeaks {
+    double displacement = 0;   // [m]
+    double velocity = 0;       // [m/s]
+};
+CornerPeaks corner_peaks(const PlateMotion& u, const Vec2& half_size);
 
 }   // namespace plate

@@ -19,7 +19,9 @@
 //                  "field": {"grid": [NX, NY, NTH], "x": [MIN, MAX], "y": [MIN, MAX]},
 //                  "fixed_points": true,                    // on the field's grid
 //                  "design": {"target": ["sink", X, Y], "starts": 4, "evaluations": 200},  // any
-//                           // KIND and numbers --target takes, judged by parse_design_target
+//                           // KIND and numbers --target takes, judged by parse_design_target;
+//                           // also "limits": [LIN, ANG], "corner_limits": [DISP, VEL], "plate_half_size":
+//                           // [HX, HY] and "seed", as plate design's flags
 //                  "cycle": {"tol": 1e-7, "rtol": 1e-8, "max_rhs": 2e6} } }
 // A pointer addresses a number of the scene, or an array of numbers, every element of which takes
 // the value (/part/friction: every contact's friction). Unknown or missing fields are errors naming
