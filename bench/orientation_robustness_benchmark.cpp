@@ -56,10 +56,10 @@ using namespace plate::design_detail;
 
 namespace {
 
-constexpr double kZ = 1.645;     // one-sided 95 %
-constexpr double kArrive = 60;   // [s] issue 51's arrival time
-constexpr int kConstraints = kPeakConstraints + 3;
-using Ring = std::vector<double>;   // theta' on theta_k = -pi + 2 pi k / n [rad/s]
+constexpr double kZ = 1.645;                         // one-sided 95 %
+constexpr double kArrive = 60;                       // [s] issue 51's arrival time
+constexpr int kConstraints = kPeakConstraints + 3;   // (no corner limits: `limits` sets none, corner_count 0)
+using Ring = std::vector<double>;                    // theta' on theta_k = -pi + 2 pi k / n [rad/s]
 
 // theta' at a fixed position, or along s* (reduced_ring: where the position's twist vanishes, linearised).
 Ring ring_at(const Scene& sc, const Vec2& s, int n, const LimitCycleOptions& cyc, bool along) {
@@ -397,7 +397,7 @@ void search(Search& s, int starts, int evaluations, std::uint64_t seed, std::vec
     std::normal_distribution<double> normal(0, 1);
     const int np = s.params();
     const auto feasible = [&](const std::vector<double>& p) {
-        double c[kConstraints];
+        double c[kConstraints + kCornerConstraints];
         s.constraints(p, c);
         return *std::max_element(c, c + kConstraints) <= 0;
     };
@@ -437,7 +437,7 @@ void search(Search& s, int starts, int evaluations, std::uint64_t seed, std::vec
             o.add_inequality_constraint(
                 [](const std::vector<double>& x, std::vector<double>&, void* d) {
                     const Con& c = *static_cast<Con*>(d);
-                    double v[kConstraints];
+                    double v[kConstraints + kCornerConstraints];
                     c.s->constraints(x, v);
                     return v[c.k];
                 },

@@ -143,7 +143,7 @@ void validate_design_options(const DesignOptions& o) {
             "corner_limits: expected a displacement from 0 to 1 m and a velocity from 0 to 100 m/s (0: none)");
     require(o.plate_half_size.x() >= 0 && o.plate_half_size.y() >= 0 && o.plate_half_size.x() <= 10 &&
                 o.plate_half_size.y() <= 10 && (o.plate_half_size.x() > 0) == (o.plate_half_size.y() > 0),
-            "plate_half_size: expected both zero (the flight check's square) or both from 0 to 10 m");
+            "plate_half_size: expected both zero (the flight check's square) or both in (0, 10] m");
     require(o.period == 0 || (o.period >= kPeriodRange[0] && o.period <= kPeriodRange[1]),
             "period: expected 0 (the part scene's) or " + number_text(kPeriodRange[0]) + " to " + number_text(kPeriodRange[1]) +
                 " s");

@@ -276,7 +276,8 @@ void verify_robust(DesignSummary& sum, const DesignTarget& target, const DesignO
 
 // --- verification (verify.cpp) -------------------------------------------------------------------
 
-constexpr const char* kNoFeasibleMotion = "no motion within the limits keeps the part on the plate over the region";
+constexpr const char* kNoFeasibleMotion =
+    "no motion within the limits (and the corner limits, if set) keeps the part on the plate over the region";
 // The verify_grid^2 grid over the region (a rigid part: verify_grid orientations too), and the designed
 // field on it.
 GridSpec verification_grid(const Scene& sc, const DesignOptions& opt);

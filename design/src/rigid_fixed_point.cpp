@@ -14,7 +14,7 @@ PlateMotion rigid_motion(const std::vector<double>& p, double T) { return motion
 
 // Constraints c_k <= 0 on a motion as placed: each axis' peak within its limit times `room`, no flight
 // under the part's contacts over the region, no coning beyond kConingLimit either way and no tilt drift
-// beyond kTiltDriftLimit (kPlacedConstraints entries).
+// beyond kTiltDriftLimit (kPlacedConstraints entries, and corner_count(opt) more after the peaks).
 void placed_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
     const int k = peak_constraints(fin, opt, part, room, c);
     const double cone = coning_rate(fin) / kConingLimit;

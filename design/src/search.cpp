@@ -88,7 +88,8 @@ double cycle_noise(const LimitCycleOptions& o) { return o.tol + 60 * o.integrati
 TaskRunner runner(const DesignOptions& opt) { return opt.tasks ? opt.tasks : thread_tasks(opt.threads); }
 
 // c_a <= 0 for each axis' peak of `fin` (axis_peaks) within `room` times the axis' limit (6 entries),
-// then c <= 0 for no flight over the region; returns the entries written (kPeakConstraints).
+// then c <= 0 for no flight over the region, then the corner limits' (corner_count(opt)); returns the
+// entries written.
 int peak_constraints(const PlateMotion& fin, const DesignOptions& opt, const Scene& part, double room, double* c) {
     const Vec6 peak = axis_peaks(fin);
     for (int axis = 0; axis < 6; ++axis) {
