@@ -293,3 +293,58 @@ TEST_CASE("identify fits the pieces first where the plate's orientation repeats,
     o4.max_iterations = 1;
     CHECK(identify(fig4, {t4}, o4).pieces == 0);
 }
+
+// minimise() runs every track's simulations at a point as one set of tasks (PointSimulations, a Ceres
+// evaluation callback); each track's block then copies them. They must be exactly what the track's own
+// Evaluate computes, and the residuals at a point already evaluated are not simulated again. Two of
+// fig4's sliding 2 s tracks, at the truth: a new point without Jacobians (1 simulation a track), the
+// Jacobians at that same point (n + 3 more a track, not n + 4), x held whole (3 a track: its start's
+// columns only), and a new point with Jacobians (n + 4). Seen failing: the residuals simulated again
+// at the same point (16 simulations against 14 after the Jacobians), and each column's two sides
+// exchanged (the copied Jacobians then differ from the tracks' own).
+TEST_CASE("every track's simulations at a point run together and equal each track's own", "[identify]") {
+    const Scene nominal = scene("fig4");
+    const std::vector<std::string> names = {"mu_k1", "mu_k2", "mu_k3"};
+    const std::vector<double> truth = {0.25, 0.30, 0.35};
+    const std::vector<Track> tracks = {filmed(nominal, names, truth, strobe(0.1, 5, 11), Vec3(0.01, -0.02, 0.4), 2.0),
+                                       filmed(nominal, names, truth, strobe(0.1, 5, 12), Vec3(-0.02, 0.01, -0.3), 2.0)};
+    const IdentifyOptions o = options(names);
+    const Layout layout(nominal, names);
+    const int n = layout.size();
+    std::vector<double> x = layout.internal(truth);
+    std::vector<std::vector<double>> q0 = {{10, -20, 0.4}, {-20, 10, -0.3}};
+    TrackCost a(nominal, layout, tracks[0], 0, o, false), b(nominal, layout, tracks[1], 0, o, false);
+    const TrackCost own_a(nominal, layout, tracks[0], 0, o, false), own_b(nominal, layout, tracks[1], 0, o, false);
+    const std::vector<TrackCost*> costs = {&a, &b};
+    const auto sims = [&] { return a.simulations() + b.simulations(); };
+    // A block's Evaluate: residuals, then both Jacobians in one vector (block 0's absent where null).
+    const auto evaluate = [&](const TrackCost& c, int t, bool block0) {
+        const int m = c.num_residuals();
+        std::vector<double> r(m), jx(static_cast<std::size_t>(m) * n), jq(static_cast<std::size_t>(m) * 3);
+        const double* params[2] = {x.data(), q0[t].data()};
+        double* jac[2] = {block0 ? jx.data() : nullptr, jq.data()};
+        REQUIRE(c.Evaluate(params, r.data(), jac));
+        if (block0) r.insert(r.end(), jx.begin(), jx.end());
+        r.insert(r.end(), jq.begin(), jq.end());
+        return r;
+    };
+    {
+        identify_detail::PointSimulations point(costs, x, q0, false, 2);
+        point.PrepareForEvaluation(false, true);
+        CHECK(sims() == 2);
+        point.PrepareForEvaluation(true, false);
+        CHECK(sims() == 2 + 2 * (n + 3));
+        CHECK(evaluate(a, 0, true) == evaluate(own_a, 0, true));
+        CHECK(evaluate(b, 1, true) == evaluate(own_b, 1, true));
+        CHECK(sims() == 2 + 2 * (n + 3));   // (the blocks copied)
+        x[1] += 1e-3;
+        point.PrepareForEvaluation(true, true);
+        CHECK(sims() == 2 + 2 * (n + 3) + 2 * (n + 4));
+        CHECK(evaluate(a, 0, true) == evaluate(own_a, 0, true));
+    }
+    const long before = sims();
+    identify_detail::PointSimulations held(costs, x, q0, true, 2);
+    held.PrepareForEvaluation(true, true);
+    CHECK(sims() == before + 2 * (1 + 3));
+    CHECK(evaluate(b, 1, false) == evaluate(own_b, 1, false));
+}

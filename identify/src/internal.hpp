@@ -94,6 +94,8 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
 // Profile mode (profile.cpp): block 0 holds z, the internal coordinates with the profiled parameter j's
 // own replaced by its value in scene units (held: its column is left zero), so that a static
 // coefficient stays at that value while its kinetic base moves; the differences stay within [lo, hi].
+struct Prepared;
+
 class TrackCost final : public ceres::CostFunction {
 public:
     TrackCost(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o, bool central);
@@ -108,6 +110,27 @@ public:
     // Evaluate that asks for Jacobians computes them anew; those after it reuse them up to that many times.
     void fresh_jacobian() const { reused_ = kFresh; }
     void reuse(int times) { reuse_ = central_ ? 0 : times; }
+
+    // An evaluation's simulations one by one (PointSimulations runs every track's at once; Evaluate
+    // runs its own in turn). A Jacobian column of block b (0: the named parameters, 1: the start):
+    // its step and the sides simulated (none: the column is zero -- the profiled parameter's).
+    struct Column {
+        int b = 0, j = 0;
+        double h = 0;
+        bool up = false, down = false;
+    };
+    std::vector<Column> columns(const double* const* parameters, bool block0, bool block1) const;
+    // The residuals with column c's coordinate moved up (upper) or down by its step.
+    bool moved(const double* const* parameters, const Column& c, bool upper, double* out) const;
+    // Column c of its block's Jacobian from the residuals at the point (r) and moved (plus, minus: may
+    // be null where c does not simulate that side).
+    void difference(const Column& c, const double* r, const double* plus, const double* minus, double* jacobian) const;
+    // Chord steps: true (the kept Jacobians copied) where this evaluation reuses them; keep() after a
+    // Jacobian computed anew.
+    bool reuse_kept(double* const* jacobians) const;
+    void keep(double* const* jacobians) const;
+    // While set, Evaluate copies what a PointSimulations prepared (minimise sets and clears it).
+    void use(const Prepared* prepared) { prepared_ = prepared; }
 
 private:
     const Scene& scene_;
@@ -124,6 +147,37 @@ private:
     int reuse_ = 0;                         // 0: a Jacobian computed at every Evaluate that asks
     mutable int reused_ = kFresh;           // times the kept Jacobians were reused since computed
     mutable std::vector<double> kept_[2];   // the last computed Jacobians, blocks 0 and 1
+    const Prepared* prepared_ = nullptr;
+};
+
+// One track's residuals and Jacobians at the point Ceres evaluates next, as PointSimulations prepared
+// them (false: a simulation stopped).
+struct Prepared {
+    bool ok = false;
+    std::vector<double> r, jacobian[2];
+};
+
+// Every track's simulations at an evaluation point as one set of tasks on `threads` (a Ceres
+// EvaluationCallback; the tracks' costs copy the results while it lives): the residuals where the point
+// is new, and with Jacobians every column's differences (block 0's unless x is held whole). Ceres'
+// own threads would share the work out by track (5 tracks on 2 threads keep 83 % of them busy), and
+// would simulate the residuals again where it asks for the Jacobian at the point it has just evaluated.
+class PointSimulations final : public ceres::EvaluationCallback {
+public:
+    PointSimulations(const std::vector<TrackCost*>& costs, const std::vector<double>& x,
+                     const std::vector<std::vector<double>>& q0, bool x_held, int threads);
+    ~PointSimulations() override;
+    PointSimulations(const PointSimulations&) = delete;
+    PointSimulations& operator=(const PointSimulations&) = delete;
+    void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
+
+private:
+    const std::vector<TrackCost*>& costs_;
+    const std::vector<double>& x_;
+    const std::vector<std::vector<double>>& q0_;
+    bool x_held_;
+    int threads_;
+    std::vector<Prepared> prepared_;
 };
 
 // One Levenberg-Marquardt solve over block 0 (`x`, the coordinates in `held` kept) and the tracks'
