@@ -332,6 +332,8 @@ TEST_CASE("every track's simulations at a point run together and equal each trac
         identify_detail::PointSimulations point(costs, x, q0, false, 2);
         point.PrepareForEvaluation(false, true);
         CHECK(sims() == 2);
+        point.PrepareForEvaluation(false, true);   // (called new, but the same bits: as a line search's end)
+        CHECK(sims() == 2);
         point.PrepareForEvaluation(true, false);
         CHECK(sims() == 2 + 2 * (n + 3));
         CHECK(evaluate(a, 0, true) == evaluate(own_a, 0, true));
@@ -347,4 +349,35 @@ TEST_CASE("every track's simulations at a point run together and equal each trac
     held.PrepareForEvaluation(true, true);
     CHECK(sims() == before + 2 * (1 + 3));
     CHECK(evaluate(b, 1, false) == evaluate(own_b, 1, false));
+}
+
+// The fit does not depend on the thread count: every track's simulations at a point are shared out as
+// tasks whose results are combined in one order, and Ceres sums the blocks on one thread. fig4's part
+// sliding, 3 tracks of 2 s, its three kinetic coefficients from 0.03 off, one start, on 1 and on 2
+// threads: every estimate, sd and the chi-square the same to the bit. Seen failing with a task lost when
+// the work is shared out (the last one skipped on more than one thread). The search before
+// PointSimulations (Ceres' threads summing the blocks' costs per thread) also passes here; on fig4's
+// stick-slip scene it differed at 1e-11 between 1 and 2 threads (docs/decisions/identification.md).
+TEST_CASE("an identification is the same to the bit on one thread and on two", "[identify]") {
+    const Scene nominal = scene("fig4");
+    const std::vector<std::string> names = {"mu_k1", "mu_k2", "mu_k3"};
+    const std::vector<double> truth = {0.25, 0.30, 0.35};
+    const std::vector<Track> tracks = {filmed(nominal, names, truth, strobe(0.1, 5, 21), Vec3(0.01, -0.02, 0.4), 2.0),
+                                       filmed(nominal, names, truth, strobe(0.1, 5, 22), Vec3(-0.02, 0.01, -0.3), 2.0),
+                                       filmed(nominal, names, truth, strobe(0.1, 5, 23), Vec3(0.0, 0.02, 1.2), 2.0)};
+    Scene guess = nominal;
+    for (int i = 0; i < 3; ++i) guess.part.mu[i] = truth[i] + 0.03;
+    IdentifyOptions o = options(names);
+    o.starts = 1;
+    const IdentifySummary one = identify(guess, tracks, o);
+    o.threads = 2;
+    const IdentifySummary two = identify(guess, tracks, o);
+    REQUIRE(one.converged);
+    CHECK(one.chi2 == two.chi2);
+    CHECK(one.iterations == two.iterations);
+    for (std::size_t j = 0; j < names.size(); ++j) {
+        CHECK(one.params[j].estimate == two.params[j].estimate);
+        CHECK(one.params[j].sd == two.params[j].sd);
+        CHECK(std::abs(one.params[j].estimate - truth[j]) < 0.01);
+    }
 }

@@ -79,7 +79,7 @@ struct IdentifyArgs : Options {
         number("--settle", o.settle_periods, "plate periods of each track left out at its start");
         number("--rtol", o.rtol, "the simulation's tolerance");
         number("--pieces", o.segment_seconds, "seconds of the pieces the search fits first (0: none)");
-        whole("--threads", o.threads, 1, 1024, "tracks simulated in parallel");
+        whole("--threads", o.threads, 1, 1024, "simulations in parallel (the fit is the same on any number)");
         text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");
         whole("--profile-steps", po.max_steps, 1, 1000, "--profile: re-minimisations per side");
         number("--profile-time-limit", po.time_limit, "--profile: seconds for every profile");

@@ -119,15 +119,17 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     s.unidentifiable.clear();
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, n + d * nt);
     s.chi2 = 0;
+    std::vector<int> first;
+    for (const Track& tr : tracks) first.push_back(first_used_frame(tr, scene.plate.T, o.settle_periods));
+    std::vector<Eigen::VectorXd> rs;
+    std::vector<Eigen::MatrixXd> Jxs, Jqs;
+    if (!tracks_jacobians(scene, layout, tracks, first, o, x, q0, o.threads, rs, Jxs, Jqs))
+        throw std::runtime_error("identify: the optimum's simulation stopped");
     for (int t = 0, row = 0; t < nt; ++t) {
-        Eigen::VectorXd r;
-        Eigen::MatrixXd Jx, Jq;
-        if (!track_jacobian(scene, layout, tracks[t], first_used_frame(tracks[t], scene.plate.T, o.settle_periods), o, x, q0[t],
-                            r, Jx, Jq))
-            throw std::runtime_error("identify: the optimum's simulation stopped");
+        const Eigen::VectorXd& r = rs[t];
         const int m = static_cast<int>(r.size());
-        J.block(row, 0, m, n) = Jx;
-        J.block(row, n + d * t, m, d) = Jq;
+        J.block(row, 0, m, n) = Jxs[t];
+        J.block(row, n + d * t, m, d) = Jqs[t];
         TrackFit f;
         f.source = tracks[t].source;
         f.frames = m / d;

@@ -69,6 +69,12 @@ std::vector<Track> segments(const std::vector<Track>& tracks, double T, double s
 bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
                     const std::vector<double>& x, const std::vector<double>& q0, Eigen::VectorXd& r, Eigen::MatrixXd& Jx,
                     Eigen::MatrixXd& Jq);
+// ... every track's at once (first[t]: track t's first frame), their simulations as one set of tasks on
+// `threads` (PointSimulations); track_jacobian is this for one track on one thread.
+bool tracks_jacobians(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const std::vector<int>& first,
+                      const IdentifyOptions& o, const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
+                      int threads, std::vector<Eigen::VectorXd>& r, std::vector<Eigen::MatrixXd>& Jx,
+                      std::vector<Eigen::MatrixXd>& Jq);
 
 // The named parameters' Gauss-Newton information J^T J with the tracks' starts (J's last starts_size
 // columns) eliminated by the Schur complement, in range-scaled internal units (each coordinate divided
@@ -159,9 +165,10 @@ struct Prepared {
 
 // Every track's simulations at an evaluation point as one set of tasks on `threads` (a Ceres
 // EvaluationCallback; the tracks' costs copy the results while it lives): the residuals where the point
-// is new, and with Jacobians every column's differences (block 0's unless x is held whole). Ceres'
-// own threads would share the work out by track (5 tracks on 2 threads keep 83 % of them busy), and
-// would simulate the residuals again where it asks for the Jacobian at the point it has just evaluated.
+// differs from the last one prepared, and with Jacobians every column's differences (block 0's unless x
+// is held whole). Ceres' own threads would share the work out by track (5 tracks on 2 threads keep 83 %
+// of them busy), and would simulate the residuals again at a point it has just evaluated (its line
+// search's accepted step; the Jacobian after it).
 class PointSimulations final : public ceres::EvaluationCallback {
 public:
     PointSimulations(const std::vector<TrackCost*>& costs, const std::vector<double>& x,
@@ -178,6 +185,8 @@ private:
     bool x_held_;
     int threads_;
     std::vector<Prepared> prepared_;
+    std::vector<double> last_x_;   // the point prepared last
+    std::vector<std::vector<double>> last_q0_;
 };
 
 // One Levenberg-Marquardt solve over block 0 (`x`, the coordinates in `held` kept) and the tracks'

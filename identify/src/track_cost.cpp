@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -113,8 +114,7 @@ bool TrackCost::moved(const double* const* parameters, const Column& c, bool upp
     return residuals(blocks[0], blocks[1], out);
 }
 
-void TrackCost::difference(const Column& c, const double* r, const double* plus, const double* minus,
-                           double* jacobian) const {
+void TrackCost::difference(const Column& c, const double* r, const double* plus, const double* minus, double* jacobian) const {
     const int m = num_residuals(), n = c.b == 0 ? layout_.size() : dim_;
     const double span = (c.up ? c.h : 0) + (c.down ? c.h : 0);
     for (int i = 0; i < m; ++i)
@@ -180,11 +180,16 @@ void PointSimulations::PrepareForEvaluation(bool evaluate_jacobians, bool new_ev
     std::vector<std::vector<std::array<int, 2>>> sides(static_cast<std::size_t>(nt));   // a column's tasks, + and -
     std::vector<std::array<double*, 2>> jac(static_cast<std::size_t>(nt), {nullptr, nullptr});
     std::vector<int> at_point(static_cast<std::size_t>(nt), -1);   // the task of the residuals at the point
+    // Ceres also calls a point new where its line search accepts the step it has just evaluated: the
+    // same bits are the same point.
+    const bool same = !new_evaluation_point || (x_ == last_x_ && q0_ == last_q0_);
+    last_x_ = x_;
+    last_q0_ = q0_;
     for (int t = 0; t < nt; ++t) {
         Prepared& p = prepared_[static_cast<std::size_t>(t)];
         const TrackCost& cost = *costs_[static_cast<std::size_t>(t)];
         const int m = cost.num_residuals();
-        if (new_evaluation_point || !p.ok) {
+        if (!same || !p.ok) {
             p.r.resize(static_cast<std::size_t>(m));
             at_point[t] = static_cast<int>(tasks.size());
             tasks.push_back({t, -1, false});
@@ -293,19 +298,45 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
     return out;
 }
 
+bool tracks_jacobians(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const std::vector<int>& first,
+                      const IdentifyOptions& o, const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
+                      int threads, std::vector<Eigen::VectorXd>& r, std::vector<Eigen::MatrixXd>& Jx,
+                      std::vector<Eigen::MatrixXd>& Jq) {
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    const std::size_t nt = tracks.size();
+    std::vector<std::unique_ptr<TrackCost>> costs;
+    std::vector<TrackCost*> ptrs;
+    for (std::size_t t = 0; t < nt; ++t) {
+        costs.push_back(std::make_unique<TrackCost>(scene, layout, tracks[t], first[t], o, true));
+        ptrs.push_back(costs.back().get());
+    }
+    PointSimulations sims(ptrs, x, q0, false, threads);
+    sims.PrepareForEvaluation(true, true);
+    r.resize(nt);
+    Jx.resize(nt);
+    Jq.resize(nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+        const int m = costs[t]->num_residuals(), n = layout.size(), d = tracks[t].point ? 2 : 3;
+        std::vector<double> rr(m), j0(static_cast<std::size_t>(m) * n), j1(static_cast<std::size_t>(m) * d);
+        const double* params[2] = {x.data(), q0[t].data()};
+        double* jac[2] = {j0.data(), j1.data()};
+        if (!costs[t]->Evaluate(params, rr.data(), jac)) return false;   // (copies what `sims` prepared)
+        r[t] = Eigen::Map<const Eigen::VectorXd>(rr.data(), m);
+        Jx[t] = Eigen::Map<const RowMajor>(j0.data(), m, n);
+        Jq[t] = Eigen::Map<const RowMajor>(j1.data(), m, d);
+    }
+    return true;
+}
+
 bool track_jacobian(const Scene& scene, const Layout& layout, const Track& track, int first, const IdentifyOptions& o,
                     const std::vector<double>& x, const std::vector<double>& q0, Eigen::VectorXd& r, Eigen::MatrixXd& Jx,
                     Eigen::MatrixXd& Jq) {
-    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-    const TrackCost cost(scene, layout, track, first, o, true);
-    const int m = cost.num_residuals(), n = layout.size(), d = track.point ? 2 : 3;
-    std::vector<double> rr(m), j0(static_cast<std::size_t>(m) * n), j1(static_cast<std::size_t>(m) * d);
-    const double* params[2] = {x.data(), q0.data()};
-    double* jac[2] = {j0.data(), j1.data()};
-    if (!cost.Evaluate(params, rr.data(), jac)) return false;
-    r = Eigen::Map<const Eigen::VectorXd>(rr.data(), m);
-    Jx = Eigen::Map<const RowMajor>(j0.data(), m, n);
-    Jq = Eigen::Map<const RowMajor>(j1.data(), m, d);
+    std::vector<Eigen::VectorXd> rs;
+    std::vector<Eigen::MatrixXd> Jxs, Jqs;
+    if (!tracks_jacobians(scene, layout, {track}, {first}, o, x, {q0}, 1, rs, Jxs, Jqs)) return false;
+    r = rs[0];
+    Jx = Jxs[0];
+    Jq = Jqs[0];
     return true;
 }
 

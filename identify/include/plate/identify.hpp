@@ -54,7 +54,8 @@ struct IdentifyOptions {
     // The simulation's tolerance (IntegrationOptions::rtol): 1e-7 keeps fig4's kinetic estimates within
     // their sd of those at 1e-8 at about a third of the time (docs/decisions/identification.md, Measured).
     double rtol = 1e-7;
-    int threads = 2;   // tracks evaluated in parallel
+    // Simulations in parallel (every track's at a search point at once); the fit does not depend on it.
+    int threads = 2;
     // The search (docs/decisions/identification.md, "A cheaper search"): each start first fits the tracks'
     // starts alone (the named parameters held: three coordinates a track, cheap), then everything, its
     // Jacobian by forward differences (one simulation a column) unless central_search (two). The
