@@ -4,6 +4,7 @@
 // ranges, and the 95 % intervals of the rest.
 #include "internal.hpp"
 
+#include "plate/profile.hpp"
 #include "plate/tasks.hpp"
 
 #include <algorithm>
@@ -18,7 +19,6 @@ namespace plate::identify_detail {
 // parameter belongs to such a direction when its weight in it exceeds kLoading (its share of the
 // direction's variance above 1 %).
 constexpr double kZ95 = 1.959963984540054, kLoading = 0.1;
-constexpr double kChi2Q95 = kZ95 * kZ95;   // 3.84: the chi-square quantile of one degree of freedom at 95 %
 
 Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>& x) {
     // The named values are linear in the internal coordinates wherever no two kinetic coefficients tie
@@ -160,7 +160,7 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
         },
         [](int, const std::string&) {});
     // A quadratic profile crossing within a fifth of the half-width of the ends (ProfileOptions' agreement).
-    const double low = kChi2Q95 / (1.2 * 1.2), high = kChi2Q95 / (0.8 * 0.8);
+    const double low = kProfileThreshold95 / (1.2 * 1.2), high = kProfileThreshold95 / (0.8 * 0.8);
     for (std::size_t c = 0; c < checked.size(); ++c) {
         FittedParameter& p = s.params[checked[c]];
         double ends[2] = {0, 0};
