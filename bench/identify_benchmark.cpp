@@ -81,6 +81,7 @@ struct Variant {
     double segment_seconds;
     int within = 0, covered = 0, counted = 0, unid = 0;
     int checks[4] = {0, 0, 0, 0}, missed_flagged = 0;   // by Linearity; misses whose check did not hold
+    int explained = 0, explained_covered = 0;           // intervals of fits that explain their tracks, covering
     double total_s = 0, worst_s = 0;
 
     void tally(const IdentifySummary& s, const std::vector<std::string>& names, const std::vector<double>& truth) {
@@ -100,6 +101,7 @@ struct Variant {
                         p.dchi2_hi, to_string(p.linearity));
             checks[static_cast<int>(p.linearity)] += 1;
             missed_flagged += !cov && p.linearity != Linearity::Holds;
+            if (s.explains_tracks) ++explained, explained_covered += cov;
         }
         total_s += s.seconds;
         worst_s = std::max(worst_s, s.seconds);
@@ -179,6 +181,7 @@ int main(int argc, char** argv) {
                         s.best_start);
             if (v.segment_seconds > 0) std::printf(" [pieces: %d iterations, %.1f s]", s.piece_iterations, s.piece_seconds);
             if (s.hops > 0) std::printf(" [hops: %d]", s.hops);
+            if (!s.explains_tracks) std::printf(" [does not explain the tracks: p %.1e]", s.p_value);
             v.tally(s, names, truth);
             std::printf("  %s\n", s.termination.substr(0, 40).c_str());
             if (s.reduced_chi2 > 1.5)   // (which track does not fit)
@@ -199,6 +202,10 @@ int main(int argc, char** argv) {
             "%s search: intervals checked at their ends: %d hold, %d too narrow, %d unconfirmed, %d not checked; "
             "of the %d misses, %d not 'holds'\n",
             v.name.c_str(), v.checks[0], v.checks[1], v.checks[2], v.checks[3], v.counted - v.covered, v.missed_flagged);
+    for (const Variant& v : variants)
+        std::printf("%s search: of the fits that explain their tracks (p >= 1e-3), intervals covering: %d of %d (%.1f %%)\n",
+                    v.name.c_str(), v.explained_covered, v.explained,
+                    v.explained ? 100.0 * v.explained_covered / v.explained : 0.0);
     if (variants.size() == 2 && variants[1].total_s > 0)
         std::printf("time ratio, %s / %s search (this run): %.3f\n", variants[0].name.c_str(), variants[1].name.c_str(),
                     variants[0].total_s / variants[1].total_s);

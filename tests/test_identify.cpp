@@ -40,11 +40,18 @@ TEST_CASE("a point part's kinetic friction from one stroboscopic track lies with
     CHECK(s.tracks[0].rms_xy_mm > 0.06);
     CHECK(s.tracks[0].rms_xy_mm < 0.14);
     CHECK(s.unidentifiable.empty());
+    // Goodness of fit: P(chi-square of dof degrees >= chi2) against the Wilson-Hilferty approximation
+    // (chi2 / dof)^(1/3) ~ normal(1 - 2 / (9 dof), 2 / (9 dof)), within 0.01 at this many degrees of freedom.
+    const double v = 2.0 / (9 * s.dof), z = (std::cbrt(s.reduced_chi2) - (1 - v)) / std::sqrt(v);
+    CHECK(s.p_value == Approx(0.5 * std::erfc(z / std::sqrt(2.0))).margin(0.01));
+    CHECK(s.explains_tracks);
 }
 
 // The same track read as if the camera's noise were ten times smaller than it is: the residuals,
 // weighed by the stated sd, are ten times too large, the reduced chi-square near 100 -- the fit says
-// its model of the noise is wrong instead of printing an interval ten times too narrow as if it held.
+// its model of the noise is wrong instead of printing an interval ten times too narrow as if it held:
+// p (what the noise alone would exceed) below 1e-100, explains_tracks false. Seen failing with the
+// other tail of the chi-square distribution (p 1.0 here; the case above then 0.29 against 0.71).
 TEST_CASE("a track whose camera understates its noise tenfold gives a reduced chi-square near 100", "[identify]") {
     const Scene nominal = scene("fig1_point");
     Track tr = filmed(nominal, {"mu_k"}, {0.27}, strobe(0.1, 0, 4), Vec3(0.01, -0.02, 0), 5.0);
@@ -53,6 +60,9 @@ TEST_CASE("a track whose camera understates its noise tenfold gives a reduced ch
     CHECK(s.reduced_chi2 > 60);
     CHECK(s.reduced_chi2 < 140);
     CHECK(s.params[0].hi - s.params[0].lo < 0.001);
+    CHECK(s.p_value < 1e-100);
+    CHECK_FALSE(s.explains_tracks);
+    CHECK_FALSE(identify_json(s, options({"mu_k"}))["goodness_of_fit"]["explains_tracks"].get<bool>());
 }
 
 // fig1_point's plate with its x harmonic's phase at pi/2: the plate starts at 20 m/s^2, far above

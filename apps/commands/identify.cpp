@@ -184,6 +184,11 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
         for (const char* f : {"--profile-steps", "--profile-time-limit"})
             if (a.has(f)) throw UsageError(std::string(f) + ": only with --profile");
     const IdentifySummary s = identify(sc, tracks, o);
+    if (!s.explains_tracks)
+        cio.err << "plate identify: warning: the fit does not explain the tracks (reduced chi-square " << s.reduced_chi2
+                << ", p = " << s.p_value << " < " << kFitPValueFloor
+                << "): a local minimum, a model the tracks contradict, or noise sds too small; its intervals mean little "
+                   "(more --starts may find the truth's basin)\n";
     const nlohmann::json j =
         a.has("--profile") ? identify_json(s, o, profile_likelihood(sc, tracks, o, s, po), po) : identify_json(s, o);
     write_file_atomic(

@@ -6,6 +6,7 @@
 #include "plate/scene_io.hpp"
 
 #include <ceres/ceres.h>
+#include <gsl/gsl_cdf.h>
 
 #include <algorithm>
 #include <chrono>
@@ -148,6 +149,8 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     s.residuals = rows;
     s.dof = rows - (n + d * nt);
     s.reduced_chi2 = s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
+    s.p_value = s.dof > 0 ? gsl_cdf_chisq_Q(s.chi2, s.dof) : std::numeric_limits<double>::quiet_NaN();
+    s.explains_tracks = !(s.p_value < kFitPValueFloor);
     const Eigen::MatrixXd cov_internal = judge(layout, o, x, J, d * nt, s);
     check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);
 }

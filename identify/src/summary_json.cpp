@@ -14,6 +14,8 @@ json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 }   // namespace
 
+static_assert(kFitPValueFloor == 1e-3, "identify_json's goodness_of_fit meaning says 0.001");
+
 json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
     json params = json::array();
     for (const FittedParameter& p : s.params) {
@@ -76,6 +78,13 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         {"residuals", s.residuals},
         {"dof", s.dof},
         {"reduced_chi2", num(s.reduced_chi2)},
+        {"goodness_of_fit",   // (the meaning's 0.001: kFitPValueFloor, asserted below)
+         {{"p_value", num(s.p_value)},
+          {"explains_tracks", s.explains_tracks},
+          {"meaning",
+           "P(chi-square of dof degrees >= chi2): below 0.001"
+           " the estimate does not explain the tracks (a local minimum, a model they contradict, or noise sds "
+           "too small); its intervals then mean little"}}},
         {"solver",
          {{"method", std::string("Ceres Levenberg-Marquardt; the search by ") + (o.central_search ? "central" : "forward") +
                          " differences of the simulation, the covariance by central ones"},

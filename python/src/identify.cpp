@@ -32,9 +32,9 @@ void io(Archive& a, FittedParameter& p) {
 void io(Archive& a, Unidentifiable& u) { a(u.combination, u.half_width); }
 void io(Archive& a, TrackFit& t) { a(t.source, t.frames, t.start, t.rms_xy_mm, t.rms_theta_mrad, t.chi2); }
 void io(Archive& a, IdentifySummary& s) {
-    a(s.params, s.covariance, s.unidentifiable, s.tracks, s.chi2, s.residuals, s.dof, s.reduced_chi2, s.starts_run, s.best_start,
-      s.held, s.iterations, s.pieces, s.piece_iterations, s.hops, s.piece_seconds, s.termination, s.converged, s.seconds,
-      s.start_costs, s.fitted);
+    a(s.params, s.covariance, s.unidentifiable, s.tracks, s.chi2, s.residuals, s.dof, s.reduced_chi2, s.p_value,
+      s.explains_tracks, s.starts_run, s.best_start, s.held, s.iterations, s.pieces, s.piece_iterations, s.hops, s.piece_seconds,
+      s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
 }
 void io(Archive& a, IdentifyOptions& o) {
     a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads,
@@ -131,6 +131,13 @@ void bind_identify(py::module_& m) {
         .def_property_readonly(
             "reduced_chi2", [](const PyIdentification& r) { return r.s.reduced_chi2; },
             "chi2 / degrees of freedom: near 1 when the model and the cameras' noise are right")
+        .def_property_readonly(
+            "p_value", [](const PyIdentification& r) { return r.s.p_value; },
+            "P(chi-square of dof degrees >= chi2): what the noise alone would exceed")
+        .def_property_readonly(
+            "explains_tracks", [](const PyIdentification& r) { return r.s.explains_tracks; },
+            "p_value at or above 1e-3; False: a local minimum, a model the tracks contradict or noise sds too small "
+            "(the intervals then mean little)")
         .def_property_readonly("converged", [](const PyIdentification& r) { return r.s.converged; })
         .def_property_readonly(
             "fitted", [](const PyIdentification& r) { return r.s.fitted; }, "the scene at the estimates")

@@ -38,6 +38,7 @@ def test_a_point_parts_kinetic_friction_from_one_track(tmp_path):
     lo, hi = r.intervals[0]
     assert abs(r.estimates[0] - 0.27) < 0.005 and lo < 0.27 < hi
     assert 0.7 < r.reduced_chi2 < 1.3   # 199 degrees of freedom: chi2 / dof within ~3 sd of 1
+    assert r.explains_tracks and r.p_value > 1e-3 and r.summary["goodness_of_fit"]["p_value"] == r.p_value
     assert r.summary["parameters"][0]["estimate"] == r.estimates[0]
     # The interval checked at its ends: the chi-square rises by 3.84 (+-5 %) there on this sliding part.
     check = r.interval_check[0]
@@ -49,7 +50,8 @@ def test_a_point_parts_kinetic_friction_from_one_track(tmp_path):
     assert '"xy_mm":0.1' in text
     wrong = tmp_path / "wrong_noise.csv"
     wrong.write_text(text.replace('"xy_mm":0.1', '"xy_mm":0.01'))
-    assert plate.identify(point_scene(0.30), [str(wrong)], ["mu_k"]).reduced_chi2 > 50
+    bad = plate.identify(point_scene(0.30), [str(wrong)], ["mu_k"])
+    assert bad.reduced_chi2 > 50 and not bad.explains_tracks and bad.p_value < 1e-100
 
 
 def test_a_static_coefficient_the_track_cannot_show(tmp_path):

@@ -133,6 +133,9 @@ struct TrackFit {
     double chi2 = 0;             // the track's sum of squared scaled residuals
 };
 
+// IdentifySummary::explains_tracks: a fit whose chi-square the noise alone exceeds less often than this.
+constexpr double kFitPValueFloor = 1e-3;
+
 struct IdentifySummary {
     std::vector<FittedParameter> params;   // in the order asked
     Eigen::MatrixXd covariance;            // of the estimates, rows and columns as params (NaN where not identifiable)
@@ -141,6 +144,11 @@ struct IdentifySummary {
     double chi2 = 0;              // sum of squared scaled residuals at the estimate
     int residuals = 0, dof = 0;   // dof: residuals - fitted parameters (the starts' included)
     double reduced_chi2 = 0;      // chi2 / dof: near 1 when the model and the noise sds are right
+    // Goodness of fit: P(a chi-square of dof degrees >= chi2), what the noise alone would exceed. Below
+    // kFitPValueFloor the estimate does not explain the tracks (a local minimum, a model the tracks
+    // contradict, or noise sds too small) and its intervals mean little (explains_tracks false).
+    double p_value = 0;
+    bool explains_tracks = true;
     int starts_run = 0, best_start = 0;
     int held = 0;               // named parameters no residual depended on at the first start: held there
     int iterations = 0;         // of the best start, its hops' included
