@@ -72,6 +72,59 @@ py::array_t<double> per_parameter(const IdentifySummary& s, double FittedParamet
 
 }   // namespace
 
+namespace {
+
+// plate.identify: the fit (and the profiles asked), judged as the command line's.
+void bind_identify_function(py::module_& m) {
+    m.def(
+        "identify",
+        [](const Scene& sc, const py::list& tracks, const std::vector<std::string>& params, const std::string& dynamics,
+           int starts, std::uint64_t seed, int max_iterations, double time_limit, double settle_periods, double rtol, int threads,
+           double pieces, const py::object& profile, int profile_steps, double profile_time_limit) {
+            require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
+            std::vector<Track> tr;
+            for (const py::handle& t : tracks) tr.push_back(track_of(t));
+            PyIdentification r;
+            r.o.params = params;
+            r.o.level = dynamics == "full" ? Dynamics::Full : Dynamics::U;
+            r.o.starts = starts;
+            r.o.seed = seed;
+            r.o.max_iterations = max_iterations;
+            r.o.time_limit = time_limit;
+            r.o.settle_periods = settle_periods;
+            r.o.rtol = rtol;
+            r.o.threads = threads;
+            r.o.segment_seconds = pieces;
+            r.profiled = !profile.is_none();
+            if (r.profiled && !(py::isinstance<py::str>(profile) && profile.cast<std::string>() == "all"))
+                r.po.params = profile.cast<std::vector<std::string>>();
+            r.po.max_steps = profile_steps;
+            r.po.time_limit = profile_time_limit;
+            if (r.profiled) r.po.validate();
+            for (const std::string& name : r.po.params)
+                require(std::find(params.begin(), params.end(), name) != params.end(),
+                        "profile: " + name + " is not among the fitted params");
+            r.s = interruptible(py::none(), [&](Watch&) { return identify(sc, tr, r.o); });
+            if (r.profiled) r.p = interruptible(py::none(), [&](Watch&) { return profile_likelihood(sc, tr, r.o, r.s, r.po); });
+            return r;
+        },
+        py::arg("scene"), py::arg("tracks"), py::arg("params"), py::kw_only(), py::arg("dynamics") = "full",
+        py::arg("starts") = IdentifyOptions{}.starts, py::arg("seed") = IdentifyOptions{}.seed,
+        py::arg("max_iterations") = IdentifyOptions{}.max_iterations, py::arg("time_limit") = IdentifyOptions{}.time_limit,
+        py::arg("settle_periods") = IdentifyOptions{}.settle_periods, py::arg("rtol") = IdentifyOptions{}.rtol,
+        py::arg("threads") = IdentifyOptions{}.threads, py::arg("pieces") = IdentifyOptions{}.segment_seconds,
+        py::arg("profile") = py::none(), py::arg("profile_steps") = ProfileOptions{}.max_steps,
+        py::arg("profile_time_limit") = ProfileOptions{}.time_limit,
+        "Fits the named parameters of `scene`'s part (mu_k, mu_k1..3, mu_s, mu_s1..3, com_x, com_y) to `tracks`\n"
+        "(plate.Track objects or track files' paths) by least squares over the hybrid simulation, as `plate identify`.\n"
+        "pieces: the search's first stage fits the tracks cut into pieces of this many seconds (0: none), as --pieces.\n"
+        "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.\n"
+        "profile='all' or a list of fitted names: their profile likelihoods too (plate identify --profile; at most\n"
+        "profile_steps re-minimisations a side, all within profile_time_limit s), in .profiles and .summary.");
+}
+
+}   // namespace
+
 void bind_identify(py::module_& m) {
     py::class_<PyIdentification>(m, "Identification",
                                  "A least-squares fit of a part's parameters to camera tracks (plate identify): estimates, "
@@ -181,51 +234,7 @@ void bind_identify(py::module_& m) {
                      (p.identifiable ? " +- " + std::to_string(1.96 * p.sd) : " (not identifiable)");
             return s + ">";
         });
-    m.def(
-        "identify",
-        [](const Scene& sc, const py::list& tracks, const std::vector<std::string>& params, const std::string& dynamics,
-           int starts, std::uint64_t seed, int max_iterations, double time_limit, double settle_periods, double rtol, int threads,
-           double pieces, const py::object& profile, int profile_steps, double profile_time_limit) {
-            require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
-            std::vector<Track> tr;
-            for (const py::handle& t : tracks) tr.push_back(track_of(t));
-            PyIdentification r;
-            r.o.params = params;
-            r.o.level = dynamics == "full" ? Dynamics::Full : Dynamics::U;
-            r.o.starts = starts;
-            r.o.seed = seed;
-            r.o.max_iterations = max_iterations;
-            r.o.time_limit = time_limit;
-            r.o.settle_periods = settle_periods;
-            r.o.rtol = rtol;
-            r.o.threads = threads;
-            r.o.segment_seconds = pieces;
-            r.profiled = !profile.is_none();
-            if (r.profiled && !(py::isinstance<py::str>(profile) && profile.cast<std::string>() == "all"))
-                r.po.params = profile.cast<std::vector<std::string>>();
-            r.po.max_steps = profile_steps;
-            r.po.time_limit = profile_time_limit;
-            if (r.profiled) r.po.validate();
-            for (const std::string& name : r.po.params)
-                require(std::find(params.begin(), params.end(), name) != params.end(),
-                        "profile: " + name + " is not among the fitted params");
-            r.s = interruptible(py::none(), [&](Watch&) { return identify(sc, tr, r.o); });
-            if (r.profiled) r.p = interruptible(py::none(), [&](Watch&) { return profile_likelihood(sc, tr, r.o, r.s, r.po); });
-            return r;
-        },
-        py::arg("scene"), py::arg("tracks"), py::arg("params"), py::kw_only(), py::arg("dynamics") = "full",
-        py::arg("starts") = IdentifyOptions{}.starts, py::arg("seed") = IdentifyOptions{}.seed,
-        py::arg("max_iterations") = IdentifyOptions{}.max_iterations, py::arg("time_limit") = IdentifyOptions{}.time_limit,
-        py::arg("settle_periods") = IdentifyOptions{}.settle_periods, py::arg("rtol") = IdentifyOptions{}.rtol,
-        py::arg("threads") = IdentifyOptions{}.threads, py::arg("pieces") = IdentifyOptions{}.segment_seconds,
-        py::arg("profile") = py::none(), py::arg("profile_steps") = ProfileOptions{}.max_steps,
-        py::arg("profile_time_limit") = ProfileOptions{}.time_limit,
-        "Fits the named parameters of `scene`'s part (mu_k, mu_k1..3, mu_s, mu_s1..3, com_x, com_y) to `tracks`\n"
-        "(plate.Track objects or track files' paths) by least squares over the hybrid simulation, as `plate identify`.\n"
-        "pieces: the search's first stage fits the tracks cut into pieces of this many seconds (0: none), as --pieces.\n"
-        "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.\n"
-        "profile='all' or a list of fitted names: their profile likelihoods too (plate identify --profile; at most\n"
-        "profile_steps re-minimisations a side, all within profile_time_limit s), in .profiles and .summary.");
+    bind_identify_function(m);
 }
 
 }   // namespace plate::python
