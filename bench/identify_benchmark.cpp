@@ -203,8 +203,8 @@ int main(int argc, char** argv) {
             "of the %d misses, %d not 'holds'\n",
             v.name.c_str(), v.checks[0], v.checks[1], v.checks[2], v.checks[3], v.counted - v.covered, v.missed_flagged);
     for (const Variant& v : variants)
-        std::printf("%s search: of the fits that explain their tracks (p >= 1e-3), intervals covering: %d of %d (%.1f %%)\n",
-                    v.name.c_str(), v.explained_covered, v.explained,
+        std::printf("%s search: of the fits that explain their tracks (p >= %g), intervals covering: %d of %d (%.1f %%)\n",
+                    v.name.c_str(), kFitPValueFloor, v.explained_covered, v.explained,
                     v.explained ? 100.0 * v.explained_covered / v.explained : 0.0);
     if (variants.size() == 2 && variants[1].total_s > 0)
         std::printf("time ratio, %s / %s search (this run): %.3f\n", variants[0].name.c_str(), variants[1].name.c_str(),

@@ -42,6 +42,7 @@ TEST_CASE("a point part's kinetic friction from one stroboscopic track lies with
     CHECK(s.unidentifiable.empty());
     // Goodness of fit: P(chi-square of dof degrees >= chi2) against the Wilson-Hilferty approximation
     // (chi2 / dof)^(1/3) ~ normal(1 - 2 / (9 dof), 2 / (9 dof)), within 0.01 at this many degrees of freedom.
+    CHECK(s.dof == 200 - 1 - 2);   // 100 frames of (x, y); mu_k and the start (x, y)
     const double v = 2.0 / (9 * s.dof), z = (std::cbrt(s.reduced_chi2) - (1 - v)) / std::sqrt(v);
     CHECK(s.p_value == Approx(0.5 * std::erfc(z / std::sqrt(2.0))).margin(0.01));
     CHECK(s.explains_tracks);

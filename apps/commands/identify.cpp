@@ -187,8 +187,8 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
     if (!s.explains_tracks)
         cio.err << "plate identify: warning: the fit does not explain the tracks (reduced chi-square " << s.reduced_chi2
                 << ", p = " << s.p_value << " < " << kFitPValueFloor
-                << "): a local minimum, a model the tracks contradict, or noise sds too small; its intervals mean little "
-                   "(more --starts may find the truth's basin)\n";
+                << "): a local minimum (its intervals mean nothing; more --starts may find the truth's basin), a model the "
+                   "tracks contradict, or the cameras' noise sds too small (the intervals too narrow)\n";
     const nlohmann::json j =
         a.has("--profile") ? identify_json(s, o, profile_likelihood(sc, tracks, o, s, po), po) : identify_json(s, o);
     write_file_atomic(

@@ -149,7 +149,10 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     s.residuals = rows;
     s.dof = rows - (n + d * nt);
     s.reduced_chi2 = s.dof > 0 ? s.chi2 / s.dof : std::numeric_limits<double>::quiet_NaN();
-    s.p_value = s.dof > 0 ? gsl_cdf_chisq_Q(s.chi2, s.dof) : std::numeric_limits<double>::quiet_NaN();
+    // (a non-finite chi-square would make GSL's error handler abort: it explains nothing)
+    s.p_value = s.dof <= 0              ? std::numeric_limits<double>::quiet_NaN()
+                : std::isfinite(s.chi2) ? gsl_cdf_chisq_Q(s.chi2, s.dof)
+                                        : 0.0;
     s.explains_tracks = !(s.p_value < kFitPValueFloor);
     const Eigen::MatrixXd cov_internal = judge(layout, o, x, J, d * nt, s);
     check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);

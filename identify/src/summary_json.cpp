@@ -78,13 +78,13 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         {"residuals", s.residuals},
         {"dof", s.dof},
         {"reduced_chi2", num(s.reduced_chi2)},
-        {"goodness_of_fit",   // (the meaning's 0.001: kFitPValueFloor, asserted below)
+        {"goodness_of_fit",   // (the meaning's 0.001: kFitPValueFloor, asserted above)
          {{"p_value", num(s.p_value)},
           {"explains_tracks", s.explains_tracks},
           {"meaning",
-           "P(chi-square of dof degrees >= chi2): below 0.001"
-           " the estimate does not explain the tracks (a local minimum, a model they contradict, or noise sds "
-           "too small); its intervals then mean little"}}},
+           "P(chi-square of dof degrees >= chi2), with the cameras' noise sds exact: below 0.001 the estimate does not "
+           "explain the tracks -- a local minimum (its intervals mean nothing), a model they contradict, or noise sds too "
+           "small (the intervals too narrow by about sqrt(reduced_chi2)); null: no degrees of freedom, not judged"}}},
         {"solver",
          {{"method", std::string("Ceres Levenberg-Marquardt; the search by ") + (o.central_search ? "central" : "forward") +
                          " differences of the simulation, the covariance by central ones"},

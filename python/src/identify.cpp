@@ -189,8 +189,8 @@ void bind_identify(py::module_& m) {
             "P(chi-square of dof degrees >= chi2): what the noise alone would exceed")
         .def_property_readonly(
             "explains_tracks", [](const PyIdentification& r) { return r.s.explains_tracks; },
-            "p_value at or above 1e-3; False: a local minimum, a model the tracks contradict or noise sds too small "
-            "(the intervals then mean little)")
+            "p_value at or above 1e-3 (or NaN: no degrees of freedom, not judged); False: a local minimum (its intervals "
+            "mean nothing), a model the tracks contradict, or noise sds too small (intervals too narrow)")
         .def_property_readonly("converged", [](const PyIdentification& r) { return r.s.converged; })
         .def_property_readonly(
             "fitted", [](const PyIdentification& r) { return r.s.fitted; }, "the scene at the estimates")
@@ -232,6 +232,7 @@ void bind_identify(py::module_& m) {
             for (const FittedParameter& p : r.s.params)
                 s += " " + p.name + " = " + std::to_string(p.estimate) +
                      (p.identifiable ? " +- " + std::to_string(1.96 * p.sd) : " (not identifiable)");
+            if (!r.s.explains_tracks) s += " [does not explain the tracks: p = " + std::to_string(r.s.p_value) + "]";
             return s + ">";
         });
     bind_identify_function(m);

@@ -144,10 +144,13 @@ struct IdentifySummary {
     double chi2 = 0;              // sum of squared scaled residuals at the estimate
     int residuals = 0, dof = 0;   // dof: residuals - fitted parameters (the starts' included)
     double reduced_chi2 = 0;      // chi2 / dof: near 1 when the model and the noise sds are right
-    // Goodness of fit: P(a chi-square of dof degrees >= chi2), what the noise alone would exceed. Below
-    // kFitPValueFloor the estimate does not explain the tracks (a local minimum, a model the tracks
-    // contradict, or noise sds too small) and its intervals mean little (explains_tracks false).
-    double p_value = 0;
+    // Goodness of fit: P(a chi-square of dof degrees >= chi2), what the noise alone would exceed (with
+    // the cameras' sds exact and Gaussian). Below kFitPValueFloor the estimate does not explain the
+    // tracks (explains_tracks false): a local minimum (its intervals then mean nothing), a model the
+    // tracks contradict, or noise sds too small (at 1500 degrees of freedom 6 % too small is enough;
+    // the intervals are then too narrow by about sqrt(reduced_chi2)). Sds too large are not flagged
+    // (p near 1, intervals too wide). NaN where dof <= 0: not judged, explains_tracks left true.
+    double p_value = std::numeric_limits<double>::quiet_NaN();
     bool explains_tracks = true;
     int starts_run = 0, best_start = 0;
     int held = 0;               // named parameters no residual depended on at the first start: held there
