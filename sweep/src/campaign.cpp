@@ -219,20 +219,17 @@ void read_design(const Reader& r, const json& g, const Scene& base, Campaign& c)
     } catch (const std::invalid_argument& e) {
         r.fail("compute.design.target", e.what());
     }
-    if (g.contains("limits")) {
-        const auto l = r.numbers(g["limits"], "compute.design.limits", 2, 2);
-        c.design_options.lin_limit = l[0];
-        c.design_options.ang_limit = l[1];
-    }
-    if (g.contains("corner_limits")) {
-        const auto l = r.numbers(g["corner_limits"], "compute.design.corner_limits", 2, 2);
-        c.design_options.corner_displacement_limit = l[0];
-        c.design_options.corner_velocity_limit = l[1];
-    }
-    if (g.contains("plate_half_size")) {
-        const auto h = r.numbers(g["plate_half_size"], "compute.design.plate_half_size", 2, 2);
-        c.design_options.plate_half_size = Vec2(h[0], h[1]);
-    }
+    // [A, B] fields: plate design's pairs of numbers, judged with the rest by validate_design_options below
+    const auto pair = [&](const char* key, double& a, double& b) {
+        if (!g.contains(key)) return;
+        const auto v = r.numbers(g[key], std::string("compute.design.") + key, 2, 2);
+        a = v[0];
+        b = v[1];
+    };
+    DesignOptions& o = c.design_options;
+    pair("limits", o.lin_limit, o.ang_limit);
+    pair("corner_limits", o.corner_displacement_limit, o.corner_velocity_limit);
+    pair("plate_half_size", o.plate_half_size.x(), o.plate_half_size.y());
     if (g.contains("starts")) c.design_options.starts = static_cast<int>(r.whole(g["starts"], "compute.design.starts", 1, 10000));
     if (g.contains("evaluations"))
         c.design_options.local_evaluations =
