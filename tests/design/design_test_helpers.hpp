@@ -10,6 +10,7 @@
 
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 namespace design_tests {
 using namespace plate;
@@ -73,6 +74,27 @@ inline PlateMotion harmonic_motion(std::initializer_list<Harmonic> h, double T =
     u.T = T;
     u.harmonics = h;
     return u;
+}
+
+// Registers a point-part target kind `name` whose designer reports success, unjudged, with these
+// harmonics at period T (0: the design's): what design() itself checks is then all that stands between
+// the motion and the user.
+inline void register_unjudged_motion(const std::string& name, std::vector<Harmonic> harmonics, double T = 0) {
+    DesignTargetType type;
+    type.name = name;
+    type.numbers = "";
+    type.count = 0;
+    type.rigid = false;
+    type.default_starts = 1;
+    type.design = [harmonics, T](const Scene& p, const DesignTarget&, const DesignOptions&, double design_T) {
+        DesignSummary s;
+        s.scene = p;
+        s.scene.plate.T = T > 0 ? T : design_T;
+        s.scene.plate.harmonics = harmonics;
+        s.verified = true;
+        return s;
+    };
+    register_design_target(type);
 }
 
 // max over N equally spaced samples of |u_a(t)| per axis (the acceleration as the model evaluates it):

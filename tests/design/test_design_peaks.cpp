@@ -120,20 +120,7 @@ TEST_CASE("a design whose motion exceeds a peak limit fails verification, naming
     // and 3, each 60 rad/s^2 and in phase at the crest, sin t - sin 3t / 3 scaled: peaks of 80 (4/3 60)
     // against a limit of 70 -- each harmonic within it, the summed signal beyond. design() judges every
     // designer's motion: not verified, and the failure says where.
-    DesignTargetType type;
-    type.name = "overdriven";
-    type.numbers = "";
-    type.count = 0;
-    type.rigid = false;
-    type.default_starts = 1;
-    type.design = [](const Scene& p, const DesignTarget&, const DesignOptions&, double T) {
-        DesignSummary s;
-        s.scene = p;
-        s.scene.plate = harmonic_motion({{Axis::rx, 1, 60.0, 0.2}, {Axis::rx, 3, -20.0, 0.6}}, T);
-        s.verified = true;
-        return s;
-    };
-    register_design_target(type);
+    register_unjudged_motion("overdriven", {{Axis::rx, 1, 60.0, 0.2}, {Axis::rx, 3, -20.0, 0.6}});
     const Scene part = scene("fig1_point");
     const DesignTarget t = parse_design_target("overdriven", {}, true);
     DesignOptions o;
