@@ -14,11 +14,11 @@
 // (everything at once by central differences, the search before staging), pieces[S] (staged, after a
 // first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
 // staged,central.
-// RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. Each
-// interval's check at its ends (the chi-square's rise there, and the verdict: FittedParameter::linearity) is printed in braces,
-// and tallied against the misses.
+// RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. COARSE:
+// IdentifyOptions::coarse_iterations. Each interval's check at its ends (the chi-square's rise there, and the verdict:
+// FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS [REUSE [HOPS]]]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE [HOPS [COARSE]]]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -149,6 +149,7 @@ int main(int argc, char** argv) {
     if (argc > 13) o.initial_trust_radius = std::stod(argv[13]);
     if (argc > 14) o.jacobian_reuse = std::stoi(argv[14]);
     if (argc > 15) o.hops = std::stoi(argv[15]);
+    if (argc > 16) o.coarse_iterations = std::stoi(argv[16]);   // (default: IdentifyOptions')
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;
@@ -179,6 +180,7 @@ int main(int argc, char** argv) {
             const IdentifySummary s = identify(from_truth ? truth_scene : nominal, tracks, o);
             std::printf("%4d  %-8s %7.2f  %8.3f  %5d  %5d ", seed, v.name.c_str(), s.seconds, s.reduced_chi2, s.iterations,
                         s.best_start);
+            if (s.coarse_iterations > 0) std::printf(" [coarse: %d steps, %.1f s]", s.coarse_iterations, s.coarse_seconds);
             if (v.segment_seconds > 0) std::printf(" [pieces: %d iterations, %.1f s]", s.piece_iterations, s.piece_seconds);
             if (s.hops > 0) std::printf(" [hops: %d]", s.hops);
             if (!s.explains_tracks) std::printf(" [does not explain the tracks: p %.1e]", s.p_value);

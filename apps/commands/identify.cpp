@@ -37,9 +37,14 @@ struct IdentifyArgs : Options {
                   "Each start of the search first fits the tracks cut into pieces of --pieces S seconds (default 2;\n"
                   "0: none), each from its own start at rest, its first 4 periods left out: short pieces keep the\n"
                   "search out of the valleys a long track's chi-square has far from its minimum (not where the\n"
-                  "plate turns about more than one axis: its orientation is then not periodic).\n"
+                  "plate turns about more than one axis: its orientation is then not periodic). Before them, up to\n"
+                  "--coarse N steps (default 2; 0: none) move the kinetic coefficients and offsets on the whole\n"
+                  "tracks by differences of 0.01 (0.1 mm), a hundred times the search's: the chi-square of a part\n"
+                  "that sticks and slips is a broad bowl broken into small cells, and a guess sits in one.\n"
                   "Levenberg-Marquardt (Ceres) over the full (or u) dynamics, from --starts starts (the scene's\n"
-                  "values, then seeded draws), the best kept; each start at most --max-iterations, all within\n"
+                  "values, then the best fit's kinetic coefficients and offsets with the static ones from the\n"
+                  "scene's values, then from seeded draws; a start runs only while none fits as well as the noise\n"
+                  "allows), the best kept; each start at most --max-iterations, all within\n"
                   "--time-limit s. JSON: the estimates with their sd and 95 % intervals, the covariance, residual\n"
                   "RMS per track [mm, mrad], chi-square and its reduced value (near 1 when model and noise are\n"
                   "right), the solver's report, and the parameter combinations the tracks cannot place within the\n"
@@ -79,6 +84,7 @@ struct IdentifyArgs : Options {
         number("--settle", o.settle_periods, "plate periods of each track left out at its start");
         number("--rtol", o.rtol, "the simulation's tolerance");
         number("--pieces", o.segment_seconds, "seconds of the pieces the search fits first (0: none)");
+        whole("--coarse", o.coarse_iterations, 0, 100, "coarse steps before the pieces (0: none)");
         whole("--threads", o.threads, 1, 1024, "simulations in parallel (the fit is the same on any number)");
         text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");
         whole("--profile-steps", po.max_steps, 1, 1000, "--profile: re-minimisations per side");

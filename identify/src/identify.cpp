@@ -158,6 +158,45 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);
 }
 
+
+// One hop: the staged search from (x, q0); into s (and best, best_q0) if it fits better there and its
+// verdict could be drawn. False otherwise (s unchanged).
+bool hop(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
+         const std::vector<TrackCost*>& costs, const std::vector<int>& held, const std::vector<double>& lo,
+         const std::vector<double>& hi, Clock::time_point t0, std::vector<double> x, std::vector<std::vector<double>> q0,
+         IdentifySummary& s, std::vector<double>& best, std::vector<std::vector<double>>& best_q0, PathEnd& better) {
+    const Solve sol = staged(costs, x, q0, held, lo, hi, o, t0, o.time_limit);
+    if (!sol.usable || !(sol.chi2 < s.chi2)) return false;
+    IdentifySummary hopped = s;
+    ++hopped.hops;
+    hopped.iterations += sol.iterations;
+    hopped.termination = sol.termination;
+    hopped.converged = sol.converged;
+    PathEnd next;
+    try {
+        conclude(scene, layout, tracks, o, costs, x, q0, hopped, next);
+    } catch (const std::runtime_error&) {   // (a simulation at the hop's optimum stopped: the fit before it stands)
+        return false;
+    }
+    s = hopped;
+    best = x;
+    best_q0 = q0;
+    better = next;
+    return true;
+}
+
+// After the fit at (best, best_q0), judged in s: while the interval check finds a fit better by more than
+// one chi-square unit at an end of its paths (the search stopped in a cell of the chi-square that a step
+// of 1.96 sd leaves: docs/decisions/identification.md, "Hops"), the search goes on from there.
+void hops(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
+          const std::vector<TrackCost*>& costs, const std::vector<int>& held, const std::vector<double>& lo,
+          const std::vector<double>& hi, Clock::time_point t0, IdentifySummary& s, std::vector<double>& best,
+          std::vector<std::vector<double>>& best_q0, PathEnd& better) {
+    const auto left = [&] { return o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count(); };
+    for (int k = 0; k < o.hops && better.chi2 < s.chi2 - 1 && left() > 0; ++k)
+        if (!hop(scene, layout, tracks, o, costs, held, lo, hi, t0, better.x, better.q0, s, best, best_q0, better)) break;
+}
+
 }   // namespace
 
 }   // namespace identify_detail
@@ -175,6 +214,7 @@ void IdentifyOptions::validate() const {
     if (!(initial_trust_radius >= 1 && initial_trust_radius <= 1e12)) bad("initial_trust_radius: from 1 to 1e12");
     if (jacobian_reuse < 0 || jacobian_reuse > 100) bad("jacobian_reuse: from 0 to 100");
     if (hops < 0 || hops > 100) bad("hops: from 0 to 100");
+    if (coarse_iterations < 0 || coarse_iterations > 100) bad("coarse_iterations: from 0 to 100");
     if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
     if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");
@@ -279,7 +319,11 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     }
     for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
         if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
-        std::vector<double> x = xs[k];
+        std::vector<double> x = k > 0 && !best.empty() ? restart(layout, best, xs[k == 1 ? 0 : k]) : xs[k];
+        CoarseResult coarse;
+        if (o.coarse_iterations > 0)
+            coarse = coarse_steps(cost_ptrs, layout, o, x, first_frames(tracks, d), held, lo, hi,
+                                  o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count());
         Solve on_pieces;
         double piece_seconds = 0;
         if (!piece_ptrs.empty()) {
@@ -301,6 +345,8 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
             s.best_start = k;
             s.iterations = sol.iterations;
             s.pieces = static_cast<int>(pieces.size());
+            s.coarse_iterations = coarse.iterations;
+            s.coarse_seconds = coarse.seconds;
             s.piece_iterations = on_pieces.iterations;
             s.piece_seconds = piece_seconds;
             s.termination = sol.termination;
@@ -310,31 +356,10 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     }
     if (best.empty()) throw std::runtime_error("identify: no start gave a usable fit (every simulation stopped?)");
 
-    // The fit's verdict at the best start's optimum; then, while the interval check finds a fit better by
-    // more than one chi-square unit at an end of its paths (the search stopped in a cell of the chi-square
-    // that a step of 1.96 sd leaves: docs/decisions/identification.md, "Hops"), the search goes on from there.
+    // The fit's verdict at the best start's optimum, then its hops.
     PathEnd better;
     conclude(scene, layout, tracks, o, cost_ptrs, best, best_q0, s, better);
-    for (int hop = 0; hop < o.hops && better.chi2 < s.chi2 - 1; ++hop) {
-        if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
-        std::vector<double> x = better.x;
-        std::vector<std::vector<double>> q0 = better.q0;
-        const Solve sol = staged(cost_ptrs, x, q0, held, lo, hi, o, t0, o.time_limit);
-        if (!sol.usable || !(sol.chi2 < s.chi2)) break;
-        IdentifySummary hopped = s;
-        ++hopped.hops;
-        hopped.iterations += sol.iterations;
-        hopped.termination = sol.termination;
-        hopped.converged = sol.converged;
-        try {
-            conclude(scene, layout, tracks, o, cost_ptrs, x, q0, hopped, better);
-        } catch (const std::runtime_error&) {   // (a simulation at the hop's optimum stopped: the fit before it stands)
-            break;
-        }
-        s = hopped;
-        best = x;
-        best_q0 = q0;
-    }
+    hops(scene, layout, tracks, o, cost_ptrs, held, lo, hi, t0, s, best, best_q0, better);
     s.fitted = at(scene, layout, best);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return s;

@@ -88,6 +88,8 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         {"solver",
          {{"method", std::string("Ceres Levenberg-Marquardt; the search by ") + (o.central_search ? "central" : "forward") +
                          " differences of the simulation, the covariance by central ones"},
+          {"coarse_iterations", s.coarse_iterations},
+          {"coarse_seconds", s.coarse_seconds},
           {"pieces", s.pieces},
           {"piece_iterations", s.piece_iterations},
           {"hops", s.hops},

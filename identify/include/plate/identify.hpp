@@ -45,7 +45,9 @@ struct IdentifyOptions {
     std::vector<std::string> params;   // the names above, each once; at least one
     Dynamics level = Dynamics::Full;   // the model the tracks are fitted with (Full or U)
     // Multi-start: the scene's values, then seeded draws within the bounds, until one fits as well as
-    // the noise allows (chi-square within 3 sds of its mean at the truth) or all have run.
+    // the noise allows (chi-square within 3 sds of its mean at the truth) or all have run. After a
+    // usable fit, a later start takes its static coefficients from its draw (the second: the scene's
+    // values) and everything else from the best fit (identify_detail::restart).
     int starts = 3;
     std::uint64_t seed = 1;      // of the drawn starts
     int max_iterations = 25;     // Levenberg-Marquardt iterations per start
@@ -82,6 +84,11 @@ struct IdentifyOptions {
     // chi-square lower by more than 1 at an end of its paths, the search goes on from there, at most this
     // many times within time_limit. 0: never.
     int hops = 4;
+    // Coarse steps first ("Coarse steps first"): before its pieces, each start takes up to this many
+    // Levenberg-Marquardt steps on the whole tracks, their starts held at the first frames, the Jacobian
+    // by central differences a hundred times the search's (0.01 in a friction coefficient): the slope of
+    // the chi-square's bowl, not of the cell the start lies in. 0: none.
+    int coarse_iterations = 2;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
@@ -153,13 +160,15 @@ struct IdentifySummary {
     double p_value = std::numeric_limits<double>::quiet_NaN();
     bool explains_tracks = true;
     int starts_run = 0, best_start = 0;
-    int held = 0;               // named parameters no residual depended on at the first start: held there
-    int iterations = 0;         // of the best start, its hops' included
-    int pieces = 0;             // fitted in the first stage (segment_seconds; 0: no such stage)
-    int piece_iterations = 0;   // of the best start's first stage on the pieces
-    int hops = 0;               // times the search went on from a better end of the interval check's paths
-    double piece_seconds = 0;   // its time [s]
-    std::string termination;    // of the best start (Ceres' termination type and message)
+    int held = 0;                // named parameters no residual depended on at the first start: held there
+    int iterations = 0;          // of the best start, its hops' included
+    int pieces = 0;              // fitted in the first stage (segment_seconds; 0: no such stage)
+    int coarse_iterations = 0;   // of the best start's coarse steps (IdentifyOptions::coarse_iterations)
+    double coarse_seconds = 0;   // their time [s]
+    int piece_iterations = 0;    // of the best start's first stage on the pieces
+    int hops = 0;                // times the search went on from a better end of the interval check's paths
+    double piece_seconds = 0;    // its time [s]
+    std::string termination;     // of the best start (Ceres' termination type and message)
     bool converged = false;
     double seconds = 0;
     std::vector<double> start_costs;   // each start's final chi2
