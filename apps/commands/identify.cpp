@@ -39,11 +39,11 @@ struct IdentifyArgs : Options {
                   "search out of the valleys a long track's chi-square has far from its minimum (not where the\n"
                   "plate turns about more than one axis: its orientation is then not periodic). Before them, up to\n"
                   "--coarse N steps (default 2; 0: none) move the kinetic coefficients and offsets on the whole\n"
-                  "tracks by differences of 0.01 (0.1 mm), a hundred times the search's: the chi-square of a part\n"
-                  "that sticks and slips is a broad bowl broken into small cells, and a guess sits in one.\n"
+                  "tracks, their starts held at the first frames and the static coefficients' excesses over the\n"
+                  "kinetic ones held: from a guess, they reach the chi-square's bowl around the truth.\n"
                   "Levenberg-Marquardt (Ceres) over the full (or u) dynamics, from --starts starts (the scene's\n"
-                  "values, then the best fit's kinetic coefficients and offsets with the static ones from the\n"
-                  "scene's values, then from seeded draws; a start runs only while none fits as well as the noise\n"
+                  "values; then the best fit's kinetic coefficients and offsets with the static excesses of the\n"
+                  "scene's values, then of seeded draws; a start runs only while none fits as well as the noise\n"
                   "allows), the best kept; each start at most --max-iterations, all within\n"
                   "--time-limit s. JSON: the estimates with their sd and 95 % intervals, the covariance, residual\n"
                   "RMS per track [mm, mrad], chi-square and its reduced value (near 1 when model and noise are\n"
@@ -193,7 +193,7 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
     if (!s.explains_tracks)
         cio.err << "plate identify: warning: the fit does not explain the tracks (reduced chi-square " << s.reduced_chi2
                 << ", p = " << s.p_value << " < " << kFitPValueFloor
-                << "): a local minimum (its intervals mean nothing; more --starts may find the truth's basin), a model the "
+                << "): a local minimum (its intervals mean nothing; more --starts restart its static coefficients), a model the "
                    "tracks contradict, or the cameras' noise sds too small (the intervals too narrow)\n";
     const nlohmann::json j =
         a.has("--profile") ? identify_json(s, o, profile_likelihood(sc, tracks, o, s, po), po) : identify_json(s, o);

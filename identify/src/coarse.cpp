@@ -1,11 +1,11 @@
 // The search's coarse first steps (IdentifyOptions::coarse_iterations; docs/decisions/identification.md,
 // "Coarse steps first"): Levenberg-Marquardt on the whole tracks, every track's start held at its first
-// frame, the Jacobian by central differences kCoarseFactor times the fine steps (Layout::step). Under
-// static friction the chi-square is a broad bowl broken into cells much smaller than the parameters'
-// distance from a guess; a fine difference sees one cell's slope, a coarse one the bowl's. The kinetic
-// coefficients and offsets move; the static coefficients' excesses are held: with the starts unfitted
-// the bowl is nearly flat along them, and measured, moving them put the search's later stages in cells
-// further from the truth than the guess's.
+// frame, the kinetic coefficients and offsets moved and the static coefficients' excesses held, the
+// Jacobian by central differences kCoarseFactor times the fine steps (Layout::step). From a guess, the
+// search's own first stage (pieces, starts fitted, every parameter) could end with the kinetic
+// coefficients short of the truth and the static ones bent to fit; these steps, from the same guess,
+// reach the chi-square's bowl around the truth. The statics are held because moving them here left the
+// later stages in worse places (the docs).
 #include "internal.hpp"
 
 #include "plate/tasks.hpp"
@@ -30,7 +30,8 @@ constexpr int kTries = 6;
 
 // Every track's residuals at each of `points` (internal coordinates), the tracks' starts q0, as one set
 // of tasks on `threads`: one stacked vector a point, empty where a simulation stopped.
-std::vector<Eigen::VectorXd> stacked_residuals(const std::vector<TrackCost*>& costs, const std::vector<std::vector<double>>& points,
+std::vector<Eigen::VectorXd> stacked_residuals(const std::vector<TrackCost*>& costs,
+                                               const std::vector<std::vector<double>>& points,
                                                const std::vector<std::vector<double>>& q0, int threads, long& simulations) {
     const int nt = static_cast<int>(costs.size()), np = static_cast<int>(points.size());
     int rows = 0;
@@ -66,18 +67,21 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const int n = static_cast<int>(x.size());
-    // (the static coefficients' excesses held: see the file's head)
     std::vector<int> free;
     for (int j = 0; j < n; ++j)
         if (std::find(held.begin(), held.end(), j) == held.end() && layout.p[j].kind != Param::Static) free.push_back(j);
     const int nf = static_cast<int>(free.size());
     CoarseResult res;
+    const auto out_of_time = [&] { return std::chrono::duration<double>(Clock::now() - t0).count() >= seconds; };
+    const auto done = [&] {
+        res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        return res;
+    };
     Eigen::VectorXd r = stacked_residuals(costs, {x}, q0, o.threads, res.simulations)[0];
     res.chi2_before = res.chi2_after = chi2_of(r);
-    if (!std::isfinite(res.chi2_before) || nf == 0) return res;
+    if (!std::isfinite(res.chi2_before) || nf == 0) return done();
     double damping = kFirstDamping;
-    for (int it = 0; it < o.coarse_iterations; ++it) {
-        if (std::chrono::duration<double>(Clock::now() - t0).count() >= seconds) break;
+    for (int it = 0; it < o.coarse_iterations && !out_of_time(); ++it) {
         // The coarse Jacobian: each free coordinate moved both ways within its bounds.
         std::vector<std::vector<double>> moved;
         std::vector<double> width(static_cast<std::size_t>(nf));
@@ -102,7 +106,7 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
         const Eigen::MatrixXd A = J.transpose() * J;
         const Eigen::VectorXd g = J.transpose() * r;
         bool stepped = false;
-        for (int tries = 0; tries < kTries && !stepped; ++tries, damping *= 10) {
+        for (int tries = 0; tries < kTries && !stepped && !out_of_time(); ++tries) {
             Eigen::MatrixXd B = A;
             for (int k = 0; k < nf; ++k) B(k, k) = A(k, k) > 0 ? A(k, k) * (1 + damping) : 1;
             const Eigen::VectorXd dx = -B.ldlt().solve(g);
@@ -116,15 +120,16 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
                 x = y;
                 r = ry;
                 stepped = true;
-                damping = std::max(damping / 100, 1e-6);   // (the loop's x10 follows)
+                damping = std::max(damping / 10, 1e-6);
+            } else {
+                damping *= 10;
             }
         }
         if (!stepped) break;
         ++res.iterations;
     }
     res.chi2_after = chi2_of(r);
-    res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return res;
+    return done();
 }
 
 }   // namespace plate::identify_detail

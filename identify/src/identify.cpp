@@ -158,7 +158,6 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);
 }
 
-
 // One hop: the staged search from (x, q0); into s (and best, best_q0) if it fits better there and its
 // verdict could be drawn. False otherwise (s unchanged).
 bool hop(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
@@ -319,11 +318,13 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     }
     for (int k = 0; k < static_cast<int>(xs.size()); ++k) {
         if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
-        std::vector<double> x = k > 0 && !best.empty() ? restart(layout, best, xs[k == 1 ? 0 : k]) : xs[k];
+        // (a later start: the best fit's kinetic coefficients and offsets, the static ones the scene's for the
+        // second, drawn after it)
+        std::vector<double> x = k > 0 && !best.empty() ? restart(layout, best, xs[k == 1 ? 0 : k], xs[k]) : xs[k];
         CoarseResult coarse;
-        if (o.coarse_iterations > 0)
+        if (o.coarse_iterations > 0)   // (at most a quarter of the time left)
             coarse = coarse_steps(cost_ptrs, layout, o, x, first_frames(tracks, d), held, lo, hi,
-                                  o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count());
+                                  0.25 * (o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count()));
         Solve on_pieces;
         double piece_seconds = 0;
         if (!piece_ptrs.empty()) {

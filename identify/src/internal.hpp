@@ -45,11 +45,11 @@ struct Layout {
 };
 
 // A later start of the search after a fit that did not fit as well as the noise allows: the fit's
-// coordinates but for the static coefficients, which come from `draw` (the second start takes the scene's)
-// -- the kinetic ones are what the tracks determine best, a static one what a search leaves in a wrong
-// cell (docs/decisions/identification.md, "Coarse steps first"). `draw` itself if no static coefficient
+// coordinates but for the static coefficients' excesses over their kinetic ones, which come from
+// `statics` (docs/decisions/identification.md, "Coarse steps first"); `draw` where no static coefficient
 // is fitted.
-std::vector<double> restart(const Layout& layout, const std::vector<double>& fit, const std::vector<double>& draw);
+std::vector<double> restart(const Layout& layout, const std::vector<double>& fit, const std::vector<double>& statics,
+                            const std::vector<double>& draw);
 
 // The scene at internal coordinates x.
 Scene at(const Scene& scene, const Layout& layout, const std::vector<double>& x);
@@ -210,10 +210,9 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
                double seconds, int threads, ceres::IterationCallback* callback = nullptr, double initial_radius = 1e4);
 
 // The search's coarse first steps (coarse.cpp; IdentifyOptions::coarse_iterations): from x, the
-// coordinates in `held` kept, the tracks' starts held at q0, within [lo, hi] and `seconds`, the
-// Jacobian by central differences `factor` times the fine steps (Layout::step): kCoarseFactor, 0.01 in a
-// friction coefficient and 0.1 mm in a centre-of-mass offset. x holds the result (unchanged if no step
-// lowered the chi-square).
+// coordinates in `held` and the static coefficients' excesses kept, the tracks' starts held at q0, within
+// [lo, hi] and `seconds`, the Jacobian by central differences `factor` times the fine steps
+// (Layout::step). x holds the result (unchanged if no step lowered the chi-square).
 constexpr double kCoarseFactor = 100;
 struct CoarseResult {
     int iterations = 0;   // steps taken (each lowered the chi-square)

@@ -126,11 +126,15 @@ Scene at(const Scene& scene, const Layout& layout, const std::vector<double>& x)
     return apply_parameters(scene, names, layout.natural(x));
 }
 
-std::vector<double> restart(const Layout& layout, const std::vector<double>& fit, const std::vector<double>& draw) {
+std::vector<double> restart(const Layout& layout, const std::vector<double>& fit, const std::vector<double>& statics,
+                            const std::vector<double>& draw) {
     std::vector<double> x = fit;
     bool any = false;
-    for (int j = 0; j < layout.size(); ++j)
-        if (layout.p[j].kind == Param::Static) x[j] = draw[j], any = true;
+    for (int j = 0; j < layout.size(); ++j) {
+        if (layout.p[j].kind != Param::Static) continue;
+        x[j] = statics[j];
+        any = true;
+    }
     return any ? x : draw;
 }
 

@@ -46,8 +46,8 @@ struct IdentifyOptions {
     Dynamics level = Dynamics::Full;   // the model the tracks are fitted with (Full or U)
     // Multi-start: the scene's values, then seeded draws within the bounds, until one fits as well as
     // the noise allows (chi-square within 3 sds of its mean at the truth) or all have run. After a
-    // usable fit, a later start takes its static coefficients from its draw (the second: the scene's
-    // values) and everything else from the best fit (identify_detail::restart).
+    // usable fit, a later start takes the best fit's coordinates but for the static coefficients'
+    // excesses (identify_detail::restart).
     int starts = 3;
     std::uint64_t seed = 1;      // of the drawn starts
     int max_iterations = 25;     // Levenberg-Marquardt iterations per start
@@ -85,9 +85,9 @@ struct IdentifyOptions {
     // many times within time_limit. 0: never.
     int hops = 4;
     // Coarse steps first ("Coarse steps first"): before its pieces, each start takes up to this many
-    // Levenberg-Marquardt steps on the whole tracks, their starts held at the first frames, the Jacobian
-    // by central differences a hundred times the search's (0.01 in a friction coefficient): the slope of
-    // the chi-square's bowl, not of the cell the start lies in. 0: none.
+    // Levenberg-Marquardt steps of the kinetic coefficients and offsets on the whole tracks, their starts
+    // held at the first frames and the static coefficients' excesses held (identify_detail::coarse_steps).
+    // 0: none.
     int coarse_iterations = 2;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
