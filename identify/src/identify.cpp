@@ -158,32 +158,6 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);
 }
 
-// One hop: the staged search from (x, q0); into s (and best, best_q0) if it fits better there and its
-// verdict could be drawn. False otherwise (s unchanged).
-bool hop(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
-         const std::vector<TrackCost*>& costs, const std::vector<int>& held, const std::vector<double>& lo,
-         const std::vector<double>& hi, Clock::time_point t0, std::vector<double> x, std::vector<std::vector<double>> q0,
-         IdentifySummary& s, std::vector<double>& best, std::vector<std::vector<double>>& best_q0, PathEnd& better) {
-    const Solve sol = staged(costs, x, q0, held, lo, hi, o, t0, o.time_limit);
-    if (!sol.usable || !(sol.chi2 < s.chi2)) return false;
-    IdentifySummary hopped = s;
-    ++hopped.hops;
-    hopped.iterations += sol.iterations;
-    hopped.termination = sol.termination;
-    hopped.converged = sol.converged;
-    PathEnd next;
-    try {
-        conclude(scene, layout, tracks, o, costs, x, q0, hopped, next);
-    } catch (const std::runtime_error&) {   // (a simulation at the hop's optimum stopped: the fit before it stands)
-        return false;
-    }
-    s = hopped;
-    best = x;
-    best_q0 = q0;
-    better = next;
-    return true;
-}
-
 // After the fit at (best, best_q0), judged in s: while the interval check finds a fit better by more than
 // one chi-square unit at an end of its paths (the search stopped in a cell of the chi-square that a step
 // of 1.96 sd leaves: docs/decisions/identification.md, "Hops"), the search goes on from there.
@@ -191,9 +165,26 @@ void hops(const Scene& scene, const Layout& layout, const std::vector<Track>& tr
           const std::vector<TrackCost*>& costs, const std::vector<int>& held, const std::vector<double>& lo,
           const std::vector<double>& hi, Clock::time_point t0, IdentifySummary& s, std::vector<double>& best,
           std::vector<std::vector<double>>& best_q0, PathEnd& better) {
-    const auto left = [&] { return o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count(); };
-    for (int k = 0; k < o.hops && better.chi2 < s.chi2 - 1 && left() > 0; ++k)
-        if (!hop(scene, layout, tracks, o, costs, held, lo, hi, t0, better.x, better.q0, s, best, best_q0, better)) break;
+    for (int hop = 0; hop < o.hops && better.chi2 < s.chi2 - 1; ++hop) {
+        if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
+        std::vector<double> x = better.x;
+        std::vector<std::vector<double>> q0 = better.q0;
+        const Solve sol = staged(costs, x, q0, held, lo, hi, o, t0, o.time_limit);
+        if (!sol.usable || !(sol.chi2 < s.chi2)) break;
+        IdentifySummary hopped = s;
+        ++hopped.hops;
+        hopped.iterations += sol.iterations;
+        hopped.termination = sol.termination;
+        hopped.converged = sol.converged;
+        try {
+            conclude(scene, layout, tracks, o, costs, x, q0, hopped, better);
+        } catch (const std::runtime_error&) {   // (a simulation at the hop's optimum stopped: the fit before it stands)
+            break;
+        }
+        s = hopped;
+        best = x;
+        best_q0 = q0;
+    }
 }
 
 }   // namespace
