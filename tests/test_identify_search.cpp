@@ -207,7 +207,7 @@ TEST_CASE("a track cut into pieces keeps its frames and the plate's phase", "[id
 }
 
 // The search's options are checked once, naming the field.
-TEST_CASE("the search's pieces, first trust region, chord steps and hops are refused out of range, naming the field",
+TEST_CASE("the search's pieces, first trust region, chord steps, hops and coarse steps are refused out of range, naming the field",
           "[identify]") {
     IdentifyOptions o = options({"mu_k"});
     REQUIRE_NOTHROW(o.validate());
@@ -226,6 +226,9 @@ TEST_CASE("the search's pieces, first trust region, chord steps and hops are ref
     o.hops = 101;
     CHECK_THROWS_WITH(o.validate(), Catch::Contains("hops"));
     o = options({"mu_k"});
+    o.coarse_iterations = -1;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("coarse_iterations"));
+    o = options({"mu_k"});
     o.segment_seconds = 0.2;   // 4 periods of fig1_point's 0.05 s: every frame of a later piece left out
     const Scene point = scene("fig1_point");
     const Track tr = filmed(point, {"mu_k"}, {0.27}, strobe(0.1, 0, 3), Vec3(0.01, -0.02, 0), 1.0);
@@ -233,6 +236,9 @@ TEST_CASE("the search's pieces, first trust region, chord steps and hops are ref
     const Run cli = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --pieces -1");
     CHECK(cli.code == 2);
     CHECK(cli.err.find("--pieces: from 0 (none) to 1e6 s") != std::string::npos);
+    const Run coarse = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --coarse 101");
+    CHECK(coarse.code == 2);
+    CHECK(coarse.err.find("--coarse") != std::string::npos);
     const Run short_pieces = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --pieces 0.2");
     CHECK(short_pieces.code == 2);
     CHECK(short_pieces.err.find("--pieces: pieces of 0.2 s are no longer than the 4 periods of 0.05 s") != std::string::npos);
