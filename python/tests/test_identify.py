@@ -1,5 +1,5 @@
 """Identification from Python: a point part's kinetic friction recovered from one filmed track within its
-interval, the command line's estimate to the bit, a static coefficient the track cannot show reported as
+interval, the command line's estimate to the bit, coarse steps asked by keyword, a static coefficient the track cannot show reported as
 such, and tracks from another set-up refused with the file and the line."""
 import json
 import os
@@ -104,3 +104,16 @@ def test_the_command_lines_estimate_to_the_bit(tmp_path):
     assert cli.returncode == 0, cli.stderr
     r = plate.identify(point_scene(0.30), [path], ["mu_k"])
     assert json.loads(out.read_text())["parameters"][0]["estimate"] == r.estimates[0]
+
+
+def test_coarse_steps_are_asked_by_keyword(tmp_path):
+    # The guess 0.03 off: the default takes its coarse steps (the JSON counts them), coarse=0 takes none,
+    # and both reach the same estimate within its sd; out of range raises naming the option.
+    path = filmed(tmp_path, point_scene(0.27))
+    with_steps = plate.identify(point_scene(0.30), [path], ["mu_k"])
+    without = plate.identify(point_scene(0.30), [path], ["mu_k"], coarse=0)
+    assert with_steps.summary["solver"]["coarse_iterations"] >= 1
+    assert without.summary["solver"]["coarse_iterations"] == 0
+    assert abs(with_steps.estimates[0] - without.estimates[0]) < with_steps.sd[0]
+    with pytest.raises(ValueError, match="coarse_iterations"):
+        plate.identify(point_scene(0.30), [path], ["mu_k"], coarse=-1)
