@@ -1,6 +1,6 @@
 """Identification from Python: a point part's kinetic friction recovered from one filmed track within its
-interval, the command line's estimate to the bit, coarse steps asked by keyword, a static coefficient the track cannot show reported as
-such, and tracks from another set-up refused with the file and the line."""
+interval, the command line's estimate to the bit, coarse steps asked by keyword, a static coefficient the
+track cannot show reported as such, and tracks from another set-up refused with the file and the line."""
 import json
 import os
 import subprocess
