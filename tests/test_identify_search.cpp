@@ -207,8 +207,9 @@ TEST_CASE("a track cut into pieces keeps its frames and the plate's phase", "[id
 }
 
 // The search's options are checked once, naming the field.
-TEST_CASE("the search's pieces, first trust region, chord steps, hops and coarse steps are refused out of range, naming the field",
-          "[identify]") {
+TEST_CASE(
+    "the search's pieces, first trust region, chord steps, hops and coarse steps are refused out of range, naming the field",
+    "[identify]") {
     IdentifyOptions o = options({"mu_k"});
     REQUIRE_NOTHROW(o.validate());
     o.segment_seconds = -1;
