@@ -15,10 +15,11 @@
 // first stage on the tracks cut into pieces of S s, default 2: IdentifyOptions::segment_seconds); both:
 // staged,central.
 // RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. COARSE:
-// IdentifyOptions::coarse_iterations. Each interval's check at its ends (the chi-square's rise there, and the verdict:
+// IdentifyOptions::coarse_iterations. CELLS: IdentifyOptions::cell_samples (each sd printed with its share from the
+// cells' spread). Each interval's check at its ends (the chi-square's rise there, and the verdict:
 // FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS [REUSE [HOPS [COARSE]]]]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS]]]]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -97,8 +98,8 @@ struct Variant {
             within += std::abs(err) <= 0.01;
             covered += cov;
             ++counted;
-            std::printf(" %s %+.4f(sd %.4f)%s{%.1f,%.1f %s}", names[j].c_str(), err, p.sd, cov ? "" : "[MISS]", p.dchi2_lo,
-                        p.dchi2_hi, to_string(p.linearity));
+            std::printf(" %s %+.4f(sd %.4f, cells %.4f)%s{%.1f,%.1f %s}", names[j].c_str(), err, p.sd, p.sd_cells,
+                        cov ? "" : "[MISS]", p.dchi2_lo, p.dchi2_hi, to_string(p.linearity));
             checks[static_cast<int>(p.linearity)] += 1;
             missed_flagged += !cov && p.linearity != Linearity::Holds;
             if (s.explains_tracks) ++explained, explained_covered += cov;
@@ -150,6 +151,7 @@ int main(int argc, char** argv) {
     if (argc > 14) o.jacobian_reuse = std::stoi(argv[14]);
     if (argc > 15) o.hops = std::stoi(argv[15]);
     if (argc > 16) o.coarse_iterations = std::stoi(argv[16]);   // (default: IdentifyOptions')
+    if (argc > 17) o.cell_samples = std::stoi(argv[17]);
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;

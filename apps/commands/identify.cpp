@@ -41,6 +41,9 @@ struct IdentifyArgs : Options {
                   "--coarse N steps (default 2; 0: none) move the kinetic coefficients and offsets on the whole\n"
                   "tracks, their starts held at the first frames and the static coefficients' excesses over the\n"
                   "kinetic ones held: from a guess, they reach the chi-square's bowl around the truth.\n"
+                  "Under static friction the chi-square is piecewise smooth on cells smaller than the sds (an arrest\n"
+                  "held or slipped through moves every later frame): each sd also takes the spread over the cells'\n"
+                  "minima near the fit, from --cells N points drawn about it (default 32; 0: none; \"sd_cells\").\n"
                   "Levenberg-Marquardt (Ceres) over the full (or u) dynamics, from --starts starts (the scene's\n"
                   "values; then the best fit's kinetic coefficients and offsets with the static excesses of the\n"
                   "scene's values, then of seeded draws; a start runs only while none fits as well as the noise\n"
@@ -85,6 +88,7 @@ struct IdentifyArgs : Options {
         number("--rtol", o.rtol, "the simulation's tolerance");
         number("--pieces", o.segment_seconds, "seconds of the pieces the search fits first (0: none)");
         whole("--coarse", o.coarse_iterations, 0, 100, "coarse steps before the pieces (0: none)");
+        whole("--cells", o.cell_samples, 0, 10000, "points drawn about the fit for the cells' spread (0: none)");
         whole("--threads", o.threads, 1, 1024, "simulations in parallel (the fit is the same on any number)");
         text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");
         whole("--profile-steps", po.max_steps, 1, 1000, "--profile: re-minimisations per side");

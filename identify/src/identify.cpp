@@ -107,12 +107,19 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
     return sol;
 }
 
+// What conclude() leaves for the cells' spread: the whole Jacobian, the residuals and the linearised
+// covariance (internal coordinates) at the fit.
+struct AtFit {
+    Eigen::MatrixXd J, cov_internal;
+    Eigen::VectorXd r0;
+};
+
 // What the fit says at internal coordinates x and starts q0: each track's fit and the chi-square, the
 // covariance and intervals from the whole Jacobian (central differences; the tracks' starts beside the
 // named parameters), and each interval's check, with the best end of its paths in `better`.
 void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
               const std::vector<TrackCost*>& costs, const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
-              IdentifySummary& s, PathEnd& better) {
+              IdentifySummary& s, PathEnd& better, AtFit& at_fit) {
     const int n = layout.size(), nt = static_cast<int>(tracks.size()), d = scene.part.point ? 2 : 3;
     int rows = 0;
     for (const TrackCost* c : costs) rows += c->num_residuals();
@@ -156,6 +163,10 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
     s.explains_tracks = !(s.p_value < kFitPValueFloor);
     const Eigen::MatrixXd cov_internal = judge(layout, o, x, J, d * nt, s);
     check_linearity(layout, o, costs, x, q0, J, cov_internal, s, better);
+    at_fit.r0.resize(rows);
+    for (int t = 0, row = 0; t < nt; row += static_cast<int>(rs[t].size()), ++t) at_fit.r0.segment(row, rs[t].size()) = rs[t];
+    at_fit.J = std::move(J);
+    at_fit.cov_internal = cov_internal;
 }
 
 // After the fit at (best, best_q0), judged in s: while the interval check finds a fit better by more than
@@ -164,7 +175,7 @@ void conclude(const Scene& scene, const Layout& layout, const std::vector<Track>
 void hops(const Scene& scene, const Layout& layout, const std::vector<Track>& tracks, const IdentifyOptions& o,
           const std::vector<TrackCost*>& costs, const std::vector<int>& held, const std::vector<double>& lo,
           const std::vector<double>& hi, Clock::time_point t0, IdentifySummary& s, std::vector<double>& best,
-          std::vector<std::vector<double>>& best_q0, PathEnd& better) {
+          std::vector<std::vector<double>>& best_q0, PathEnd& better, AtFit& at_fit) {
     for (int hop = 0; hop < o.hops && better.chi2 < s.chi2 - 1; ++hop) {
         if (std::chrono::duration<double>(Clock::now() - t0).count() >= o.time_limit) break;
         std::vector<double> x = better.x;
@@ -172,16 +183,18 @@ void hops(const Scene& scene, const Layout& layout, const std::vector<Track>& tr
         const Solve sol = staged(costs, x, q0, held, lo, hi, o, t0, o.time_limit);
         if (!sol.usable || !(sol.chi2 < s.chi2)) break;
         IdentifySummary hopped = s;
+        AtFit hopped_at;
         ++hopped.hops;
         hopped.iterations += sol.iterations;
         hopped.termination = sol.termination;
         hopped.converged = sol.converged;
         try {
-            conclude(scene, layout, tracks, o, costs, x, q0, hopped, better);
+            conclude(scene, layout, tracks, o, costs, x, q0, hopped, better, hopped_at);
         } catch (const std::runtime_error&) {   // (a simulation at the hop's optimum stopped: the fit before it stands)
             break;
         }
         s = hopped;
+        at_fit = std::move(hopped_at);
         best = x;
         best_q0 = q0;
     }
@@ -205,6 +218,7 @@ void IdentifyOptions::validate() const {
     if (jacobian_reuse < 0 || jacobian_reuse > 100) bad("jacobian_reuse: from 0 to 100");
     if (hops < 0 || hops > 100) bad("hops: from 0 to 100");
     if (coarse_iterations < 0 || coarse_iterations > 100) bad("coarse_iterations: from 0 to 100");
+    if (cell_samples < 0 || cell_samples > 10000) bad("cell_samples: from 0 to 10000");
     if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
     if (!(mu_min > 0 && mu_min < mu_max && mu_max <= 10)) bad("mu_min, mu_max: 0 < mu_min < mu_max <= 10");
@@ -350,8 +364,11 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
 
     // The fit's verdict at the best start's optimum, then its hops.
     PathEnd better;
-    conclude(scene, layout, tracks, o, cost_ptrs, best, best_q0, s, better);
-    hops(scene, layout, tracks, o, cost_ptrs, held, lo, hi, t0, s, best, best_q0, better);
+    AtFit at_fit;
+    conclude(scene, layout, tracks, o, cost_ptrs, best, best_q0, s, better, at_fit);
+    hops(scene, layout, tracks, o, cost_ptrs, held, lo, hi, t0, s, best, best_q0, better, at_fit);
+    add_cells(layout, best, cell_spread(layout, o, cost_ptrs, best, best_q0, at_fit.J, at_fit.r0, at_fit.cov_internal, s.chi2),
+              s);
     s.fitted = at(scene, layout, best);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return s;

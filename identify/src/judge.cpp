@@ -89,6 +89,7 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
             if (std::abs(A(j, k)) > 1e-9 && !internal_ok[k]) p.identifiable = false;
         p.at_bound = x[j] <= layout.lower(j, o) + 1e-9 || x[j] >= layout.upper(j, o) - 1e-9;
         p.sd = p.identifiable ? std::sqrt(std::max(s.covariance(j, j), 0.0)) : nan;
+        p.sd_cells = p.identifiable ? 0.0 : nan;
         p.lo = p.estimate - kZ95 * p.sd;
         p.hi = p.estimate + kZ95 * p.sd;
         s.params.push_back(p);
@@ -99,6 +100,22 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
             s.covariance.col(j).setConstant(nan);
         }
     return cov_internal;
+}
+
+void add_cells(const Layout& layout, const std::vector<double>& x, const Eigen::MatrixXd& cov_cells, IdentifySummary& s) {
+    const int n = layout.size();
+    const Eigen::MatrixXd A = natural_jacobian(layout, x);
+    const Eigen::MatrixXd cells = A * cov_cells * A.transpose();
+    for (int j = 0; j < n; ++j) {
+        FittedParameter& p = s.params[j];
+        if (!p.identifiable) continue;
+        for (int k = 0; k < n; ++k)
+            if (s.params[k].identifiable) s.covariance(j, k) += cells(j, k);
+        p.sd_cells = std::sqrt(std::max(cells(j, j), 0.0));
+        p.sd = std::sqrt(std::max(s.covariance(j, j), 0.0));
+        p.lo = p.estimate - kZ95 * p.sd;
+        p.hi = p.estimate + kZ95 * p.sd;
+    }
 }
 
 void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,

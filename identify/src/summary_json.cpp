@@ -22,12 +22,15 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         json j{{"name", p.name}, {"unit", p.unit}, {"estimate", p.estimate}, {"at_bound", p.at_bound}};
         if (p.identifiable) {
             j["sd"] = num(p.sd);
+            j["sd_cells"] = num(p.sd_cells);
             j["interval95"] = {num(p.lo), num(p.hi)};
-            j["interval95_check"] = {{"dchi2_at_ends", {num(p.dchi2_lo), num(p.dchi2_hi)}},
+            j["interval95_check"] = {{"of", "the interval within the fit's cell: estimate -+ 1.96 sqrt(sd^2 - sd_cells^2)"},
+                                     {"dchi2_at_ends", {num(p.dchi2_lo), num(p.dchi2_hi)}},
                                      {"quadratic_dchi2", kProfileThreshold95},
                                      {"verdict", to_string(p.linearity)}};
         } else {
             j["sd"] = nullptr;
+            j["sd_cells"] = nullptr;
             j["interval95"] = nullptr;
             j["identifiable"] = "not identifiable from these tracks";
         }
@@ -68,6 +71,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
               {"initial_trust_radius", o.initial_trust_radius},
               {"jacobian_reuse", o.jacobian_reuse},
               {"hops", o.hops},
+              {"cell_samples", o.cell_samples},
               {"rtol", o.rtol}};
     return json{
         {"parameters", params},

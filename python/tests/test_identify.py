@@ -117,3 +117,37 @@ def test_coarse_steps_are_asked_by_keyword(tmp_path):
     assert abs(with_steps.estimates[0] - without.estimates[0]) < with_steps.sd[0]
     with pytest.raises(ValueError, match="coarse_iterations"):
         plate.identify(point_scene(0.30), [path], ["mu_k"], coarse=-1)
+
+
+def test_the_cells_spread_is_asked_by_keyword(tmp_path):
+    # A part sliding throughout has no cells: the default's spread over them is a small part of the sd (its
+    # own, in .sd_cells and the JSON), cells=0 leaves none and the within-cell sd alone; out of range raises.
+    path = filmed(tmp_path, point_scene(0.27))
+    with_cells = plate.identify(point_scene(0.30), [path], ["mu_k"])
+    without = plate.identify(point_scene(0.30), [path], ["mu_k"], cells=0)
+    assert 0 < with_cells.sd_cells[0] < 0.1 * with_cells.sd[0]
+    assert with_cells.summary["parameters"][0]["sd_cells"] == with_cells.sd_cells[0]
+    assert with_cells.summary["options"]["cell_samples"] == 32
+    assert without.sd_cells[0] == 0
+    assert without.sd[0] ** 2 == pytest.approx(with_cells.sd[0] ** 2 - with_cells.sd_cells[0] ** 2, rel=1e-9)
+    with pytest.raises(ValueError, match="cell_samples"):
+        plate.identify(point_scene(0.30), [path], ["mu_k"], cells=-1)
+
+
+@pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
+def test_the_command_lines_cells_option(tmp_path):
+    # --cells 0: no spread over the cells, the JSON says so; the default's equals the module's to the bit.
+    path = filmed(tmp_path, point_scene(0.27))
+    scene_file = tmp_path / "nominal.json"
+    scene_file.write_text(json.dumps(plate.scene_to_dict(point_scene(0.30))))
+    for cells in ("0", None):
+        out = tmp_path / "est.json"
+        args = [EXE, "identify", str(scene_file), "--tracks", path, "--params", "mu_k", "--out", str(out)]
+        cli = subprocess.run(args + (["--cells", cells] if cells else []), capture_output=True, text=True)
+        assert cli.returncode == 0, cli.stderr
+        est = json.loads(out.read_text())
+        if cells:
+            assert est["options"]["cell_samples"] == 0
+            assert est["parameters"][0]["sd_cells"] == 0
+        else:
+            assert est["parameters"][0]["sd_cells"] == plate.identify(point_scene(0.30), [path], ["mu_k"]).sd_cells[0]

@@ -89,6 +89,11 @@ struct IdentifyOptions {
     // held at the first frames and the static coefficients' excesses held (identify_detail::coarse_steps).
     // 0: none.
     int coarse_iterations = 2;
+    // Cells near the fit ("The spread over the chi-square's cells"): the interval's sd also takes the
+    // spread of the chi-square's cell minima near the fit, found from this many points drawn about it (half
+    // at the linearised covariance, half at twice its sds), each taken one Gauss-Newton step to its cell's
+    // minimum and weighted by its likelihood (identify_detail::cell_spread). 0: the linearised sd alone.
+    int cell_samples = 32;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
@@ -111,7 +116,9 @@ const char* to_string(Linearity l);
 struct FittedParameter {
     std::string name, unit;   // unit "1" (friction) or "m"
     double estimate = 0;
-    double sd = 0;              // from the covariance; NaN where not identifiable
+    double sd = 0;              // from the covariance (the cells' spread included); NaN where not identifiable
+    double sd_cells = 0;        // of which the spread over the chi-square's cells near the fit: sd^2 - sd_cells^2
+                                // is the linearised (within its cell) variance
     double lo = 0, hi = 0;      // 95 %: estimate -+ 1.96 sd; NaN where not identifiable
     bool identifiable = true;   // false: part of a combination the tracks cannot separate
     bool at_bound = false;      // the estimate lies on a physical bound (the interval is then one-sided at best)
@@ -145,7 +152,8 @@ constexpr double kFitPValueFloor = 1e-3;
 
 struct IdentifySummary {
     std::vector<FittedParameter> params;   // in the order asked
-    Eigen::MatrixXd covariance;            // of the estimates, rows and columns as params (NaN where not identifiable)
+    Eigen::MatrixXd covariance;            // of the estimates, rows and columns as params (NaN where not identifiable),
+                                           // the spread over the chi-square's cells included
     std::vector<Unidentifiable> unidentifiable;
     std::vector<TrackFit> tracks;
     double chi2 = 0;              // sum of squared scaled residuals at the estimate

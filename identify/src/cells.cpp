@@ -1,0 +1,109 @@
+// The spread of the estimate over the chi-square's cells near the fit. Under static friction the
+// chi-square is piecewise smooth on cells smaller than the parameters' sds (an arrest held or slipped
+// through moves every later frame); the search ends in one cell, whose curvature is the linearised
+// covariance. Which cell the noise makes the lowest is a second, larger spread: it is found here from the
+// cells' minima about the fit (docs/decisions/identification.md, "The spread over the chi-square's cells").
+#include "internal.hpp"
+
+#include "plate/tasks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace plate::identify_detail {
+namespace {
+
+// The starts' regression on the named coordinates, -F_qq^+ F_qx (as the interval check's paths).
+Eigen::MatrixXd start_regression(const Eigen::MatrixXd& F, int n) {
+    const int ns = static_cast<int>(F.rows()) - n;
+    if (ns == 0) return Eigen::MatrixXd(0, n);
+    return -F.bottomRightCorner(ns, ns).completeOrthogonalDecomposition().solve(F.bottomLeftCorner(ns, n));
+}
+
+}   // namespace
+
+std::vector<Eigen::VectorXd> cell_moves(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x,
+                                        const Eigen::MatrixXd& J, const Eigen::MatrixXd& cov_internal) {
+    const int n = layout.size(), ns = static_cast<int>(J.cols()) - n, samples = o.cell_samples;
+    const Eigen::MatrixXd regress = start_regression(J.transpose() * J, n);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (cov_internal + cov_internal.transpose()));
+    const Eigen::MatrixXd root = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    std::mt19937_64 gen(o.seed ^ 0x63656c6cULL);
+    std::normal_distribution<double> normal;
+    std::vector<Eigen::VectorXd> moves(samples, Eigen::VectorXd::Zero(n + ns));
+    for (int k = 0; k < samples; ++k) {
+        Eigen::VectorXd z(n);
+        for (int j = 0; j < n; ++j) z[j] = normal(gen);
+        Eigen::VectorXd& v = moves[k];
+        v.head(n) = (2 * k < samples ? 1.0 : 2.0) * root * z;
+        for (int j = 0; j < n; ++j) v[j] = std::clamp(x[j] + v[j], layout.lower(j, o), layout.upper(j, o)) - x[j];
+        v.tail(ns) = regress * v.head(n);
+    }
+    return moves;
+}
+
+Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0, double chi2, const Eigen::MatrixXd& cov_internal,
+                             const std::vector<Eigen::VectorXd>& moves, const std::vector<Eigen::VectorXd>& r) {
+    const int n = static_cast<int>(cov_internal.rows()), ns = static_cast<int>(J.cols()) - n;
+    const Eigen::MatrixXd F = J.transpose() * J;
+    const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Fd(F);
+    const Eigen::MatrixXd regress = start_regression(F, n);
+    // Each draw's cell minimum: the shift from the fit -- the named coordinates', the starts eliminated,
+    // along the identifiable directions only: -cov_internal (g_x + regress^T g_q), g = J^T d for the
+    // residuals' departure d from the linear model -- and the linear model's chi-square there.
+    std::vector<Eigen::VectorXd> shift;
+    std::vector<double> minimum;
+    for (std::size_t k = 0; k < moves.size(); ++k) {
+        if (r[k].size() == 0) continue;
+        const Eigen::VectorXd g = J.transpose() * (r[k] - r0 - J * moves[k]);
+        const Eigen::VectorXd reduced = g.head(n) + regress.transpose() * g.tail(ns);
+        shift.push_back(-cov_internal * reduced);
+        const Eigen::VectorXd gk = J.transpose() * r[k];
+        minimum.push_back(r[k].squaredNorm() - gk.dot(Fd.solve(gk)));
+    }
+    // The mixture: the fit (no shift) and the minima, each weighted by its likelihood exp(-chi2 / 2).
+    double lowest = chi2;
+    for (const double m : minimum) lowest = std::min(lowest, m);
+    double total = std::exp(-0.5 * (chi2 - lowest));
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+    for (std::size_t k = 0; k < shift.size(); ++k) {
+        const double w = std::exp(-0.5 * (minimum[k] - lowest));
+        total += w;
+        cov += w * shift[k] * shift[k].transpose();
+    }
+    return cov / total;
+}
+
+Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
+                            const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
+                            const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal, double chi2) {
+    const int n = layout.size(), nt = static_cast<int>(costs.size()), ns = static_cast<int>(J.cols()) - n;
+    const int d = nt > 0 ? ns / nt : 0;
+    if (o.cell_samples <= 0 || n == 0) return Eigen::MatrixXd::Zero(n, n);
+    const std::vector<Eigen::VectorXd> moves = cell_moves(layout, o, x, J, cov_internal);
+    const int samples = static_cast<int>(moves.size()), tasks = samples * nt;
+    // Every (draw, track) prediction as a task; a draw with a stopped simulation is left out.
+    std::vector<int> offset(nt + 1, 0);
+    for (int t = 0; t < nt; ++t) offset[t + 1] = offset[t] + costs[t]->num_residuals();
+    std::vector<Eigen::VectorXd> r(samples, Eigen::VectorXd::Zero(offset[nt]));
+    std::vector<char> stopped(static_cast<std::size_t>(tasks), 0);
+    thread_tasks(std::max(1, std::min(o.threads, tasks)))(
+        tasks,
+        [&](int i) {
+            const int k = i / nt, t = i % nt;
+            std::vector<double> xe(n), qe(d);
+            for (int j = 0; j < n; ++j) xe[j] = x[j] + moves[k][j];
+            for (int j = 0; j < d; ++j) qe[j] = q0[t][j] + moves[k][n + d * t + j];
+            stopped[i] = !costs[t]->residuals(xe.data(), qe.data(), r[k].data() + offset[t]);
+            return std::string();
+        },
+        [](int, const std::string&) {});
+    for (int k = 0; k < samples; ++k)
+        for (int t = 0; t < nt; ++t)
+            if (stopped[static_cast<std::size_t>(k) * nt + t]) r[k].resize(0);
+    return cell_mixture(J, r0, chi2, cov_internal, moves, r);
+}
+
+}   // namespace plate::identify_detail
