@@ -145,7 +145,7 @@ void section_identify(Ctx& c, const fs::path& src, const ReportOptions& opt) {
     for (std::size_t i = 0; i < p.profiles.size(); ++i) {
         const FittedParameter& f = s.params[i];
         const ParameterProfile& pr = p.profiles[i];
-        const double lo = pr.interval_is_profile ? pr.lo : f.lo, hi = pr.interval_is_profile ? pr.hi : f.hi;
+        const double lo = pr.interval_is_profile ? pr.lo_reported : f.lo, hi = pr.interval_is_profile ? pr.hi_reported : f.hi;
         const bool reported = pr.identifiable && std::isfinite(lo);
         c.html << "<tr><td>" << esc(f.name) << "</td><td>" << fmt(truth[i]) << "</td><td>" << fmt(f.estimate, 5) << "</td><td>"
                << (f.identifiable ? interval_text(f.lo, f.hi) : "none (not identifiable)") << "</td><td>"

@@ -44,26 +44,40 @@ std::vector<Eigen::VectorXd> cell_moves(const Layout& layout, const IdentifyOpti
     return moves;
 }
 
-Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0, double chi2, const Eigen::MatrixXd& cov_internal,
+Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal,
+                             const std::vector<double>& lower, const std::vector<double>& upper,
                              const std::vector<Eigen::VectorXd>& moves, const std::vector<Eigen::VectorXd>& r) {
     const int n = static_cast<int>(cov_internal.rows()), ns = static_cast<int>(J.cols()) - n;
     const Eigen::MatrixXd F = J.transpose() * J;
-    const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Fd(F);
     const Eigen::MatrixXd regress = start_regression(F, n);
+    const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Fqq(
+        ns > 0 ? Eigen::MatrixXd(F.bottomRightCorner(ns, ns)) : Eigen::MatrixXd::Identity(1, 1));   // (unused without starts)
+    const Eigen::MatrixXd Jx = J.leftCols(n), Jq = J.rightCols(ns);
+    // The linear model's chi-square from residuals u, the starts at their best: |u|^2 - h^T F_qq^+ h, h = J_q^T u.
+    const auto over_starts = [&](const Eigen::VectorXd& u) {
+        if (ns == 0) return u.squaredNorm();
+        const Eigen::VectorXd h = Jq.transpose() * u;
+        return u.squaredNorm() - h.dot(Fqq.solve(h));
+    };
     // Each draw's cell minimum: the shift from the fit -- the named coordinates', the starts eliminated,
     // along the identifiable directions only: -cov_internal (g_x + regress^T g_q), g = J^T d for the
-    // residuals' departure d from the linear model -- and the linear model's chi-square there.
+    // residuals' departure d from the linear model, kept within the bounds -- and the linear model's
+    // chi-square there, through the draw's residuals; the fit's own by the same formula (no move, no shift).
     std::vector<Eigen::VectorXd> shift;
     std::vector<double> minimum;
     for (std::size_t k = 0; k < moves.size(); ++k) {
         if (r[k].size() == 0) continue;
         const Eigen::VectorXd g = J.transpose() * (r[k] - r0 - J * moves[k]);
         const Eigen::VectorXd reduced = g.head(n) + regress.transpose() * g.tail(ns);
-        shift.push_back(-cov_internal * reduced);
-        const Eigen::VectorXd gk = J.transpose() * r[k];
-        minimum.push_back(r[k].squaredNorm() - gk.dot(Fd.solve(gk)));
+        Eigen::VectorXd sh = -cov_internal * reduced;
+        for (int j = 0; j < n; ++j) sh[j] = std::clamp(sh[j], lower[j], upper[j]);
+        const double m = over_starts(r[k] + Jx * (sh - moves[k].head(n)) - Jq * moves[k].tail(ns));
+        if (!std::isfinite(m) || !sh.allFinite()) continue;
+        shift.push_back(sh);
+        minimum.push_back(m);
     }
     // The mixture: the fit (no shift) and the minima, each weighted by its likelihood exp(-chi2 / 2).
+    const double chi2 = over_starts(r0);
     double lowest = chi2;
     for (const double m : minimum) lowest = std::min(lowest, m);
     double total = std::exp(-0.5 * (chi2 - lowest));
@@ -78,7 +92,7 @@ Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0
 
 Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                             const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
-                            const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal, double chi2) {
+                            const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal) {
     const int n = layout.size(), nt = static_cast<int>(costs.size()), ns = static_cast<int>(J.cols()) - n;
     const int d = nt > 0 ? ns / nt : 0;
     if (o.cell_samples <= 0 || n == 0) return Eigen::MatrixXd::Zero(n, n);
@@ -103,7 +117,12 @@ Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, cons
     for (int k = 0; k < samples; ++k)
         for (int t = 0; t < nt; ++t)
             if (stopped[static_cast<std::size_t>(k) * nt + t]) r[k].resize(0);
-    return cell_mixture(J, r0, chi2, cov_internal, moves, r);
+    std::vector<double> lower(n), upper(n);   // (the shifts' bounds: the fit's coordinates within theirs)
+    for (int j = 0; j < n; ++j) {
+        lower[j] = layout.lower(j, o) - x[j];
+        upper[j] = layout.upper(j, o) - x[j];
+    }
+    return cell_mixture(J, r0, cov_internal, lower, upper, moves, r);
 }
 
 }   // namespace plate::identify_detail

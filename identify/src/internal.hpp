@@ -242,26 +242,29 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
 
 // The spread of the estimate over the chi-square's cells near the fit (cells.cpp; "The spread over the
 // chi-square's cells", docs/decisions/identification.md): o.cell_samples points drawn about the fit at
-// internal coordinates x and starts q0 (cell_moves), each taken one Gauss-Newton step by the fit's
-// Jacobian J from its simulated residuals to its cell's minimum (cell_mixture). Returns the cells'
-// covariance in internal coordinates (zero where nothing was drawn). r0: the residuals at the fit, chi2
-// their chi-square. The draws are seeded by o.seed: the result does not depend on threads.
+// internal coordinates x and starts q0 (cell_moves), their residuals simulated, each taken one
+// Gauss-Newton step by the fit's Jacobian J (cell_mixture). Returns the cells' covariance in internal
+// coordinates (zero where nothing was drawn). r0: the residuals at the fit. The draws are seeded by
+// o.seed: the result does not depend on threads. Its simulations run after the search (as the interval
+// check's), beyond o.time_limit.
 Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                             const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Eigen::MatrixXd& J,
-                            const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal, double chi2);
+                            const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal);
 // The draws' moves over the named coordinates then the starts: the named ones from the linearised
 // covariance cov_internal, the first half at its sds and the rest at twice them, kept within the bounds;
 // the starts by their regression on them.
 std::vector<Eigen::VectorXd> cell_moves(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x,
                                         const Eigen::MatrixXd& J, const Eigen::MatrixXd& cov_internal);
-// From the residuals r[k] at each move (empty: a simulation stopped there): the step from move k lands on
-// its cell's minimum, shifted from the fit by -F^+ J^T d_k (d_k = r[k] - r0 - J move_k, the departure from
-// the linear model; the starts eliminated, the identifiable directions of cov_internal only), with the
-// linear model's chi-square there. The fit and those minima, each weighted by exp(-chi2 / 2), make a
-// mixture; its second moment about the fit is returned (n x n, n = cov_internal's size).
-Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0, double chi2,
-                             const Eigen::MatrixXd& cov_internal, const std::vector<Eigen::VectorXd>& moves,
-                             const std::vector<Eigen::VectorXd>& r);
+// From the residuals r[k] at each move (empty: a simulation stopped there): the linear model through the
+// draw's residuals (the fit's Jacobian J) has its minimum shifted from the fit by -F^+ J^T d_k (d_k = r[k]
+// - r0 - J move_k, the departure from the fit's linear model: the cells the move crossed; the starts
+// eliminated, along the identifiable directions of cov_internal only, within [lower, upper] of the shift),
+// with its chi-square there, the starts at their best; the fit's own by the same formula. The fit and those
+// minima, each weighted by exp(-chi2 / 2), make a mixture; its second moment about the fit is returned
+// (n x n, n = cov_internal's size). A non-finite minimum is left out.
+Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0, const Eigen::MatrixXd& cov_internal,
+                             const std::vector<double>& lower, const std::vector<double>& upper,
+                             const std::vector<Eigen::VectorXd>& moves, const std::vector<Eigen::VectorXd>& r);
 
 // s's covariance, sds and intervals with the cells' covariance (internal coordinates) added (judge.cpp).
 void add_cells(const Layout& layout, const std::vector<double>& x, const Eigen::MatrixXd& cov_cells, IdentifySummary& s);

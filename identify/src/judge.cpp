@@ -18,7 +18,7 @@ namespace plate::identify_detail {
 // the whole range (the tracks cannot place it anywhere narrower than the bounds already do); a
 // parameter belongs to such a direction when its weight in it exceeds kLoading (its share of the
 // direction's variance above 1 %).
-constexpr double kZ95 = 1.959963984540054, kLoading = 0.1;
+constexpr double kLoading = 0.1;
 
 Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>& x) {
     // The named values are linear in the internal coordinates wherever no two kinetic coefficients tie

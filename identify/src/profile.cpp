@@ -249,8 +249,9 @@ ProfileSummary profile_likelihood(const Scene& scene, const std::vector<Track>& 
         p.name = f.name;
         p.unit = f.unit;
         p.estimate = f.estimate;
-        p.linear_lo = f.identifiable ? f.lo : std::numeric_limits<double>::quiet_NaN();
-        p.linear_hi = f.identifiable ? f.hi : std::numeric_limits<double>::quiet_NaN();
+        const double within = std::sqrt(std::max(f.sd * f.sd - f.sd_cells * f.sd_cells, 0.0));   // (NaN: not identifiable)
+        p.linear_lo = f.identifiable ? f.estimate - kZ95 * within : std::numeric_limits<double>::quiet_NaN();
+        p.linear_hi = f.identifiable ? f.estimate + kZ95 * within : std::numeric_limits<double>::quiet_NaN();
         Walk w{layout, o, po, costs, budget, j, x_hat, q0_hat, {}, fit.chi2};
         w.z_hat[j] = f.estimate;
         const Param& q = layout.p[j];
@@ -270,7 +271,7 @@ ProfileSummary profile_likelihood(const Scene& scene, const std::vector<Track>& 
         }
         // The first step: the linearised sd where there is one, else a sixteenth of the range.
         const double range = p.bound_hi - p.bound_lo;
-        const double delta = f.identifiable && f.sd > 0 ? std::min(f.sd, range / 4) : range / 16;
+        const double delta = f.identifiable && within > 0 ? std::min(within, range / 4) : range / 16;
         std::vector<ProfilePoint> pts{{f.estimate, 0}};
         p.lo = f.estimate > p.bound_lo ? walk(w, f.estimate, p.bound_lo, -1, delta, p.lo_end, p.chi2_drop, pts) : p.bound_lo;
         if (f.estimate <= p.bound_lo) p.lo_end = ProfileEnd::AtBound;
@@ -279,6 +280,9 @@ ProfileSummary profile_likelihood(const Scene& scene, const std::vector<Track>& 
         std::sort(pts.begin(), pts.end(), [](const ProfilePoint& a, const ProfilePoint& b) { return a.value < b.value; });
         p.points = pts;
         judge_profile(p, po.agreement);
+        const double cells = f.identifiable ? kZ95 * f.sd_cells : 0.0;
+        p.lo_reported = std::max(p.bound_lo, p.estimate - std::hypot(p.estimate - p.lo, cells));
+        p.hi_reported = std::min(p.bound_hi, p.estimate + std::hypot(p.hi - p.estimate, cells));
         if (p.chi2_drop > 1)
             p.verdict += "; the profile found a chi-square " + std::to_string(p.chi2_drop) +
                          " below the fit's: the fit was not at its minimum";

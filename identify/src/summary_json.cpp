@@ -132,7 +132,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o, const Pro
             q["interval95_profile"] = interval;
             q["interval_method"] = pr.interval_is_profile ? "profile likelihood" : "linearised";
             q["profile_verdict"] = pr.verdict;
-            if (pr.interval_is_profile) q["interval95"] = pr.identifiable ? json{pr.lo, pr.hi} : json(nullptr);
+            if (pr.interval_is_profile) q["interval95"] = pr.identifiable ? json{pr.lo_reported, pr.hi_reported} : json(nullptr);
             if (!pr.identifiable)
                 q["identifiable"] = "not identifiable from these tracks";
             else if (q.contains("identifiable") && pr.interval_is_profile)

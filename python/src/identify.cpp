@@ -44,7 +44,7 @@ void io(Archive& a, IdentifyOptions& o) {
 void io(Archive& a, ProfilePoint& p) { a(p.value, p.dchi2); }
 void io(Archive& a, ParameterProfile& p) {
     a(p.name, p.unit, p.estimate, p.points, p.lo, p.hi, p.lo_end, p.hi_end, p.bound_lo, p.bound_hi, p.linear_lo, p.linear_hi,
-      p.interval_is_profile, p.identifiable, p.chi2_drop, p.verdict, p.simulations, p.seconds);
+      p.lo_reported, p.hi_reported, p.interval_is_profile, p.identifiable, p.chi2_drop, p.verdict, p.simulations, p.seconds);
 }
 void io(Archive& a, ProfileSummary& s) { a(s.profiles, s.chi2_min, s.simulations, s.seconds); }
 void io(Archive& a, ProfileOptions& o) {
@@ -182,9 +182,10 @@ void bind_identify(py::module_& m) {
                 }
                 return out;
             },
-            "per parameter, the 95 % interval checked at its ends: a dict -- dchi2_at_ends (the chi-square's rise "
-            "there along the linearised profile's path; 3.84 where the chi-square is quadratic; NaN where not "
-            "checked), verdict ('holds', 'too narrow', 'unconfirmed' or 'not checked')")
+            "per parameter, the 95 % interval within the fit's cell (estimate -+ 1.96 sqrt(sd^2 - sd_cells^2)) checked "
+            "at its ends: a dict -- dchi2_at_ends (the chi-square's rise there along the linearised profile's path; "
+            "3.84 where the chi-square is quadratic; NaN where not checked), verdict ('holds', 'too narrow', "
+            "'unconfirmed' or 'not checked')")
         .def_property_readonly(
             "covariance", [](const PyIdentification& r) { return Eigen::MatrixXd(r.s.covariance); },
             "of the estimates, rows and columns as names (NaN where not identifiable)")
@@ -219,6 +220,7 @@ void bind_identify(py::module_& m) {
                     d["ends"] = py::make_tuple(to_string(pr.lo_end), to_string(pr.hi_end));
                     d["bounds"] = py::make_tuple(pr.bound_lo, pr.bound_hi);
                     d["interval_is_profile"] = pr.interval_is_profile;
+                    d["reported"] = py::make_tuple(pr.lo_reported, pr.hi_reported);
                     d["identifiable"] = pr.identifiable;
                     d["verdict"] = pr.verdict;
                     d["simulations"] = pr.simulations;
@@ -229,7 +231,8 @@ void bind_identify(py::module_& m) {
             },
             "the profile likelihoods asked (profile=): per parameter a dict -- points (value, chi2 - chi2_min) as an "
             "(n, 2) array, interval (lo, hi), ends ('crossed', 'at bound' or 'cut short'), bounds, interval_is_profile "
-            "(the reported 95 % interval is the profile's, else the linearised one), identifiable, verdict; [] if none")
+            "(the reported 95 % interval is the profile's, else the linearised one), reported (the profile's interval "
+            "widened by the cells' spread, as reported where interval_is_profile), identifiable, verdict; [] if none")
         .def_property_readonly(
             "summary",
             [](const PyIdentification& r) {

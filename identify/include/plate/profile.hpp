@@ -41,6 +41,8 @@ struct ProfileOptions {
 
 // Chi-square quantile of one degree of freedom at 95 %: the profile's threshold.
 constexpr double kProfileThreshold95 = 3.841458820694124;
+// Its square root, the normal distribution's 97.5 % quantile: a 95 % interval's half-width in sds.
+constexpr double kZ95 = 1.959963984540054;
 
 struct ProfilePoint {
     double value = 0;   // the parameter, scene units
@@ -61,11 +63,16 @@ struct ParameterProfile {
     std::vector<ProfilePoint> points;   // by value, the estimate's (0) included
     double lo = 0, hi = 0;              // the profile's 95 % interval
     ProfileEnd lo_end = ProfileEnd::CutShort, hi_end = ProfileEnd::CutShort;
-    double bound_lo = 0, bound_hi = 0;     // the physical bounds along the profile
-    double linear_lo = 0, linear_hi = 0;   // the linearised interval (NaN where judged not identifiable)
-    bool interval_is_profile = false;      // THE 95 % interval is the profile's (else the linearised one)
-    bool identifiable = true;              // false: the profile stays below 3.84 from bound to bound
-    double chi2_drop = 0;                  // the largest drop below the fit's chi2 seen along the profile (> 0: a better minimum)
+    double bound_lo = 0, bound_hi = 0;   // the physical bounds along the profile
+    // The linearised interval within the fit's cell, estimate -+ 1.96 sqrt(sd^2 - sd_cells^2), the profile's
+    // counterpart (NaN where judged not identifiable).
+    double linear_lo = 0, linear_hi = 0;
+    // THE 95 % interval is the profile's, each side widened by the cells' spread in quadrature (as the sd
+    // takes it) within the bounds (lo_reported, hi_reported); else the linearised one with the cells' spread.
+    bool interval_is_profile = false;
+    double lo_reported = 0, hi_reported = 0;
+    bool identifiable = true;   // false: the profile stays below 3.84 from bound to bound
+    double chi2_drop = 0;       // the largest drop below the fit's chi2 seen along the profile (> 0: a better minimum)
     std::string verdict;
     long simulations = 0;
     double seconds = 0;
