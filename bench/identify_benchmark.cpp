@@ -185,6 +185,7 @@ int main(int argc, char** argv) {
             if (s.coarse_iterations > 0) std::printf(" [coarse: %d steps, %.1f s]", s.coarse_iterations, s.coarse_seconds);
             if (v.segment_seconds > 0) std::printf(" [pieces: %d iterations, %.1f s]", s.piece_iterations, s.piece_seconds);
             if (s.hops > 0) std::printf(" [hops: %d]", s.hops);
+            if (s.cells_seconds > 0) std::printf(" [cells: %.1f s]", s.cells_seconds);
             if (!s.explains_tracks) std::printf(" [does not explain the tracks: p %.1e]", s.p_value);
             v.tally(s, names, truth);
             std::printf("  %s\n", s.termination.substr(0, 40).c_str());

@@ -94,6 +94,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
                          " differences of the simulation, the covariance by central ones"},
           {"coarse_iterations", s.coarse_iterations},
           {"coarse_seconds", s.coarse_seconds},
+          {"cells_seconds", s.cells_seconds},
           {"pieces", s.pieces},
           {"piece_iterations", s.piece_iterations},
           {"hops", s.hops},

@@ -33,8 +33,8 @@ void io(Archive& a, Unidentifiable& u) { a(u.combination, u.half_width); }
 void io(Archive& a, TrackFit& t) { a(t.source, t.frames, t.start, t.rms_xy_mm, t.rms_theta_mrad, t.chi2); }
 void io(Archive& a, IdentifySummary& s) {
     a(s.params, s.covariance, s.unidentifiable, s.tracks, s.chi2, s.residuals, s.dof, s.reduced_chi2, s.p_value,
-      s.explains_tracks, s.starts_run, s.best_start, s.held, s.iterations, s.coarse_iterations, s.coarse_seconds, s.pieces,
-      s.piece_iterations, s.hops, s.piece_seconds, s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
+      s.explains_tracks, s.starts_run, s.best_start, s.held, s.iterations, s.coarse_iterations, s.coarse_seconds, s.cells_seconds,
+      s.pieces, s.piece_iterations, s.hops, s.piece_seconds, s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
 }
 void io(Archive& a, IdentifyOptions& o) {
     a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads,

@@ -173,6 +173,7 @@ struct IdentifySummary {
     int pieces = 0;              // fitted in the first stage (segment_seconds; 0: no such stage)
     int coarse_iterations = 0;   // of the best start's coarse steps (IdentifyOptions::coarse_iterations)
     double coarse_seconds = 0;   // their time [s]
+    double cells_seconds = 0;    // the cells' draws' time [s] (IdentifyOptions::cell_samples)
     int piece_iterations = 0;    // of the best start's first stage on the pieces
     int hops = 0;                // times the search went on from a better end of the interval check's paths
     double piece_seconds = 0;    // its time [s]
