@@ -5,24 +5,11 @@
 // cells' minima about the fit (docs/decisions/identification.md, "The spread over the chi-square's cells").
 #include "internal.hpp"
 
-#include "plate/tasks.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <string>
 
 namespace plate::identify_detail {
-namespace {
-
-// The starts' regression on the named coordinates, -F_qq^+ F_qx (as the interval check's paths).
-Eigen::MatrixXd start_regression(const Eigen::MatrixXd& F, int n) {
-    const int ns = static_cast<int>(F.rows()) - n;
-    if (ns == 0) return Eigen::MatrixXd(0, n);
-    return -F.bottomRightCorner(ns, ns).completeOrthogonalDecomposition().solve(F.bottomLeftCorner(ns, n));
-}
-
-}   // namespace
 
 std::vector<Eigen::VectorXd> cell_moves(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x,
                                         const Eigen::MatrixXd& J, const Eigen::MatrixXd& cov_internal) {
@@ -97,26 +84,16 @@ Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, cons
     const int d = nt > 0 ? ns / nt : 0;
     if (o.cell_samples <= 0 || n == 0) return Eigen::MatrixXd::Zero(n, n);
     const std::vector<Eigen::VectorXd> moves = cell_moves(layout, o, x, J, cov_internal);
-    const int samples = static_cast<int>(moves.size()), tasks = samples * nt;
-    // Every (draw, track) prediction as a task; a draw with a stopped simulation is left out.
-    std::vector<int> offset(nt + 1, 0);
-    for (int t = 0; t < nt; ++t) offset[t + 1] = offset[t] + costs[t]->num_residuals();
-    std::vector<Eigen::VectorXd> r(samples, Eigen::VectorXd::Zero(offset[nt]));
-    std::vector<char> stopped(static_cast<std::size_t>(tasks), 0);
-    thread_tasks(std::max(1, std::min(o.threads, tasks)))(
-        tasks,
-        [&](int i) {
-            const int k = i / nt, t = i % nt;
-            std::vector<double> xe(n), qe(d);
-            for (int j = 0; j < n; ++j) xe[j] = x[j] + moves[k][j];
-            for (int j = 0; j < d; ++j) qe[j] = q0[t][j] + moves[k][n + d * t + j];
-            stopped[i] = !costs[t]->residuals(xe.data(), qe.data(), r[k].data() + offset[t]);
-            return std::string();
-        },
-        [](int, const std::string&) {});
-    for (int k = 0; k < samples; ++k)
+    // Each draw's point and starts; its residuals empty where a simulation stopped (cell_mixture leaves it out).
+    std::vector<std::vector<double>> points(moves.size(), x);
+    std::vector<std::vector<std::vector<double>>> starts(moves.size(), q0);
+    for (std::size_t k = 0; k < moves.size(); ++k) {
+        for (int j = 0; j < n; ++j) points[k][j] += moves[k][j];
         for (int t = 0; t < nt; ++t)
-            if (stopped[static_cast<std::size_t>(k) * nt + t]) r[k].resize(0);
+            for (int j = 0; j < d; ++j) starts[k][t][j] += moves[k][n + d * t + j];
+    }
+    long simulations = 0;
+    const std::vector<Eigen::VectorXd> r = stacked_residuals(costs, points, starts, o.threads, simulations);
     std::vector<double> lower(n), upper(n);   // (the shifts' bounds: the fit's coordinates within theirs)
     for (int j = 0; j < n; ++j) {
         lower[j] = layout.lower(j, o) - x[j];

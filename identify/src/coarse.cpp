@@ -28,35 +28,6 @@ namespace {
 constexpr double kFirstDamping = 1e-3;
 constexpr int kTries = 6;
 
-// Every track's residuals at each of `points` (internal coordinates), the tracks' starts q0, as one set
-// of tasks on `threads`: one stacked vector a point, empty where a simulation stopped.
-std::vector<Eigen::VectorXd> stacked_residuals(const std::vector<TrackCost*>& costs,
-                                               const std::vector<std::vector<double>>& points,
-                                               const std::vector<std::vector<double>>& q0, int threads, long& simulations) {
-    const int nt = static_cast<int>(costs.size()), np = static_cast<int>(points.size());
-    int rows = 0;
-    std::vector<int> offset(static_cast<std::size_t>(nt));
-    for (int t = 0; t < nt; ++t) {
-        offset[static_cast<std::size_t>(t)] = rows;
-        rows += costs[static_cast<std::size_t>(t)]->num_residuals();
-    }
-    std::vector<Eigen::VectorXd> out(static_cast<std::size_t>(np), Eigen::VectorXd(rows));
-    std::vector<char> ok(static_cast<std::size_t>(np) * static_cast<std::size_t>(nt), 0);
-    thread_tasks(std::max(1, std::min(threads, np * nt)))(
-        np * nt,
-        [&](int i) {
-            const std::size_t p = static_cast<std::size_t>(i / nt), t = static_cast<std::size_t>(i % nt);
-            ok[static_cast<std::size_t>(i)] = costs[t]->residuals(points[p].data(), q0[t].data(), out[p].data() + offset[t]);
-            return std::string();
-        },
-        [](int, const std::string&) {});
-    simulations += static_cast<long>(np) * nt;
-    for (int p = 0; p < np; ++p)
-        for (int t = 0; t < nt; ++t)
-            if (!ok[static_cast<std::size_t>(p) * nt + t]) out[static_cast<std::size_t>(p)].resize(0);
-    return out;
-}
-
 double chi2_of(const Eigen::VectorXd& r) { return r.size() ? r.squaredNorm() : std::numeric_limits<double>::infinity(); }
 
 }   // namespace
@@ -77,7 +48,7 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
         res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
         return res;
     };
-    Eigen::VectorXd r = stacked_residuals(costs, {x}, q0, o.threads, res.simulations)[0];
+    Eigen::VectorXd r = stacked_residuals(costs, {x}, {q0}, o.threads, res.simulations)[0];
     res.chi2_before = res.chi2_after = chi2_of(r);
     if (!std::isfinite(res.chi2_before) || nf == 0) return done();
     double damping = kFirstDamping;
@@ -95,7 +66,7 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
             moved.push_back(up);
             moved.push_back(down);
         }
-        const std::vector<Eigen::VectorXd> rm = stacked_residuals(costs, moved, q0, o.threads, res.simulations);
+        const std::vector<Eigen::VectorXd> rm = stacked_residuals(costs, moved, {q0}, o.threads, res.simulations);
         Eigen::MatrixXd J = Eigen::MatrixXd::Zero(r.size(), nf);
         for (int k = 0; k < nf; ++k) {   // (a side whose simulation stopped: the coordinate not moved this time)
             const Eigen::VectorXd& up = rm[2 * static_cast<std::size_t>(k)];
@@ -115,7 +86,7 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
                 const int j = free[static_cast<std::size_t>(k)];
                 y[j] = std::min(std::max(x[j] + dx[k], lo[j]), hi[j]);
             }
-            const Eigen::VectorXd ry = stacked_residuals(costs, {y}, q0, o.threads, res.simulations)[0];
+            const Eigen::VectorXd ry = stacked_residuals(costs, {y}, {q0}, o.threads, res.simulations)[0];
             if (chi2_of(ry) < chi2_of(r)) {
                 x = y;
                 r = ry;

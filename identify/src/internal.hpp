@@ -89,6 +89,11 @@ bool tracks_jacobians(const Scene& scene, const Layout& layout, const std::vecto
 // the ranges (judge.cpp).
 Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size);
 
+// The tracks' starts' regression on the named parameters, -F_qq^+ F_qx (F = J^T J over the n named
+// coordinates, then the starts): the quadratic model's minimum over the starts moves by it times dx when
+// the parameters move by dx (judge.cpp).
+Eigen::MatrixXd start_regression(const Eigen::MatrixXd& F, int n);
+
 // d(named values)/d(internal coordinates) at x (judge.cpp).
 Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>& x);
 
@@ -195,6 +200,14 @@ private:
     std::vector<double> last_x_;   // the point prepared last
     std::vector<std::vector<double>> last_q0_;
 };
+
+// Every track's residuals at each of `points` (internal coordinates), the tracks' starts starts[p] (or
+// starts[0] for every point), as one set of tasks on `threads`: one stacked vector a point (track 0's
+// residuals first), empty where a simulation stopped; `simulations` counts them (residuals.cpp).
+std::vector<Eigen::VectorXd> stacked_residuals(const std::vector<TrackCost*>& costs,
+                                               const std::vector<std::vector<double>>& points,
+                                               const std::vector<std::vector<std::vector<double>>>& starts, int threads,
+                                               long& simulations);
 
 // One Levenberg-Marquardt solve over block 0 (`x`, the coordinates in `held` kept) and the tracks'
 // starts q0, within [lo, hi], as the fit runs it; x and q0 hold the result. `callback` (may be null)

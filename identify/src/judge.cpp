@@ -35,6 +35,12 @@ Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>
     return A;
 }
 
+Eigen::MatrixXd start_regression(const Eigen::MatrixXd& F, int n) {
+    const int ns = static_cast<int>(F.rows()) - n;
+    if (ns == 0) return Eigen::MatrixXd(0, n);
+    return -F.bottomRightCorner(ns, ns).completeOrthogonalDecomposition().solve(F.bottomLeftCorner(ns, n));
+}
+
 Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size) {
     const int n = layout.size();
     const Eigen::MatrixXd F = J.transpose() * J;
@@ -125,11 +131,7 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
     const int n = layout.size(), nt = static_cast<int>(costs.size()), ns = static_cast<int>(J.cols()) - n;
     const int d = nt > 0 ? ns / nt : 0;
     const Eigen::MatrixXd F = J.transpose() * J;
-    // The starts' regression on the named parameters: the quadratic model's minimum over the starts
-    // moves by -Fqq^+ Fqx dx when the parameters move by dx.
-    const Eigen::MatrixXd regress =
-        ns > 0 ? Eigen::MatrixXd(-F.bottomRightCorner(ns, ns).completeOrthogonalDecomposition().solve(F.bottomLeftCorner(ns, n)))
-               : Eigen::MatrixXd(0, n);
+    const Eigen::MatrixXd regress = start_regression(F, n);
     const Eigen::MatrixXd A = natural_jacobian(layout, x);
     // Each identifiable parameter's path: per linearised sd of it, the internal coordinates move by
     // C a^T / sqrt(a C a^T) (a its row of A), which the quadratic model climbs as the square.

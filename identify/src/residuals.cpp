@@ -1,6 +1,8 @@
 // A track's prediction and its scaled residuals.
 #include "internal.hpp"
 
+#include "plate/tasks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -61,6 +63,31 @@ std::vector<Track> segments(const std::vector<Track>& tracks, double T, double s
             shifts.push_back(shift);
         }
     }
+    return out;
+}
+
+std::vector<Eigen::VectorXd> stacked_residuals(const std::vector<TrackCost*>& costs,
+                                               const std::vector<std::vector<double>>& points,
+                                               const std::vector<std::vector<std::vector<double>>>& starts, int threads,
+                                               long& simulations) {
+    const int nt = static_cast<int>(costs.size()), np = static_cast<int>(points.size());
+    std::vector<int> offset(static_cast<std::size_t>(nt) + 1, 0);
+    for (int t = 0; t < nt; ++t) offset[t + 1] = offset[t] + costs[t]->num_residuals();
+    std::vector<Eigen::VectorXd> out(static_cast<std::size_t>(np), Eigen::VectorXd(offset[nt]));
+    std::vector<char> ok(static_cast<std::size_t>(np) * static_cast<std::size_t>(nt), 0);
+    thread_tasks(std::max(1, std::min(threads, np * nt)))(
+        np * nt,
+        [&](int i) {
+            const std::size_t p = static_cast<std::size_t>(i / nt), t = static_cast<std::size_t>(i % nt);
+            const std::vector<double>& q0 = starts.size() == 1 ? starts[0][t] : starts[p][t];
+            ok[static_cast<std::size_t>(i)] = costs[t]->residuals(points[p].data(), q0.data(), out[p].data() + offset[t]);
+            return std::string();
+        },
+        [](int, const std::string&) {});
+    simulations += static_cast<long>(np) * nt;
+    for (int p = 0; p < np; ++p)
+        for (int t = 0; t < nt; ++t)
+            if (!ok[static_cast<std::size_t>(p) * nt + t]) out[static_cast<std::size_t>(p)].resize(0);
     return out;
 }
 
