@@ -74,9 +74,10 @@ void profile_figures(Ctx& c, const IdentifySummary& s, const ProfileSummary& p, 
                              ",10 nohead dt 3 lw 2 lc rgb '#208020'\n";
         std::string plot = "plot 'data/" + n + ".dat' u 1:2 w lp pt 7 lw 2 lc rgb '#3050c0' t 'profile (re-minimised)', " +
                            fmt(kProfileThreshold95, 6) + " w l dt 2 lw 2 lc rgb '#c03030' t '3.84 (95 %)'";
-        if (f.identifiable && f.sd > 0)
-            plot += ", ((x - " + fmt(f.estimate, 10) + ") / " + fmt(f.sd, 10) +
-                    ")**2 w l dt 4 lc rgb '#888888' t 'linearised: ((x - estimate) / sd)^2'";
+        const double within = (pr.linear_hi - pr.linear_lo) / (2 * kZ95);   // (the profile's counterpart: NaN if none)
+        if (f.identifiable && within > 0)
+            plot += ", ((x - " + fmt(f.estimate, 10) + ") / " + fmt(within, 10) +
+                    ")**2 w l dt 4 lc rgb '#888888' t 'linearised within the cell: ((x - estimate) / sd)^2'";
         plot += ", NaN w l dt 3 lw 2 lc rgb '#208020' t 'truth'\n";
         c.plot(n, script + plot,
                "Profile likelihood of " + pr.name + ": " + esc(pr.verdict) + ". Interval " +
@@ -89,12 +90,12 @@ void profile_figures(Ctx& c, const IdentifySummary& s, const ProfileSummary& p, 
 // What the run says of the static coefficient: a part that sticks only briefly after its start shows
 // it through a threshold, where a linearised interval can run below the kinetic coefficient.
 std::string static_sentence(const FittedParameter& f, const ParameterProfile& pr) {
-    std::string s = "The static coefficient's linearised interval ";
+    std::string s = "The static coefficient's linearised interval (within the fit's cell) ";
     if (!f.identifiable)
         s += "is none (judged not identifiable)";
     else
-        s += std::string(f.lo < pr.bound_lo ? "runs below" : "stays above") + " the kinetic coefficient " + fmt(pr.bound_lo, 4) +
-             (f.lo < pr.bound_lo ? " (no static coefficient can)" : "");
+        s += std::string(pr.linear_lo < pr.bound_lo ? "runs below" : "stays above") + " the kinetic coefficient " +
+             fmt(pr.bound_lo, 4) + (pr.linear_lo < pr.bound_lo ? " (no static coefficient can)" : "");
     s += "; its profile ";
     if (!pr.identifiable) return s + "stays within 3.84 of its minimum from bound to bound: not identifiable.";
     if (pr.lo_end == ProfileEnd::AtBound || pr.hi_end == ProfileEnd::AtBound)
@@ -140,7 +141,8 @@ void section_identify(Ctx& c, const fs::path& src, const ReportOptions& opt) {
            << "stepped until it rises by 3.84 or reaches the physical bound (" << p.simulations << " simulations, "
            << fmt(p.seconds, 3) << " s). " << static_sentence(s.params[1], p.profiles[1]) << "</p>\n";
     tracks_figure(c, tr, fitted);
-    c.html << "<table><tr><th>parameter</th><th>truth</th><th>estimate</th><th>linearised 95 %</th><th>profile 95 %</th>"
+    c.html << "<table><tr><th>parameter</th><th>truth</th><th>estimate</th><th>linearised 95 % (within the cell)</th><th>profile "
+              "95 %</th>"
            << "<th>reported 95 %</th><th>covers the truth</th><th>verdict</th></tr>\n";
     for (std::size_t i = 0; i < p.profiles.size(); ++i) {
         const FittedParameter& f = s.params[i];
@@ -148,9 +150,10 @@ void section_identify(Ctx& c, const fs::path& src, const ReportOptions& opt) {
         const double lo = pr.interval_is_profile ? pr.lo_reported : f.lo, hi = pr.interval_is_profile ? pr.hi_reported : f.hi;
         const bool reported = pr.identifiable && std::isfinite(lo);
         c.html << "<tr><td>" << esc(f.name) << "</td><td>" << fmt(truth[i]) << "</td><td>" << fmt(f.estimate, 5) << "</td><td>"
-               << (f.identifiable ? interval_text(f.lo, f.hi) : "none (not identifiable)") << "</td><td>"
+               << (f.identifiable ? interval_text(pr.linear_lo, pr.linear_hi) : "none (not identifiable)") << "</td><td>"
                << interval_text(pr.lo, pr.hi, pr.lo_end == ProfileEnd::AtBound, pr.hi_end == ProfileEnd::AtBound) << "</td><td>"
-               << (reported ? interval_text(lo, hi) + (pr.interval_is_profile ? " (profile)" : " (linearised)")
+               << (reported ? interval_text(lo, hi) + (pr.interval_is_profile ? " (profile, cells' spread added)"
+                                                                              : " (linearised, cells' spread added)")
                             : "not identifiable")
                << "</td><td>" << (reported ? (lo <= truth[i] && truth[i] <= hi ? "yes" : "no") : "-") << "</td><td>"
                << esc(pr.verdict) << "</td></tr>\n";
