@@ -16,10 +16,10 @@
 // staged,central.
 // RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. COARSE:
 // IdentifyOptions::coarse_iterations. CELLS: IdentifyOptions::cell_samples (each sd printed with its share from the
-// cells' spread). Each interval's check at its ends (the chi-square's rise there, and the verdict:
-// FittedParameter::linearity) is printed in braces, and tallied against the misses.
+// cells' spread). WIDE: IdentifyOptions::wide_iterations. Each interval's check at its ends (the chi-square's rise there, and the
+// verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS]]]]]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS [WIDE]]]]]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -152,6 +152,7 @@ int main(int argc, char** argv) {
     if (argc > 15) o.hops = std::stoi(argv[15]);
     if (argc > 16) o.coarse_iterations = std::stoi(argv[16]);   // (default: IdentifyOptions')
     if (argc > 17) o.cell_samples = std::stoi(argv[17]);
+    if (argc > 18) o.wide_iterations = std::stoi(argv[18]);
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;
@@ -185,6 +186,8 @@ int main(int argc, char** argv) {
             if (s.coarse_iterations > 0) std::printf(" [coarse: %d steps, %.1f s]", s.coarse_iterations, s.coarse_seconds);
             if (v.segment_seconds > 0) std::printf(" [pieces: %d iterations, %.1f s]", s.piece_iterations, s.piece_seconds);
             if (s.hops > 0) std::printf(" [hops: %d]", s.hops);
+            if (s.wide_seconds > 0)
+                std::printf(" [wide: %d steps, chi2 -%.1f, %.1f s]", s.wide_iterations, s.wide_chi2_drop, s.wide_seconds);
             if (s.cells_seconds > 0) std::printf(" [cells: %.1f s]", s.cells_seconds);
             if (!s.explains_tracks) std::printf(" [does not explain the tracks: p %.1e]", s.p_value);
             v.tally(s, names, truth);

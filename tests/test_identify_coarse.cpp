@@ -42,42 +42,54 @@ Scene suggested_fig4() {
     return s;
 }
 
+const std::vector<std::string> kNames = {"mu_k1", "mu_k2", "mu_k3", "mu_s1", "mu_s2", "mu_s3"};
+const std::vector<double> kTruth = {0.25, 0.30, 0.35, 0.30, 0.36, 0.42};
+
+// bench_identify's seed `seed` (5 tracks of 10 s from random starts, filmed at kTruth) and the search's
+// track costs over them (forward differences), the tracks' first frames and the bounds.
+struct SeedTracks {
+    Scene nominal = suggested_fig4();
+    std::vector<Track> tracks;
+    IdentifyOptions o = options(kNames);
+    Layout layout{nominal, kNames};
+    std::vector<std::unique_ptr<TrackCost>> costs;
+    std::vector<TrackCost*> ptrs;
+    std::vector<std::vector<double>> first;
+    std::vector<double> lo, hi;
+
+    explicit SeedTracks(int seed) {
+        Rng rng(1000 + seed);
+        for (int k = 0; k < 5; ++k) {
+            const Vec3 q0(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), rng.uniform(-kPi, kPi));
+            tracks.push_back(filmed(nominal, kNames, kTruth, strobe(0.1, 5, 100 * seed + k), q0, 10.0));
+        }
+        o.threads = 2;
+        for (const Track& tr : tracks) {
+            costs.push_back(std::make_unique<TrackCost>(nominal, layout, tr, 0, o, false));
+            ptrs.push_back(costs.back().get());
+            first.push_back({tr.q.front().x() * 1e3, tr.q.front().y() * 1e3, tr.q.front().z()});
+        }
+        for (int j = 0; j < layout.size(); ++j) {
+            lo.push_back(layout.lower(j, o));
+            hi.push_back(layout.upper(j, o));
+        }
+    }
+};
+
 }   // namespace
 
 TEST_CASE("coarse steps take the kinetic coefficients from a guess 0.05 off to within 0.005 of the truth", "[identify][coarse]") {
-    const Scene nominal = suggested_fig4();
-    const std::vector<std::string> names = {"mu_k1", "mu_k2", "mu_k3", "mu_s1", "mu_s2", "mu_s3"};
-    const std::vector<double> truth = {0.25, 0.30, 0.35, 0.30, 0.36, 0.42};
-    // bench_identify's seed 41 (5 tracks of 10 s from random starts), whose search from the guess ended
-    // in a local minimum before coarse steps.
-    const int seed = 41;
-    Rng rng(1000 + seed);
-    std::vector<Track> tracks;
-    for (int k = 0; k < 5; ++k) {
-        const Vec3 q0(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), rng.uniform(-kPi, kPi));
-        tracks.push_back(filmed(nominal, names, truth, strobe(0.1, 5, 100 * seed + k), q0, 10.0));
-    }
-    IdentifyOptions o = options(names);
-    o.threads = 2;
-    o.coarse_iterations = 2;
-    const Layout layout(nominal, names);
-    std::vector<std::unique_ptr<TrackCost>> costs;
-    std::vector<TrackCost*> ptrs;
-    std::vector<std::vector<double>> q0;
-    for (const Track& tr : tracks) {
-        costs.push_back(std::make_unique<TrackCost>(nominal, layout, tr, 0, o, false));
-        ptrs.push_back(costs.back().get());
-        q0.push_back({tr.q.front().x() * 1e3, tr.q.front().y() * 1e3, tr.q.front().z()});
-    }
-    std::vector<double> lo, hi;
-    for (int j = 0; j < layout.size(); ++j) {
-        lo.push_back(layout.lower(j, o));
-        hi.push_back(layout.upper(j, o));
-    }
+    // bench_identify's seed 41, whose search from the guess ended in a local minimum before coarse steps.
+    SeedTracks f(41);
+    f.o.coarse_iterations = 2;
+    const Layout& layout = f.layout;
+    const std::vector<double>& truth = kTruth;
     const std::vector<double> guess = layout.internal(layout.scene_values());   // 0.30 and 0.36 everywhere
     const auto step = [&](double factor, std::vector<double>& natural) {
         std::vector<double> x = guess;
-        const CoarseResult c = identify_detail::coarse_steps(ptrs, layout, o, x, q0, {}, lo, hi, 60, factor);
+        std::vector<std::vector<double>> starts = f.first;
+        const CoarseResult c = identify_detail::coarse_steps(f.ptrs, layout, f.o, x, starts, {}, f.lo, f.hi, 60,
+                                                             f.o.coarse_iterations, factor, false);
         natural = layout.natural(x);
         return c;
     };
@@ -109,4 +121,43 @@ TEST_CASE("a later start keeps the fit's kinetic coefficients and offsets and ta
     CHECK(identify_detail::restart(both, fit, statics, draw) == std::vector<double>{0.25, 0.06, 0.31, 1.5});
     const Layout kinetic(fig4, {"mu_k1", "mu_k2"});
     CHECK(identify_detail::restart(kinetic, {0.25, 0.31}, {0.3, 0.3}, {0.6, 0.7}) == std::vector<double>{0.6, 0.7});
+}
+
+// The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
+// cells"): bench_identify's seed 16, whose search from the guess stopped with every coefficient 3-7 sds
+// (within its cell) off and a chi-square 187 above the truth's (the tracks' starts fitted there). From
+// those coefficients, their starts fitted, the wide steps' secant (differences 10 times the fine steps,
+// every start moved) reaches the truth's level; the fine steps' tangent, which ended the search there,
+// does not.
+TEST_CASE("wide steps take a fit stopped in a cell of the chi-square down to the truth's level", "[identify][coarse]") {
+    SeedTracks f(16);
+    const Layout& layout = f.layout;
+    const std::vector<double>& truth = kTruth;
+    const std::vector<double> stopped = {0.2521, 0.3011, 0.3473, 0.3073, 0.3613, 0.4075};   // the search's end
+    const std::vector<int> every = {0, 1, 2, 3, 4, 5};
+    // The chi-square with the coefficients at `values`, the starts fitted (q: the fitted starts).
+    const auto starts_fitted = [&](const std::vector<double>& values, std::vector<std::vector<double>>& q) {
+        std::vector<double> x = layout.internal(values);
+        q = f.first;
+        return identify_detail::minimise(f.ptrs, x, q, every, f.lo, f.hi, 100, 120, 2).chi2;
+    };
+    std::vector<std::vector<double>> q;
+    const double at_truth = starts_fitted(truth, q);
+    const double at_stop = starts_fitted(stopped, q);
+    REQUIRE(at_stop > at_truth + 100);
+    std::vector<double> x = layout.internal(stopped);
+    const identify_detail::CoarseResult wide = identify_detail::coarse_steps(
+        f.ptrs, layout, f.o, x, q, {}, f.lo, f.hi, 120, f.o.wide_iterations, identify_detail::kWideFactor, true);
+    const std::vector<double> v = layout.natural(x);
+    INFO("chi2: truth " << at_truth << ", stopped " << at_stop << ", wide " << wide.chi2_after << " after " << wide.iterations
+                        << " steps; kinetic " << v[0] << " " << v[1] << " " << v[2] << ", static " << v[3] << " " << v[4] << " "
+                        << v[5]);
+    // Each step: 2 x 6 points, 2 x 15 tracks' starts (a fifth of a point each), a trial point at least.
+    CHECK(wide.simulations >= 5 * (1 + wide.iterations * (2 * 6 + 1)) + wide.iterations * 30);
+    // To the truth's level: within the chi-square's sd at the truth, sqrt(2 dof); the kinetic coefficients
+    // within 0.001 (the stopped search's: 0.0011-0.0027 off).
+    int rows = 0;
+    for (const TrackCost* c : f.ptrs) rows += c->num_residuals();
+    CHECK(wide.chi2_after < at_truth + std::sqrt(2.0 * (rows - 6 - 15)));
+    for (int j = 0; j < 3; ++j) CHECK(std::abs(v[j] - truth[j]) < 0.001);
 }

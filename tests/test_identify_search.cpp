@@ -233,6 +233,9 @@ TEST_CASE(
     o.cell_samples = -1;
     CHECK_THROWS_WITH(o.validate(), Catch::Contains("cell_samples"));
     o = options({"mu_k"});
+    o.wide_iterations = 1001;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("wide_iterations"));
+    o = options({"mu_k"});
     o.segment_seconds = 0.2;   // 4 periods of fig1_point's 0.05 s: every frame of a later piece left out
     const Scene point = scene("fig1_point");
     const Track tr = filmed(point, {"mu_k"}, {0.27}, strobe(0.1, 0, 3), Vec3(0.01, -0.02, 0), 1.0);
@@ -243,6 +246,9 @@ TEST_CASE(
     const Run coarse = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --coarse 101");
     CHECK(coarse.code == 2);
     CHECK(coarse.err.find("--coarse") != std::string::npos);
+    const Run wide = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --wide -1");
+    CHECK(wide.code == 2);
+    CHECK(wide.err.find("--wide") != std::string::npos);
     const Run cells = run("identify " + kScenes + "fig1_point.json --params mu_k --tracks track.csv --cells -1");
     CHECK(cells.code == 2);
     CHECK(cells.err.find("--cells") != std::string::npos);

@@ -40,7 +40,10 @@ struct IdentifyArgs : Options {
                   "plate turns about more than one axis: its orientation is then not periodic). Before them, up to\n"
                   "--coarse N steps (default 2; 0: none) move the kinetic coefficients and offsets on the whole\n"
                   "tracks, their starts held at the first frames and the static coefficients' excesses over the\n"
-                  "kinetic ones held: from a guess, they reach the chi-square's bowl around the truth.\n"
+                  "kinetic ones held: from a guess, they reach the chi-square's bowl around the truth. After the\n"
+                  "search, up to --wide N steps (default 4; 0: none) move every coefficient and start at once, the\n"
+                  "Jacobian by differences 10 times the search's: where the search stopped in one of the cells\n"
+                  "below, above the truth's chi-square, they take it on (then the search again from there).\n"
                   "Under static friction the chi-square is piecewise smooth on cells smaller than the sds (an arrest\n"
                   "held or slipped through moves every later frame): each sd also takes the spread over the cells'\n"
                   "minima near the fit, from --cells N points drawn about it (default 32; 0: none; \"sd_cells\").\n"
@@ -89,6 +92,7 @@ struct IdentifyArgs : Options {
         number("--rtol", o.rtol, "the simulation's tolerance");
         number("--pieces", o.segment_seconds, "seconds of the pieces the search fits first (0: none)");
         whole("--coarse", o.coarse_iterations, 0, 100, "coarse steps before the pieces (0: none)");
+        whole("--wide", o.wide_iterations, 0, 1000, "wide steps after the search (0: none)");
         whole("--cells", o.cell_samples, 0, 10000, "points drawn about the fit for the cells' spread (0: none)");
         whole("--threads", o.threads, 1, 1024, "simulations in parallel (the fit is the same on any number)");
         text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");

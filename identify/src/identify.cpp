@@ -107,6 +107,37 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
     return sol;
 }
 
+// The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
+// cells"): from the best fit (x, q0, its chi-square chi2), coarse_steps' wide Levenberg-Marquardt, then,
+// where that lowered the chi-square, the fine search from there; x, q0 and chi2 take the result. Within
+// o.time_limit.
+void wide_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const std::vector<int>& held,
+                const std::vector<double>& lo, const std::vector<double>& hi, const IdentifyOptions& o, Clock::time_point t0,
+                std::vector<double>& x, std::vector<std::vector<double>>& q0, double& chi2, IdentifySummary& s) {
+    const auto start = Clock::now();
+    const auto left = [&] { return o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count(); };
+    if (o.wide_iterations == 0 || left() <= 0) return;
+    std::vector<double> y = x;
+    std::vector<std::vector<double>> qy = q0;
+    const CoarseResult wide = coarse_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations, kWideFactor, true);
+    if (wide.chi2_after < chi2) {
+        std::vector<double> z = y;
+        std::vector<std::vector<double>> qz = qy;
+        Solve fine;
+        if (left() > 0)
+            fine = minimise(costs, z, qz, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
+        const bool refined = fine.usable && fine.chi2 <= wide.chi2_after;
+        s.wide_iterations = wide.iterations;
+        s.wide_chi2_drop = chi2 - (refined ? fine.chi2 : wide.chi2_after);
+        s.iterations += refined ? fine.iterations : 0;
+        if (refined) s.termination = fine.termination, s.converged = fine.converged;
+        x = refined ? z : y;
+        q0 = refined ? qz : qy;
+        chi2 -= s.wide_chi2_drop;
+    }
+    s.wide_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 // What conclude() leaves for the cells' spread: the whole Jacobian, the residuals and the linearised
 // covariance (internal coordinates) at the fit.
 struct AtFit {
@@ -218,6 +249,7 @@ void IdentifyOptions::validate() const {
     if (jacobian_reuse < 0 || jacobian_reuse > 100) bad("jacobian_reuse: from 0 to 100");
     if (hops < 0 || hops > 100) bad("hops: from 0 to 100");
     if (coarse_iterations < 0 || coarse_iterations > 100) bad("coarse_iterations: from 0 to 100");
+    if (wide_iterations < 0 || wide_iterations > 1000) bad("wide_iterations: from 0 to 1000");
     if (cell_samples < 0 || cell_samples > 10000) bad("cell_samples: from 0 to 10000");
     if (!(segment_settle_periods >= 0 && segment_settle_periods <= 1e6)) bad("segment_settle_periods: from 0 to 1e6");
     if (threads < 1 || threads > 1024) bad("threads: from 1 to 1024");
@@ -327,9 +359,12 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         // second, drawn after it)
         std::vector<double> x = k > 0 && !best.empty() ? restart(layout, best, xs[k == 1 ? 0 : k], xs[k]) : xs[k];
         CoarseResult coarse;
-        if (o.coarse_iterations > 0)   // (at most a quarter of the time left)
-            coarse = coarse_steps(cost_ptrs, layout, o, x, first_frames(tracks, d), held, lo, hi,
-                                  0.25 * (o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count()));
+        if (o.coarse_iterations > 0) {   // (at most a quarter of the time left)
+            std::vector<std::vector<double>> at_first = first_frames(tracks, d);
+            coarse = coarse_steps(cost_ptrs, layout, o, x, at_first, held, lo, hi,
+                                  0.25 * (o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count()),
+                                  o.coarse_iterations, kCoarseFactor, false);
+        }
         Solve on_pieces;
         double piece_seconds = 0;
         if (!piece_ptrs.empty()) {
@@ -361,6 +396,8 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
         if (best_cost <= enough) break;
     }
     if (best.empty()) throw std::runtime_error("identify: no start gave a usable fit (every simulation stopped?)");
+
+    wide_steps(cost_ptrs, layout, held, lo, hi, o, t0, best, best_q0, best_cost, s);
 
     // The fit's verdict at the best start's optimum, then its hops.
     PathEnd better;

@@ -222,20 +222,23 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
                const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi, int max_iterations,
                double seconds, int threads, ceres::IterationCallback* callback = nullptr, double initial_radius = 1e4);
 
-// The search's coarse first steps (coarse.cpp; IdentifyOptions::coarse_iterations): from x, the
-// coordinates in `held` and the static coefficients' excesses kept, the tracks' starts held at q0, within
-// [lo, hi] and `seconds`, the Jacobian by central differences `factor` times the fine steps
-// (Layout::step). x holds the result (unchanged if no step lowered the chi-square).
-constexpr double kCoarseFactor = 100;
+// The search's coarse first steps (coarse.cpp; IdentifyOptions::coarse_iterations) and its wide last ones
+// (IdentifyOptions::wide_iterations): up to `iterations` Levenberg-Marquardt steps from x, the coordinates
+// in `held` kept, within [lo, hi] and `seconds`, the Jacobian by central differences `factor` times the
+// fine steps (Layout::step; a track's start: kStartStepMm, kStartStepRad). Coarse (`wide` false): the
+// static coefficients' excesses kept and the tracks' starts held at q0. Wide: every named coordinate and
+// every track's start moved. x and q0 hold the result (unchanged if no step lowered the chi-square).
+constexpr double kCoarseFactor = 100, kWideFactor = 10;
+constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // the fine difference steps of a track's start
 struct CoarseResult {
     int iterations = 0;   // steps taken (each lowered the chi-square)
     double chi2_before = 0, chi2_after = 0, seconds = 0;
     long simulations = 0;
 };
 CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
-                          std::vector<double>& x, const std::vector<std::vector<double>>& q0, const std::vector<int>& held,
-                          const std::vector<double>& lo, const std::vector<double>& hi, double seconds,
-                          double factor = kCoarseFactor);
+                          std::vector<double>& x, std::vector<std::vector<double>>& q0, const std::vector<int>& held,
+                          const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations,
+                          double factor, bool wide);
 
 // A point of the search's space (internal coordinates, the tracks' starts) and the tracks' chi-square there.
 struct PathEnd {

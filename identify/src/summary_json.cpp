@@ -72,6 +72,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
               {"jacobian_reuse", o.jacobian_reuse},
               {"hops", o.hops},
               {"cell_samples", o.cell_samples},
+              {"wide_iterations", o.wide_iterations},
               {"rtol", o.rtol}};
     return json{
         {"parameters", params},
@@ -95,6 +96,9 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
           {"coarse_iterations", s.coarse_iterations},
           {"coarse_seconds", s.coarse_seconds},
           {"cells_seconds", s.cells_seconds},
+          {"wide_iterations", s.wide_iterations},
+          {"wide_chi2_drop", s.wide_chi2_drop},
+          {"wide_seconds", s.wide_seconds},
           {"pieces", s.pieces},
           {"piece_iterations", s.piece_iterations},
           {"hops", s.hops},

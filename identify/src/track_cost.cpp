@@ -22,7 +22,6 @@ namespace {
 // coefficient of a part that hardly sticks: 1e-2-1e2, against 1e8 for a kinetic one) is then not
 // stepped across its whole range, into a regime it does not hold (docs/decisions/identification.md).
 constexpr double kMinLmDiagonal = 1e4;
-constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // central-difference steps of a track's start
 
 }   // namespace
 

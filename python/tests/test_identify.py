@@ -134,6 +134,19 @@ def test_the_cells_spread_is_asked_by_keyword(tmp_path):
         plate.identify(point_scene(0.30), [path], ["mu_k"], cells=-1)
 
 
+def test_the_wide_steps_are_asked_by_keyword(tmp_path):
+    # wide=0: none taken, the options and the solver's report say so; the default's count is the library's;
+    # out of range raises.
+    path = filmed(tmp_path, point_scene(0.27))
+    without = plate.identify(point_scene(0.30), [path], ["mu_k"], wide=0)
+    assert without.summary["options"]["wide_iterations"] == 0
+    assert without.summary["solver"]["wide_iterations"] == 0
+    assert without.summary["solver"]["wide_seconds"] == 0
+    assert plate.identify(point_scene(0.30), [path], ["mu_k"]).summary["options"]["wide_iterations"] == 4
+    with pytest.raises(ValueError, match="wide_iterations"):
+        plate.identify(point_scene(0.30), [path], ["mu_k"], wide=1001)
+
+
 @pytest.mark.skipif(not EXE, reason="PLATE_EXE (the program) not given")
 def test_the_command_lines_cells_option(tmp_path):
     # --cells 0: no spread over the cells, the JSON says so; the default's equals the module's to the bit.

@@ -89,6 +89,12 @@ struct IdentifyOptions {
     // held at the first frames and the static coefficients' excesses held (identify_detail::coarse_steps).
     // 0: none.
     int coarse_iterations = 2;
+    // Wide steps last ("Wide steps across the cells"): after the search, the best fit takes up to this many
+    // Levenberg-Marquardt steps with the Jacobian by central differences identify_detail::kWideFactor times
+    // the fine steps (a secant over the chi-square's cells, where the fine steps' tangent sees one cell's
+    // floor), every coordinate and track's start moved; where they lower the chi-square, the fine search
+    // goes on from there. 0: none.
+    int wide_iterations = 4;
     // Cells near the fit ("The spread over the chi-square's cells"): the interval's sd also takes the
     // spread of the chi-square's cell minima near the fit, found from this many points drawn about it (half
     // at the linearised covariance, half at twice its sds), each taken one Gauss-Newton step to its cell's
@@ -174,6 +180,9 @@ struct IdentifySummary {
     int coarse_iterations = 0;   // of the best start's coarse steps (IdentifyOptions::coarse_iterations)
     double coarse_seconds = 0;   // their time [s]
     double cells_seconds = 0;    // the cells' draws' time [s] (IdentifyOptions::cell_samples)
+    int wide_iterations = 0;     // the wide steps taken (IdentifyOptions::wide_iterations)
+    double wide_chi2_drop = 0;   // how far they and the fine search after them lowered the chi-square
+    double wide_seconds = 0;     // their time [s] (IdentifyOptions::wide_iterations)
     int piece_iterations = 0;    // of the best start's first stage on the pieces
     int hops = 0;                // times the search went on from a better end of the interval check's paths
     double piece_seconds = 0;    // its time [s]
