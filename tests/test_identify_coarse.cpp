@@ -126,9 +126,10 @@ TEST_CASE("a later start keeps the fit's kinetic coefficients and offsets and ta
 // The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
 // cells"): bench_identify's seed 16, whose search from the guess stopped with every coefficient 3-7 sds
 // (within its cell) off and a chi-square 187 above the truth's (the tracks' starts fitted there). From
-// those coefficients, their starts fitted, the wide steps' secant (differences 10 times the fine steps,
-// every start moved) reaches the truth's level; the fine steps' tangent, which ended the search there,
-// does not.
+// those coefficients, their starts fitted, the wide steps (every coefficient and start moved at once)
+// reach the truth's level. What this checks is the joint step with the starts; the factor 10 over the
+// fine steps is not isolated here (at the fine steps the same Levenberg-Marquardt also gets there from
+// this point: the docs).
 TEST_CASE("wide steps take a fit stopped in a cell of the chi-square down to the truth's level", "[identify][coarse]") {
     SeedTracks f(16);
     const Layout& layout = f.layout;

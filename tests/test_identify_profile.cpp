@@ -84,8 +84,9 @@ TEST_CASE("a point part's kinetic friction: its interval's ends lie 3.84 above t
 // from there until no end does, and reaches the chi-square of the search left to converge. Measured: cut
 // short 415.2 (mu_k 0.2895), after 5 hops 185.87 (0.2675), converged 185.79 (0.2677). Seen failing with
 // the hops never taken (0 hops, 415.2). The wide steps (IdentifyOptions::wide_iterations) are left out
-// for this: they take the search cut short on to the converged chi-square themselves, without a hop (seen
-// failing with their steps never kept).
+// for this: they (and the one fine iteration after them) take the search cut short on to the converged
+// chi-square themselves, their drop the difference from the search without them (seen failing with their
+// steps never kept).
 TEST_CASE("a search cut short goes on from the better end of its interval's check", "[identify][profile]") {
     const Scene nominal = scene("fig1_point");
     const Track tr = filmed(nominal, {"mu_k"}, {0.27}, strobe(0.1, 0, 3), Vec3(0.01, -0.02, 0), 5.0);
@@ -101,6 +102,7 @@ TEST_CASE("a search cut short goes on from the better end of its interval's chec
     CHECK(widened.chi2 < full.chi2 + 1);
     o.wide_iterations = 0;
     const IdentifySummary cut = identify(nominal, {tr}, o);
+    CHECK(widened.wide_chi2_drop == Approx(cut.chi2 - widened.chi2).epsilon(1e-9));
     o.hops = 20;
     const IdentifySummary hopped = identify(nominal, {tr}, o);
     INFO("chi2: full " << full.chi2 << ", cut " << cut.chi2 << ", hopped " << hopped.chi2 << " after " << hopped.hops << " hops");

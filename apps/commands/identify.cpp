@@ -41,7 +41,7 @@ struct IdentifyArgs : Options {
                   "--coarse N steps (default 2; 0: none) move the kinetic coefficients and offsets on the whole\n"
                   "tracks, their starts held at the first frames and the static coefficients' excesses over the\n"
                   "kinetic ones held: from a guess, they reach the chi-square's bowl around the truth. After the\n"
-                  "search, up to --wide N steps (default 4; 0: none) move every coefficient and start at once, the\n"
+                  "search, up to --wide N steps (default 4; 0: none) move every fitted coefficient and start at once, the\n"
                   "Jacobian by differences 10 times the search's: where the search stopped in one of the cells\n"
                   "below, above the truth's chi-square, they take it on (then the search again from there).\n"
                   "Under static friction the chi-square is piecewise smooth on cells smaller than the sds (an arrest\n"

@@ -109,8 +109,8 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
 
 // The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
 // cells"): from the best fit (x, q0, its chi-square chi2), coarse_steps' wide Levenberg-Marquardt, then,
-// where that lowered the chi-square, the fine search from there; x, q0 and chi2 take the result. Within
-// o.time_limit.
+// where a step lowered the chi-square, the fine search from there; x, q0 and chi2 take its end where that
+// search is usable and lower (else the fit stays). Within o.time_limit.
 void wide_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const std::vector<int>& held,
                 const std::vector<double>& lo, const std::vector<double>& hi, const IdentifyOptions& o, Clock::time_point t0,
                 std::vector<double>& x, std::vector<std::vector<double>>& q0, double& chi2, IdentifySummary& s) {
@@ -120,20 +120,22 @@ void wide_steps(const std::vector<TrackCost*>& costs, const Layout& layout, cons
     std::vector<double> y = x;
     std::vector<std::vector<double>> qy = q0;
     const CoarseResult wide = coarse_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations, kWideFactor, true);
-    if (wide.chi2_after < chi2) {
-        std::vector<double> z = y;
-        std::vector<std::vector<double>> qz = qy;
-        Solve fine;
-        if (left() > 0)
-            fine = minimise(costs, z, qz, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
-        const bool refined = fine.usable && fine.chi2 <= wide.chi2_after;
-        s.wide_iterations = wide.iterations;
-        s.wide_chi2_drop = chi2 - (refined ? fine.chi2 : wide.chi2_after);
-        s.iterations += refined ? fine.iterations : 0;
-        if (refined) s.termination = fine.termination, s.converged = fine.converged;
-        x = refined ? z : y;
-        q0 = refined ? qz : qy;
-        chi2 -= s.wide_chi2_drop;
+    if (wide.iterations > 0 && wide.chi2_after < chi2 && left() > 0) {
+        // (the fine search's end confirmed by Jacobians computed anew, as staged's)
+        for (TrackCost* c : costs) c->reuse(0);
+        const Solve fine =
+            minimise(costs, y, qy, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
+        for (TrackCost* c : costs) c->reuse(o.jacobian_reuse);
+        if (fine.usable && fine.chi2 < chi2) {
+            s.wide_iterations = wide.iterations;
+            s.wide_chi2_drop = chi2 - fine.chi2;
+            s.iterations += fine.iterations;
+            s.termination = fine.termination;
+            s.converged = fine.converged;
+            x = y;
+            q0 = qy;
+            chi2 = fine.chi2;
+        }
     }
     s.wide_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 }
