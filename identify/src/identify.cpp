@@ -109,8 +109,9 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
 
 // The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
 // cells"): from the best fit (x, q0, its chi-square chi2), coarse_steps' wide Levenberg-Marquardt, then,
-// where a step lowered the chi-square, the fine search from there; x, q0 and chi2 take its end where that
-// search is usable and lower (else the fit stays). Within o.time_limit.
+// where they lowered the chi-square by more than 1 (as the hops ask: less is no evidence of a better fit,
+// and moves the fit to a neighbouring cell for nothing), the fine search from there; x, q0 and chi2 take its
+// end where that search is usable and lower (else the fit stays). Within o.time_limit.
 void wide_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const std::vector<int>& held,
                 const std::vector<double>& lo, const std::vector<double>& hi, const IdentifyOptions& o, Clock::time_point t0,
                 std::vector<double>& x, std::vector<std::vector<double>>& q0, double& chi2, IdentifySummary& s) {
@@ -120,7 +121,7 @@ void wide_steps(const std::vector<TrackCost*>& costs, const Layout& layout, cons
     std::vector<double> y = x;
     std::vector<std::vector<double>> qy = q0;
     const CoarseResult wide = coarse_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations, kWideFactor, true);
-    if (wide.iterations > 0 && wide.chi2_after < chi2 && left() > 0) {
+    if (wide.iterations > 0 && wide.chi2_after < chi2 - 1 && left() > 0) {
         // (the fine search's end confirmed by Jacobians computed anew, as staged's)
         for (TrackCost* c : costs) c->reuse(0);
         const Solve fine =

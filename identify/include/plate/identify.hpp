@@ -93,7 +93,8 @@ struct IdentifyOptions {
     // Levenberg-Marquardt steps with the Jacobian by central differences identify_detail::kWideFactor times
     // the fine steps (a secant over the chi-square's cells, where the fine steps' tangent sees one cell's
     // floor), every coordinate the search moves and every track's start at once; where they lower the
-    // chi-square, the fine search goes on from there and its end is the fit if lower still. 0: none.
+    // chi-square by more than 1, the fine search goes on from there and its end is the fit if lower still.
+    // 0: none.
     int wide_iterations = 4;
     // Cells near the fit ("The spread over the chi-square's cells"): the interval's sd also takes the
     // spread of the chi-square's cell minima near the fit, found from this many points drawn about it (half
@@ -180,7 +181,7 @@ struct IdentifySummary {
     int coarse_iterations = 0;   // of the best start's coarse steps (IdentifyOptions::coarse_iterations)
     double coarse_seconds = 0;   // their time [s]
     double cells_seconds = 0;    // the cells' draws' time [s] (IdentifyOptions::cell_samples)
-    int wide_iterations = 0;     // the wide steps taken (IdentifyOptions::wide_iterations)
+    int wide_iterations = 0;     // the wide steps the fit took (IdentifyOptions::wide_iterations; 0: none kept)
     double wide_chi2_drop = 0;   // how far they and the fine search after them lowered the chi-square
     double wide_seconds = 0;     // their time [s] (IdentifyOptions::wide_iterations)
     int piece_iterations = 0;    // of the best start's first stage on the pieces
