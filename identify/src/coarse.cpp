@@ -79,7 +79,7 @@ Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layo
         [&](int i) {
             const auto [t, c] = which[static_cast<std::size_t>(i / 2)];
             std::vector<double> q = q0[t];
-            q[c] += (i % 2 ? -1 : 1) * factor * (c < 2 ? kStartStepMm : kStartStepRad);
+            q[c] += (i % 2 ? -1 : 1) * factor * start_step(c);
             side[static_cast<std::size_t>(i)].resize(costs[t]->num_residuals());
             ok[static_cast<std::size_t>(i)] = costs[t]->residuals(x.data(), q.data(), side[static_cast<std::size_t>(i)].data());
             return std::string();
@@ -89,7 +89,7 @@ Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layo
     for (std::size_t w = 0; w < which.size(); ++w) {
         const auto [t, c] = which[w];
         if (!ok[2 * w] || !ok[2 * w + 1]) continue;
-        const double h = factor * (c < 2 ? kStartStepMm : kStartStepRad);
+        const double h = factor * start_step(c);
         J.block(rows[t], first_column[t] + c, side[2 * w].size(), 1) = (side[2 * w] - side[2 * w + 1]) / (2 * h);
     }
     return J;

@@ -225,11 +225,12 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
 // The search's coarse first steps (coarse.cpp; IdentifyOptions::coarse_iterations) and its wide last ones
 // (IdentifyOptions::wide_iterations): up to `iterations` Levenberg-Marquardt steps from x, the coordinates
 // in `held` kept, within [lo, hi] and `seconds`, the Jacobian by central differences `factor` times the
-// fine steps (Layout::step; a track's start: kStartStepMm, kStartStepRad). Coarse (`wide` false): the
+// fine steps (Layout::step; a track's start: start_step). Coarse (`wide` false): the
 // static coefficients' excesses kept and the tracks' starts held at q0. Wide: every named coordinate and
 // every track's start moved. x and q0 hold the result (unchanged if no step lowered the chi-square).
 constexpr double kCoarseFactor = 100, kWideFactor = 10;
-constexpr double kStartStepMm = 1e-3, kStartStepRad = 1e-5;   // the fine difference steps of a track's start
+// The fine difference step of a track's start coordinate c: s_x, s_y [mm] 1e-3, theta [rad] 1e-5.
+constexpr double start_step(int c) { return c < 2 ? 1e-3 : 1e-5; }
 struct CoarseResult {
     int iterations = 0;   // steps taken (each lowered the chi-square)
     double chi2_before = 0, chi2_after = 0, seconds = 0;

@@ -93,7 +93,7 @@ std::vector<TrackCost::Column> TrackCost::columns(const double* const* parameter
                 out.push_back(c);
                 continue;
             }
-            c.h = b == 0 ? layout_.step(j) : (j < 2 ? kStartStepMm : kStartStepRad);
+            c.h = b == 0 ? layout_.step(j) : start_step(j);
             const double x0 = parameters[b][j];
             // One-sided at a bound (a static excess at 0: below it the part would have static < kinetic).
             c.up = b != 0 || x0 + c.h <= hi_[j];
