@@ -16,10 +16,11 @@
 // staged,central.
 // RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. COARSE:
 // IdentifyOptions::coarse_iterations. CELLS: IdentifyOptions::cell_samples (each sd printed with its share from the
-// cells' spread). WIDE: IdentifyOptions::wide_iterations. Each interval's check at its ends (the chi-square's rise there, and the
+// cells' spread and the envelope). WIDE: IdentifyOptions::wide_iterations. ENVELOPE: IdentifyOptions::envelope (1 or
+// 0). Each interval's check at its ends (the chi-square's rise there, and the
 // verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS [WIDE]]]]]]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS [WIDE [ENVELOPE]]]]]]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -153,6 +154,7 @@ int main(int argc, char** argv) {
     if (argc > 16) o.coarse_iterations = std::stoi(argv[16]);   // (default: IdentifyOptions')
     if (argc > 17) o.cell_samples = std::stoi(argv[17]);
     if (argc > 18) o.wide_iterations = std::stoi(argv[18]);
+    if (argc > 19) o.envelope = std::stoi(argv[19]) != 0;
     const bool from_truth = argc > 11 && std::string(argv[11]) == "truth";
     const std::string diff = argc > 12 ? argv[12] : "staged";
     std::vector<Variant> variants;
@@ -189,6 +191,7 @@ int main(int argc, char** argv) {
             if (s.wide_seconds > 0)
                 std::printf(" [wide: %d steps, chi2 -%.1f, %.1f s]", s.wide_iterations, s.wide_chi2_drop, s.wide_seconds);
             if (s.cells_seconds > 0) std::printf(" [cells: %.1f s]", s.cells_seconds);
+            if (s.envelope_seconds > 0) std::printf(" [envelope: %.1f s]", s.envelope_seconds);
             if (!s.explains_tracks) std::printf(" [does not explain the tracks: p %.1e]", s.p_value);
             v.tally(s, names, truth);
             std::printf("  %s\n", s.termination.substr(0, 40).c_str());

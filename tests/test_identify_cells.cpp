@@ -208,6 +208,7 @@ TEST_CASE("a part that slides throughout: the cells add nothing to its kinetic c
     const Track tr2 = filmed(nominal, {"mu_k"}, {0.27}, strobe(0.1, 0, 5), Vec3(-0.02, 0.01, 0), 5.0);
     IdentifyOptions o = options({"mu_k"});
     o.threads = 2;
+    o.envelope = false;   // (its own share of sd_cells: test_identify_envelope.cpp)
     const IdentifySummary s = identify(nominal, {tr, tr2}, o);
     const FittedParameter& p = s.params[0];
     INFO("sd " << p.sd << ", of which cells " << p.sd_cells);

@@ -23,6 +23,7 @@ struct IdentifyArgs : Options {
     std::vector<std::string> tracks;
     std::vector<double> limits;
     bool suggest = false;
+    bool no_envelope = false;
     IdentifyOptions o;
     SuggestOptions so;
     ProfileOptions po;
@@ -46,7 +47,9 @@ struct IdentifyArgs : Options {
                   "below, above the truth's chi-square, they take it on (then the search again from there).\n"
                   "Under static friction the chi-square is piecewise smooth on cells smaller than the sds (an arrest\n"
                   "held or slipped through moves every later frame): each sd also takes the spread over the cells'\n"
-                  "minima near the fit, from --cells N points drawn about it (default 32; 0: none; \"sd_cells\").\n"
+                  "minima near the fit, from --cells N points drawn about it (default 32; 0: none; \"sd_cells\"); the\n"
+                  "within-cell sd is replaced by the Jacobian's by differences 3, 10 or 30 times the search's where\n"
+                  "that is wider (a secant over several cells, their envelope; --no-envelope: not; in \"sd_cells\" too).\n"
                   "Levenberg-Marquardt (Ceres) over the full (or u) dynamics, from --starts starts (the scene's\n"
                   "values; then the best fit's kinetic coefficients and offsets with the static excesses of the\n"
                   "scene's values, then of seeded draws; a start runs only while none fits as well as the noise\n"
@@ -94,6 +97,7 @@ struct IdentifyArgs : Options {
         whole("--coarse", o.coarse_iterations, 0, 100, "coarse steps before the pieces (0: none)");
         whole("--wide", o.wide_iterations, 0, 1000, "wide steps after the search (0: none)");
         whole("--cells", o.cell_samples, 0, 10000, "points drawn about the fit for the cells' spread (0: none)");
+        flag("--no-envelope", no_envelope, "the within-cell sds not widened to the secants' over several cells");
         whole("--threads", o.threads, 1, 1024, "simulations in parallel (the fit is the same on any number)");
         text("--profile", profile, "NAMES|all", "profile likelihood of these fitted parameters");
         whole("--profile-steps", po.max_steps, 1, 1000, "--profile: re-minimisations per side");
@@ -164,6 +168,7 @@ int cmd_identify(const IdentifyArgs& a, Io& cio) {
     if (a.dynamics != "full" && a.dynamics != "u") throw UsageError("--dynamics: full or u");
     const Scene sc = scene_arg(a.scene, cio);
     IdentifyOptions o = a.o;
+    o.envelope = !a.no_envelope;
     o.params = split_names(a.params);
     o.level = a.dynamics == "u" ? Dynamics::U : Dynamics::Full;
     try {

@@ -36,9 +36,8 @@ constexpr int kTries = 6;
 
 double chi2_of(const Eigen::VectorXd& r) { return r.size() ? r.squaredNorm() : std::numeric_limits<double>::infinity(); }
 
-// The Jacobian by central differences `factor` times the fine steps: the named coordinates in `free`
-// (within [lo, hi]; a side whose simulation stopped: the column left zero), then, with `starts`, each
-// track's start coordinates (that track's rows alone). `rows`: each track's first row.
+}   // namespace
+
 Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
                                 const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
                                 const std::vector<int>& free, const std::vector<double>& lo, const std::vector<double>& hi,
@@ -94,8 +93,6 @@ Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layo
     }
     return J;
 }
-
-}   // namespace
 
 CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
                           std::vector<double>& x, std::vector<std::vector<double>>& q0, const std::vector<int>& held,

@@ -410,6 +410,12 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     const auto cells_start = Clock::now();
     add_cells(layout, best, cell_spread(layout, o, cost_ptrs, best, best_q0, at_fit.J, at_fit.r0, at_fit.cov_internal), s);
     s.cells_seconds = std::chrono::duration<double>(Clock::now() - cells_start).count();
+    if (o.envelope) {
+        const auto envelope_start = Clock::now();
+        long simulations = 0;
+        add_envelope(envelope_sds(layout, o, cost_ptrs, best, best_q0, held, simulations), s);
+        s.envelope_seconds = std::chrono::duration<double>(Clock::now() - envelope_start).count();
+    }
     s.fitted = at(scene, layout, best);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return s;

@@ -97,6 +97,12 @@ Eigen::MatrixXd start_regression(const Eigen::MatrixXd& F, int n);
 // d(named values)/d(internal coordinates) at x (judge.cpp).
 Eigen::MatrixXd natural_jacobian(const Layout& layout, const std::vector<double>& x);
 
+// The named parameters' covariance in internal coordinates from the whole Jacobian J (the tracks' starts'
+// starts_size columns last): the range-scaled information (scaled_information) inverted along its
+// directions whose 95 % half-width lies within the ranges, none along the others; each of those is
+// appended to `weak` (its half-width as a share of the ranges, and its unit vector) where given (judge.cpp).
+Eigen::MatrixXd identifiable_covariance(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size,
+                                        std::vector<std::pair<double, Eigen::VectorXd>>* weak);
 // Covariance, intervals and identifiability at internal coordinates x from the whole Jacobian J (the
 // named parameters' columns, then the starts'), into s.params, s.covariance, s.unidentifiable; returns
 // the named parameters' covariance in internal coordinates (none along the directions judged not
@@ -231,6 +237,14 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
 constexpr double kCoarseFactor = 100, kWideFactor = 10;
 // The fine difference step of a track's start coordinate c: s_x, s_y [mm] 1e-3, theta [rad] 1e-5.
 constexpr double start_step(int c) { return c < 2 ? 1e-3 : 1e-5; }
+// The Jacobian by central differences `factor` times the fine steps (coarse.cpp): the named coordinates in
+// `free` (within [lo, hi]; a side whose simulation stopped: the column left zero) as its first columns,
+// then, with `starts`, each track's start coordinates (that track's rows alone). `rows`: each track's first
+// row, and the total last; `columns`: the Jacobian's.
+Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
+                                const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
+                                const std::vector<int>& free, const std::vector<double>& lo, const std::vector<double>& hi,
+                                double factor, bool starts, const std::vector<int>& rows, int columns, long& simulations);
 struct CoarseResult {
     int iterations = 0;   // steps taken (each lowered the chi-square)
     double chi2_before = 0, chi2_after = 0, seconds = 0;
@@ -285,5 +299,23 @@ Eigen::MatrixXd cell_mixture(const Eigen::MatrixXd& J, const Eigen::VectorXd& r0
 
 // s's covariance, sds and intervals with the cells' covariance (internal coordinates) added (judge.cpp).
 void add_cells(const Layout& layout, const std::vector<double>& x, const Eigen::MatrixXd& cov_cells, IdentifySummary& s);
+
+// The chi-square's envelope across its cells ("The envelope across the cells", docs/decisions/identification.md):
+// the fit's Jacobian by central differences kEnvelopeFactors times the fine steps (secant_jacobian: every
+// named coordinate but those in `held`, and every track's start) is a secant over several cells, where
+// the fine one is the tangent of one cell's floor; 3 to 30 fine steps span the scales from the cliffs
+// between cells (1-4e-4 apart along a static coefficient) to the static coefficients' sds (about 3e-3).
+// Each factor's covariance as judge() forms it; returns per named parameter its largest sd over the
+// factors (scene units; 0 where no factor places it) (cells.cpp). `simulations` counts them.
+constexpr double kEnvelopeFactors[] = {3, 10, 30};
+std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
+                                 const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
+                                 const std::vector<int>& held, long& simulations);
+// s's sds with the envelope (per parameter, scene units): sd^2 = max(within, sd_envelope)^2 + cells^2, the
+// within-cell sd (sqrt(sd^2 - sd_cells^2)) replaced by the envelope's where that is wider, the cells' spread
+// (sd_cells, from add_cells) kept beside it. Where the sd grows, the covariance's row and column are scaled
+// by the ratio (its correlations kept), the interval set anew, and sd_cells takes the added share, so that
+// sd^2 - sd_cells^2 stays the within-cell variance (judge.cpp).
+void add_envelope(const std::vector<double>& sd_envelope, IdentifySummary& s);
 
 }   // namespace plate::identify_detail

@@ -56,23 +56,33 @@ Eigen::MatrixXd scaled_information(const Layout& layout, const IdentifyOptions& 
     return 0.5 * (scaled + scaled.transpose());
 }
 
-Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
-                      int starts_size, IdentifySummary& s) {
+Eigen::MatrixXd identifiable_covariance(const Layout& layout, const IdentifyOptions& o, const Eigen::MatrixXd& J, int starts_size,
+                                        std::vector<std::pair<double, Eigen::VectorXd>>* weak) {
     const int n = layout.size();
-    const double nan = std::numeric_limits<double>::quiet_NaN();
     Eigen::VectorXd range(n);
     for (int j = 0; j < n; ++j) range[j] = layout.range(j, o);
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled_information(layout, o, J, starts_size));
     Eigen::MatrixXd pinv = Eigen::MatrixXd::Zero(n, n);
-    std::vector<bool> internal_ok(n, true);
     for (int i = 0; i < n; ++i) {
         const double lambda = eig.eigenvalues()[i];
         const Eigen::VectorXd v = eig.eigenvectors().col(i);
         const double half = lambda > 0 ? kZ95 / std::sqrt(lambda) : std::numeric_limits<double>::infinity();
-        if (half <= 1) {
+        if (half <= 1)
             pinv += v * v.transpose() / lambda;
-            continue;
-        }
+        else if (weak)
+            weak->emplace_back(half, v);
+    }
+    return range.asDiagonal() * pinv * range.asDiagonal();
+}
+
+Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std::vector<double>& x, const Eigen::MatrixXd& J,
+                      int starts_size, IdentifySummary& s) {
+    const int n = layout.size();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::vector<std::pair<double, Eigen::VectorXd>> weak;
+    const Eigen::MatrixXd cov_internal = identifiable_covariance(layout, o, J, starts_size, &weak);
+    std::vector<bool> internal_ok(n, true);
+    for (const auto& [half, v] : weak) {
         Unidentifiable u;
         u.half_width = half;
         for (int j = 0; j < n; ++j) {
@@ -81,7 +91,6 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
         }
         s.unidentifiable.push_back(u);
     }
-    const Eigen::MatrixXd cov_internal = range.asDiagonal() * pinv * range.asDiagonal();
     const std::vector<double> v0 = layout.natural(x);
     const Eigen::MatrixXd A = natural_jacobian(layout, x);
     s.covariance = A * cov_internal * A.transpose();
@@ -119,6 +128,31 @@ void add_cells(const Layout& layout, const std::vector<double>& x, const Eigen::
             if (s.params[k].identifiable) s.covariance(j, k) += cells(j, k);
         p.sd_cells = std::sqrt(std::max(cells(j, j), 0.0));
         p.sd = std::sqrt(std::max(s.covariance(j, j), 0.0));
+        p.lo = p.estimate - kZ95 * p.sd;
+        p.hi = p.estimate + kZ95 * p.sd;
+    }
+}
+
+void add_envelope(const std::vector<double>& sd_envelope, IdentifySummary& s) {
+    const int n = static_cast<int>(s.params.size());
+    Eigen::VectorXd widen = Eigen::VectorXd::Ones(n), sd(n);
+    for (int j = 0; j < n; ++j) {
+        const FittedParameter& p = s.params[j];
+        const double within = std::sqrt(std::max(p.sd * p.sd - p.sd_cells * p.sd_cells, 0.0));
+        sd[j] = std::hypot(std::max(within, sd_envelope[j]), p.sd_cells);
+        if (p.identifiable && p.sd > 0 && sd[j] > p.sd) widen[j] = sd[j] / p.sd;
+    }
+    for (int j = 0; j < n; ++j) {
+        FittedParameter& p = s.params[j];
+        if (!p.identifiable || widen[j] == 1) continue;
+        for (int k = 0; k < n; ++k)
+            if (s.params[k].identifiable) {
+                s.covariance(j, k) *= widen[j];
+                s.covariance(k, j) *= widen[j];
+            }
+        const double within2 = p.sd * p.sd - p.sd_cells * p.sd_cells;
+        p.sd = sd[j];
+        p.sd_cells = std::sqrt(std::max(p.sd * p.sd - within2, 0.0));
         p.lo = p.estimate - kZ95 * p.sd;
         p.hi = p.estimate + kZ95 * p.sd;
     }

@@ -1,8 +1,11 @@
 // The identification's summary as JSON (plate identify --out).
+#include "internal.hpp"
 #include "plate/identify.hpp"
 #include "plate/profile.hpp"
 
 #include <cmath>
+#include <iterator>
+#include <vector>
 
 namespace plate {
 namespace {
@@ -72,6 +75,9 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
               {"jacobian_reuse", o.jacobian_reuse},
               {"hops", o.hops},
               {"cell_samples", o.cell_samples},
+              {"envelope_factors", o.envelope ? json(std::vector<double>(std::begin(identify_detail::kEnvelopeFactors),
+                                                                         std::end(identify_detail::kEnvelopeFactors)))
+                                              : json::array()},
               {"wide_iterations", o.wide_iterations},
               {"rtol", o.rtol}};
     return json{
@@ -96,6 +102,7 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
           {"coarse_iterations", s.coarse_iterations},
           {"coarse_seconds", s.coarse_seconds},
           {"cells_seconds", s.cells_seconds},
+          {"envelope_seconds", s.envelope_seconds},
           {"wide_iterations", s.wide_iterations},
           {"wide_chi2_drop", s.wide_chi2_drop},
           {"wide_seconds", s.wide_seconds},

@@ -34,13 +34,13 @@ void io(Archive& a, TrackFit& t) { a(t.source, t.frames, t.start, t.rms_xy_mm, t
 void io(Archive& a, IdentifySummary& s) {
     a(s.params, s.covariance, s.unidentifiable, s.tracks, s.chi2, s.residuals, s.dof, s.reduced_chi2, s.p_value,
       s.explains_tracks, s.starts_run, s.best_start, s.held, s.iterations, s.coarse_iterations, s.coarse_seconds, s.cells_seconds,
-      s.wide_iterations, s.wide_chi2_drop, s.wide_seconds, s.pieces, s.piece_iterations, s.hops, s.piece_seconds, s.termination,
-      s.converged, s.seconds, s.start_costs, s.fitted);
+      s.envelope_seconds, s.wide_iterations, s.wide_chi2_drop, s.wide_seconds, s.pieces, s.piece_iterations, s.hops,
+      s.piece_seconds, s.termination, s.converged, s.seconds, s.start_costs, s.fitted);
 }
 void io(Archive& a, IdentifyOptions& o) {
     a(o.params, o.level, o.starts, o.seed, o.max_iterations, o.time_limit, o.settle_periods, o.rtol, o.threads,
       o.fit_starts_first, o.central_search, o.segment_seconds, o.segment_settle_periods, o.initial_trust_radius, o.jacobian_reuse,
-      o.hops, o.coarse_iterations, o.cell_samples, o.wide_iterations, o.mu_min, o.mu_max, o.com_max);
+      o.hops, o.coarse_iterations, o.cell_samples, o.envelope, o.wide_iterations, o.mu_min, o.mu_max, o.com_max);
 }
 void io(Archive& a, ProfilePoint& p) { a(p.value, p.dchi2); }
 void io(Archive& a, ParameterProfile& p) {
@@ -81,7 +81,7 @@ void bind_identify_function(py::module_& m) {
         "identify",
         [](const Scene& sc, const py::list& tracks, const std::vector<std::string>& params, const std::string& dynamics,
            int starts, std::uint64_t seed, int max_iterations, double time_limit, double settle_periods, double rtol, int threads,
-           double pieces, int coarse, int wide, int cells, const py::object& profile, int profile_steps,
+           double pieces, int coarse, int wide, int cells, bool envelope, const py::object& profile, int profile_steps,
            double profile_time_limit) {
             require(dynamics == "full" || dynamics == "u", "dynamics: expected 'full' or 'u', got '" + dynamics + "'");
             std::vector<Track> tr;
@@ -100,6 +100,7 @@ void bind_identify_function(py::module_& m) {
             r.o.coarse_iterations = coarse;
             r.o.wide_iterations = wide;
             r.o.cell_samples = cells;
+            r.o.envelope = envelope;
             r.profiled = !profile.is_none();
             if (r.profiled && !(py::isinstance<py::str>(profile) && profile.cast<std::string>() == "all"))
                 r.po.params = profile.cast<std::vector<std::string>>();
@@ -119,14 +120,16 @@ void bind_identify_function(py::module_& m) {
         py::arg("settle_periods") = IdentifyOptions{}.settle_periods, py::arg("rtol") = IdentifyOptions{}.rtol,
         py::arg("threads") = IdentifyOptions{}.threads, py::arg("pieces") = IdentifyOptions{}.segment_seconds,
         py::arg("coarse") = IdentifyOptions{}.coarse_iterations, py::arg("wide") = IdentifyOptions{}.wide_iterations,
-        py::arg("cells") = IdentifyOptions{}.cell_samples, py::arg("profile") = py::none(),
-        py::arg("profile_steps") = ProfileOptions{}.max_steps, py::arg("profile_time_limit") = ProfileOptions{}.time_limit,
+        py::arg("cells") = IdentifyOptions{}.cell_samples, py::arg("envelope") = IdentifyOptions{}.envelope,
+        py::arg("profile") = py::none(), py::arg("profile_steps") = ProfileOptions{}.max_steps,
+        py::arg("profile_time_limit") = ProfileOptions{}.time_limit,
         "Fits the named parameters of `scene`'s part (mu_k, mu_k1..3, mu_s, mu_s1..3, com_x, com_y) to `tracks`\n"
         "(plate.Track objects or track files' paths) by least squares over the hybrid simulation, as `plate identify`.\n"
         "pieces: the search's first stage fits the tracks cut into pieces of this many seconds (0: none), as --pieces.\n"
         "coarse: before them, at most this many coarse steps of the kinetic coefficients and offsets, as --coarse.\n"
         "wide: after the search, at most this many wide steps (every coordinate and start), as --wide.\n"
         "cells: points drawn about the fit to find the spread over the chi-square's cells (0: none), as --cells.\n"
+        "envelope: the within-cell sd widened to the secants' over several cells (False: not), as --no-envelope.\n"
         "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.\n"
         "profile='all' or a list of fitted names: their profile likelihoods too (plate identify --profile; at most\n"
         "profile_steps re-minimisations a side, all within profile_time_limit s), in .profiles and .summary.");

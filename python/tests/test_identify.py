@@ -122,9 +122,10 @@ def test_coarse_steps_are_asked_by_keyword(tmp_path):
 def test_the_cells_spread_is_asked_by_keyword(tmp_path):
     # A part sliding throughout has no cells: the default's spread over them is a small part of the sd (its
     # own, in .sd_cells and the JSON), cells=0 leaves none and the within-cell sd alone; out of range raises.
+    # (The envelope, which also counts in sd_cells, is left out here: its own test follows.)
     path = filmed(tmp_path, point_scene(0.27))
-    with_cells = plate.identify(point_scene(0.30), [path], ["mu_k"])
-    without = plate.identify(point_scene(0.30), [path], ["mu_k"], cells=0)
+    with_cells = plate.identify(point_scene(0.30), [path], ["mu_k"], envelope=False)
+    without = plate.identify(point_scene(0.30), [path], ["mu_k"], cells=0, envelope=False)
     assert 0 < with_cells.sd_cells[0] < 0.1 * with_cells.sd[0]
     assert with_cells.summary["parameters"][0]["sd_cells"] == with_cells.sd_cells[0]
     assert with_cells.summary["options"]["cell_samples"] == 32
@@ -132,6 +133,22 @@ def test_the_cells_spread_is_asked_by_keyword(tmp_path):
     assert without.sd[0] ** 2 == pytest.approx(with_cells.sd[0] ** 2 - with_cells.sd_cells[0] ** 2, rel=1e-9)
     with pytest.raises(ValueError, match="cell_samples"):
         plate.identify(point_scene(0.30), [path], ["mu_k"], cells=-1)
+
+
+def test_the_envelope_is_asked_by_keyword(tmp_path):
+    # A part sliding throughout: its chi-square is smooth, so the secants over 3, 10 and 30 times the fine steps
+    # are its tangent and widen nothing beyond 1 %; envelope=False: none, the options say so (an empty list of
+    # factors) and the solver's report spends no time on it; the default's factors are the library's.
+    path = filmed(tmp_path, point_scene(0.27))
+    on = plate.identify(point_scene(0.30), [path], ["mu_k"], cells=0)
+    off = plate.identify(point_scene(0.30), [path], ["mu_k"], cells=0, envelope=False)
+    assert on.summary["options"]["envelope_factors"] == [3, 10, 30]
+    assert on.summary["solver"]["envelope_seconds"] > 0
+    assert off.summary["options"]["envelope_factors"] == []
+    assert off.summary["solver"]["envelope_seconds"] == 0
+    assert off.sd_cells[0] == 0
+    assert off.sd[0] <= on.sd[0] < 1.01 * off.sd[0]
+    assert on.sd[0] ** 2 - on.sd_cells[0] ** 2 == pytest.approx(off.sd[0] ** 2, rel=1e-9)
 
 
 def test_the_wide_steps_are_asked_by_keyword(tmp_path):
@@ -156,11 +173,12 @@ def test_the_command_lines_cells_option(tmp_path):
     for cells in ("0", None):
         out = tmp_path / "est.json"
         args = [EXE, "identify", str(scene_file), "--tracks", path, "--params", "mu_k", "--out", str(out)]
-        cli = subprocess.run(args + (["--cells", cells] if cells else []), capture_output=True, text=True)
+        cli = subprocess.run(args + (["--cells", cells, "--no-envelope"] if cells else []), capture_output=True, text=True)
         assert cli.returncode == 0, cli.stderr
         est = json.loads(out.read_text())
         if cells:
             assert est["options"]["cell_samples"] == 0
+            assert est["options"]["envelope_factors"] == []
             assert est["parameters"][0]["sd_cells"] == 0
         else:
             assert est["parameters"][0]["sd_cells"] == plate.identify(point_scene(0.30), [path], ["mu_k"]).sd_cells[0]

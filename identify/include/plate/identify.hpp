@@ -101,6 +101,11 @@ struct IdentifyOptions {
     // at the linearised covariance, half at twice its sds), each taken one Gauss-Newton step to its cell's
     // minimum and weighted by its likelihood (identify_detail::cell_spread). 0: the linearised sd alone.
     int cell_samples = 32;
+    // The envelope across the cells ("The envelope across the cells"): the within-cell sd is replaced by the
+    // one from the fit's Jacobian by differences 3, 10 or 30 times the fine steps where that is wider (a secant
+    // over several cells, where the fine Jacobian is one cell's tangent), the cells' spread added to it as
+    // before; the widening counts in sd_cells. false: the within-cell sd and the cells' spread alone.
+    bool envelope = true;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
     void validate() const;
@@ -124,8 +129,8 @@ struct FittedParameter {
     std::string name, unit;   // unit "1" (friction) or "m"
     double estimate = 0;
     double sd = 0;              // from the covariance (the cells' spread included); NaN where not identifiable
-    double sd_cells = 0;        // of which the spread over the chi-square's cells near the fit: sd^2 - sd_cells^2
-                                // is the linearised (within its cell) variance
+    double sd_cells = 0;        // of which the share of the chi-square's cells near the fit (their minima's spread, or
+                                // where wider their envelope): sd^2 - sd_cells^2 is the linearised (within its cell) variance
     double lo = 0, hi = 0;      // 95 %: estimate -+ 1.96 sd; NaN where not identifiable
     bool identifiable = true;   // false: part of a combination the tracks cannot separate
     bool at_bound = false;      // the estimate lies on a physical bound (the interval is then one-sided at best)
@@ -175,19 +180,20 @@ struct IdentifySummary {
     double p_value = std::numeric_limits<double>::quiet_NaN();
     bool explains_tracks = true;
     int starts_run = 0, best_start = 0;
-    int held = 0;                // named parameters no residual depended on at the first start: held there
-    int iterations = 0;          // of the best start, its hops' included
-    int pieces = 0;              // fitted in the first stage (segment_seconds; 0: no such stage)
-    int coarse_iterations = 0;   // of the best start's coarse steps (IdentifyOptions::coarse_iterations)
-    double coarse_seconds = 0;   // their time [s]
-    double cells_seconds = 0;    // the cells' draws' time [s] (IdentifyOptions::cell_samples)
-    int wide_iterations = 0;     // the wide steps the fit took (IdentifyOptions::wide_iterations; 0: none kept)
-    double wide_chi2_drop = 0;   // how far they and the fine search after them lowered the chi-square
-    double wide_seconds = 0;     // their time [s] (IdentifyOptions::wide_iterations)
-    int piece_iterations = 0;    // of the best start's first stage on the pieces
-    int hops = 0;                // times the search went on from a better end of the interval check's paths
-    double piece_seconds = 0;    // its time [s]
-    std::string termination;     // of the best start (Ceres' termination type and message)
+    int held = 0;                  // named parameters no residual depended on at the first start: held there
+    int iterations = 0;            // of the best start, its hops' included
+    int pieces = 0;                // fitted in the first stage (segment_seconds; 0: no such stage)
+    int coarse_iterations = 0;     // of the best start's coarse steps (IdentifyOptions::coarse_iterations)
+    double coarse_seconds = 0;     // their time [s]
+    double cells_seconds = 0;      // the cells' draws' time [s] (IdentifyOptions::cell_samples)
+    double envelope_seconds = 0;   // the envelope's Jacobians' time [s] (IdentifyOptions::envelope)
+    int wide_iterations = 0;       // the wide steps the fit took (IdentifyOptions::wide_iterations; 0: none kept)
+    double wide_chi2_drop = 0;     // how far they and the fine search after them lowered the chi-square
+    double wide_seconds = 0;       // their time [s] (IdentifyOptions::wide_iterations)
+    int piece_iterations = 0;      // of the best start's first stage on the pieces
+    int hops = 0;                  // times the search went on from a better end of the interval check's paths
+    double piece_seconds = 0;      // its time [s]
+    std::string termination;       // of the best start (Ceres' termination type and message)
     bool converged = false;
     double seconds = 0;
     std::vector<double> start_costs;   // each start's final chi2
