@@ -16,7 +16,7 @@
 // staged,central.
 // RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. COARSE:
 // IdentifyOptions::coarse_iterations. CELLS: IdentifyOptions::cell_samples (each sd printed with its share from the
-// cells' spread and the envelope). WIDE: IdentifyOptions::wide_iterations. ENVELOPE: IdentifyOptions::envelope (1 or
+// cells' spread and the envelope's widening). WIDE: IdentifyOptions::wide_iterations. ENVELOPE: IdentifyOptions::envelope (1 or
 // 0). Each interval's check at its ends (the chi-square's rise there, and the
 // verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
@@ -99,8 +99,8 @@ struct Variant {
             within += std::abs(err) <= 0.01;
             covered += cov;
             ++counted;
-            std::printf(" %s %+.4f(sd %.4f, cells %.4f)%s{%.1f,%.1f %s}", names[j].c_str(), err, p.sd, p.sd_cells,
-                        cov ? "" : "[MISS]", p.dchi2_lo, p.dchi2_hi, to_string(p.linearity));
+            std::printf(" %s %+.4f(sd %.4f, cells %.4f, envelope %.4f)%s{%.1f,%.1f %s}", names[j].c_str(), err, p.sd, p.sd_cells,
+                        p.sd_envelope, cov ? "" : "[MISS]", p.dchi2_lo, p.dchi2_hi, to_string(p.linearity));
             checks[static_cast<int>(p.linearity)] += 1;
             missed_flagged += !cov && p.linearity != Linearity::Holds;
             if (s.explains_tracks) ++explained, explained_covered += cov;

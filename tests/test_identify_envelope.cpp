@@ -45,9 +45,9 @@ struct Costs {
 // envelope)^2 + cells^2: a's 9 + 1 = 10, d's 3.24 + 2.25 = 5.49 (wider than its 2 though the envelope is
 // narrower than the sd: it replaces the within-cell part only); b (envelope within its within-cell sd) and c
 // (no sd) stay. A widened parameter's covariance row and column scale by its ratio (the diagonal by the
-// square, correlations kept), its interval is set anew, sd_cells^2 = sd^2 - within^2. Seen failing with the
-// envelope as a floor on the whole sd (a's 3, d's 2), with the diagonal scaled once (a's sqrt 10 x 2 against
-// 10) and with sd_cells left (a's 1 against sqrt 7).
+// square, correlations kept), its interval is set anew, sd_envelope^2 = envelope^2 - within^2 (a's 6, d's
+// 1.49) with sd_cells kept, so the within-cell sd stays. Seen failing with the envelope as a floor on the
+// whole sd (a's 3, d's 2) and with the diagonal scaled once (a's sqrt 10 x 2 against 10).
 TEST_CASE("the envelope replaces a wider within-cell sd, the cells' spread kept beside it", "[identify][envelope]") {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     IdentifySummary s;
@@ -76,13 +76,18 @@ TEST_CASE("the envelope replaces a wider within-cell sd, the cells' spread kept 
     CHECK(s.covariance(1, 3) == 0);
     CHECK(std::isnan(s.covariance(2, 2)));
     CHECK(s.params[0].sd == Approx(std::sqrt(10.0)).epsilon(1e-14));
-    CHECK(s.params[0].sd_cells == Approx(std::sqrt(7.0)).epsilon(1e-14));
+    CHECK(s.params[0].sd_cells == 1);
+    CHECK(s.params[0].sd_envelope == Approx(std::sqrt(6.0)).epsilon(1e-14));
+    CHECK(within_cell_sd(s.params[0]) == Approx(std::sqrt(3.0)).epsilon(1e-14));
     CHECK(s.params[0].lo == Approx(0.3 - kZ95 * std::sqrt(10.0)).epsilon(1e-14));
     CHECK(s.params[0].hi == Approx(0.3 + kZ95 * std::sqrt(10.0)).epsilon(1e-14));
     CHECK(s.params[3].sd == Approx(std::sqrt(5.49)).epsilon(1e-14));
-    CHECK(s.params[3].sd_cells == Approx(std::sqrt(5.49 - 1.75)).epsilon(1e-14));
+    CHECK(s.params[3].sd_cells == 1.5);
+    CHECK(s.params[3].sd_envelope == Approx(std::sqrt(1.49)).epsilon(1e-14));
+    CHECK(within_cell_sd(s.params[3]) == Approx(std::sqrt(1.75)).epsilon(1e-14));
     CHECK(s.params[1].sd == 3);
     CHECK(s.params[1].sd_cells == 0);
+    CHECK(s.params[1].sd_envelope == 0);
     CHECK(s.params[1].lo == 0.4 - kZ95 * 3);
     CHECK(std::isnan(s.params[2].sd));
 }
@@ -114,8 +119,10 @@ TEST_CASE("a part that slides throughout: the envelope equals the fit's own sd",
     CHECK(simulations == 3 * (2 * 2 + 2 * 2 * 2));
     CHECK(on.params[0].sd >= off.params[0].sd);
     CHECK(on.params[0].sd < 1.01 * off.params[0].sd);
-    CHECK(on.params[0].sd * on.params[0].sd - on.params[0].sd_cells * on.params[0].sd_cells ==
-          Approx(off.params[0].sd * off.params[0].sd).epsilon(1e-9));
+    // The fit's own envelope is the test's (its starts round-tripped through metres): the sd it reports.
+    CHECK(on.params[0].sd == Approx(std::max(env[0], off.params[0].sd)).epsilon(1e-6));
+    CHECK(on.params[0].sd_cells == 0);
+    CHECK(within_cell_sd(on.params[0]) == Approx(off.params[0].sd).epsilon(1e-9));
     CHECK(on.envelope_seconds > 0);
     CHECK(off.envelope_seconds == 0);
 }

@@ -133,7 +133,8 @@ std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o,
         for (int k = 0; k < nf; ++k) J.col(free[k]) = Jf.col(k);
         J.rightCols(starts_size) = Jf.rightCols(starts_size);
         const Eigen::MatrixXd cov = A * identifiable_covariance(layout, o, J, starts_size, nullptr) * A.transpose();
-        for (int j = 0; j < n; ++j) sd[j] = std::max(sd[j], std::sqrt(std::max(cov(j, j), 0.0)));
+        for (int j = 0; j < n; ++j)
+            if (std::isfinite(cov(j, j))) sd[j] = std::max(sd[j], std::sqrt(std::max(cov(j, j), 0.0)));
     }
     return sd;
 }

@@ -314,8 +314,8 @@ std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o,
 // s's sds with the envelope (per parameter, scene units): sd^2 = max(within, sd_envelope)^2 + cells^2, the
 // within-cell sd (sqrt(sd^2 - sd_cells^2)) replaced by the envelope's where that is wider, the cells' spread
 // (sd_cells, from add_cells) kept beside it. Where the sd grows, the covariance's row and column are scaled
-// by the ratio (its correlations kept), the interval set anew, and sd_cells takes the added share, so that
-// sd^2 - sd_cells^2 stays the within-cell variance (judge.cpp).
+// by the ratio (its correlations kept), the interval set anew, and sd_envelope takes the added share
+// (sqrt(envelope^2 - within^2)), so that within_cell_sd stays the same (judge.cpp).
 void add_envelope(const std::vector<double>& sd_envelope, IdentifySummary& s);
 
 }   // namespace plate::identify_detail

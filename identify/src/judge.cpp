@@ -105,6 +105,7 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
         p.at_bound = x[j] <= layout.lower(j, o) + 1e-9 || x[j] >= layout.upper(j, o) - 1e-9;
         p.sd = p.identifiable ? std::sqrt(std::max(s.covariance(j, j), 0.0)) : nan;
         p.sd_cells = p.identifiable ? 0.0 : nan;
+        p.sd_envelope = p.sd_cells;
         p.lo = p.estimate - kZ95 * p.sd;
         p.hi = p.estimate + kZ95 * p.sd;
         s.params.push_back(p);
@@ -138,8 +139,7 @@ void add_envelope(const std::vector<double>& sd_envelope, IdentifySummary& s) {
     Eigen::VectorXd widen = Eigen::VectorXd::Ones(n), sd(n);
     for (int j = 0; j < n; ++j) {
         const FittedParameter& p = s.params[j];
-        const double within = std::sqrt(std::max(p.sd * p.sd - p.sd_cells * p.sd_cells, 0.0));
-        sd[j] = std::hypot(std::max(within, sd_envelope[j]), p.sd_cells);
+        sd[j] = std::hypot(std::max(within_cell_sd(p), sd_envelope[j]), p.sd_cells);
         if (p.identifiable && p.sd > 0 && sd[j] > p.sd) widen[j] = sd[j] / p.sd;
     }
     for (int j = 0; j < n; ++j) {
@@ -150,9 +150,9 @@ void add_envelope(const std::vector<double>& sd_envelope, IdentifySummary& s) {
                 s.covariance(j, k) *= widen[j];
                 s.covariance(k, j) *= widen[j];
             }
-        const double within2 = p.sd * p.sd - p.sd_cells * p.sd_cells;
+        const double within = within_cell_sd(p);
         p.sd = sd[j];
-        p.sd_cells = std::sqrt(std::max(p.sd * p.sd - within2, 0.0));
+        p.sd_envelope = std::sqrt(std::max(sd_envelope[j] * sd_envelope[j] - within * within, 0.0));
         p.lo = p.estimate - kZ95 * p.sd;
         p.hi = p.estimate + kZ95 * p.sd;
     }
@@ -237,6 +237,10 @@ void check_linearity(const Layout& layout, const IdentifyOptions& o, const std::
 }   // namespace plate::identify_detail
 
 namespace plate {
+
+double within_cell_sd(const FittedParameter& p) {
+    return std::sqrt(std::max(p.sd * p.sd - p.sd_cells * p.sd_cells - p.sd_envelope * p.sd_envelope, 0.0));
+}
 
 const char* to_string(Linearity l) {
     switch (l) {

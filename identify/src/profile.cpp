@@ -249,7 +249,7 @@ ProfileSummary profile_likelihood(const Scene& scene, const std::vector<Track>& 
         p.name = f.name;
         p.unit = f.unit;
         p.estimate = f.estimate;
-        const double within = std::sqrt(std::max(f.sd * f.sd - f.sd_cells * f.sd_cells, 0.0));   // (NaN: not identifiable)
+        const double within = within_cell_sd(f);   // (NaN: not identifiable)
         p.linear_lo = f.identifiable ? f.estimate - kZ95 * within : std::numeric_limits<double>::quiet_NaN();
         p.linear_hi = f.identifiable ? f.estimate + kZ95 * within : std::numeric_limits<double>::quiet_NaN();
         Walk w{layout, o, po, costs, budget, j, x_hat, q0_hat, {}, fit.chi2};

@@ -26,14 +26,18 @@ json identify_json(const IdentifySummary& s, const IdentifyOptions& o) {
         if (p.identifiable) {
             j["sd"] = num(p.sd);
             j["sd_cells"] = num(p.sd_cells);
+            j["sd_envelope"] = num(p.sd_envelope);
             j["interval95"] = {num(p.lo), num(p.hi)};
-            j["interval95_check"] = {{"of", "the interval within the fit's cell: estimate -+ 1.96 sqrt(sd^2 - sd_cells^2)"},
+            j["interval95_check"] = {{"of",
+                                      "the interval within the fit's cell: estimate -+ 1.96 sqrt(sd^2 - sd_cells^2 - "
+                                      "sd_envelope^2)"},
                                      {"dchi2_at_ends", {num(p.dchi2_lo), num(p.dchi2_hi)}},
                                      {"quadratic_dchi2", kProfileThreshold95},
                                      {"verdict", to_string(p.linearity)}};
         } else {
             j["sd"] = nullptr;
             j["sd_cells"] = nullptr;
+            j["sd_envelope"] = nullptr;
             j["interval95"] = nullptr;
             j["identifiable"] = "not identifiable from these tracks";
         }

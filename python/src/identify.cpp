@@ -27,7 +27,8 @@ struct PyIdentification {
 // Each struct's members once (pickling.hpp).
 namespace pickling {
 void io(Archive& a, FittedParameter& p) {
-    a(p.name, p.unit, p.estimate, p.sd, p.sd_cells, p.lo, p.hi, p.identifiable, p.at_bound, p.dchi2_lo, p.dchi2_hi, p.linearity);
+    a(p.name, p.unit, p.estimate, p.sd, p.sd_cells, p.sd_envelope, p.lo, p.hi, p.identifiable, p.at_bound, p.dchi2_lo, p.dchi2_hi,
+      p.linearity);
 }
 void io(Archive& a, Unidentifiable& u) { a(u.combination, u.half_width); }
 void io(Archive& a, TrackFit& t) { a(t.source, t.frames, t.start, t.rms_xy_mm, t.rms_theta_mrad, t.chi2); }
@@ -155,10 +156,15 @@ void bind_identify(py::module_& m) {
             "the estimates (friction: 1, com_x/com_y: m)")
         .def_property_readonly(
             "sd", [](const PyIdentification& r) { return per_parameter(r.s, &FittedParameter::sd); },
-            "standard deviations (the spread over the chi-square's cells included); NaN where not identifiable")
+            "standard deviations (the spread over the chi-square's cells and the envelope included); NaN where not "
+            "identifiable")
         .def_property_readonly(
             "sd_cells", [](const PyIdentification& r) { return per_parameter(r.s, &FittedParameter::sd_cells); },
-            "of sd, the spread over the chi-square's cells near the fit (sd^2 - sd_cells^2: within the fit's cell); NaN "
+            "of sd, the spread over the chi-square's cells near the fit (sd^2 - sd_cells^2 - sd_envelope^2: within the "
+            "fit's cell); NaN where not identifiable")
+        .def_property_readonly(
+            "sd_envelope", [](const PyIdentification& r) { return per_parameter(r.s, &FittedParameter::sd_envelope); },
+            "of sd, the envelope's widening of the within-cell sd (secants over several cells; 0 where not wider); NaN "
             "where not identifiable")
         .def_property_readonly(
             "intervals",
@@ -189,7 +195,8 @@ void bind_identify(py::module_& m) {
                 }
                 return out;
             },
-            "per parameter, the 95 % interval within the fit's cell (estimate -+ 1.96 sqrt(sd^2 - sd_cells^2)) checked "
+            "per parameter, the 95 % interval within the fit's cell (estimate -+ 1.96 sqrt(sd^2 - sd_cells^2 - sd_envelope^2)) "
+            "checked "
             "at its ends: a dict -- dchi2_at_ends (the chi-square's rise there along the linearised profile's path; "
             "3.84 where the chi-square is quadratic; NaN where not checked), verdict ('holds', 'too narrow', "
             "'unconfirmed' or 'not checked')")

@@ -146,9 +146,11 @@ def test_the_envelope_is_asked_by_keyword(tmp_path):
     assert on.summary["solver"]["envelope_seconds"] > 0
     assert off.summary["options"]["envelope_factors"] == []
     assert off.summary["solver"]["envelope_seconds"] == 0
-    assert off.sd_cells[0] == 0
+    assert off.sd_cells[0] == 0 and off.sd_envelope[0] == 0
     assert off.sd[0] <= on.sd[0] < 1.01 * off.sd[0]
-    assert on.sd[0] ** 2 - on.sd_cells[0] ** 2 == pytest.approx(off.sd[0] ** 2, rel=1e-9)
+    assert on.sd_cells[0] == 0
+    assert on.summary["parameters"][0]["sd_envelope"] == on.sd_envelope[0]
+    assert on.sd[0] ** 2 - on.sd_envelope[0] ** 2 == pytest.approx(off.sd[0] ** 2, rel=1e-9)
 
 
 def test_the_wide_steps_are_asked_by_keyword(tmp_path):

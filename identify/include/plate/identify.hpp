@@ -104,7 +104,7 @@ struct IdentifyOptions {
     // The envelope across the cells ("The envelope across the cells"): the within-cell sd is replaced by the
     // one from the fit's Jacobian by differences 3, 10 or 30 times the fine steps where that is wider (a secant
     // over several cells, where the fine Jacobian is one cell's tangent), the cells' spread added to it as
-    // before; the widening counts in sd_cells. false: the within-cell sd and the cells' spread alone.
+    // before; the widening is FittedParameter::sd_envelope. false: the within-cell sd and the cells' spread alone.
     bool envelope = true;
     double mu_min = 0.05, mu_max = 1.5;   // physical bounds of a friction coefficient
     double com_max = 0.02;                // [m]: |com_x|, |com_y| at most this
@@ -129,8 +129,9 @@ struct FittedParameter {
     std::string name, unit;   // unit "1" (friction) or "m"
     double estimate = 0;
     double sd = 0;              // from the covariance (the cells' spread included); NaN where not identifiable
-    double sd_cells = 0;        // of which the share of the chi-square's cells near the fit (their minima's spread, or
-                                // where wider their envelope): sd^2 - sd_cells^2 is the linearised (within its cell) variance
+    double sd_cells = 0;        // of which the spread over the chi-square's cells' minima near the fit
+    double sd_envelope = 0;     // of which the envelope's widening of the within-cell sd (IdentifyOptions::envelope):
+                                // sd^2 - sd_cells^2 - sd_envelope^2 is the linearised (within its cell) variance
     double lo = 0, hi = 0;      // 95 %: estimate -+ 1.96 sd; NaN where not identifiable
     bool identifiable = true;   // false: part of a combination the tracks cannot separate
     bool at_bound = false;      // the estimate lies on a physical bound (the interval is then one-sided at best)
@@ -158,6 +159,10 @@ struct TrackFit {
     double rms_theta_mrad = 0;   // of theta [mrad] (0 for a point part)
     double chi2 = 0;             // the track's sum of squared scaled residuals
 };
+
+// The linearised sd within the fit's cell, sqrt(sd^2 - sd_cells^2 - sd_envelope^2): what the interval check
+// and the profile are set beside (NaN where not identifiable).
+double within_cell_sd(const FittedParameter& p);
 
 // IdentifySummary::explains_tracks: a fit whose chi-square the noise alone exceeds less often than this.
 constexpr double kFitPValueFloor = 1e-3;

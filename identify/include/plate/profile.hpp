@@ -64,11 +64,12 @@ struct ParameterProfile {
     double lo = 0, hi = 0;              // the profile's 95 % interval
     ProfileEnd lo_end = ProfileEnd::CutShort, hi_end = ProfileEnd::CutShort;
     double bound_lo = 0, bound_hi = 0;   // the physical bounds along the profile
-    // The linearised interval within the fit's cell, estimate -+ 1.96 sqrt(sd^2 - sd_cells^2), the profile's
-    // counterpart (NaN where judged not identifiable).
+    // The linearised interval within the fit's cell, estimate -+ 1.96 within_cell_sd (identify.hpp), the
+    // profile's counterpart (NaN where judged not identifiable).
     double linear_lo = 0, linear_hi = 0;
     // THE 95 % interval is the profile's, each side widened by the cells' spread in quadrature (as the sd
-    // takes it) within the bounds (lo_reported, hi_reported); else the linearised one with the cells' spread.
+    // takes it; not by the envelope, which the profile's re-minimisations see themselves) within the bounds (lo_reported,
+    // hi_reported); else the linearised one with the cells' spread.
     bool interval_is_profile = false;
     double lo_reported = 0, hi_reported = 0;
     bool identifiable = true;   // false: the profile stays below 3.84 from bound to bound
