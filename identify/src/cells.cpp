@@ -102,10 +102,6 @@ Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, cons
     return cell_mixture(J, r0, cov_internal, lower, upper, moves, r);
 }
 
-}   // namespace plate::identify_detail
-
-namespace plate::identify_detail {
-
 std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                                  const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
                                  const std::vector<int>& held, long& simulations) {

@@ -105,7 +105,7 @@ Eigen::MatrixXd judge(const Layout& layout, const IdentifyOptions& o, const std:
         p.at_bound = x[j] <= layout.lower(j, o) + 1e-9 || x[j] >= layout.upper(j, o) - 1e-9;
         p.sd = p.identifiable ? std::sqrt(std::max(s.covariance(j, j), 0.0)) : nan;
         p.sd_cells = p.identifiable ? 0.0 : nan;
-        p.sd_envelope = p.sd_cells;
+        p.sd_envelope = p.identifiable ? 0.0 : nan;
         p.lo = p.estimate - kZ95 * p.sd;
         p.hi = p.estimate + kZ95 * p.sd;
         s.params.push_back(p);
