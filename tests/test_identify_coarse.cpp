@@ -183,7 +183,7 @@ TEST_CASE("at a search stopped in a cell the envelope is wider than the cell", "
         identify_detail::secant_jacobian(f.ptrs, layout, f.o, x, q, every, f.lo, f.hi, 1, true, rows, 6 + 15, simulations);
     const Eigen::MatrixXd A = identify_detail::natural_jacobian(layout, x);
     const Eigen::MatrixXd fine = A * identify_detail::identifiable_covariance(layout, f.o, J, 15, nullptr) * A.transpose();
-    const std::vector<double> env = identify_detail::envelope_sds(layout, f.o, f.ptrs, x, q, {}, simulations);
+    const std::vector<double> env = identify_detail::envelope_sds(layout, f.o, f.ptrs, x, q, {}, f.lo, f.hi, simulations);
     for (int j : {3, 5}) {
         INFO(kNames[j] << ": fine sd " << std::sqrt(fine(j, j)) << ", envelope " << env[j]);
         CHECK(env[j] > 3 * std::sqrt(fine(j, j)));

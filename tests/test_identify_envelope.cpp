@@ -112,7 +112,8 @@ TEST_CASE("a part that slides throughout: the envelope equals the fit's own sd",
     Costs c(nominal, layout, tracks, o, &off);
     long simulations = 0;
     const std::vector<double> x = layout.internal({off.params[0].estimate});
-    const std::vector<double> env = identify_detail::envelope_sds(layout, o, c.ptrs, x, c.starts, {}, simulations);
+    const std::vector<double> lo = {layout.lower(0, o)}, hi = {layout.upper(0, o)};
+    const std::vector<double> env = identify_detail::envelope_sds(layout, o, c.ptrs, x, c.starts, {}, lo, hi, simulations);
     INFO("sd " << off.params[0].sd << ", envelope " << env[0] << ", reported with it " << on.params[0].sd);
     CHECK(std::abs(env[0] / off.params[0].sd - 1) < 0.01);
     // Per factor (3): the coefficient both ways on each of the 2 tracks, each track's 2 start coordinates both ways.

@@ -104,15 +104,13 @@ Eigen::MatrixXd cell_spread(const Layout& layout, const IdentifyOptions& o, cons
 
 std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                                  const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
-                                 const std::vector<int>& held, long& simulations) {
+                                 const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi,
+                                 long& simulations) {
     const int n = layout.size(), nt = static_cast<int>(costs.size());
-    std::vector<double> sd(static_cast<std::size_t>(n), 0.0), lo(n), hi(n);
+    std::vector<double> sd(static_cast<std::size_t>(n), 0.0);
     std::vector<int> free;
-    for (int j = 0; j < n; ++j) {
-        lo[j] = layout.lower(j, o);
-        hi[j] = layout.upper(j, o);
+    for (int j = 0; j < n; ++j)
         if (std::find(held.begin(), held.end(), j) == held.end()) free.push_back(j);
-    }
     const int nf = static_cast<int>(free.size());
     std::vector<int> rows(static_cast<std::size_t>(nt) + 1, 0);
     int starts_size = 0;

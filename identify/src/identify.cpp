@@ -413,7 +413,7 @@ IdentifySummary identify(const Scene& scene, const std::vector<Track>& tracks, c
     if (o.envelope) {
         const auto envelope_start = Clock::now();
         long simulations = 0;
-        add_envelope(envelope_sds(layout, o, cost_ptrs, best, best_q0, held, simulations), s);
+        add_envelope(envelope_sds(layout, o, cost_ptrs, best, best_q0, held, lo, hi, simulations), s);
         s.envelope_seconds = std::chrono::duration<double>(Clock::now() - envelope_start).count();
     }
     s.fitted = at(scene, layout, best);

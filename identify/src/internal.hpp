@@ -310,7 +310,8 @@ void add_cells(const Layout& layout, const std::vector<double>& x, const Eigen::
 constexpr double kEnvelopeFactors[] = {3, 10, 30};
 std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o, const std::vector<TrackCost*>& costs,
                                  const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
-                                 const std::vector<int>& held, long& simulations);
+                                 const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi,
+                                 long& simulations);
 // s's sds with the envelope (per parameter, scene units): sd^2 = max(within, sd_envelope)^2 + cells^2, the
 // within-cell sd (sqrt(sd^2 - sd_cells^2)) replaced by the envelope's where that is wider, the cells' spread
 // (sd_cells, from add_cells) kept beside it. Where the sd grows, the covariance's row and column are scaled
