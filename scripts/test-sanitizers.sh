@@ -15,6 +15,7 @@ cmake -S . -B build-asan -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None -D
       -DPLATE_SANITIZE=ON >/dev/null
 # (A sanitizer build compiles only the test files whose cases run here: tests/CMakeLists.txt.)
 cmake --build build-asan -j"$(nproc)" --target plate_tests plate plate_fuzz_replay
+echo "=== sanitizers: built after $SECONDS s"
 export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 
