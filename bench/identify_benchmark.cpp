@@ -7,7 +7,7 @@
 // the coverage and the mean and largest seconds. MOTION "suggest": the tracks are filmed under the
 // motion suggest_motion() proposes (its candidates printed) for the scene's part with static friction
 // 20 % above its kinetic (the user's guess: that the part has some), and the fit starts from there.
-// TIME_LIMIT: each identification's (IdentifyOptions::time_limit, default 60 s). START "truth": the fit
+// TIME_LIMIT: each identification's (IdentifyOptions::time_limit, default 150 s). START "truth": the fit
 // starts from the truth (what the tracks can tell, apart from the search), else from the scene's values.
 // SEARCH: a comma-separated list of searches, each seed's tracks fitted by each (the time ratio of the
 // first two printed): staged (the tracks' starts first, then forward differences), central

@@ -47,8 +47,8 @@ struct IdentifyOptions {
     // Multi-start: the scene's values, then seeded draws within the bounds, until one fits as well as
     // the noise allows (chi-square within 3 sds of its mean at the truth) or all have run. After a
     // usable fit, a later start takes the best fit's coordinates but for the static coefficients'
-    // excesses (identify_detail::restart). starts and time_limit: the settings the benchmarks' figures are
-    // of (docs/decisions/identification.md, "The defaults: two starts within 150 s").
+    // excesses (identify_detail::restart). starts and time_limit: the settings of the benchmarks' coverage
+    // runs (docs/decisions/identification.md, "The defaults: two starts within 150 s").
     int starts = 2;
     std::uint64_t seed = 1;      // of the drawn starts
     int max_iterations = 25;     // Levenberg-Marquardt iterations per start
