@@ -17,10 +17,11 @@
 // RADIUS: IdentifyOptions::initial_trust_radius. REUSE: IdentifyOptions::jacobian_reuse. HOPS: IdentifyOptions::hops. COARSE:
 // IdentifyOptions::coarse_iterations. CELLS: IdentifyOptions::cell_samples (each sd printed with its share from the
 // cells' spread and the envelope's widening). WIDE: IdentifyOptions::wide_iterations. ENVELOPE: IdentifyOptions::envelope (1 or
-// 0). Each interval's check at its ends (the chi-square's rise there, and the
+// 0). TRUTH: the true kinetic coefficients "k1,k2,k3" (static 20 % above) or "k1,k2,k3,s1,s2,s3" (default
+// 0.25,0.30,0.35). Each interval's check at its ends (the chi-square's rise there, and the
 // verdict: FittedParameter::linearity) is printed in braces, and tallied against the misses.
 //   bench_identify [SEEDS [SCENE [PARAMS [TRACKS [DURATION [THREADS [RTOL [FIRST_SEED [MOTION [TIME_LIMIT [START
-//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS [WIDE [ENVELOPE]]]]]]]]]]]]]]]]]]]
+//   [SEARCH [RADIUS [REUSE [HOPS [COARSE [CELLS [WIDE [ENVELOPE [TRUTH]]]]]]]]]]]]]]]]]]]]
 #include "plate/identify.hpp"
 #include "plate/observe.hpp"
 #include "plate/random_scene.hpp"
@@ -126,14 +127,27 @@ int main(int argc, char** argv) {
     std::vector<std::string> names;
     std::stringstream in(plist);
     for (std::string w; std::getline(in, w, ',');) names.push_back(w);
-    const double kin[3] = {0.25, 0.30, 0.35};
+    double kin[3] = {0.25, 0.30, 0.35}, stat[3] = {1.2 * kin[0], 1.2 * kin[1], 1.2 * kin[2]};
+    if (argc > 20) {   // TRUTH: k1,k2,k3 or k1,k2,k3,s1,s2,s3
+        std::vector<double> v;
+        std::stringstream tin(argv[20]);
+        for (std::string w; std::getline(tin, w, ',');) v.push_back(std::stod(w));
+        if (v.size() != 3 && v.size() != 6) {
+            std::fprintf(stderr, "bench_identify: TRUTH: three kinetic coefficients, or three kinetic then three static\n");
+            return 2;
+        }
+        for (int i = 0; i < 3; ++i) {
+            kin[i] = v[static_cast<std::size_t>(i)];
+            stat[i] = v.size() == 6 ? v[static_cast<std::size_t>(3 + i)] : 1.2 * kin[i];
+        }
+    }
     std::vector<double> truth;
     for (const std::string& n : names) {
         const int i = n.size() == 5 ? n[4] - '1' : 1;
         if (n.rfind("mu_k", 0) == 0)
             truth.push_back(kin[i]);
         else if (n.rfind("mu_s", 0) == 0)
-            truth.push_back(1.2 * kin[i]);
+            truth.push_back(stat[i]);
         else
             truth.push_back(n == "com_x" ? 0.001 : -0.0005);
     }
