@@ -131,7 +131,11 @@ int main(int argc, char** argv) {
     if (argc > 20) {   // TRUTH: k1,k2,k3 or k1,k2,k3,s1,s2,s3
         std::vector<double> v;
         std::stringstream tin(argv[20]);
-        for (std::string w; std::getline(tin, w, ',');) v.push_back(std::stod(w));
+        try {
+            for (std::string w; std::getline(tin, w, ',');) v.push_back(std::stod(w));
+        } catch (const std::exception&) {
+            v.clear();
+        }
         if (v.size() != 3 && v.size() != 6) {
             std::fprintf(stderr, "bench_identify: TRUTH: three kinetic coefficients, or three kinetic then three static\n");
             return 2;
