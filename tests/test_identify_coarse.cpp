@@ -106,7 +106,19 @@ TEST_CASE("coarse steps take the kinetic coefficients from a guess 0.05 off to w
     // Seen failing: with the step's sign flipped (no step lowers the chi-square) and with the static
     // excesses moved too (0.0059 off). The search's own difference step does as well here (the docs).
     CHECK(coarse_off < 0.005);
-    CHECK(c.chi2_after < 0.02 * c.chi2_before);
+    // The chi-square the steps can reach: along the line from the guess to the truth's kinetic coefficients
+    // (the static excesses the guess's, the starts held) the chi-square is a bowl (the docs), c_T + (c_G -
+    // c_T) s^2 at s of the way from the truth; within 0.005 of the truth (a tenth of the guess's 0.05) it is
+    // below c_T + 0.01 (c_G - c_T).
+    std::vector<double> at_truth = guess;
+    for (int i = 0; i < 3; ++i) at_truth[i] = truth[i];   // (internal: kinetic as themselves, the excesses kept)
+    long sims = 0;
+    const auto r = identify_detail::stacked_residuals(f.ptrs, {at_truth}, {f.first}, 2, sims);
+    REQUIRE(r.size() == 1);
+    REQUIRE(r[0].size() > 0);
+    const double c_truth = r[0].squaredNorm();
+    INFO("chi2 at the truth's kinetic coefficients, the guess's excesses: " << c_truth);
+    CHECK(c.chi2_after < c_truth + 0.01 * (c.chi2_before - c_truth));
     for (int j = 3; j < 6; ++j) CHECK(coarse[j] - coarse[j - 3] == Approx(guess[j]).margin(1e-12));   // excesses held
 }
 
@@ -124,17 +136,18 @@ TEST_CASE("a later start keeps the fit's kinetic coefficients and offsets and ta
 }
 
 // The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
-// cells"): bench_identify's seed 16, whose search from the guess stopped with every coefficient 3-7 sds
-// (within its cell) off and a chi-square 187 above the truth's (the tracks' starts fitted there). From
+// cells"): bench_identify's seed 56, whose search from the guess without wide steps stopped with mu_k1 and
+// mu_k3 0.003 off, 7-8 sds (within its cell), and a chi-square far above the truth's (the tracks' starts
+// fitted there; reduced 1.140 against about 1.0). From
 // those coefficients, their starts fitted, the wide steps (every coefficient and start moved at once)
 // reach the truth's level. What this checks is the joint step with the starts; the factor 10 over the
 // fine steps is not isolated here (at the fine steps the same Levenberg-Marquardt also gets there from
 // this point: the docs).
 TEST_CASE("wide steps take a fit stopped in a cell of the chi-square down to the truth's level", "[identify][coarse]") {
-    SeedTracks f(16);
+    SeedTracks f(56);
     const Layout& layout = f.layout;
     const std::vector<double>& truth = kTruth;
-    const std::vector<double> stopped = {0.2521, 0.3011, 0.3473, 0.3073, 0.3613, 0.4075};   // the search's end
+    const std::vector<double> stopped = {0.2468, 0.3000, 0.3530, 0.3032, 0.3600, 0.4158};   // the search's end
     const std::vector<int> every = {0, 1, 2, 3, 4, 5};
     // The chi-square with the coefficients at `values`, the starts fitted (q: the fitted starts).
     const auto starts_fitted = [&](const std::vector<double>& values, std::vector<std::vector<double>>& q) {
@@ -156,7 +169,7 @@ TEST_CASE("wide steps take a fit stopped in a cell of the chi-square down to the
     // Each step: 2 x 6 points, 2 x 15 tracks' starts (a fifth of a point each), a trial point at least.
     CHECK(wide.simulations >= 5 * (1 + wide.iterations * (2 * 6 + 1)) + wide.iterations * 30);
     // To the truth's level: within the chi-square's sd at the truth, sqrt(2 dof); the kinetic coefficients
-    // within 0.001 (the stopped search's: 0.0011-0.0027 off).
+    // within 0.001 (the stopped search's mu_k1 and mu_k3: 0.0032 and 0.0030 off).
     int rows = 0;
     for (const TrackCost* c : f.ptrs) rows += c->num_residuals();
     CHECK(wide.chi2_after < at_truth + std::sqrt(2.0 * (rows - 6 - 15)));
@@ -164,14 +177,16 @@ TEST_CASE("wide steps take a fit stopped in a cell of the chi-square down to the
 }
 
 // The envelope across the cells (IdentifyOptions::envelope; "The envelope across the cells", the docs): at
-// the same stopped search's end (seed 16's), its starts fitted, the fine Jacobian's sds of the static
-// coefficients measure its cell (mu_s1's 0.0004, 0.0073 from the truth); the secants over 3, 10 and 30 times
-// the fine steps see across the cells, at least 3 times wider for mu_s1 and mu_s3 (measured: 0.00036 ->
-// 0.0027 and 0.00075 -> 0.0027). Seen failing with the envelope's factors at 1 (the fine steps: the same sds).
+// bench_identify's seed 16's search end without wide steps (a reduced chi-square of 0.987: it explains its
+// tracks), its starts fitted, the fine Jacobian's sds of the static coefficients measure its cell (mu_s1's
+// 0.0004, 0.0094 from the truth); the secants over 3, 10 and 30 times the fine steps see across the cells,
+// at least 3 times wider for mu_s1 and mu_s3 (measured: 0.00044 -> 0.0049 and 0.00049 -> 0.0041; before the
+// stick exit's pivot, engine.md, at that engine's search end: 0.00036 -> 0.0027 and 0.00075 -> 0.0027).
+// Seen failing with the envelope's factors at 1 (the fine steps: the same sds).
 TEST_CASE("at a search stopped in a cell the envelope is wider than the cell", "[identify][envelope]") {
     SeedTracks f(16);
     const Layout& layout = f.layout;
-    const std::vector<double> stopped = {0.2521, 0.3011, 0.3473, 0.3073, 0.3613, 0.4075};
+    const std::vector<double> stopped = {0.2506, 0.3003, 0.3494, 0.3094, 0.3604, 0.4072};
     const std::vector<int> every = {0, 1, 2, 3, 4, 5};
     std::vector<double> x = layout.internal(stopped);
     std::vector<std::vector<double>> q = f.first;

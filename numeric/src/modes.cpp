@@ -386,6 +386,41 @@ void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Ve
     }
 }
 
+namespace {
+
+// A stick exit (the gauge g at 1, its optimum on no kink) of a part whose static friction exceeds its
+// kinetic friction somewhere. At the boundary every contact is at the rim of its static disk and the
+// motion that starts is the boundary twist -d, contact i slipping at a rate proportional to |v_i(-d)|.
+// A contact that slips drops to its kinetic disk, so the faster contacts drop first; where one contact
+// k is strictly the slowest, the others have dropped before it slips (the limit of a smooth law whose
+// drop from mu_s to mu_k narrows to zero slip), and if its static friction then holds it while they
+// slide -- the pivot about k turning as -d does, |f_k| <= mu_sk N_k, every N_i >= 0, theta'' of that
+// sense -- the part pivots about k (docs/decisions/engine.md, "A stick exit with static above kinetic
+// friction"). Returns a slide otherwise (ws then holds the stuck state's evaluation again).
+ModeChoice exit_pivot(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
+                      const FrictionGauge& g, Workspace& ws) {
+    const Part& P = sc.part;
+    std::array<Vec2, 3> v;
+    slip_velocities(P, q, Vec3(-g.direction), v);
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+        if (v[i].norm() < v[k].norm()) k = i;
+    ModeChoice out;
+    for (int j = 0; j < 3; ++j)
+        if (j != k && v[k].norm() >= (1 - 1e-6) * v[j].norm()) return out;   // no contact strictly the slowest
+    const Mode pivot{ModeKind::Pivot, k, g.direction[2] > 0 ? -1.0 : 1.0};
+    mode_accelerations(sc, level, q, qd, ps, pivot, ws);
+    if (ws.n.minCoeff() >= 0 && ws.f_held[k].norm() <= P.friction().static_(k) * ws.n[k] && pivot.sense * ws.qdd[2] > 0) {
+        out.mode = pivot;
+        out.gamma = g.gamma;
+        return out;
+    }
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+    return out;
+}
+
+}   // namespace
+
 ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd, const PlateState& ps, unsigned zero,
                        Workspace& ws, bool hold) {
     detail::StickSlipState& ss = detail::stick_slip(ws);
@@ -468,6 +503,10 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
         if (!normal_ok()) return out;   // held, but the part would tip
         out.mode = Mode{ModeKind::Stuck};
         return out;
+    }
+    if (!hold && !P.point && !P.friction().single() && g.pivot < 0 && g.gamma <= 1 + 1e-6) {
+        const ModeChoice held = exit_pivot(sc, level, q, qd, ps, g, ws);
+        if (held.mode.kind == ModeKind::Pivot) return held;
     }
     // Off the stick boundary (a start at rest where friction cannot hold, the twist passing through
     // zero): the motion that starts is the consistent one -- a pivot about contact k turning with
