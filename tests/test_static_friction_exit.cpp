@@ -157,8 +157,8 @@ TEST_CASE("a stick exit with static above kinetic friction pivots where the smoo
         // break-away): quartering vs cuts the largest distance over the 31 samples to 0.39 of itself here
         // (measured, 4e-6 -> 1e-6 -> 2.5e-7 m/s: 3.30 -> 1.30 -> 0.50 um and 0.032 -> 0.012 -> 0.0048 mrad;
         // eps = 1e-4 vs). Without the exit's pivot the engine is a limit the smooth law does not approach:
-        // 12.3 -> 10.3 -> 9.5 um, 0.24 -> 0.22 -> 0.21 mrad (ratios 0.84 and 0.92). Half is the bound: the
-        // order-1/2 rate the lagging drop alone would give.
+        // 12.3 -> 10.3 -> 9.5 um, 0.24 -> 0.22 -> 0.21 mrad (ratios 0.84 and 0.92). Half is the bound: a
+        // distance that at least halves each time vs is quartered goes to zero (at least order 1/2 in vs).
         std::vector<double> times;
         for (const Sample& s : tr.samples) times.push_back(s.t);
         auto distance = [&](double vs) {

@@ -388,15 +388,27 @@ void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Ve
 
 namespace {
 
+// Does the pivot hold from the stuck state's boundary: contact k's static friction fits its disk while the
+// others slide at their kinetic coefficients, every N_i >= 0, and theta'' has the pivot's sense? ws holds
+// the stuck state's evaluation again afterwards where it does not.
+bool pivot_holds(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, const Mode& pivot,
+                 Workspace& ws) {
+    mode_accelerations(sc, level, q, qd, ps, pivot, ws);
+    const int k = pivot.k;
+    if (ws.n.minCoeff() >= 0 && ws.f_held[k].norm() <= sc.part.friction().static_(k) * ws.n[k] && pivot.sense * ws.qdd[2] > 0)
+        return true;
+    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
+    return false;
+}
+
 // A stick exit (the gauge g at 1, its optimum on no kink) of a part whose static friction exceeds its
 // kinetic friction somewhere. At the boundary every contact is at the rim of its static disk and the
-// motion that starts is the boundary twist -d, contact i slipping at a rate proportional to |v_i(-d)|.
-// A contact that slips drops to its kinetic disk, so the faster contacts drop first; where one contact
-// k is strictly the slowest, the others have dropped before it slips (the limit of a smooth law whose
-// drop from mu_s to mu_k narrows to zero slip), and if its static friction then holds it while they
-// slide -- the pivot about k turning as -d does, |f_k| <= mu_sk N_k, every N_i >= 0, theta'' of that
-// sense -- the part pivots about k (docs/decisions/engine.md, "A stick exit with static above kinetic
-// friction"). Returns a slide otherwise (ws then holds the stuck state's evaluation again).
+// boundary twist -d would slip each at its own rate; the contacts that slip drop to their kinetic disks,
+// and the motion that follows can be a pivot. Offered: the pivot about the contact strictly the slowest
+// under -d (none on a tie), turning as -d does, taken where it holds (pivot_holds). A rule checked against
+// a smooth Stribeck law's limit on fig4's part, not derived: the Coulomb model with mu_s > mu_k can have
+// several consistent motions here (docs/decisions/engine.md, "A stick exit with static above kinetic
+// friction", and the cases it leaves untested). Returns a slide where no pivot is taken.
 ModeChoice exit_pivot(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps,
                       const FrictionGauge& g, Workspace& ws) {
     const Part& P = sc.part;
@@ -409,13 +421,10 @@ ModeChoice exit_pivot(const Scene& sc, Dynamics level, const Vec3& q, const Vec3
     for (int j = 0; j < 3; ++j)
         if (j != k && v[k].norm() >= (1 - 1e-6) * v[j].norm()) return out;   // no contact strictly the slowest
     const Mode pivot{ModeKind::Pivot, k, g.direction[2] > 0 ? -1.0 : 1.0};
-    mode_accelerations(sc, level, q, qd, ps, pivot, ws);
-    if (ws.n.minCoeff() >= 0 && ws.f_held[k].norm() <= P.friction().static_(k) * ws.n[k] && pivot.sense * ws.qdd[2] > 0) {
+    if (pivot_holds(sc, level, q, qd, ps, pivot, ws)) {
         out.mode = pivot;
         out.gamma = g.gamma;
-        return out;
     }
-    mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
     return out;
 }
 
