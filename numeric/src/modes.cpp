@@ -388,15 +388,19 @@ void mode_accelerations(const Scene& sc, Dynamics level, const Vec3& q, const Ve
 
 namespace {
 
-// Does the pivot hold from the stuck state's boundary: contact k's static friction fits its disk while the
-// others slide at their kinetic coefficients, every N_i >= 0, and theta'' has the pivot's sense? ws holds
-// the stuck state's evaluation again afterwards where it does not.
+// Is the pivot ws has just evaluated consistent: its contact k's static friction fits its disk while the
+// others slide at their kinetic coefficients, every N_i >= 0, and theta'' has the pivot's sense?
+bool pivot_consistent(const Part& P, const Mode& pivot, const Workspace& ws) {
+    const int k = pivot.k;
+    return ws.n.minCoeff() >= 0 && ws.f_held[k].norm() <= P.friction().static_(k) * ws.n[k] && pivot.sense * ws.qdd[2] > 0;
+}
+
+// Does the pivot hold from the stuck state's boundary (pivot_consistent)? ws holds the stuck state's
+// evaluation again afterwards where it does not.
 bool pivot_holds(const Scene& sc, Dynamics level, const Vec3& q, const Vec3& qd, const PlateState& ps, const Mode& pivot,
                  Workspace& ws) {
     mode_accelerations(sc, level, q, qd, ps, pivot, ws);
-    const int k = pivot.k;
-    if (ws.n.minCoeff() >= 0 && ws.f_held[k].norm() <= sc.part.friction().static_(k) * ws.n[k] && pivot.sense * ws.qdd[2] > 0)
-        return true;
+    if (pivot_consistent(sc.part, pivot, ws)) return true;
     mode_accelerations(sc, level, q, qd, ps, Mode{ModeKind::Stuck}, ws);
     return false;
 }
@@ -527,8 +531,7 @@ ModeChoice choose_mode(const Scene& sc, Dynamics level, const Vec3& q, Vec3& qd,
             for (double sense : {1.0, -1.0}) {
                 const Mode pv{ModeKind::Pivot, kk, sense};
                 mode_accelerations(sc, level, q, qd, ps, pv, ws);
-                const bool held = ws.f_held[kk].norm() <= P.friction().static_(kk) * ws.n[kk];
-                if (ws.n.minCoeff() >= 0 && held && sense * ws.qdd[2] > 0) {
+                if (pivot_consistent(P, pv, ws)) {
                     out.mode = pv;
                     return out;
                 }
