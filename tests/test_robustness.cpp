@@ -349,6 +349,18 @@ TEST_CASE("every attractor is counted (points, a stable line, the stuck region)"
     CHECK(s.nominal_result.outcome == Outcome::none);
     CHECK(s.nominal_result.attractors == 1);
     CHECK(s.nominal_result.note.find("a region where the part sticks") != std::string::npos);
+
+    // The point part of Fig. 1(b): u1 has a line of stable fixed points on s_x = 0 and no isolated one
+    // (test_field.cpp). A target on the line is no point the part converges to: outcome none, the line
+    // its one attractor, named.
+    RobustnessOptions ol = quick(1);
+    ol.target = Vec3(0, 0.02, 0);
+    ol.sensitivities = false;
+    const RobustnessSummary sl = robustness(load_scene(kDir + "fig1_point.json"), spec_of(R"({"seed": 1})"), ol);
+    INFO(sl.nominal_result.note);
+    CHECK(sl.nominal_result.outcome == Outcome::none);
+    CHECK(sl.nominal_result.attractors == 1);
+    CHECK(sl.nominal_result.note.find("a stable line of fixed points") != std::string::npos);
 }
 
 TEST_CASE("full-dynamics arrival is the time after which the part stays within the tolerances", "[robustness][audit]") {
