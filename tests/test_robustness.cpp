@@ -350,9 +350,10 @@ TEST_CASE("every attractor is counted (points, a stable line, the stuck region)"
     CHECK(s.nominal_result.attractors == 1);
     CHECK(s.nominal_result.note.find("a region where the part sticks") != std::string::npos);
 
-    // The point part of Fig. 1(b): u1 has a line of stable fixed points on s_x = 0 and no isolated one
-    // (test_field.cpp). A target on the line is no point the part converges to: outcome none, the line
-    // its one attractor, named.
+    // The point part of Fig. 1(b): u1 has a line of stable fixed points on s_x = 0 (test_field.cpp). A
+    // target on the line is not an isolated stable fixed point (s_y is neutral: the part stops wherever
+    // along the line it arrives): outcome none, the line its one attractor, named -- on the nominal
+    // plate and on the one draw, which has no spread.
     RobustnessOptions ol = quick(1);
     ol.target = Vec3(0, 0.02, 0);
     ol.sensitivities = false;
@@ -361,6 +362,7 @@ TEST_CASE("every attractor is counted (points, a stable line, the stuck region)"
     CHECK(sl.nominal_result.outcome == Outcome::none);
     CHECK(sl.nominal_result.attractors == 1);
     CHECK(sl.nominal_result.note.find("a stable line of fixed points") != std::string::npos);
+    CHECK(sl.counts[static_cast<int>(Outcome::none)] == 1);
 }
 
 TEST_CASE("full-dynamics arrival is the time after which the part stays within the tolerances", "[robustness][audit]") {
