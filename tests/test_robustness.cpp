@@ -337,31 +337,29 @@ TEST_CASE("predicted covariance and 95 % radius/angle are those of S p over the 
 }
 
 TEST_CASE("every attractor is counted (points, a stable line, the stuck region)", "[robustness][audit]") {
+    // Outcome none at `target`, one attractor, named `named` in the note; the one draw (no spread) reads none.
+    auto one_attractor = [](const std::string& scene, const Vec3& target, const std::string& named) {
+        RobustnessOptions o = quick(1);
+        o.target = target;
+        o.sensitivities = false;
+        const RobustnessSummary s = robustness(load_scene(kDir + scene), spec_of(R"({"seed": 1})"), o);
+        INFO(scene << ": " << s.nominal_result.note);
+        CHECK(s.nominal_result.outcome == Outcome::none);
+        CHECK(s.nominal_result.attractors == 1);
+        CHECK(s.nominal_result.note.find(named) != std::string::npos);
+        return s;
+    };
     // plate fixed-points scenes/heave_yaw_point.json: one region where the part sticks, x, y in [-0.0333,
     // 0.0333] m (before issue 54 its edge, where the twist is 1e-12 m/s, was read as stable points at
     // (-0.00833, 0.04167) and (0.04167, 0.00833) and a stable line, 4 attractors): no stable point at the
     // target, one attractor, the region named.
-    RobustnessOptions o = quick(1);
-    o.target = Vec3(-0.008333, 0.041667, 0);
-    o.sensitivities = false;
-    const RobustnessSummary s = robustness(load_scene(kDir + "heave_yaw_point.json"), spec_of(R"({"seed": 1})"), o);
-    INFO(s.nominal_result.note);
-    CHECK(s.nominal_result.outcome == Outcome::none);
-    CHECK(s.nominal_result.attractors == 1);
-    CHECK(s.nominal_result.note.find("a region where the part sticks") != std::string::npos);
+    one_attractor("heave_yaw_point.json", Vec3(-0.008333, 0.041667, 0), "a region where the part sticks");
 
     // The point part of Fig. 1(b): u1 has a line of stable fixed points on s_x = 0 (test_field.cpp). A
     // target on the line is not an isolated stable fixed point (s_y is neutral: the part stops wherever
     // along the line it arrives): outcome none, the line its one attractor, named -- on the nominal
     // plate and on the one draw, which has no spread.
-    RobustnessOptions ol = quick(1);
-    ol.target = Vec3(0, 0.02, 0);
-    ol.sensitivities = false;
-    const RobustnessSummary sl = robustness(load_scene(kDir + "fig1_point.json"), spec_of(R"({"seed": 1})"), ol);
-    INFO(sl.nominal_result.note);
-    CHECK(sl.nominal_result.outcome == Outcome::none);
-    CHECK(sl.nominal_result.attractors == 1);
-    CHECK(sl.nominal_result.note.find("a stable line of fixed points") != std::string::npos);
+    const RobustnessSummary sl = one_attractor("fig1_point.json", Vec3(0, 0.02, 0), "a stable line of fixed points");
     CHECK(sl.counts[static_cast<int>(Outcome::none)] == 1);
 }
 
