@@ -47,7 +47,11 @@ namespace plate::detail {
 
 // The zero band, relative to v_ref: a slip below it counts as zero (a lingering slip is offered to
 // static friction), so it bounds the engine's error in a slip -- and in a cycle's start after a stick.
-inline double zero_band(double rtol) { return std::clamp(3e2 * rtol, 1e-9, 3e-3); }
+// Ten times narrower where some contact's static friction exceeds its kinetic friction (`hysteresis`):
+// there a slip taken as zero is held by the static disk where the slip itself would have gone on at the
+// kinetic one, so the band's error is not a small slip but another motion (docs/decisions/engine.md,
+// "The zero band under static friction").
+inline double zero_band(double rtol, bool hysteresis = false) { return std::clamp((hysteresis ? 3e1 : 3e2) * rtol, 1e-9, 3e-3); }
 
 // A non-owning reference to a callable with signature R(A...): Engine::advance's step observer,
 // so that the loop is compiled once per model and not once per observer. It must not outlive the

@@ -20,12 +20,12 @@ Engine<Model>::Engine(Model& model, const Scene& scene, const IntegrationOptions
     // keeps its last direction: v/|v| of a slip that small is rounding noise (just after a
     // break-away its direction is the hint choose_mode set).
     stick_slip().use_hints = true;
-    // Both grow with rtol only up to rtol 1e-5's values, so that hint_speed < zero_abs_ < the
-    // creep speed (1e-2 v_ref) at any tolerance: uncapped, at rtol 1e-2 every slip below 3 v_ref
-    // would count as zero and a part that never sticks would stick (docs/decisions.md, Slip
-    // thresholds: the hint speed, the linger test and their cap).
+    // Both grow with rtol only up to rtol 1e-5's values (the zero band under static friction: 1e-4's),
+    // so that hint_speed < zero_abs_ < the creep speed (1e-2 v_ref) at any tolerance: uncapped, at rtol
+    // 1e-2 every slip below 3 v_ref would count as zero and a part that never sticks would stick
+    // (docs/decisions.md, Slip thresholds: the hint speed, the linger test and their cap).
     stick_slip().hint_speed = std::clamp(10 * opt_.rtol, 1e-12, 1e-4) * v_ref_;
-    zero_abs_ = zero_band(opt_.rtol) * v_ref_;
+    zero_abs_ = zero_band(opt_.rtol, !scene_.part.friction().single()) * v_ref_;
     // A contact that breaks away creeps (StickSlipState::creep: its friction along the consistent
     // direction, the direction's fast relaxation left out) while its slip is below 1e-2 v_ref and
     // the error that leaves stays below creep_budget_ (creep_step), 100 rtol v_ref: about the
