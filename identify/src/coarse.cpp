@@ -12,6 +12,11 @@
 // Wide (IdentifyOptions::wide_iterations; "Wide steps across the cells"): after the search, every
 // coordinate and start moved, the differences kWideFactor times the fine steps: a secant over the
 // chi-square's cells, where the fine steps' tangent sees one cell's floor.
+//
+// Line steps (the wide steps' later rungs; "Line steps over the cells"): Gauss-Newton steps on secants
+// wider still, each step's length the one of kLineLengths whose chi-square is lowest: between the cells'
+// floors and the bowl they lie in, the chi-square along a step jumps up and down by tens, and Marquardt's
+// damping (the wide steps') only shortens a step into the next jump.
 #include "internal.hpp"
 
 #include "plate/tasks.hpp"
@@ -156,6 +161,64 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
     }
     res.chi2_after = chi2_of(r);
     return done();
+}
+
+CoarseResult line_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
+                        std::vector<double>& x, std::vector<std::vector<double>>& q0, const std::vector<int>& held,
+                        const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations,
+                        double factor) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    const int n = static_cast<int>(x.size()), nt = static_cast<int>(costs.size());
+    std::vector<int> free;
+    for (int j = 0; j < n; ++j)
+        if (std::find(held.begin(), held.end(), j) == held.end()) free.push_back(j);
+    const int nf = static_cast<int>(free.size());
+    std::vector<int> rows(static_cast<std::size_t>(nt) + 1, 0);
+    int columns = nf;
+    for (int t = 0; t < nt; ++t) {
+        rows[t + 1] = rows[t] + costs[t]->num_residuals();
+        columns += static_cast<int>(q0[t].size());
+    }
+    CoarseResult res;
+    const auto out_of_time = [&] { return std::chrono::duration<double>(Clock::now() - t0).count() >= seconds; };
+    Eigen::VectorXd r = stacked_residuals(costs, {x}, {q0}, o.threads, res.simulations)[0];
+    res.chi2_before = res.chi2_after = chi2_of(r);
+    for (int it = 0; it < iterations && std::isfinite(res.chi2_after) && !out_of_time(); ++it) {
+        const Eigen::MatrixXd J =
+            secant_jacobian(costs, layout, o, x, q0, free, lo, hi, factor, true, rows, columns, res.simulations);
+        Eigen::MatrixXd A = J.transpose() * J;
+        for (int k = 0; k < columns; ++k) A(k, k) = A(k, k) > 0 ? A(k, k) * (1 + kFirstDamping) : 1;
+        const Eigen::VectorXd dx = -A.ldlt().solve(J.transpose() * r);
+        if (!dx.allFinite()) break;
+        // Every length's point at once; the lowest kept where it lowers the chi-square.
+        std::vector<std::vector<double>> ys;
+        std::vector<std::vector<std::vector<double>>> qs;
+        for (const double length : kLineLengths) {
+            std::vector<double> y = x;
+            for (int k = 0; k < nf; ++k) {
+                const int j = free[static_cast<std::size_t>(k)];
+                y[j] = std::min(std::max(x[j] + length * dx[k], lo[j]), hi[j]);
+            }
+            std::vector<std::vector<double>> qy = q0;
+            for (int t = 0, k = nf; t < nt; ++t)
+                for (double& c : qy[t]) c += length * dx[k++];
+            ys.push_back(std::move(y));
+            qs.push_back(std::move(qy));
+        }
+        const std::vector<Eigen::VectorXd> rl = stacked_residuals(costs, ys, qs, o.threads, res.simulations);
+        int best = -1;
+        for (int k = 0; k < static_cast<int>(rl.size()); ++k)
+            if (chi2_of(rl[k]) < (best < 0 ? chi2_of(r) : chi2_of(rl[best]))) best = k;
+        if (best < 0) break;
+        x = ys[best];
+        q0 = qs[best];
+        r = rl[best];
+        ++res.iterations;
+    }
+    res.chi2_after = chi2_of(r);
+    res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return res;
 }
 
 }   // namespace plate::identify_detail

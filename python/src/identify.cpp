@@ -128,7 +128,7 @@ void bind_identify_function(py::module_& m) {
         "(plate.Track objects or track files' paths) by least squares over the hybrid simulation, as `plate identify`.\n"
         "pieces: the search's first stage fits the tracks cut into pieces of this many seconds (0: none), as --pieces.\n"
         "coarse: before them, at most this many coarse steps of the kinetic coefficients and offsets, as --coarse.\n"
-        "wide: after the search, at most this many wide steps (every coordinate and start), as --wide.\n"
+        "wide: after the search, at most this many wide steps (every coordinate and start) and line steps a rung, as --wide.\n"
         "cells: points drawn about the fit to find the spread over the chi-square's cells (0: none), as --cells.\n"
         "envelope: the within-cell sd widened to the secants' over several cells (False: not), as --no-envelope.\n"
         "Tracks from another set-up, too few frames or a bad file raise plate.InputError naming the file and line.\n"

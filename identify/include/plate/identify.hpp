@@ -93,9 +93,11 @@ struct IdentifyOptions {
     // Wide steps last ("Wide steps across the cells"): after the search, the best fit takes up to this many
     // Levenberg-Marquardt steps with the Jacobian by central differences identify_detail::kWideFactor times
     // the fine steps (a secant over the chi-square's cells, where the fine steps' tangent sees one cell's
-    // floor), every coordinate the search moves and every track's start at once; where they lower the
-    // chi-square by more than 1, the fine search goes on from there and its end is the fit if lower still.
-    // 0: none.
+    // floor), every coordinate the search moves and every track's start at once; then ("Line steps over the
+    // cells") up to this many Gauss-Newton steps at each of identify_detail::kLineFactors times the fine steps,
+    // each step's length the one of identify_detail::kLineLengths whose chi-square is lowest. Where either
+    // kind lowers the chi-square by more than 1, the fine search goes on from there and its end is the fit if
+    // lower still. 0: none.
     int wide_iterations = 4;
     // Cells near the fit ("The spread over the chi-square's cells"): the interval's sd also takes the
     // spread of the chi-square's cell minima near the fit, found from this many points drawn about it (half
