@@ -1,4 +1,4 @@
-// The search's coarse first steps and wide last ones (internal.hpp, coarse_steps).
+// The search's coarse first steps, and its wide and line steps last (internal.hpp, coarse_steps and line_steps).
 //
 // Coarse (IdentifyOptions::coarse_iterations; docs/decisions/identification.md, "Coarse steps first"):
 // Levenberg-Marquardt on the whole tracks, every track's start held at its first
@@ -13,10 +13,10 @@
 // coordinate and start moved, the differences kWideFactor times the fine steps: a secant over the
 // chi-square's cells, where the fine steps' tangent sees one cell's floor.
 //
-// Line steps (the wide steps' later rungs; "Line steps over the cells"): Gauss-Newton steps on secants
-// wider still, each step's length the one of kLineLengths whose chi-square is lowest: between the cells'
-// floors and the bowl they lie in, the chi-square along a step jumps up and down by tens, and Marquardt's
-// damping (the wide steps') only shortens a step into the next jump.
+// Line steps (the wide steps' second rung; "Line steps over the cells"): Gauss-Newton steps on secants
+// wider still, each step's length the one of kLineLengths whose chi-square is lowest: along a step the
+// chi-square leaves the bowl the cells' floors lie in wherever an arrest is held or slipped through, and
+// Marquardt's damping (the wide steps') only shortens a step into such a band.
 #include "internal.hpp"
 
 #include "plate/tasks.hpp"
@@ -26,8 +26,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace plate::identify_detail {
@@ -37,9 +39,55 @@ namespace {
 // Levenberg-Marquardt's damping: its first value (relative to each parameter's information), and the
 // tries a step gets (damping x10 each) before the stage ends.
 constexpr double kFirstDamping = 1e-3;
+// The line steps' damping, relative as the wide steps' first (it only keeps a step finite along a direction
+// the secant does not see).
+constexpr double kLineDamping = kFirstDamping;
 constexpr int kTries = 6;
 
 double chi2_of(const Eigen::VectorXd& r) { return r.size() ? r.squaredNorm() : std::numeric_limits<double>::infinity(); }
+
+// The coordinates a secant moves: the named ones in `free`, then (with `starts`) every track's start; `rows`:
+// each track's first row in the stacked residuals, and the total last.
+struct Columns {
+    std::vector<int> free, rows;
+    int count = 0;
+};
+Columns columns_of(const std::vector<TrackCost*>& costs, const std::vector<std::vector<double>>& q0, std::vector<int> free,
+                   bool starts) {
+    Columns c;
+    const int nt = static_cast<int>(costs.size());
+    c.count = static_cast<int>(free.size());
+    c.free = std::move(free);
+    c.rows.assign(static_cast<std::size_t>(nt) + 1, 0);
+    for (int t = 0; t < nt; ++t) {
+        c.rows[t + 1] = c.rows[t] + costs[t]->num_residuals();
+        if (starts) c.count += static_cast<int>(q0[t].size());
+    }
+    return c;
+}
+
+// The damped normal equations' step -(A + damping diag A)^-1 g, A = J^T J, g = J^T r (a column of zeros: no step).
+Eigen::VectorXd damped_step(const Eigen::MatrixXd& A, const Eigen::VectorXd& g, double damping) {
+    Eigen::MatrixXd B = A;
+    for (int k = 0; k < A.cols(); ++k) B(k, k) = A(k, k) > 0 ? A(k, k) * (1 + damping) : 1;
+    return -B.ldlt().solve(g);
+}
+
+// x and q0 moved by `length` times dx (over c's columns): the named coordinates kept within [lo, hi], the
+// tracks' starts moved with `starts`.
+void moved(const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Columns& c, const Eigen::VectorXd& dx,
+           double length, const std::vector<double>& lo, const std::vector<double>& hi, bool starts, std::vector<double>& y,
+           std::vector<std::vector<double>>& qy) {
+    const int nf = static_cast<int>(c.free.size());
+    y = x;
+    for (int k = 0; k < nf; ++k) {
+        const int j = c.free[static_cast<std::size_t>(k)];
+        y[j] = std::min(std::max(x[j] + length * dx[k], lo[j]), hi[j]);
+    }
+    qy = q0;
+    for (std::size_t t = 0, k = static_cast<std::size_t>(nf); starts && t < qy.size(); ++t)
+        for (double& v : qy[t]) v += length * dx[static_cast<Eigen::Index>(k++)];
+}
 
 }   // namespace
 
@@ -105,18 +153,12 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
                           double factor, bool wide) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
-    const int n = static_cast<int>(x.size()), nt = static_cast<int>(costs.size());
+    const int n = static_cast<int>(x.size());
     std::vector<int> free;
     for (int j = 0; j < n; ++j)
         if (std::find(held.begin(), held.end(), j) == held.end() && (wide || layout.p[j].kind != Param::Static))
             free.push_back(j);
-    const int nf = static_cast<int>(free.size());
-    std::vector<int> rows(static_cast<std::size_t>(nt) + 1, 0);
-    int columns = nf;
-    for (int t = 0; t < nt; ++t) {
-        rows[t + 1] = rows[t] + costs[t]->num_residuals();
-        if (wide) columns += static_cast<int>(q0[t].size());
-    }
+    const Columns c = columns_of(costs, q0, free, wide);
     CoarseResult res;
     const auto out_of_time = [&] { return std::chrono::duration<double>(Clock::now() - t0).count() >= seconds; };
     const auto done = [&] {
@@ -125,26 +167,18 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
     };
     Eigen::VectorXd r = stacked_residuals(costs, {x}, {q0}, o.threads, res.simulations)[0];
     res.chi2_before = res.chi2_after = chi2_of(r);
-    if (!std::isfinite(res.chi2_before) || columns == 0) return done();
+    if (!std::isfinite(res.chi2_before) || c.count == 0) return done();
     double damping = kFirstDamping;
     for (int it = 0; it < iterations && !out_of_time(); ++it) {
         const Eigen::MatrixXd J =
-            secant_jacobian(costs, layout, o, x, q0, free, lo, hi, factor, wide, rows, columns, res.simulations);
+            secant_jacobian(costs, layout, o, x, q0, c.free, lo, hi, factor, wide, c.rows, c.count, res.simulations);
         const Eigen::MatrixXd A = J.transpose() * J;
         const Eigen::VectorXd g = J.transpose() * r;
         bool stepped = false;
         for (int tries = 0; tries < kTries && !stepped && !out_of_time(); ++tries) {
-            Eigen::MatrixXd B = A;
-            for (int k = 0; k < columns; ++k) B(k, k) = A(k, k) > 0 ? A(k, k) * (1 + damping) : 1;
-            const Eigen::VectorXd dx = -B.ldlt().solve(g);
-            std::vector<double> y = x;
-            for (int k = 0; k < nf; ++k) {
-                const int j = free[static_cast<std::size_t>(k)];
-                y[j] = std::min(std::max(x[j] + dx[k], lo[j]), hi[j]);
-            }
-            std::vector<std::vector<double>> qy = q0;
-            for (int t = 0, k = nf; wide && t < nt; ++t)
-                for (double& c : qy[t]) c += dx[k++];
+            std::vector<double> y;
+            std::vector<std::vector<double>> qy;
+            moved(x, q0, c, damped_step(A, g, damping), 1.0, lo, hi, wide, y, qy);
             const Eigen::VectorXd ry = stacked_residuals(costs, {y}, {qy}, o.threads, res.simulations)[0];
             if (chi2_of(ry) < chi2_of(r)) {
                 x = y;
@@ -165,56 +199,38 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
 
 CoarseResult line_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
                         std::vector<double>& x, std::vector<std::vector<double>>& q0, const std::vector<int>& held,
-                        const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations,
-                        double factor) {
+                        const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
-    const int n = static_cast<int>(x.size()), nt = static_cast<int>(costs.size());
     std::vector<int> free;
-    for (int j = 0; j < n; ++j)
+    for (int j = 0; j < static_cast<int>(x.size()); ++j)
         if (std::find(held.begin(), held.end(), j) == held.end()) free.push_back(j);
-    const int nf = static_cast<int>(free.size());
-    std::vector<int> rows(static_cast<std::size_t>(nt) + 1, 0);
-    int columns = nf;
-    for (int t = 0; t < nt; ++t) {
-        rows[t + 1] = rows[t] + costs[t]->num_residuals();
-        columns += static_cast<int>(q0[t].size());
-    }
+    const Columns c = columns_of(costs, q0, free, true);
     CoarseResult res;
     const auto out_of_time = [&] { return std::chrono::duration<double>(Clock::now() - t0).count() >= seconds; };
     Eigen::VectorXd r = stacked_residuals(costs, {x}, {q0}, o.threads, res.simulations)[0];
-    res.chi2_before = res.chi2_after = chi2_of(r);
-    for (int it = 0; it < iterations && std::isfinite(res.chi2_after) && !out_of_time(); ++it) {
-        const Eigen::MatrixXd J =
-            secant_jacobian(costs, layout, o, x, q0, free, lo, hi, factor, true, rows, columns, res.simulations);
-        Eigen::MatrixXd A = J.transpose() * J;
-        for (int k = 0; k < columns; ++k) A(k, k) = A(k, k) > 0 ? A(k, k) * (1 + kFirstDamping) : 1;
-        const Eigen::VectorXd dx = -A.ldlt().solve(J.transpose() * r);
-        if (!dx.allFinite()) break;
-        // Every length's point at once; the lowest kept where it lowers the chi-square.
-        std::vector<std::vector<double>> ys;
-        std::vector<std::vector<std::vector<double>>> qs;
-        for (const double length : kLineLengths) {
-            std::vector<double> y = x;
-            for (int k = 0; k < nf; ++k) {
-                const int j = free[static_cast<std::size_t>(k)];
-                y[j] = std::min(std::max(x[j] + length * dx[k], lo[j]), hi[j]);
-            }
-            std::vector<std::vector<double>> qy = q0;
-            for (int t = 0, k = nf; t < nt; ++t)
-                for (double& c : qy[t]) c += length * dx[k++];
-            ys.push_back(std::move(y));
-            qs.push_back(std::move(qy));
+    res.chi2_before = chi2_of(r);
+    for (const double factor : kLineFactors) {
+        for (int it = 0; it < iterations && std::isfinite(chi2_of(r)) && !out_of_time(); ++it) {
+            const Eigen::MatrixXd J =
+                secant_jacobian(costs, layout, o, x, q0, c.free, lo, hi, factor, true, c.rows, c.count, res.simulations);
+            const Eigen::VectorXd dx = damped_step(J.transpose() * J, J.transpose() * r, kLineDamping);
+            if (!dx.allFinite()) break;
+            // Every length's point as one set of tasks; the lowest kept where it lowers the chi-square.
+            std::vector<std::vector<double>> points(std::size(kLineLengths));
+            std::vector<std::vector<std::vector<double>>> starts(std::size(kLineLengths));
+            for (std::size_t k = 0; k < std::size(kLineLengths); ++k)
+                moved(x, q0, c, dx, kLineLengths[k], lo, hi, true, points[k], starts[k]);
+            const std::vector<Eigen::VectorXd> along = stacked_residuals(costs, points, starts, o.threads, res.simulations);
+            int best = -1;
+            for (int k = 0; k < static_cast<int>(along.size()); ++k)
+                if (chi2_of(along[k]) < (best < 0 ? chi2_of(r) : chi2_of(along[best]))) best = k;
+            if (best < 0) break;
+            x = points[best];
+            q0 = starts[best];
+            r = along[best];
+            ++res.iterations;
         }
-        const std::vector<Eigen::VectorXd> rl = stacked_residuals(costs, ys, qs, o.threads, res.simulations);
-        int best = -1;
-        for (int k = 0; k < static_cast<int>(rl.size()); ++k)
-            if (chi2_of(rl[k]) < (best < 0 ? chi2_of(r) : chi2_of(rl[best]))) best = k;
-        if (best < 0) break;
-        x = ys[best];
-        q0 = qs[best];
-        r = rl[best];
-        ++res.iterations;
     }
     res.chi2_after = chi2_of(r);
     res.seconds = std::chrono::duration<double>(Clock::now() - t0).count();

@@ -108,43 +108,32 @@ Solve staged(const std::vector<TrackCost*>& costs, std::vector<double>& x, std::
 }
 
 // The wide steps (IdentifyOptions::wide_iterations; docs/decisions/identification.md, "Wide steps across the
-// cells" and "Line steps over the cells"), from the best fit (x, q0, its chi-square chi2), in two rungs: first
-// coarse_steps' wide Levenberg-Marquardt, then line_steps at each of kLineFactors in turn, widest first. After
-// each rung, where it lowered the chi-square by more than 1 (as the hops ask: less is no evidence of a better
-// fit, and moves the fit to a neighbouring cell for nothing), the fine search runs from there; x, q0 and chi2
-// take its end where that search is usable and lower (else the fit stays). Within o.time_limit.
+// cells" and "Line steps over the cells"), from the best fit (x, q0, its chi-square chi2), in two rungs:
+// coarse_steps' wide Levenberg-Marquardt, then line_steps. After each, where it lowered the chi-square by more
+// than 1 (as the hops ask: less is no evidence of a better fit, and moves the fit to a neighbouring cell for
+// nothing), the fine search runs from there; x, q0 and chi2 take its end where that search is usable and lower
+// (else the fit stays). Within o.time_limit.
 void wide_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const std::vector<int>& held,
                 const std::vector<double>& lo, const std::vector<double>& hi, const IdentifyOptions& o, Clock::time_point t0,
                 std::vector<double>& x, std::vector<std::vector<double>>& q0, double& chi2, IdentifySummary& s) {
     const auto start = Clock::now();
     const auto left = [&] { return o.time_limit - std::chrono::duration<double>(Clock::now() - t0).count(); };
-    for (int rung = 0; rung < 2; ++rung) {
-        if (o.wide_iterations == 0 || left() <= 0) break;
+    if (o.wide_iterations == 0 || left() <= 0) return;
+    for (const bool line : {false, true}) {
+        if (left() <= 0) break;
         std::vector<double> y = x;
         std::vector<std::vector<double>> qy = q0;
-        int steps = 0;
-        double after = chi2;
-        if (rung == 0) {
-            const CoarseResult wide =
-                coarse_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations, kWideFactor, true);
-            steps = wide.iterations;
-            after = wide.chi2_after;
-        } else {
-            for (const double factor : kLineFactors) {
-                if (left() <= 0) break;
-                const CoarseResult line = line_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations, factor);
-                steps += line.iterations;
-                after = std::min(after, line.chi2_after);
-            }
-        }
-        if (!(steps > 0 && after < chi2 - 1 && left() > 0)) continue;
+        const CoarseResult rung =
+            line ? line_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations)
+                 : coarse_steps(costs, layout, o, y, qy, held, lo, hi, left(), o.wide_iterations, kWideFactor, true);
+        if (!(rung.iterations > 0 && rung.chi2_after < chi2 - 1 && left() > 0)) continue;
         // (the fine search's end confirmed by Jacobians computed anew, as staged's)
         for (TrackCost* c : costs) c->reuse(0);
         const Solve fine =
             minimise(costs, y, qy, held, lo, hi, o.max_iterations, left(), o.threads, nullptr, o.initial_trust_radius);
         for (TrackCost* c : costs) c->reuse(o.jacobian_reuse);
         if (!(fine.usable && fine.chi2 < chi2)) continue;
-        s.wide_iterations += steps;
+        s.wide_iterations += rung.iterations;
         s.wide_chi2_drop += chi2 - fine.chi2;
         s.iterations += fine.iterations;
         s.termination = fine.termination;

@@ -255,18 +255,17 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
                           const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations,
                           double factor, bool wide);
 
-// The line steps (coarse.cpp; the wide steps' later rungs, "Line steps over the cells"): up to `iterations`
-// Gauss-Newton steps from x and q0 (every named coordinate not in `held`, within [lo, hi], and every track's
-// start), the Jacobian by central differences `factor` times the fine steps, each step's length the one of
-// kLineLengths (times the Gauss-Newton step) whose chi-square is lowest, kept where lower than before;
-// they stop at the first step no length lowers. Within `seconds`; x and q0 hold the result.
-constexpr double kLineLengths[] = {0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0};
-// The rungs' factors, widest first (wide_steps, after the wide steps at kWideFactor).
+// The line steps (coarse.cpp; the wide steps' second rung, "Line steps over the cells"): from x and q0, at each
+// of kLineFactors in turn (widest first), up to `iterations` Gauss-Newton steps of every named coordinate not
+// in `held` (within [lo, hi]) and every track's start, the Jacobian by central differences that factor times
+// the fine steps, each step's length the one of kLineLengths (times the Gauss-Newton step) whose chi-square is
+// lowest, kept where lower than before; a factor's steps stop at the first no length lowers. Within `seconds`;
+// x and q0 hold the result (unchanged if no step lowered the chi-square).
 constexpr double kLineFactors[] = {300, 100, 30};
+constexpr double kLineLengths[] = {0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0};
 CoarseResult line_steps(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
                         std::vector<double>& x, std::vector<std::vector<double>>& q0, const std::vector<int>& held,
-                        const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations,
-                        double factor);
+                        const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations);
 
 // A point of the search's space (internal coordinates, the tracks' starts) and the tracks' chi-square there.
 struct PathEnd {

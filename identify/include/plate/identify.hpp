@@ -195,9 +195,9 @@ struct IdentifySummary {
     double coarse_seconds = 0;     // their time [s]
     double cells_seconds = 0;      // the cells' draws' time [s] (IdentifyOptions::cell_samples)
     double envelope_seconds = 0;   // the envelope's Jacobians' time [s] (IdentifyOptions::envelope)
-    int wide_iterations = 0;       // the wide steps the fit took (IdentifyOptions::wide_iterations; 0: none kept)
-    double wide_chi2_drop = 0;     // how far they and the fine search after them lowered the chi-square
-    double wide_seconds = 0;       // their time [s] (IdentifyOptions::wide_iterations)
+    int wide_iterations = 0;       // the wide and line steps the fit took (IdentifyOptions::wide_iterations; 0: none kept)
+    double wide_chi2_drop = 0;     // how far they and the fine searches after them lowered the chi-square
+    double wide_seconds = 0;       // their time and those searches' [s] (IdentifyOptions::wide_iterations)
     int piece_iterations = 0;      // of the best start's first stage on the pieces
     int hops = 0;                  // times the search went on from a better end of the interval check's paths
     double piece_seconds = 0;      // its time [s]
