@@ -192,11 +192,9 @@ TEST_CASE("at a search stopped in a cell the envelope is wider than the cell", "
     std::vector<double> x = layout.internal(stopped);
     std::vector<std::vector<double>> q = f.first;
     identify_detail::minimise(f.ptrs, x, q, every, f.lo, f.hi, 100, 120, 2);
-    std::vector<int> rows = {0};
-    for (const TrackCost* c : f.ptrs) rows.push_back(rows.back() + c->num_residuals());
     long simulations = 0;
-    const Eigen::MatrixXd J =
-        identify_detail::secant_jacobian(f.ptrs, layout, f.o, x, q, every, f.lo, f.hi, 1, true, rows, 6 + 15, simulations);
+    const identify_detail::Columns columns = identify_detail::columns_of(f.ptrs, q, every, true);
+    const Eigen::MatrixXd J = identify_detail::secant_jacobian(f.ptrs, layout, f.o, x, q, columns, f.lo, f.hi, 1, simulations);
     const Eigen::MatrixXd A = identify_detail::natural_jacobian(layout, x);
     const Eigen::MatrixXd fine = A * identify_detail::identifiable_covariance(layout, f.o, J, 15, nullptr) * A.transpose();
     const std::vector<double> env = identify_detail::envelope_sds(layout, f.o, f.ptrs, x, q, {}, f.lo, f.hi, simulations);

@@ -106,25 +106,16 @@ std::vector<double> envelope_sds(const Layout& layout, const IdentifyOptions& o,
                                  const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
                                  const std::vector<int>& held, const std::vector<double>& lo, const std::vector<double>& hi,
                                  long& simulations) {
-    const int n = layout.size(), nt = static_cast<int>(costs.size());
+    const int n = layout.size();
     std::vector<double> sd(static_cast<std::size_t>(n), 0.0);
-    std::vector<int> free;
-    for (int j = 0; j < n; ++j)
-        if (std::find(held.begin(), held.end(), j) == held.end()) free.push_back(j);
-    const int nf = static_cast<int>(free.size());
-    std::vector<int> rows(static_cast<std::size_t>(nt) + 1, 0);
-    int starts_size = 0;
-    for (int t = 0; t < nt; ++t) {
-        rows[t + 1] = rows[t] + costs[t]->num_residuals();
-        starts_size += static_cast<int>(q0[t].size());
-    }
+    const Columns c = columns_of(costs, q0, not_held(n, held), true);
+    const int nf = static_cast<int>(c.free.size()), starts_size = c.count - nf;
     const Eigen::MatrixXd A = natural_jacobian(layout, x);
     for (const double factor : kEnvelopeFactors) {
-        const Eigen::MatrixXd Jf =
-            secant_jacobian(costs, layout, o, x, q0, free, lo, hi, factor, true, rows, nf + starts_size, simulations);
+        const Eigen::MatrixXd Jf = secant_jacobian(costs, layout, o, x, q0, c, lo, hi, factor, simulations);
         // (the named coordinates' columns in their places, a held one's zero, then the starts')
         Eigen::MatrixXd J = Eigen::MatrixXd::Zero(Jf.rows(), n + starts_size);
-        for (int k = 0; k < nf; ++k) J.col(free[k]) = Jf.col(k);
+        for (int k = 0; k < nf; ++k) J.col(c.free[k]) = Jf.col(k);
         J.rightCols(starts_size) = Jf.rightCols(starts_size);
         const Eigen::MatrixXd cov = A * identifiable_covariance(layout, o, J, starts_size, nullptr) * A.transpose();
         for (int j = 0; j < n; ++j)

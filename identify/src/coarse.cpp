@@ -46,26 +46,6 @@ constexpr int kTries = 6;
 
 double chi2_of(const Eigen::VectorXd& r) { return r.size() ? r.squaredNorm() : std::numeric_limits<double>::infinity(); }
 
-// The coordinates a secant moves: the named ones in `free`, then (with `starts`) every track's start; `rows`:
-// each track's first row in the stacked residuals, and the total last.
-struct Columns {
-    std::vector<int> free, rows;
-    int count = 0;
-};
-Columns columns_of(const std::vector<TrackCost*>& costs, const std::vector<std::vector<double>>& q0, std::vector<int> free,
-                   bool starts) {
-    Columns c;
-    const int nt = static_cast<int>(costs.size());
-    c.count = static_cast<int>(free.size());
-    c.free = std::move(free);
-    c.rows.assign(static_cast<std::size_t>(nt) + 1, 0);
-    for (int t = 0; t < nt; ++t) {
-        c.rows[t + 1] = c.rows[t] + costs[t]->num_residuals();
-        if (starts) c.count += static_cast<int>(q0[t].size());
-    }
-    return c;
-}
-
 // The damped normal equations' step -(A + damping diag A)^-1 g, A = J^T J, g = J^T r (a column of zeros: no step).
 Eigen::VectorXd damped_step(const Eigen::MatrixXd& A, const Eigen::VectorXd& g, double damping) {
     Eigen::MatrixXd B = A;
@@ -74,7 +54,7 @@ Eigen::VectorXd damped_step(const Eigen::MatrixXd& A, const Eigen::VectorXd& g, 
 }
 
 // x and q0 moved by `length` times dx (over c's columns): the named coordinates kept within [lo, hi], the
-// tracks' starts moved with `starts`.
+// tracks' starts moved with `starts` (c's columns must hold them).
 void moved(const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Columns& c, const Eigen::VectorXd& dx,
            double length, const std::vector<double>& lo, const std::vector<double>& hi, bool starts, std::vector<double>& y,
            std::vector<std::vector<double>>& qy) {
@@ -91,12 +71,34 @@ void moved(const std::vector<double>& x, const std::vector<std::vector<double>>&
 
 }   // namespace
 
+Columns columns_of(const std::vector<TrackCost*>& costs, const std::vector<std::vector<double>>& q0, std::vector<int> free,
+                   bool starts) {
+    Columns c;
+    const int nt = static_cast<int>(costs.size());
+    c.count = static_cast<int>(free.size());
+    c.free = std::move(free);
+    c.starts = starts;
+    c.rows.assign(static_cast<std::size_t>(nt) + 1, 0);
+    for (int t = 0; t < nt; ++t) {
+        c.rows[t + 1] = c.rows[t] + costs[t]->num_residuals();
+        if (starts) c.count += static_cast<int>(q0[t].size());
+    }
+    return c;
+}
+
+std::vector<int> not_held(int n, const std::vector<int>& held) {
+    std::vector<int> free;
+    for (int j = 0; j < n; ++j)
+        if (std::find(held.begin(), held.end(), j) == held.end()) free.push_back(j);
+    return free;
+}
+
 Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
-                                const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
-                                const std::vector<int>& free, const std::vector<double>& lo, const std::vector<double>& hi,
-                                double factor, bool starts, const std::vector<int>& rows, int columns, long& simulations) {
+                                const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Columns& c,
+                                const std::vector<double>& lo, const std::vector<double>& hi, double factor, long& simulations) {
+    const std::vector<int>& free = c.free;
     const int nf = static_cast<int>(free.size()), nt = static_cast<int>(costs.size());
-    std::vector<std::vector<double>> moved;
+    std::vector<std::vector<double>> sides;
     std::vector<double> width(static_cast<std::size_t>(nf));
     for (int k = 0; k < nf; ++k) {
         const int j = free[static_cast<std::size_t>(k)];
@@ -105,33 +107,33 @@ Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layo
         up[j] = std::min(x[j] + h, hi[j]);
         down[j] = std::max(x[j] - h, lo[j]);
         width[static_cast<std::size_t>(k)] = up[j] - down[j];
-        moved.push_back(up);
-        moved.push_back(down);
+        sides.push_back(up);
+        sides.push_back(down);
     }
-    const std::vector<Eigen::VectorXd> rm = stacked_residuals(costs, moved, {q0}, o.threads, simulations);
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows[static_cast<std::size_t>(nt)], columns);
+    const std::vector<Eigen::VectorXd> rm = stacked_residuals(costs, sides, {q0}, o.threads, simulations);
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(c.rows[static_cast<std::size_t>(nt)], c.count);
     for (int k = 0; k < nf; ++k) {
         const Eigen::VectorXd& up = rm[2 * static_cast<std::size_t>(k)];
         const Eigen::VectorXd& down = rm[2 * static_cast<std::size_t>(k) + 1];
         if (up.size() && down.size() && width[static_cast<std::size_t>(k)] > 0)
             J.col(k) = (up - down) / width[static_cast<std::size_t>(k)];
     }
-    if (!starts) return J;
+    if (!c.starts) return J;
     // Each track's start columns: task i moves track t's coordinate c up (even i) or down.
     std::vector<int> first_column(static_cast<std::size_t>(nt) + 1, nf);
     for (int t = 0; t < nt; ++t) first_column[t + 1] = first_column[t] + static_cast<int>(q0[t].size());
     std::vector<std::pair<int, int>> which;   // (track, coordinate)
     for (int t = 0; t < nt; ++t)
-        for (int c = 0; c < static_cast<int>(q0[t].size()); ++c) which.emplace_back(t, c);
+        for (int k = 0; k < static_cast<int>(q0[t].size()); ++k) which.emplace_back(t, k);
     const int tasks = 2 * static_cast<int>(which.size());
     std::vector<Eigen::VectorXd> side(static_cast<std::size_t>(tasks));
     std::vector<char> ok(static_cast<std::size_t>(tasks), 0);
     thread_tasks(std::max(1, std::min(o.threads, tasks)))(
         tasks,
         [&](int i) {
-            const auto [t, c] = which[static_cast<std::size_t>(i / 2)];
+            const auto [t, k] = which[static_cast<std::size_t>(i / 2)];
             std::vector<double> q = q0[t];
-            q[c] += (i % 2 ? -1 : 1) * factor * start_step(c);
+            q[k] += (i % 2 ? -1 : 1) * factor * start_step(k);
             side[static_cast<std::size_t>(i)].resize(costs[t]->num_residuals());
             ok[static_cast<std::size_t>(i)] = costs[t]->residuals(x.data(), q.data(), side[static_cast<std::size_t>(i)].data());
             return std::string();
@@ -139,10 +141,10 @@ Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layo
         [](int, const std::string&) {});
     simulations += tasks;
     for (std::size_t w = 0; w < which.size(); ++w) {
-        const auto [t, c] = which[w];
+        const auto [t, k] = which[w];
         if (!ok[2 * w] || !ok[2 * w + 1]) continue;
-        const double h = factor * start_step(c);
-        J.block(rows[t], first_column[t] + c, side[2 * w].size(), 1) = (side[2 * w] - side[2 * w + 1]) / (2 * h);
+        const double h = factor * start_step(k);
+        J.block(c.rows[t], first_column[t] + k, side[2 * w].size(), 1) = (side[2 * w] - side[2 * w + 1]) / (2 * h);
     }
     return J;
 }
@@ -155,10 +157,9 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
     const auto t0 = Clock::now();
     const int n = static_cast<int>(x.size());
     std::vector<int> free;
-    for (int j = 0; j < n; ++j)
-        if (std::find(held.begin(), held.end(), j) == held.end() && (wide || layout.p[j].kind != Param::Static))
-            free.push_back(j);
-    const Columns c = columns_of(costs, q0, free, wide);
+    for (const int j : not_held(n, held))
+        if (wide || layout.p[j].kind != Param::Static) free.push_back(j);
+    const Columns c = columns_of(costs, q0, std::move(free), wide);
     CoarseResult res;
     const auto out_of_time = [&] { return std::chrono::duration<double>(Clock::now() - t0).count() >= seconds; };
     const auto done = [&] {
@@ -170,8 +171,7 @@ CoarseResult coarse_steps(const std::vector<TrackCost*>& costs, const Layout& la
     if (!std::isfinite(res.chi2_before) || c.count == 0) return done();
     double damping = kFirstDamping;
     for (int it = 0; it < iterations && !out_of_time(); ++it) {
-        const Eigen::MatrixXd J =
-            secant_jacobian(costs, layout, o, x, q0, c.free, lo, hi, factor, wide, c.rows, c.count, res.simulations);
+        const Eigen::MatrixXd J = secant_jacobian(costs, layout, o, x, q0, c, lo, hi, factor, res.simulations);
         const Eigen::MatrixXd A = J.transpose() * J;
         const Eigen::VectorXd g = J.transpose() * r;
         bool stepped = false;
@@ -202,18 +202,14 @@ CoarseResult line_steps(const std::vector<TrackCost*>& costs, const Layout& layo
                         const std::vector<double>& lo, const std::vector<double>& hi, double seconds, int iterations) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
-    std::vector<int> free;
-    for (int j = 0; j < static_cast<int>(x.size()); ++j)
-        if (std::find(held.begin(), held.end(), j) == held.end()) free.push_back(j);
-    const Columns c = columns_of(costs, q0, free, true);
+    const Columns c = columns_of(costs, q0, not_held(static_cast<int>(x.size()), held), true);
     CoarseResult res;
     const auto out_of_time = [&] { return std::chrono::duration<double>(Clock::now() - t0).count() >= seconds; };
     Eigen::VectorXd r = stacked_residuals(costs, {x}, {q0}, o.threads, res.simulations)[0];
     res.chi2_before = chi2_of(r);
     for (const double factor : kLineFactors) {
         for (int it = 0; it < iterations && std::isfinite(chi2_of(r)) && !out_of_time(); ++it) {
-            const Eigen::MatrixXd J =
-                secant_jacobian(costs, layout, o, x, q0, c.free, lo, hi, factor, true, c.rows, c.count, res.simulations);
+            const Eigen::MatrixXd J = secant_jacobian(costs, layout, o, x, q0, c, lo, hi, factor, res.simulations);
             const Eigen::VectorXd dx = damped_step(J.transpose() * J, J.transpose() * r, kLineDamping);
             if (!dx.allFinite()) break;
             // Every length's point as one set of tasks; the lowest kept where it lowers the chi-square.

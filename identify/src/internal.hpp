@@ -237,14 +237,23 @@ Solve minimise(const std::vector<TrackCost*>& costs, std::vector<double>& x, std
 constexpr double kCoarseFactor = 100, kWideFactor = 10;
 // The fine difference step of a track's start coordinate c: s_x, s_y [mm] 1e-3, theta [rad] 1e-5.
 constexpr double start_step(int c) { return c < 2 ? 1e-3 : 1e-5; }
-// The Jacobian by central differences `factor` times the fine steps (coarse.cpp): the named coordinates in
-// `free` (within [lo, hi]; a side whose simulation stopped: the column left zero) as its first columns,
-// then, with `starts`, each track's start coordinates (that track's rows alone). `rows`: each track's first
-// row, and the total last; `columns`: the Jacobian's.
+// The coordinates a secant moves: the named ones in `free`, then (with `starts`) every track's start; `rows`:
+// each track's first row in the stacked residuals, and the total last; `count`: the coordinates (coarse.cpp).
+struct Columns {
+    std::vector<int> free, rows;
+    bool starts = false;
+    int count = 0;
+};
+Columns columns_of(const std::vector<TrackCost*>& costs, const std::vector<std::vector<double>>& q0, std::vector<int> free,
+                   bool starts);
+// The named coordinates not in `held`, of n.
+std::vector<int> not_held(int n, const std::vector<int>& held);
+// The Jacobian by central differences `factor` times the fine steps (coarse.cpp) over c's columns: the named
+// coordinates in c.free (within [lo, hi]; a side whose simulation stopped: the column left zero) first, then,
+// with c.starts, each track's start coordinates (that track's rows alone).
 Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layout& layout, const IdentifyOptions& o,
-                                const std::vector<double>& x, const std::vector<std::vector<double>>& q0,
-                                const std::vector<int>& free, const std::vector<double>& lo, const std::vector<double>& hi,
-                                double factor, bool starts, const std::vector<int>& rows, int columns, long& simulations);
+                                const std::vector<double>& x, const std::vector<std::vector<double>>& q0, const Columns& c,
+                                const std::vector<double>& lo, const std::vector<double>& hi, double factor, long& simulations);
 struct CoarseResult {
     int iterations = 0;   // steps taken (each lowered the chi-square)
     double chi2_before = 0, chi2_after = 0, seconds = 0;
