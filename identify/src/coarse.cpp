@@ -119,7 +119,7 @@ Eigen::MatrixXd secant_jacobian(const std::vector<TrackCost*>& costs, const Layo
             J.col(k) = (up - down) / width[static_cast<std::size_t>(k)];
     }
     if (!c.starts) return J;
-    // Each track's start columns: task i moves track t's coordinate c up (even i) or down.
+    // Each track's start columns: task i moves track t's coordinate k up (even i) or down.
     std::vector<int> first_column(static_cast<std::size_t>(nt) + 1, nf);
     for (int t = 0; t < nt; ++t) first_column[t + 1] = first_column[t] + static_cast<int>(q0[t].size());
     std::vector<std::pair<int, int>> which;   // (track, coordinate)
