@@ -158,10 +158,11 @@ inline void set_plate_accelerations(const PlateState& ps, gen::KernelInput& in) 
 inline void set_configuration(const Part& P, const Vec3& q, Workspace& ws) {
     detail::KernelScratch& ks = detail::kernels(ws);
     gen::KernelInput& in = ks.in;
-    if (q[2] != ks.theta) {
-        ks.theta = q[2];
-        in.ct = std::cos(q[2]);
-        in.st = std::sin(q[2]);
+    const double theta = q[2];   // (a local: the stores below could alias q, which would keep sin and cos apart)
+    if (theta != ks.theta) {
+        ks.theta = theta;
+        in.ct = std::cos(theta);
+        in.st = std::sin(theta);
         for (int i = 0; i < 3; ++i)
             ws.r[i] = Vec2(in.ct * P.c[i].x() - in.st * P.c[i].y(), in.st * P.c[i].x() + in.ct * P.c[i].y());
     }

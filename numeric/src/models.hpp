@@ -202,9 +202,10 @@ struct FullModel {
     explicit FullModel(const Scene& s) : sc(s) {}
 
     void rhs(double t, const State& y, State& dy) {
-        const PlateState ps = plate(t, y);
+        const So3Angle g(Vec3(y[6], y[7], y[8]));
+        const PlateState ps = u.state(t, level, exp_so3(g));
         mode_accelerations(sc, level, q(y), qd(y), ps, mode, ws);
-        const Vec3 phid = dexp_inv(Vec3(y[6], y[7], y[8]), ps.w1);
+        const Vec3 phid = dexp_inv(g, ps.w1);
         for (int i = 0; i < 3; ++i) {
             dy[i] = y[3 + i];
             dy[3 + i] = ws.qdd[i];
