@@ -22,7 +22,7 @@ struct So3Angle {
     Vec3 phi;
     double a, s, c;
     explicit So3Angle(const Vec3& p) : phi(p), a(p.norm()), s(0.0), c(1.0) {
-        if (a > 0) {
+        if (a != 0) {   // (NaN included: the NaNs propagate as AngleAxis's did)
             s = std::sin(a);
             c = std::cos(a);
         }
