@@ -31,8 +31,10 @@
 // point near the centre if any. --aligned searches the motions without tilt drift and coning by
 // construction instead (Search::aligned); --fixed-point asks the held margin's search for the position's
 // fixed point and pull as well (Search::pull_score); --write PATH writes the best drive placed on the
-// target (0.02, -0.01, 0.5) as a scene, for plate robustness. Arguments: [--draws N] [--starts S]
-// [--evaluations E] [--harmonics K] [--tilt-drift | --aligned] [--fixed-point] [--write PATH] [DESIGN.json ...].
+// target (0.02, -0.01, 0.5) as a scene, for plate robustness; --period-factor F searches drives of F times
+// fig4's period under the same peaks (at fixed accelerations the slips and every rate of theta' scale
+// with the period, the passage's need inversely). Arguments: [--draws N] [--starts S] [--evaluations E]
+// [--harmonics K] [--tilt-drift | --aligned] [--fixed-point] [--period-factor F] [--write PATH] [DESIGN.json ...].
 #include "../design/src/internal.hpp"   // (design's internal header: reduced_ring, the placed constraints, the layout)
 #include "plate/output.hpp"
 #include "plate/scene_io.hpp"
@@ -519,6 +521,7 @@ void fixed_point_near(const Scene& sc, const Ring& w, const LimitCycleOptions& c
 
 int main(int argc, char** argv) {
     int draws = 200, starts = 4, evaluations = 600, top = 3;
+    double period_factor = 1;
     bool tilt_drift = false, aligned = false, fixed_point = false;
     std::string write;   // the best drive placed on the target (0.02, -0.01, 0.5), as a scene
     std::vector<std::string> designs;
@@ -538,17 +541,24 @@ int main(int argc, char** argv) {
             aligned = true;
         else if (a == "--fixed-point")
             fixed_point = true;
+        else if (a == "--period-factor" && i + 1 < argc)
+            period_factor = std::atof(argv[++i]);
         else if (a == "--write" && i + 1 < argc)
             write = argv[++i];
         else
             designs.push_back(a);
+    }
+    if (!(period_factor > 0)) {
+        std::fprintf(stderr, "bench_orientation_robustness: --period-factor must be a positive number\n");
+        return 2;
     }
     if (designs.empty())
         designs = {PLATE_SOURCE_DIR "/scenes/designs/fig4_fixed_point.json",
                    PLATE_SOURCE_DIR "/bench/fig4_fixed_point_peak.json"};
     const auto t_all = std::chrono::steady_clock::now();
     std::printf("machine: %s\n", machine_description().c_str());
-    const Scene fig4 = load_scene(PLATE_SOURCE_DIR "/scenes/fig4.json");
+    Scene fig4 = load_scene(PLATE_SOURCE_DIR "/scenes/fig4.json");
+    fig4.plate.T *= period_factor;   // (the searched drives' period; the shipped designs keep theirs)
     const UncertaintySpec spec = load_uncertainty(PLATE_SOURCE_DIR "/scenes/uncertainty/ppod.json");
     // Part A
     Vec3 N;
