@@ -47,6 +47,7 @@
 #include <complex>
 #include <numeric>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
@@ -541,9 +542,11 @@ int main(int argc, char** argv) {
             aligned = true;
         else if (a == "--fixed-point")
             fixed_point = true;
-        else if (a == "--period-factor" && i + 1 < argc)
-            period_factor = std::atof(argv[++i]);
-        else if (a == "--write" && i + 1 < argc)
+        else if (a == "--period-factor" && i + 1 < argc) {
+            char* end = nullptr;
+            period_factor = std::strtod(argv[++i], &end);
+            if (*end != '\0') period_factor = 0;   // (not a number: refused below)
+        } else if (a == "--write" && i + 1 < argc)
             write = argv[++i];
         else
             designs.push_back(a);
@@ -573,11 +576,13 @@ int main(int argc, char** argv) {
     std::vector<PlateMotion> centred;
     for (const std::string& d : designs) centred.push_back(shipped(d, spec, draws, N));
     // Part C
-    std::printf("\nsearch: %d starts x %d evaluations per objective, harmonics 1..K on x..rz, peak limits 20 / 150, seed 1%s\n",
-                starts, evaluations,
-                aligned      ? "; aligned: rx, ry, rz on one line per n (no tilt drift, no coning)"
-                : tilt_drift ? "; tilt drift within 2e-6 rad/s"
-                             : "; tilt drift not limited");
+    std::printf(
+        "\nsearch: %d starts x %d evaluations per objective, harmonics 1..K on x..rz, peak limits 20 / 150, period "
+        "%.4g s (%g times fig4's), seed 1%s\n",
+        starts, evaluations, fig4.plate.T, period_factor,
+        aligned      ? "; aligned: rx, ry, rz on one line per n (no tilt drift, no coning)"
+        : tilt_drift ? "; tilt drift within 2e-6 rad/s"
+                     : "; tilt drift not limited");
     std::printf("%-6s %s %5s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s  %4s %4s %4s %4s %4s %4s\n", "obj", "K", "start", "M", "B1",
                 "B2", "rB1_fr", "sd_tw_fr", "gap_fr", "need", "retuned", "held_fr", "held", "x", "y", "z", "rx", "ry", "rz");
     // Per K: B_1 first, then the held margin from the B_1 search's best (start 0); the drive with the
